@@ -1,0 +1,204 @@
+"""The central data type: a drawing's pen-down paths in input units.
+
+Every stage of the pipeline takes a :class:`Drawing` and returns a new one (or a
+structure derived from it); nothing mutates a drawing once built.
+
+Units
+-----
+*Input units* are HP-GL plotter units: 40 per millimetre of the drawing (0.025 mm).
+Files that use SC/IP user units are converted to plotter units on import, so every
+coordinate in a :class:`Drawing` is in plotter units, whatever the file used.
+"""
+
+from __future__ import annotations
+
+import hashlib
+from collections.abc import Iterable, Mapping
+from dataclasses import dataclass, field, replace
+from types import MappingProxyType
+
+import numpy as np
+
+#: HP-GL plotter units per millimetre of the drawing.
+UNITS_PER_MM = 40.0
+
+
+@dataclass(frozen=True, slots=True)
+class SourcePos:
+    """A place in the input file: 1-based line and column (column counts bytes)."""
+
+    line: int
+    col: int
+
+    def __str__(self) -> str:
+        return f"line {self.line}, column {self.col}"
+
+
+@dataclass(frozen=True, slots=True)
+class Warning:  # noqa: A001 - a drawing's warning, deliberately short name inside the module
+    """A problem found while reading or processing that did not stop the work.
+
+    ``line``/``col`` are 1-based positions in the input file (0, 0 when the warning
+    does not belong to one place).
+    """
+
+    line: int
+    col: int
+    message: str
+
+    def as_dict(self) -> dict[str, object]:
+        return {"line": self.line, "col": self.col, "message": self.message}
+
+    def __str__(self) -> str:
+        if self.line:
+            return f"line {self.line}, column {self.col}: {self.message}"
+        return self.message
+
+
+def _frozen_points(points: object) -> np.ndarray:
+    arr = np.array(points, dtype=np.float64, copy=True)
+    if arr.ndim != 2 or arr.shape[1] != 2:
+        arr = arr.reshape(-1, 2)
+    arr.setflags(write=False)
+    return arr
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class Path:
+    """One pen-down path.
+
+    Attributes
+    ----------
+    points:
+        float64 array of shape (N, 2), N >= 1, in input units, read-only. A single point
+        (N == 1) is a dot (the pen went down and up without moving).
+    pen:
+        The pen number selected when the path was drawn (SP), 1 by default.
+    closed:
+        True when the path is a closed ring: its first point equals its last (N >= 4 for a
+        ring that encloses area). Set by the importer for rectangles, circles, polygon-mode
+        rings and for pen-down runs that return exactly to their start.
+    start:
+        Where in the file the path began.
+    """
+
+    points: np.ndarray
+    pen: int = 1
+    closed: bool = False
+    start: SourcePos = field(default_factory=lambda: SourcePos(0, 0))
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "points", _frozen_points(self.points))
+
+    @classmethod
+    def from_points(
+        cls,
+        points: object,
+        *,
+        pen: int = 1,
+        closed: bool | None = None,
+        start: SourcePos | None = None,
+    ) -> Path:
+        """Build a path; ``closed=None`` means "closed when first point equals last"."""
+        arr = _frozen_points(points)
+        if closed is None:
+            closed = len(arr) >= 3 and bool(np.array_equal(arr[0], arr[-1]))
+        return cls(arr, pen=pen, closed=closed, start=start or SourcePos(0, 0))
+
+    def __len__(self) -> int:
+        return len(self.points)
+
+    @property
+    def length(self) -> float:
+        """Polyline length in input units."""
+        if len(self.points) < 2:
+            return 0.0
+        return float(np.hypot(*np.diff(self.points, axis=0).T).sum())
+
+    def with_points(self, points: object, *, closed: bool | None = None) -> Path:
+        """A copy with new points (same pen and source position)."""
+        return replace(
+            self,
+            points=_frozen_points(points),
+            closed=self.closed if closed is None else closed,
+        )
+
+
+@dataclass(frozen=True, eq=False)
+class Drawing:
+    """The pen-down paths of one file plus what is known about the file.
+
+    Attributes
+    ----------
+    paths:
+        Pen-down paths in file order. ``source_index`` in a job file is the index here.
+    name:
+        The file's name (no folder).
+    sha256:
+        Hex SHA-256 of the file's bytes.
+    commands:
+        How many times each mnemonic occurred (read-only mapping, upper case).
+    warnings:
+        Problems met while reading, in file order.
+    """
+
+    paths: tuple[Path, ...]
+    name: str = ""
+    sha256: str = ""
+    commands: Mapping[str, int] = field(default_factory=dict)
+    warnings: tuple[Warning, ...] = ()
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "paths", tuple(self.paths))
+        object.__setattr__(self, "commands", MappingProxyType(dict(self.commands)))
+        object.__setattr__(self, "warnings", tuple(self.warnings))
+
+    # --- derived facts ---------------------------------------------------------------
+    @property
+    def n_points(self) -> int:
+        return sum(len(p.points) for p in self.paths)
+
+    @property
+    def n_closed(self) -> int:
+        return sum(1 for p in self.paths if p.closed)
+
+    def bbox(self) -> tuple[float, float, float, float] | None:
+        """(xmin, ymin, xmax, ymax) in input units, or None for an empty drawing."""
+        if not self.paths:
+            return None
+        pts = np.concatenate([p.points for p in self.paths])
+        lo = pts.min(axis=0)
+        hi = pts.max(axis=0)
+        return float(lo[0]), float(lo[1]), float(hi[0]), float(hi[1])
+
+    def size_mm(self) -> tuple[float, float]:
+        """Width and height of the bounding box in mm of the drawing (40 units per mm)."""
+        bb = self.bbox()
+        if bb is None:
+            return 0.0, 0.0
+        return (bb[2] - bb[0]) / UNITS_PER_MM, (bb[3] - bb[1]) / UNITS_PER_MM
+
+    def with_paths(self, paths: Iterable[Path], *, warnings: Iterable[Warning] = ()) -> Drawing:
+        """A new drawing with other paths and extra warnings, same file metadata."""
+        return replace(self, paths=tuple(paths), warnings=self.warnings + tuple(warnings))
+
+    def info(self) -> dict[str, object]:
+        """A JSON-ready summary (what ``galvo-core info`` prints)."""
+        bb = self.bbox()
+        w, h = self.size_mm()
+        return {
+            "file": self.name,
+            "sha256": self.sha256,
+            "paths": len(self.paths),
+            "points": self.n_points,
+            "closed_paths": self.n_closed,
+            "bbox": list(bb) if bb is not None else None,
+            "size_mm": [w, h],
+            "pens": sorted({p.pen for p in self.paths}),
+            "commands": dict(sorted(self.commands.items())),
+            "warnings": [w_.as_dict() for w_ in self.warnings],
+        }
+
+
+def sha256_hex(data: bytes) -> str:
+    return hashlib.sha256(data).hexdigest()
