@@ -1,0 +1,275 @@
+"""Vectorised plane geometry for lines and cubic Béziers (numpy only, no Qt).
+
+Conventions
+-----------
+* Coordinates are float64 in *input units* (HP-GL plotter units) unless stated otherwise;
+  every function is unit-agnostic (distances come back in the units of the coordinates).
+* A cubic Bézier is given by its control polygon ``ctrl``: array-like of shape (4, 2),
+  ``ctrl[0]`` and ``ctrl[3]`` are the curve's end points.
+* Curve parameters ``t`` / ``u`` are in [0, 1].
+* Point sets are arrays of shape (K, 2).
+
+Nothing here loops over points in Python: the work is done on whole arrays, chunked where a
+pairwise table could otherwise grow large.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+__all__ = [
+    "cubic_eval",
+    "cubic_derivative",
+    "cubic_second_derivative",
+    "cubic_length",
+    "nearest_on_cubic",
+    "point_segment_distance",
+    "point_polyline_distance",
+    "flatten_cubic",
+]
+
+#: Largest pairwise table (rows x columns) built in one go by the chunked routines.
+_CHUNK_CELLS = 1 << 21
+
+
+def _ctrl(ctrl: object) -> np.ndarray:
+    c = np.asarray(ctrl, dtype=np.float64)
+    if c.shape != (4, 2):
+        raise ValueError(f"a cubic needs 4 control points of shape (4, 2), got {c.shape}")
+    return c
+
+
+def _power_coeffs(c: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """Power-basis coefficients: B(t) = a t^3 + b t^2 + d t + e."""
+    p0, p1, p2, p3 = c
+    a = -p0 + 3.0 * p1 - 3.0 * p2 + p3
+    b = 3.0 * p0 - 6.0 * p1 + 3.0 * p2
+    d = -3.0 * p0 + 3.0 * p1
+    return a, b, d, p0
+
+
+def cubic_eval(ctrl: object, t: object) -> np.ndarray:
+    """Points of the cubic at parameters ``t``.
+
+    ``ctrl`` (4, 2), ``t`` (M,) in [0, 1] (values outside extrapolate) -> (M, 2), same units
+    as ``ctrl``. Uses the Bernstein form, so ``t == 0`` and ``t == 1`` give ``ctrl[0]`` and
+    ``ctrl[3]`` exactly.
+    """
+    c = _ctrl(ctrl)
+    t = np.asarray(t, dtype=np.float64).reshape(-1, 1)
+    s = 1.0 - t
+    return (
+        (s * s * s) * c[0]
+        + (3.0 * s * s * t) * c[1]
+        + (3.0 * s * t * t) * c[2]
+        + (t * t * t) * c[3]
+    )
+
+
+def cubic_derivative(ctrl: object, t: object) -> np.ndarray:
+    """First derivative dB/dt at ``t``: (M,) -> (M, 2), units per unit parameter."""
+    c = _ctrl(ctrl)
+    t = np.asarray(t, dtype=np.float64).reshape(-1, 1)
+    s = 1.0 - t
+    d0 = c[1] - c[0]
+    d1 = c[2] - c[1]
+    d2 = c[3] - c[2]
+    return 3.0 * ((s * s) * d0 + (2.0 * s * t) * d1 + (t * t) * d2)
+
+
+def cubic_second_derivative(ctrl: object, t: object) -> np.ndarray:
+    """Second derivative d²B/dt² at ``t``: (M,) -> (M, 2)."""
+    c = _ctrl(ctrl)
+    t = np.asarray(t, dtype=np.float64).reshape(-1, 1)
+    e0 = c[2] - 2.0 * c[1] + c[0]
+    e1 = c[3] - 2.0 * c[2] + c[1]
+    return 6.0 * ((1.0 - t) * e0 + t * e1)
+
+
+def cubic_length(ctrl: object, n: int = 64) -> float:
+    """Arc length of the cubic (Gauss-Legendre over ``n`` equal parameter pieces)."""
+    c = _ctrl(ctrl)
+    xg, wg = np.polynomial.legendre.leggauss(5)
+    edges = np.linspace(0.0, 1.0, n + 1)
+    half = 0.5 * (edges[1:] - edges[:-1])
+    mid = 0.5 * (edges[1:] + edges[:-1])
+    t = (mid[:, None] + half[:, None] * xg[None, :]).ravel()
+    speed = np.hypot(*cubic_derivative(c, t).T).reshape(n, 5)
+    return float((speed * wg[None, :]).sum(axis=1).dot(half))
+
+
+def flatten_cubic(ctrl: object, tol: float) -> np.ndarray:
+    """A polyline within ``tol`` of the cubic: (M, 2), M >= 2, first/last = the end points.
+
+    Uniform parameter steps, as many as the bound |B''| <= 6 max|P_i - 2P_(i+1) + P_(i+2)|
+    requires for a chord-height error <= ``tol`` (chord error <= |B''|max h² / 8).
+    ``tol`` in the units of ``ctrl``, > 0. Every point of the curve is within ``tol`` of the
+    polyline and every vertex lies on the curve.
+    """
+    c = _ctrl(ctrl)
+    if not (tol > 0.0 and np.isfinite(tol)):
+        raise ValueError("flatten_cubic: tol must be a positive finite number")
+    m = 6.0 * max(
+        float(np.hypot(*(c[2] - 2.0 * c[1] + c[0]))), float(np.hypot(*(c[3] - 2.0 * c[2] + c[1])))
+    )
+    n = int(np.ceil(np.sqrt(m / (8.0 * tol)))) if m > 0.0 else 1
+    n = max(1, min(n, 1_000_000))
+    return cubic_eval(c, np.linspace(0.0, 1.0, n + 1))
+
+
+def _newton_nearest(
+    c: np.ndarray, p: np.ndarray, u: np.ndarray, lo: object, hi: object, iters: int
+) -> np.ndarray:
+    """Newton on f(u) = B'(u)·(B(u) - p), each u kept inside its bracket [lo, hi]."""
+    a, b, d, e = _power_coeffs(c)
+    ax, ay = float(a[0]), float(a[1])
+    bx, by = float(b[0]), float(b[1])
+    dx, dy = float(d[0]), float(d[1])
+    ex = float(e[0])
+    ey = float(e[1])
+    qx = p[:, 0] - ex
+    qy = p[:, 1] - ey
+    a3x, a3y, b2x, b2y = 3.0 * ax, 3.0 * ay, 2.0 * bx, 2.0 * by
+    a6x, a6y = 6.0 * ax, 6.0 * ay
+    for _ in range(iters):
+        rx = ((ax * u + bx) * u + dx) * u - qx
+        ry = ((ay * u + by) * u + dy) * u - qy
+        d1x = (a3x * u + b2x) * u + dx
+        d1y = (a3y * u + b2y) * u + dy
+        f = d1x * rx + d1y * ry
+        fp = (a6x * u + b2x) * rx + (a6y * u + b2y) * ry + d1x * d1x + d1y * d1y
+        step = f / np.where(fp > 0.0, fp, np.inf)
+        u = np.clip(u - step, lo, hi)
+    return u
+
+
+def nearest_on_cubic(
+    ctrl: object, pts: object, *, seeds: int = 48, iters: int = 6
+) -> tuple[np.ndarray, np.ndarray]:
+    """True nearest point on the cubic for every point.
+
+    ``ctrl`` (4, 2), ``pts`` (K, 2) -> ``(t, dist)``: ``t`` (K,) the parameter in [0, 1] of
+    the nearest curve point, ``dist`` (K,) its Euclidean distance (same units as the input).
+
+    Robust against local minima: the curve is sampled at ``seeds + 1`` parameters (more for
+    curves whose control polygon turns a lot), each point starts at its nearest sample,
+    ``iters`` Newton steps refine it inside the bracket of the neighbouring samples, and the
+    result is never worse than the best sample or either end point.
+    """
+    c = _ctrl(ctrl)
+    p = np.asarray(pts, dtype=np.float64).reshape(-1, 2)
+    k = len(p)
+    if k == 0:
+        return np.zeros(0), np.zeros(0)
+    # more seeds for curves whose control polygon turns a lot (loops, cusps)
+    legs = np.diff(c, axis=0)
+    ang = np.arctan2(legs[:, 1], legs[:, 0])
+    turn = np.abs(np.angle(np.exp(1j * np.diff(ang)))).sum()
+    ns = int(seeds * max(1.0, turn / (np.pi / 2)))
+    su = np.linspace(0.0, 1.0, ns + 1)
+    sp = cubic_eval(c, su)
+    t_out = np.empty(k)
+    d_out = np.empty(k)
+    rows = max(1, _CHUNK_CELLS // (ns + 1))
+    for s0 in range(0, k, rows):
+        q = p[s0 : s0 + rows]
+        d2 = (q[:, 0:1] - sp[None, :, 0]) ** 2 + (q[:, 1:2] - sp[None, :, 1]) ** 2
+        j = np.argmin(d2, axis=1)
+        best_d2 = d2[np.arange(len(q)), j]
+        u0 = su[j]
+        lo = su[np.maximum(j - 1, 0)]
+        hi = su[np.minimum(j + 1, ns)]
+        u = _newton_nearest(c, q, u0, lo, hi, iters)
+        r = cubic_eval(c, u) - q
+        dn = r[:, 0] * r[:, 0] + r[:, 1] * r[:, 1]
+        better = dn < best_d2
+        u = np.where(better, u, u0)
+        dd = np.where(better, dn, best_d2)
+        t_out[s0 : s0 + rows] = u
+        d_out[s0 : s0 + rows] = np.sqrt(dd)
+    return t_out, d_out
+
+
+def nearest_on_cubic_warm(
+    ctrl: object, pts: object, t0: np.ndarray, *, iters: int = 4
+) -> tuple[np.ndarray, np.ndarray]:
+    """Nearest-point refinement from known starting parameters ``t0`` (K,) (no seeding).
+
+    Cheap and local: for a curve that changed little since ``t0`` was computed (used inside
+    the fitting bisection). Returns ``(t, dist)`` like :func:`nearest_on_cubic`.
+    """
+    c = _ctrl(ctrl)
+    p = np.asarray(pts, dtype=np.float64).reshape(-1, 2)
+    u = _newton_nearest(c, p, np.asarray(t0, dtype=np.float64), 0.0, 1.0, iters)
+    r = cubic_eval(c, u) - p
+    return u, np.hypot(r[:, 0], r[:, 1])
+
+
+def point_segment_distance(pts: object, a: object, b: object) -> np.ndarray:
+    """Euclidean distance of each point to the closed segment [a, b].
+
+    ``pts`` (K, 2); ``a``, ``b`` (2,) or (K, 2) (broadcast) -> (K,). A zero-length segment
+    is its point.
+    """
+    p = np.asarray(pts, dtype=np.float64).reshape(-1, 2)
+    a = np.asarray(a, dtype=np.float64)
+    b = np.asarray(b, dtype=np.float64)
+    ab = b - a
+    ap = p - a
+    den = (ab * ab).sum(axis=-1)
+    num = (ap * ab).sum(axis=-1)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        s = np.where(den > 0.0, num / np.where(den > 0.0, den, 1.0), 0.0)
+    s = np.clip(s, 0.0, 1.0)
+    s = np.asarray(s)[..., None]
+    return np.hypot(*(ap - s * ab).reshape(-1, 2).T)
+
+
+def point_polyline_distance(pts: object, poly: object) -> np.ndarray:
+    """Distance of each point to the polyline ``poly`` (true Euclidean distance).
+
+    ``pts`` (K, 2), ``poly`` (N, 2) with N >= 1 -> (K,). Brute force over all segments,
+    chunked so that no table exceeds about two million cells.
+    """
+    p = np.asarray(pts, dtype=np.float64).reshape(-1, 2)
+    q = np.asarray(poly, dtype=np.float64).reshape(-1, 2)
+    if len(q) == 0:
+        raise ValueError("point_polyline_distance: empty polyline")
+    if len(q) == 1:
+        return np.hypot(*(p - q[0]).T)
+    if len(p) * len(q) > 8 * _CHUNK_CELLS:
+        return _polyline_distance_rtree(p, q)
+    a = q[:-1]
+    ab = q[1:] - a
+    den = (ab * ab).sum(axis=1)
+    inv = np.where(den > 0.0, 1.0 / np.where(den > 0.0, den, 1.0), 0.0)
+    out = np.full(len(p), np.inf)
+    srows = max(1, min(len(a), _CHUNK_CELLS // max(1, min(len(p), 4096))))
+    prow = max(1, _CHUNK_CELLS // srows)
+    for s0 in range(0, len(a), srows):
+        aa = a[s0 : s0 + srows]
+        vv = ab[s0 : s0 + srows]
+        ii = inv[s0 : s0 + srows]
+        for p0 in range(0, len(p), prow):
+            pp = p[p0 : p0 + prow]
+            dx = pp[:, 0:1] - aa[None, :, 0]
+            dy = pp[:, 1:2] - aa[None, :, 1]
+            s = np.clip((dx * vv[None, :, 0] + dy * vv[None, :, 1]) * ii[None, :], 0.0, 1.0)
+            ex = dx - s * vv[None, :, 0]
+            ey = dy - s * vv[None, :, 1]
+            d2 = (ex * ex + ey * ey).min(axis=1)
+            np.minimum(out[p0 : p0 + prow], d2, out=out[p0 : p0 + prow])
+    return np.sqrt(out)
+
+
+def _polyline_distance_rtree(p: np.ndarray, q: np.ndarray) -> np.ndarray:
+    """Large inputs: GEOS R-tree of the segments (shapely), exact nearest distances."""
+    import shapely
+
+    segs = shapely.linestrings(np.stack([q[:-1], q[1:]], axis=1))
+    tree = shapely.STRtree(segs)
+    pts = shapely.points(p)
+    (ip, _), dist = tree.query_nearest(pts, return_distance=True, all_matches=False)
+    out = np.full(len(p), np.inf)
+    np.minimum.at(out, ip, dist)
+    return out

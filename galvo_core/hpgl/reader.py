@@ -1,0 +1,1204 @@
+"""The HP-GL / HP-GL/2 reader: bytes in, :class:`~galvo_core.drawing.Drawing` out.
+
+What it reads
+-------------
+* Pen moves: PA PR PU PD (with and without coordinates; ``PD;`` then ``PU`` is a dot),
+  PE (polyline encoded, see :mod:`.pe`).
+* Rectangles EA ER RA RR and wedges EW WG as closed rings; arcs and circles AA AR CI AT RT
+  flattened by the HP-GL chord rule (:mod:`.arcs`), CT chord-tolerance mode honoured;
+  Béziers BZ BR (and BA, the name paper 001 uses for BZ) flattened within 0.1 unit; XT/YT
+  tick marks.
+* Polygon mode: PM0/PM1/PM2 fill a polygon buffer; the first EP or FP after it emits each
+  sub-polygon once as a closed ring (geometry, not paint: an edged *and* filled polygon is
+  one region, not two).
+* Geometry state: IN DF IP IR SC (types 0, 1, 2) RO IW PS SP; user units are converted to
+  plotter units, RO rotates about the plotter origin (x, y) -> (-y, x) for 90 degrees,
+  IW clips pen-down lines to the window.
+* Recorded, not drawn: LT VS FS PW LA PT FT and the like; labels LB/BL/WD (skipped to their
+  terminator, DT honoured), CO comments, SM symbols, vendor ``!XX`` commands.
+* Wrappers: PCL (ESC E, ESC%#A / ESC%#B, parameterised escapes with binary data), PJL
+  (``@PJL ENTER LANGUAGE=HPGL2``), UEL, HP 7475A device control ESC.( ESC.I…: (also with
+  the ESC byte lost), NUL padding.
+
+Syntax decisions (where the standard is ambiguous or files break it)
+--------------------------------------------------------------------
+* A command is two letters (any case); its parameters end at ``;``, at the next letter or at
+  ESC. Numbers are separated by commas, white space, or a sign; a trailing comma is fine.
+* A command with an odd coordinate count drops the last number with a warning.
+* A label without its terminator ends at the end of its line (warning), so that one broken
+  label does not swallow the rest of the file.
+* An unquoted CO comment ends at ``;``, at the label terminator or at the end of the line.
+* Default P1/P2 (for SC without IP, and IR) are those of an HP 7475A on ANSI A paper:
+  (250, 596) and (10250, 7796); after PS w,h they are (0, 0) and (w, h).
+* SP, IN, RO, IP, SC, IW lift the pen: a pen-down path ends there.
+* Pages (PG) are overlaid: a galvo has one field; a warning says how many pages there were.
+* A path is ``closed`` when its last point equals its first and it has at least 4 points.
+
+Errors
+------
+A file that is not HP-GL (empty, binary, SVG, DXF, Summa DM/PL, G-code, a PCL job without
+HP-GL/2, mostly unreadable) raises :class:`~galvo_core.errors.InputError`. A malformed or
+unknown command inside a good file is skipped with a warning naming line and column. Time
+and memory are linear in the file size.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+import re
+from collections import Counter
+from collections.abc import Callable
+
+import numpy as np
+
+from galvo_core.drawing import Drawing, Path, SourcePos, Warning, sha256_hex
+from galvo_core.errors import InputError
+from galvo_core.hpgl.arcs import arc_points, bezier_points, chord_angle, circle_through
+from galvo_core.hpgl.fastrun import CODE_A, CODE_D, CODE_R, CODE_U, ffill_state, tokenize_run
+from galvo_core.hpgl.pe import decode_pe
+from galvo_core.hpgl.sniff import refusal_reason
+
+#: largest file the reader accepts (bytes); larger files are refused, not half-read.
+MAX_FILE_BYTES = 512 * 1024 * 1024
+
+DEFAULT_P1 = (250.0, 596.0)
+DEFAULT_P2 = (10250.0, 7796.0)
+BEZIER_TOL = 0.1  # plotter units
+ETX = 0x03
+
+KNOWN = frozenset(
+    (
+        "AA AC AD AF AH AP AR AS AT BA BF BL BP BR BZ CA CC CF CI CM CO CP CR CS CT CV DC DF"
+        " DI DL DP DR DS DT DV EA EC EP ER ES EW FI FN FP FR FS FT GC GM GP IM IN IP IR IV IW"
+        " KY LA LB LM LO LT MC MG MT NP NR OA OC OD OE OF OG OH OI OL OO OP OS OT OW PA PB PC"
+        " PD PE PG PM PP PR PS PT PU PW QL RA RF RO RP RR RT SA SB SC SD SG SI SL SM SP SR SS"
+        " ST SV TD TL TR UC UF UL VS WD WG WU XT YT"
+    ).split()
+)
+
+# one ordinary command with its leading separators: mnemonic, parameters, optional ';'
+_CMD_RE = re.compile(rb"[\x00-\x1a\x1c-\x20;,]*([A-Za-z]{2})([^A-Za-z;\x1b]*)(;?)")
+_RUN_RE = re.compile(
+    rb"(?:[\x00-\x1a\x1c-\x20;,]*[Pp][UuDdAaRr][-+0-9.,;\x00-\x1a\x1c-\x20]*)+"
+)
+_FAST_MIN_BYTES = 256  # shorter runs go command by command
+_SEP_RE = re.compile(rb"[\x00-\x1a\x1c-\x20;,]*")
+_NUM_RE = re.compile(rb"[-+]?(?:\d+\.?\d*|\.\d+)")
+_JUNK_PARAM_RE = re.compile(rb"[^\s,0-9.+\-\x00]")
+_DEVCTL_RE = re.compile(rb"\x1b?\.(?:[()YZBEJKLORU]|[@HIMNPQST][0-9;.\s]{0,80}:?)")
+_PCL_ESC_RE = re.compile(
+    rb"\x1b(?:%-12345X"
+    rb"|([!-/])([`-~]?)((?:[+-]?\d*(?:\.\d*)?[`-~]){0,64})([+-]?\d*(?:\.\d*)?)([@-^])"
+    rb"|([0-~]))"
+)
+_PCL_SCAN_RE = re.compile(
+    rb"\x1b|@PJL[ \t]+ENTER[ \t]+LANGUAGE[ \t]*=[ \t]*\"?([A-Za-z0-9\-/]+)[^\n]*\n?", re.I
+)
+_VENDOR_RE = re.compile(rb"!([A-Za-z]{2})([^;\x1b\n]*);?")
+_PCL_START_RE = re.compile(rb"[\x00-\x20]*(?:\x1bE|\x1b%-12345X|@PJL|\x1b[&*(]|\x1b%-?\d*A)")
+
+_WARN_CAP = 20  # warnings of one kind kept verbatim; the rest are counted
+
+
+def _nums(params: bytes) -> list[float]:
+    return [float(t) for t in _NUM_RE.findall(params)]
+
+
+class _Reader:
+    """One pass over the bytes of one file. Not reusable."""
+
+    def __init__(self, data: bytes, name: str) -> None:
+        self.data = data
+        self.name = name
+        self.n = len(data)
+        # outputs
+        self.paths: list[tuple[np.ndarray, int, bool, int]] = []  # points, pen, closed, offset
+        self.commands: Counter[str] = Counter()
+        self._warn: list[tuple[int, str]] = []
+        self._warn_count: Counter[str] = Counter()
+        self.recognised = 0
+        self.junk_bytes = 0
+        self.pages = 0
+        self.labels = 0
+        self.line_types = 0
+        self.text_symbols = 0
+        # lexer state
+        self.term = ETX
+        self._no_term_after: dict[int, int] = {}
+        self.hpgl_mode = True
+        # geometry state
+        self.reset()
+        self.pen = 1
+
+    # ------------------------------------------------------------------ warnings
+    def warn(self, offset: int, message: str, key: str | None = None) -> None:
+        k = key or message
+        self._warn_count[k] += 1
+        if self._warn_count[k] <= _WARN_CAP:
+            self._warn.append((offset, message))
+
+    # ------------------------------------------------------------------ state
+    def reset(self) -> None:
+        """IN: everything to power-on defaults (pen number is kept)."""
+        self.flush()
+        self.x = 0.0
+        self.y = 0.0
+        self.pen_down = False
+        self.absolute = True
+        self.p1 = DEFAULT_P1
+        self.p2 = DEFAULT_P2
+        self.hard = (DEFAULT_P1, DEFAULT_P2)
+        self.sc: tuple[float, float, float, float] | None = None  # ax, bx, ay, by
+        self.sc_params: list[float] | None = None
+        self.rot = 0
+        self.window: tuple[float, float, float, float] | None = None
+        self.ct_tol = False
+        self.term = ETX
+        self.poly: list[list[tuple[float, float]]] | None = None  # rings while in PM
+        self.poly_ring: list[tuple[float, float]] = []
+        self.poly_buffer: list[list[tuple[float, float]]] = []
+        self.poly_emitted = True
+        self.poly_offset = 0
+        self.tick = (0.5, 0.5)
+        self.cur: list[float] = []  # current pen-down path, flat x, y (plotter units)
+        self.cur_offset = 0
+
+    def defaults(self) -> None:
+        """DF: defaults that do not touch P1/P2 or rotation."""
+        self.flush()
+        self.absolute = True
+        self.sc = None
+        self.sc_params = None
+        self.window = None
+        self.ct_tol = False
+        self.term = ETX
+        self.poly = None
+        self.tick = (0.5, 0.5)
+
+    # ------------------------------------------------------------------ units
+    def to_plotter(self, x: float, y: float) -> tuple[float, float]:
+        sc = self.sc
+        if sc is None:
+            return x, y
+        return sc[0] * x + sc[1], sc[2] * y + sc[3]
+
+    def delta_to_plotter(self, dx: float, dy: float) -> tuple[float, float]:
+        sc = self.sc
+        if sc is None:
+            return dx, dy
+        return sc[0] * dx, sc[2] * dy
+
+    def to_user(self, x: float, y: float) -> tuple[float, float]:
+        sc = self.sc
+        if sc is None:
+            return x, y
+        return (x - sc[1]) / sc[0], (y - sc[3]) / sc[2]
+
+    def update_scaling(self, offset: int) -> None:
+        p = self.sc_params
+        if p is None:
+            self.sc = None
+            return
+        (p1x, p1y), (p2x, p2y) = self.p1, self.p2
+        kind = int(p[4]) if len(p) >= 5 else 0
+        try:
+            if kind == 2:
+                xmin, xf, ymin, yf = p[:4]
+                if xf == 0 or yf == 0:
+                    raise ZeroDivisionError
+                self.sc = (xf, p1x - xmin * xf, yf, p1y - ymin * yf)
+                return
+            xmin, xmax, ymin, ymax = p[:4]
+            ax = (p2x - p1x) / (xmax - xmin)
+            ay = (p2y - p1y) / (ymax - ymin)
+            if ax == 0 or ay == 0:
+                raise ZeroDivisionError
+            if kind == 1:
+                s = min(abs(ax), abs(ay))
+                left = p[5] if len(p) >= 6 else 50.0
+                bottom = p[6] if len(p) >= 7 else 50.0
+                sx = math.copysign(s, ax)
+                sy = math.copysign(s, ay)
+                spare_x = (p2x - p1x) - sx * (xmax - xmin)
+                spare_y = (p2y - p1y) - sy * (ymax - ymin)
+                self.sc = (
+                    sx,
+                    p1x - xmin * sx + spare_x * left / 100.0,
+                    sy,
+                    p1y - ymin * sy + spare_y * bottom / 100.0,
+                )
+            else:
+                self.sc = (ax, p1x - xmin * ax, ay, p1y - ymin * ay)
+        except ZeroDivisionError:
+            self.warn(offset, "SC with an empty range (or P1 = P2) ignored: scaling off")
+            self.sc = None
+            self.sc_params = None
+
+    # ------------------------------------------------------------------ output
+    def _orient(self, pts: np.ndarray) -> np.ndarray:
+        r = self.rot
+        if r == 0:
+            return pts
+        x = pts[:, 0].copy()
+        y = pts[:, 1].copy()
+        if r == 90:
+            return np.column_stack((-y, x))
+        if r == 180:
+            return np.column_stack((-x, -y))
+        return np.column_stack((y, -x))
+
+    def emit(self, pts: np.ndarray, offset: int, *, closed: bool | None = None) -> None:
+        """Add a finished path (plotter units, before rotation and clipping)."""
+        if self.window is not None:
+            pieces = _clip_polyline(pts, self.window)
+            if not pieces:
+                return
+            if len(pieces) > 1 or len(pieces[0]) != len(pts):
+                closed = False
+        else:
+            pieces = [pts]
+        for piece in pieces:
+            piece = self._orient(piece)
+            is_closed = (
+                closed
+                if closed is not None
+                else len(piece) >= 4 and piece[0, 0] == piece[-1, 0] and piece[0, 1] == piece[-1, 1]
+            )
+            self.paths.append((piece, self.pen, bool(is_closed), offset))
+
+    def flush(self) -> None:
+        cur = getattr(self, "cur", None)
+        if cur:
+            self.emit(np.array(cur, dtype=np.float64).reshape(-1, 2), self.cur_offset)
+            self.cur = []
+
+    def emit_ring(self, ring_pts: np.ndarray, offset: int) -> None:
+        """A closed figure (rectangle, circle, wedge): into the polygon buffer in PM."""
+        if len(ring_pts) and (ring_pts[0] != ring_pts[-1]).any():
+            ring_pts = np.vstack((ring_pts, ring_pts[:1]))
+        elif len(ring_pts):
+            ring_pts = ring_pts.copy()
+            ring_pts[-1] = ring_pts[0]
+        if self.poly is not None:
+            self._poly_close_ring()
+            self.poly_buffer.append([tuple(p) for p in ring_pts.tolist()])
+            self.poly_ring = [(self.x, self.y)]
+            return
+        self.emit(ring_pts, offset, closed=len(ring_pts) >= 4)
+
+    # ------------------------------------------------------------------ moves
+    def pen_to(self, x: float, y: float, offset: int) -> None:
+        """Move to plotter point (x, y) with the current pen state."""
+        if self.poly is not None:
+            self._poly_move(x, y)
+        elif self.pen_down:
+            if not self.cur:
+                self.cur = [self.x, self.y]
+                self.cur_offset = offset
+            self.cur.append(x)
+            self.cur.append(y)
+        self.x, self.y = x, y
+
+    def draw_polyline(self, pts: np.ndarray, offset: int) -> None:
+        """Pen-down (or pen-up) through an (N, 2) array of plotter points."""
+        if len(pts) == 0:
+            return
+        if self.poly is not None:
+            for px, py in pts.tolist():
+                self._poly_move(px, py)
+        elif self.pen_down:
+            if not self.cur:
+                self.cur = [self.x, self.y]
+                self.cur_offset = offset
+            self.cur.extend(pts.ravel().tolist())
+        self.x, self.y = float(pts[-1, 0]), float(pts[-1, 1])
+
+    def points_from_params(self, v: list[float], offset: int, mn: str) -> np.ndarray | None:
+        if len(v) % 2:
+            self.warn(offset, f"{mn} has an odd number of coordinates; the last was ignored",
+                      key=f"odd-{mn}")
+            v = v[:-1]
+        if not v:
+            return None
+        arr = np.array(v, dtype=np.float64).reshape(-1, 2)
+        if self.absolute:
+            if self.sc is not None:
+                sc = self.sc
+                arr[:, 0] = sc[0] * arr[:, 0] + sc[1]
+                arr[:, 1] = sc[2] * arr[:, 1] + sc[3]
+        else:
+            if self.sc is not None:
+                arr[:, 0] *= self.sc[0]
+                arr[:, 1] *= self.sc[2]
+            arr = np.cumsum(arr, axis=0)
+            arr[:, 0] += self.x
+            arr[:, 1] += self.y
+        return arr
+
+    def move_params(self, params: bytes, offset: int, mn: str) -> None:
+        v = _nums(params)
+        if len(v) == 2 and self.poly is None:  # the common one-point command, no numpy
+            x, y = v
+            if self.absolute:
+                if self.sc is not None:
+                    x, y = self.to_plotter(x, y)
+            else:
+                dx, dy = self.delta_to_plotter(x, y)
+                x, y = self.x + dx, self.y + dy
+            if self.pen_down:
+                if not self.cur:
+                    self.cur = [self.x, self.y]
+                    self.cur_offset = offset
+                self.cur.append(x)
+                self.cur.append(y)
+            self.x, self.y = x, y
+            return
+        pts = self.points_from_params(v, offset, mn)
+        if pts is not None:
+            if self.pen_down or self.poly is not None:
+                self.draw_polyline(pts, offset)
+            else:
+                self.x, self.y = float(pts[-1, 0]), float(pts[-1, 1])
+
+    def set_pen_down(self, down: bool, offset: int) -> None:
+        if down and not self.pen_down:
+            self.pen_down = True
+            if self.poly is None:
+                self.flush()
+                self.cur = [self.x, self.y]
+                self.cur_offset = offset
+        elif not down and self.pen_down:
+            self.pen_down = False
+            if self.poly is None:
+                self.flush()
+
+    # ------------------------------------------------------------------ polygon mode
+    def _poly_move(self, x: float, y: float) -> None:
+        if self.pen_down:
+            self.poly_ring.append((x, y))
+        else:
+            if len(self.poly_ring) > 1:
+                self._poly_close_ring()
+            self.poly_ring = [(x, y)]
+
+    def _poly_close_ring(self) -> None:
+        ring = self.poly_ring
+        if len(ring) > 1:
+            if ring[0] != ring[-1]:
+                ring = ring + [ring[0]]
+            self.poly_buffer.append(ring)
+        self.poly_ring = [(self.x, self.y)]
+
+    def do_pm(self, v: list[float], offset: int) -> None:
+        mode = int(v[0]) if v else 0
+        if mode == 0:
+            self.flush()
+            if self.poly is not None:
+                self.warn(offset, "PM0 inside polygon mode: the earlier polygon was discarded")
+            self.poly = []
+            self.poly_buffer = []
+            self.poly_ring = [(self.x, self.y)]
+            self.poly_emitted = False
+            self.poly_offset = offset
+        elif mode == 1:
+            if self.poly is None:
+                self.warn(offset, "PM1 outside polygon mode ignored")
+                return
+            self._poly_close_ring()
+        elif mode == 2:
+            if self.poly is None:
+                self.warn(offset, "PM2 outside polygon mode ignored")
+                return
+            self._poly_close_ring()
+            self.poly = None
+        else:
+            self.warn(offset, f"PM{mode}: unknown polygon mode ignored")
+
+    def do_edge_fill(self, mn: str, offset: int) -> None:
+        if self.poly is not None:
+            self.warn(offset, f"{mn} inside polygon mode ignored")
+            return
+        if self.poly_emitted:
+            return  # the same buffer edged and filled: one region
+        self.poly_emitted = True
+        for ring in self.poly_buffer:
+            pts = np.array(ring, dtype=np.float64)
+            self.emit(pts, self.poly_offset, closed=len(pts) >= 4)
+
+    # ------------------------------------------------------------------ commands
+    def do_arc(self, cx: float, cy: float, sweep: float, chord_arg: float | None,
+               offset: int) -> None:
+        """Arc around user-unit centre (cx, cy) starting at the current position."""
+        ux, uy = self.to_user(self.x, self.y)
+        r = math.hypot(ux - cx, uy - cy)
+        if r == 0 or sweep == 0:
+            return
+        start = math.degrees(math.atan2(uy - cy, ux - cx))
+        ca = chord_angle(chord_arg, r, tolerance_mode=self.ct_tol)
+        pts = arc_points(cx, cy, r, start, sweep, ca)[1:]
+        self._draw_user_pts(pts, offset)
+
+    def _draw_user_pts(self, pts: np.ndarray, offset: int) -> None:
+        if self.sc is not None:
+            sc = self.sc
+            pts = np.column_stack((sc[0] * pts[:, 0] + sc[1], sc[2] * pts[:, 1] + sc[3]))
+        if self.pen_down or self.poly is not None:
+            self.draw_polyline(pts, offset)
+        else:
+            self.x, self.y = float(pts[-1, 0]), float(pts[-1, 1])
+
+    def user_ring_to_plotter(self, pts: np.ndarray) -> np.ndarray:
+        if self.sc is None:
+            return pts
+        sc = self.sc
+        return np.column_stack((sc[0] * pts[:, 0] + sc[1], sc[2] * pts[:, 1] + sc[3]))
+
+    def do_rect(self, v: list[float], relative: bool, offset: int, mn: str) -> None:
+        if len(v) < 2:
+            self.warn(offset, f"{mn} needs two coordinates; ignored", key=f"args-{mn}")
+            return
+        ux, uy = self.to_user(self.x, self.y)
+        ex, ey = (ux + v[0], uy + v[1]) if relative else (v[0], v[1])
+        ring = np.array([(ux, uy), (ex, uy), (ex, ey), (ux, ey), (ux, uy)], dtype=np.float64)
+        pts = self.user_ring_to_plotter(ring)
+        self.flush_if_drawing()
+        self.emit_ring(pts, offset)
+
+    def flush_if_drawing(self) -> None:
+        if self.poly is None and self.cur:
+            self.flush()
+            if self.pen_down:
+                self.cur = []
+
+    def do_wedge(self, v: list[float], offset: int, mn: str) -> None:
+        if len(v) < 3:
+            self.warn(offset, f"{mn} needs radius, start and sweep; ignored", key=f"args-{mn}")
+            return
+        r, start, sweep = v[0], v[1], v[2]
+        if r < 0:
+            r, start = -r, start + 180.0
+        cx, cy = self.to_user(self.x, self.y)
+        ca = chord_angle(v[3] if len(v) > 3 else None, r, tolerance_mode=self.ct_tol)
+        arc = arc_points(cx, cy, r, start, max(-360.0, min(360.0, sweep)), ca)
+        if abs(sweep) >= 360.0 or r == 0:
+            ring = arc
+        else:
+            ring = np.vstack(([(cx, cy)], arc, [(cx, cy)]))
+        self.flush_if_drawing()
+        self.emit_ring(self.user_ring_to_plotter(ring), offset)
+
+    def do_circle(self, v: list[float], offset: int) -> None:
+        if not v:
+            self.warn(offset, "CI without a radius ignored", key="args-CI")
+            return
+        r = v[0]
+        start = 0.0
+        if r < 0:
+            r, start = -r, 180.0
+        if r == 0:
+            return
+        cx, cy = self.to_user(self.x, self.y)
+        ca = chord_angle(v[1] if len(v) > 1 else None, r, tolerance_mode=self.ct_tol)
+        ring = arc_points(cx, cy, r, start, 360.0, ca)
+        ring[-1] = ring[0]
+        self.flush_if_drawing()
+        self.emit_ring(self.user_ring_to_plotter(ring), offset)
+
+    def do_three_point(self, v: list[float], relative: bool, offset: int, mn: str) -> None:
+        if len(v) < 4:
+            self.warn(offset, f"{mn} needs four coordinates; ignored", key=f"args-{mn}")
+            return
+        ux, uy = self.to_user(self.x, self.y)
+        if relative:
+            mid = (ux + v[0], uy + v[1])
+            end = (ux + v[2], uy + v[3])
+        else:
+            mid, end = (v[0], v[1]), (v[2], v[3])
+        circ = circle_through((ux, uy), mid, end)
+        if circ is None:
+            pts = np.array([mid, end], dtype=np.float64)
+            if mid == (ux, uy) or mid == end:
+                pts = pts[1:]
+        else:
+            cx, cy, r, start, sweep = circ
+            ca = chord_angle(v[4] if len(v) > 4 else None, r, tolerance_mode=self.ct_tol)
+            pts = arc_points(cx, cy, r, start, sweep, ca)[1:]
+            pts[-1] = end
+        self._draw_user_pts(pts, offset)
+
+    def do_bezier(self, v: list[float], relative: bool, offset: int, mn: str) -> None:
+        if len(v) % 6:
+            self.warn(offset, f"{mn} needs coordinates in groups of six; the rest was ignored",
+                      key=f"args-{mn}")
+            v = v[: len(v) - len(v) % 6]
+        for k in range(0, len(v), 6):
+            ux, uy = self.to_user(self.x, self.y)
+            c = np.array(v[k : k + 6], dtype=np.float64).reshape(3, 2)
+            if relative:
+                c += (ux, uy)
+            ctrl = np.vstack(([(ux, uy)], c))
+            ctrl_p = self.user_ring_to_plotter(ctrl)
+            pts = bezier_points(ctrl_p, BEZIER_TOL)[1:]
+            if self.pen_down or self.poly is not None:
+                self.draw_polyline(pts, offset)
+            else:
+                self.x, self.y = float(pts[-1, 0]), float(pts[-1, 1])
+
+    def do_tick(self, vertical: bool, offset: int) -> None:
+        tp, tn = self.tick
+        (p1x, p1y), (p2x, p2y) = self.p1, self.p2
+        span = abs(p2y - p1y) if vertical else abs(p2x - p1x)
+        up, down = span * tp / 100.0, span * tn / 100.0
+        x, y = self.x, self.y
+        if vertical:
+            pts = np.array([(x, y - down), (x, y + up)])
+        else:
+            pts = np.array([(x - down, y), (x + up, y)])
+        if self.poly is None:
+            self.flush_if_drawing()
+            self.emit(pts, offset, closed=False)
+
+    def do_ip(self, v: list[float], offset: int) -> None:
+        if not v:
+            self.p1, self.p2 = self.hard
+        elif len(v) >= 4:
+            self.p1, self.p2 = (v[0], v[1]), (v[2], v[3])
+        elif len(v) == 2:
+            dx, dy = self.p2[0] - self.p1[0], self.p2[1] - self.p1[1]
+            self.p1 = (v[0], v[1])
+            self.p2 = (v[0] + dx, v[1] + dy)
+        else:
+            self.warn(offset, "IP needs 0, 2 or 4 numbers; ignored", key="args-IP")
+            return
+        self.update_scaling(offset)
+
+    def do_ir(self, v: list[float], offset: int) -> None:
+        (hx1, hy1), (hx2, hy2) = self.hard
+        w, h = hx2 - hx1, hy2 - hy1
+        if not v:
+            self.p1, self.p2 = self.hard
+        elif len(v) >= 2:
+            self.p1 = (hx1 + w * v[0] / 100.0, hy1 + h * v[1] / 100.0)
+            if len(v) >= 4:
+                self.p2 = (hx1 + w * v[2] / 100.0, hy1 + h * v[3] / 100.0)
+            else:
+                dx, dy = self.p2[0] - self.p1[0], self.p2[1] - self.p1[1]
+                self.p2 = (self.p1[0] + dx, self.p1[1] + dy)
+        self.update_scaling(offset)
+
+    def do_sc(self, v: list[float], offset: int) -> None:
+        if not v:
+            self.sc_params = None
+            self.sc = None
+            return
+        if len(v) < 4:
+            self.warn(offset, "SC needs at least four numbers; ignored", key="args-SC")
+            return
+        self.sc_params = v
+        self.update_scaling(offset)
+
+    def do_iw(self, v: list[float], offset: int) -> None:
+        self.flush()
+        if not v:
+            self.window = None
+            return
+        if len(v) < 4:
+            self.warn(offset, "IW needs four numbers; ignored", key="args-IW")
+            return
+        x1, y1 = self.to_plotter(v[0], v[1])
+        x2, y2 = self.to_plotter(v[2], v[3])
+        self.window = (min(x1, x2), min(y1, y2), max(x1, x2), max(y1, y2))
+
+    # ------------------------------------------------------------------ main loop
+    def run(self) -> None:
+        data = self.data
+        n = self.n
+        if _PCL_START_RE.match(data):
+            self.hpgl_mode = False
+        i = 0
+        cmd_match = _CMD_RE.match
+        handlers = self._handlers()
+        commands = self.commands
+        run_match = _RUN_RE.match
+        slow_until = 0
+        while i < n:
+            if not self.hpgl_mode:
+                i = self._pcl(i)
+                continue
+            if self.poly is None and i >= slow_until:
+                rm = run_match(data, i)
+                if rm is not None:
+                    if rm.end() - i >= _FAST_MIN_BYTES and self._fast_run(i, rm.end()):
+                        i = rm.end()
+                        continue
+                    slow_until = rm.end()  # read this run command by command
+            m = cmd_match(data, i)
+            if m is not None:
+                mn = m.group(1).upper().decode()
+                start = m.start(1)
+                if mn in _SPECIAL:
+                    commands[mn] += 1
+                    self.recognised += 1
+                    i = _SPECIAL[mn](self, start + 2)
+                    continue
+                commands[mn] += 1
+                h = handlers.get(mn)
+                if h is not None:
+                    self.recognised += 1
+                    params = m.group(2)
+                    h(params, start, mn)
+                elif mn in KNOWN:
+                    self.recognised += 1
+                else:
+                    self.junk_bytes += m.end() - start
+                    self.warn(start, f"unknown command {mn} skipped", key=f"unknown-{mn}")
+                i = m.end()
+                continue
+            # not an ordinary command: separators then something else
+            i = _SEP_RE.match(data, i).end()
+            if i >= n:
+                break
+            c = data[i]
+            if c == 0x1B:
+                i = self._escape_in_hpgl(i)
+            elif c == 0x2E and (dm := _DEVCTL_RE.match(data, i)) is not None:  # '.'
+                i = dm.end()
+            elif c == 0x21 and (vm := _VENDOR_RE.match(data, i)) is not None:  # '!'
+                name = "!" + vm.group(1).upper().decode()
+                commands[name] += 1
+                self.warn(i, f"vendor command {name} ignored", key=f"vendor-{name}")
+                i = vm.end()
+            else:
+                j = i + 1
+                while j < n and not (
+                    (65 <= data[j] <= 90 or 97 <= data[j] <= 122) or data[j] in (0x1B, 0x3B)
+                ):
+                    j += 1
+                self.junk_bytes += j - i
+                snippet = data[i : min(j, i + 12)]
+                self.warn(i, f"unreadable text {snippet!r} skipped", key="junk")
+                i = j
+        self.flush()
+        if self.poly is not None:
+            self.warn(n, "file ends in polygon mode (PM0 without PM2): polygon not drawn")
+        elif not self.poly_emitted and self.poly_buffer:
+            self.warn(self.poly_offset,
+                      "polygon defined with PM but never edged or filled (EP/FP): not drawn")
+
+    def _fast_run(self, start: int, end: int) -> bool:
+        """Read a run of PU/PD/PA/PR commands in one vectorised step (see fastrun).
+
+        Returns False (having changed nothing) when the run needs the general reader.
+        """
+        tok = tokenize_run(memoryview(self.data)[start:end])
+        if tok is None:
+            return False
+        code = tok.cmd_code
+        ncmd = len(code)
+        counts = np.bincount(tok.num_cmd, minlength=ncmd)
+        odd = np.flatnonzero(counts % 2)
+        keep = np.ones(len(tok.num_val), dtype=bool)
+        for c in odd.tolist():  # rare: drop the last number of such commands
+            mn = "P" + "UDAR"[code[c]]
+            self.warn(start + int(tok.cmd_pos[c]),
+                      f"{mn} has an odd number of coordinates; the last was ignored",
+                      key=f"odd-{mn}")
+            last = np.flatnonzero(tok.num_cmd == c)[-1]
+            keep[last] = False
+        vals = tok.num_val[keep]
+        ncmd_of = tok.num_cmd[keep]
+        xs, ys = vals[0::2], vals[1::2]
+        pair_cmd = ncmd_of[0::2]
+        pen_set = np.where(code == CODE_U, 0, np.where(code == CODE_D, 1, -1)).astype(np.int8)
+        mode_set = np.where(code == CODE_A, 1, np.where(code == CODE_R, 0, -1)).astype(np.int8)
+        pen_after = ffill_state(pen_set, int(self.pen_down))
+        mode_after = ffill_state(mode_set, int(self.absolute))
+        pen_before = np.empty_like(pen_after)
+        pen_before[0] = int(self.pen_down)
+        pen_before[1:] = pen_after[:-1]
+        # positions of every pair, in plotter units
+        absolute = mode_after[pair_cmd].astype(bool)
+        if self.sc is not None:
+            ax, bx, ay, by = self.sc
+            xs = np.where(absolute, ax * xs + bx, ax * xs)
+            ys = np.where(absolute, ay * ys + by, ay * ys)
+        K = len(xs)
+        q = np.empty((K + 1, 2))
+        q[0] = (self.x, self.y)
+        if K:
+            dx = np.where(absolute, 0.0, xs)
+            dy = np.where(absolute, 0.0, ys)
+            cx = np.cumsum(dx)
+            cy = np.cumsum(dy)
+            base = np.where(absolute, np.arange(K), -1)
+            np.maximum.accumulate(base, out=base)
+            has = base >= 0
+            b0 = np.maximum(base, 0)
+            q[1:, 0] = np.where(has, xs[b0] - cx[b0], self.x) + cx
+            q[1:, 1] = np.where(has, ys[b0] - cy[b0], self.y) + cy
+        # paths: one per up->down transition; pairs drawn where the pen is down
+        trans = np.flatnonzero((pen_before == 0) & (pen_after == 1))
+        drawn = pen_after[pair_cmd] == 1 if K else np.zeros(0, dtype=bool)
+        # index of the last pair before each transition command -> the path's start point
+        pairs_before = np.searchsorted(pair_cmd, trans, side="left")  # pairs of earlier cmds
+        path_of_pair = np.searchsorted(trans, pair_cmd, side="right") - 1  # -1: open path
+        d_idx = np.flatnonzero(drawn)
+        d_path = path_of_pair[d_idx]
+        # continuation of a path open before the run
+        cont = d_idx[d_path < 0]
+        if len(cont):
+            self.cur.extend(q[cont + 1].ravel().tolist())
+        elif self.pen_down and not self.cur:
+            pass
+        if self.cur and (len(trans) or not bool(pen_after[-1])):
+            self.flush()
+        npaths = len(trans)
+        if npaths:
+            sel = d_path >= 0
+            d_idx = d_idx[sel]
+            d_path = d_path[sel]
+            per = np.bincount(d_path, minlength=npaths) + 1
+            out_start = np.cumsum(per) - per
+            out = np.empty((int(per.sum()), 2))
+            out[out_start] = q[pairs_before]
+            first_of_path = np.searchsorted(d_path, np.arange(npaths), side="left")
+            rank = np.arange(len(d_idx)) - first_of_path[d_path]
+            out[out_start[d_path] + 1 + rank] = q[d_idx + 1]
+            offsets = (start + tok.cmd_pos[trans]).tolist()
+            pieces = np.split(out, out_start[1:])
+            open_last = bool(pen_after[-1])
+            last = npaths - 1
+            for k, (piece, off) in enumerate(zip(pieces, offsets, strict=True)):
+                if k == last and open_last:
+                    self.cur = piece.ravel().tolist()
+                    self.cur_offset = off
+                else:
+                    self.emit(piece, off)
+        self.x, self.y = float(q[-1, 0]), float(q[-1, 1])
+        self.pen_down = bool(pen_after[-1])
+        self.absolute = bool(mode_after[-1])
+        cc = np.bincount(code, minlength=4)
+        for k, name in enumerate(("PU", "PD", "PA", "PR")):
+            if cc[k]:
+                self.commands[name] += int(cc[k])
+        self.recognised += ncmd
+        return True
+
+    def _handlers(self) -> dict[str, Callable[[bytes, int, str], None]]:
+        def move(mode: bool | None, down: bool | None) -> Callable[[bytes, int, str], None]:
+            def h(params: bytes, off: int, mn: str) -> None:
+                if mode is not None:
+                    self.absolute = mode
+                if down is not None:
+                    self.set_pen_down(down, off)
+                if params:
+                    self.move_params(params, off, mn)
+            return h
+
+        def nums(fn: Callable[[list[float], int], None]) -> Callable[[bytes, int, str], None]:
+            return lambda params, off, mn: fn(_nums(params), off)
+
+        def nums_mn(fn: Callable[[list[float], int, str], None]) -> Callable[..., None]:
+            return lambda params, off, mn: fn(_nums(params), off, mn)
+
+        def arc(relative: bool) -> Callable[[bytes, int, str], None]:
+            def h(params: bytes, off: int, mn: str) -> None:
+                v = _nums(params)
+                if len(v) < 3:
+                    self.warn(off, f"{mn} needs centre and sweep; ignored", key=f"args-{mn}")
+                    return
+                cx, cy = v[0], v[1]
+                if relative:
+                    ux, uy = self.to_user(self.x, self.y)
+                    cx, cy = ux + cx, uy + cy
+                self.do_arc(cx, cy, v[2], v[3] if len(v) > 3 else None, off)
+            return h
+
+        def pen(params: bytes, off: int, mn: str) -> None:
+            v = _nums(params)
+            self.flush()
+            self.pen_down = False
+            self.pen = int(v[0]) if v else 0
+
+        def ro(params: bytes, off: int, mn: str) -> None:
+            v = _nums(params)
+            self.flush()
+            ang = int(v[0]) % 360 if v else 0
+            if ang not in (0, 90, 180, 270):
+                self.warn(off, f"RO{ang}: only 0, 90, 180, 270 exist; treated as 0")
+                ang = 0
+            self.rot = ang
+
+        def ps(params: bytes, off: int, mn: str) -> None:
+            v = _nums(params)
+            if len(v) >= 2:
+                w, h = abs(v[0]), abs(v[1])
+            elif len(v) == 1:
+                w = h = abs(v[0])
+            else:
+                w, h = DEFAULT_P2[0] - DEFAULT_P1[0], DEFAULT_P2[1] - DEFAULT_P1[1]
+            self.hard = ((0.0, 0.0), (w, h))
+            self.p1, self.p2 = self.hard
+            self.update_scaling(off)
+
+        def ct(params: bytes, off: int, mn: str) -> None:
+            v = _nums(params)
+            self.ct_tol = bool(v and int(v[0]) == 1)
+
+        def tl(params: bytes, off: int, mn: str) -> None:
+            v = _nums(params)
+            self.tick = (v[0] if v else 0.5, v[1] if len(v) > 1 else (0.0 if v else 0.5))
+
+        def pg(params: bytes, off: int, mn: str) -> None:
+            self.flush()
+            self.pages += 1
+
+        def lt(params: bytes, off: int, mn: str) -> None:
+            if _nums(params):
+                self.line_types += 1
+
+        def in_(params: bytes, off: int, mn: str) -> None:
+            self.reset()
+
+        def df(params: bytes, off: int, mn: str) -> None:
+            self.defaults()
+
+        def edge_fill(params: bytes, off: int, mn: str) -> None:
+            self.do_edge_fill(mn, off)
+
+        def sm(params: bytes, off: int, mn: str) -> None:  # only reached for 'SM;'
+            pass
+
+        return {
+            "PA": move(True, None),
+            "PR": move(False, None),
+            "PU": move(None, False),
+            "PD": move(None, True),
+            "AA": arc(False),
+            "AR": arc(True),
+            "AT": nums_mn(lambda v, o, mn: self.do_three_point(v, False, o, mn)),
+            "RT": nums_mn(lambda v, o, mn: self.do_three_point(v, True, o, mn)),
+            "CI": nums(self.do_circle),
+            "EA": nums_mn(lambda v, o, mn: self.do_rect(v, False, o, mn)),
+            "RA": nums_mn(lambda v, o, mn: self.do_rect(v, False, o, mn)),
+            "ER": nums_mn(lambda v, o, mn: self.do_rect(v, True, o, mn)),
+            "RR": nums_mn(lambda v, o, mn: self.do_rect(v, True, o, mn)),
+            "EW": nums_mn(self.do_wedge),
+            "WG": nums_mn(self.do_wedge),
+            "BZ": nums_mn(lambda v, o, mn: self.do_bezier(v, False, o, mn)),
+            "BA": nums_mn(lambda v, o, mn: self.do_bezier(v, False, o, mn)),
+            "BR": nums_mn(lambda v, o, mn: self.do_bezier(v, True, o, mn)),
+            "PM": nums(self.do_pm),
+            "EP": edge_fill,
+            "FP": edge_fill,
+            "XT": lambda p, o, mn: self.do_tick(True, o),
+            "YT": lambda p, o, mn: self.do_tick(False, o),
+            "TL": tl,
+            "SP": pen,
+            "RO": ro,
+            "PS": ps,
+            "IP": nums(self.do_ip),
+            "IR": nums(self.do_ir),
+            "SC": nums(self.do_sc),
+            "IW": nums(self.do_iw),
+            "CT": ct,
+            "IN": in_,
+            "DF": df,
+            "PG": pg,
+            "LT": lt,
+            "SM": sm,
+        }
+
+    # ------------------------------------------------------------------ text-like commands
+    def _find_term(self, start: int, term: int) -> int:
+        """Offset of ``term`` at or after ``start``, or -1 (cached to stay linear)."""
+        none_after = self._no_term_after.get(term)
+        if none_after is not None and start >= none_after:
+            return -1
+        j = self.data.find(bytes((term,)), start)
+        if j < 0:
+            self._no_term_after[term] = start
+        return j
+
+    def _end_of_line(self, start: int) -> int:
+        j = self.data.find(b"\n", start)
+        return self.n if j < 0 else j + 1
+
+    def label(self, pos: int) -> int:
+        """LB/BL/WD: skip text to the terminator; returns the offset after it."""
+        self.labels += 1
+        j = self._find_term(pos, self.term)
+        if j < 0:
+            end = self._end_of_line(pos)
+            self.warn(pos - 2, "label without its terminator: ended at the end of the line",
+                      key="label-unterminated")
+            return end
+        return j + 1
+
+    def dt(self, pos: int) -> int:
+        data, n = self.data, self.n
+        if pos >= n or data[pos] == 0x3B:  # 'DT;' -> default ETX
+            self.term = ETX
+            return min(pos + 1, n)
+        t = data[pos]
+        if t in (0x00, 0x0A, 0x0D, 0x1B) or t == 0x3B:
+            self.warn(pos, f"DT with terminator {bytes((t,))!r} refused; ETX kept")
+            self.term = ETX
+        else:
+            self.term = t
+        m = re.compile(rb"(?:,\s*\d*)?;?").match(data, pos + 1)
+        return m.end() if m else pos + 1
+
+    def sm(self, pos: int) -> int:
+        data, n = self.data, self.n
+        if pos >= n or data[pos] in b";\r\n":
+            return min(pos + 1, n) if pos < n and data[pos] == 0x3B else pos
+        self.text_symbols += 1
+        end = pos + 1
+        if end < n and data[end] == 0x3B:
+            end += 1
+        return end
+
+    def co(self, pos: int) -> int:
+        data, n = self.data, self.n
+        m = _SEP_RE.match(data, pos)
+        j = m.end() if m else pos
+        if j < n and data[j] == 0x22:  # '"'
+            k = self._find_term(j + 1, 0x22)
+            if k < 0:
+                self.warn(pos - 2, "CO comment without its closing quote: ended at end of line")
+                return self._end_of_line(j + 1)
+            k += 1
+            if k < n and data[k] == 0x3B:
+                k += 1
+            return k
+        stop = re.compile(rb"[^;\r\n" + re.escape(bytes((self.term,))) + rb"]*").match(data, pos)
+        k = stop.end() if stop else pos
+        return min(k + 1, n)
+
+    def pe(self, pos: int) -> int:
+        res = decode_pe(self.data, pos)
+        for off, msg in res.problems:
+            self.warn(off, msg, key="pe")
+        saved_abs = self.absolute
+        for item in res.items:
+            if item.kind == "pen":
+                self.flush()
+                self.pen = item.value
+                continue
+            if item.pen_up:
+                self.set_pen_down(False, pos)
+            elif not self.pen_down:
+                self.set_pen_down(True, pos)
+            if item.absolute:
+                x, y = self.to_plotter(item.x, item.y)
+            else:
+                dx, dy = self.delta_to_plotter(item.x, item.y)
+                x, y = self.x + dx, self.y + dy
+            self.pen_to(x, y, pos)
+            if item.pen_up:
+                # after a pen-up move, later pairs draw: the pen goes down at this point
+                self.set_pen_down(True, pos)
+        self.absolute = saved_abs
+        if res.items and res.items[-1].kind == "pair" and res.items[-1].pen_up:
+            self.set_pen_down(False, pos)
+        return res.end
+
+    # ------------------------------------------------------------------ escapes and PCL
+    def _escape_in_hpgl(self, i: int) -> int:
+        data = self.data
+        dm = _DEVCTL_RE.match(data, i)
+        if dm is not None:
+            self.recognised += 1
+            return dm.end()
+        m = _PCL_ESC_RE.match(data, i)
+        if m is None:
+            self.junk_bytes += 1
+            return i + 1
+        self.recognised += 1
+        if m.group(0) == b"\x1b%-12345X" or m.group(6) == b"E":
+            self.flush()
+            self.hpgl_mode = False
+            return m.end()
+        if m.group(1) == b"%" and m.group(5) == b"A":
+            self.flush()
+            self.hpgl_mode = False
+            return m.end()
+        return self._skip_pcl_data(m)
+
+    def _skip_pcl_data(self, m: re.Match[bytes]) -> int:
+        end = m.end()
+        term = m.group(5)
+        if term in (b"W", b"X") and (term == b"W" or m.group(2) == b"p"):
+            try:
+                count = int(float(m.group(4) or b"0"))
+            except ValueError:
+                count = 0
+            end = min(self.n, end + max(0, count))
+        return end
+
+    def _pcl(self, i: int) -> int:
+        """In PCL/PJL mode: skip to the next way back into HP-GL/2."""
+        data = self.data
+        m = _PCL_SCAN_RE.search(data, i)
+        if m is None:
+            return self.n
+        if m.group(0) != b"\x1b":
+            lang = m.group(1).upper().replace(b"-", b"")
+            if lang.startswith(b"HPGL"):
+                self.hpgl_mode = True
+            return m.end()
+        e = _PCL_ESC_RE.match(data, m.start())
+        if e is None:
+            return m.start() + 1
+        self.recognised += 1
+        if e.group(1) == b"%" and e.group(5) == b"B":
+            self.hpgl_mode = True
+            return e.end()
+        return self._skip_pcl_data(e)
+
+
+_SPECIAL: dict[str, Callable[[_Reader, int], int]] = {
+    "LB": _Reader.label,
+    "BL": _Reader.label,
+    "WD": _Reader.label,
+    "DT": _Reader.dt,
+    "CO": _Reader.co,
+    "PE": _Reader.pe,
+}
+
+
+def _clip_polyline(pts: np.ndarray, win: tuple[float, float, float, float]) -> list[np.ndarray]:
+    """Clip a polyline to an axis-aligned window (Liang–Barsky per segment)."""
+    xmin, ymin, xmax, ymax = win
+    if len(pts) == 1:
+        x, y = pts[0]
+        return [pts] if xmin <= x <= xmax and ymin <= y <= ymax else []
+    a = pts[:-1]
+    d = pts[1:] - a
+    t0 = np.zeros(len(a))
+    t1 = np.ones(len(a))
+    visible = np.ones(len(a), dtype=bool)
+    for p, q in (
+        (-d[:, 0], a[:, 0] - xmin),
+        (d[:, 0], xmax - a[:, 0]),
+        (-d[:, 1], a[:, 1] - ymin),
+        (d[:, 1], ymax - a[:, 1]),
+    ):
+        zero = p == 0
+        visible &= ~(zero & (q < 0))
+        with np.errstate(divide="ignore", invalid="ignore"):
+            r = np.where(zero, 0.0, q / np.where(zero, 1.0, p))
+        neg = (p < 0) & ~zero
+        pos_ = (p > 0) & ~zero
+        t0 = np.where(neg, np.maximum(t0, r), t0)
+        t1 = np.where(pos_, np.minimum(t1, r), t1)
+    visible &= t0 <= t1
+    out: list[np.ndarray] = []
+    cur: list[np.ndarray] = []
+    for k in np.flatnonzero(visible):
+        s = a[k] + t0[k] * d[k]
+        e = a[k] + t1[k] * d[k]
+        if cur and t0[k] == 0.0 and k > 0 and visible[k - 1] and t1[k - 1] == 1.0 and last_k == k - 1:
+            cur.append(e)
+        else:
+            if cur:
+                out.append(np.array(cur))
+            cur = [s, e]
+        last_k = k
+    if cur:
+        out.append(np.array(cur))
+    return out
+
+
+def _line_cols(data: bytes, offsets: list[int]) -> list[tuple[int, int]]:
+    if not offsets:
+        return []
+    nl = np.flatnonzero(np.frombuffer(data, dtype=np.uint8) == 10)
+    offs = np.asarray(offsets, dtype=np.int64)
+    idx = np.searchsorted(nl, offs, side="left")  # newlines strictly before offset
+    line_start = np.where(idx > 0, nl[np.maximum(idx - 1, 0)] + 1 if len(nl) else 0, 0)
+    lines = idx + 1
+    cols = offs - line_start + 1
+    return list(zip(lines.tolist(), cols.tolist(), strict=True))
+
+
+def read_bytes(data: bytes, name: str = "<bytes>") -> Drawing:
+    """Read HP-GL / HP-GL/2 from bytes. Raises InputError when it is not HP-GL."""
+    if len(data) > MAX_FILE_BYTES:
+        raise InputError(name, f"file is larger than {MAX_FILE_BYTES // 2**20} MiB")
+    head = data[: 1 << 16].lstrip(b"\x00") if data[:1] == b"\x00" else data[: 1 << 16]
+    if data[:1] == b"\x00" and not head:
+        head = data.lstrip(b"\x00")[: 1 << 16]
+    reason = refusal_reason(head)
+    if reason is not None:
+        raise InputError(name, reason)
+    rd = _Reader(data, name)
+    try:
+        rd.run()
+    except RecursionError as exc:  # pragma: no cover - defensive
+        raise InputError(name, "file too deeply nested to read") from exc
+    body = len(data) - data.count(b"\x00")
+    if rd.recognised == 0:
+        if not rd.hpgl_mode or _PCL_START_RE.match(data):
+            raise InputError(name, "a PCL/PJL print job without HP-GL/2 graphics")
+        raise InputError(name, "no HP-GL commands found: not an HP-GL/PLT file")
+    if rd.junk_bytes > 0.5 * max(body, 1):
+        share = 100.0 * rd.junk_bytes / max(body, 1)
+        raise InputError(name, f"not HP-GL: {share:.0f}% of the file is not HP-GL commands")
+    if rd.pages > 1:
+        rd.warn(0, f"the file has {rd.pages} pages (PG); they are overlaid in one field")
+    if rd.labels:
+        rd.warn(0, f"{rd.labels} text label(s) (LB) are not drawn: convert text to curves")
+    if rd.line_types:
+        rd.warn(0, "line types (LT) are not applied: every line is imported solid")
+    if rd.text_symbols:
+        rd.warn(0, "symbol mode (SM) characters are not drawn")
+    if not rd.paths:
+        rd.warn(0, "the file has no pen-down geometry")
+    for key, count in rd._warn_count.items():
+        if count > _WARN_CAP:
+            rd._warn.append((rd.n, f"... and {count - _WARN_CAP} more warnings like: {key}"))
+    # positions
+    offsets = [p[3] for p in rd.paths]
+    w_offsets = [w[0] for w in rd._warn]
+    lc = _line_cols(data, offsets + w_offsets)
+    paths = []
+    for (pts, pen, closed, _), (line, col) in zip(rd.paths, lc[: len(offsets)], strict=True):
+        paths.append(Path(pts, pen=pen, closed=closed, start=SourcePos(line, col)))
+    warnings = []
+    for (off, msg), (line, col) in zip(rd._warn, lc[len(offsets) :], strict=True):
+        if off <= 0 and msg[:1] != "." and off == 0 and msg.startswith(("the file", "line types",
+                                                                          "symbol", "text")):
+            line, col = 0, 0
+        warnings.append(Warning(line, col, msg))
+    warnings.sort(key=lambda w: (w.line == 0, w.line, w.col))
+    return Drawing(
+        paths=tuple(paths),
+        name=name,
+        sha256=sha256_hex(data),
+        commands=dict(rd.commands),
+        warnings=tuple(warnings),
+    )
+
+
+def read_file(path: str | os.PathLike[str]) -> Drawing:
+    """Read a PLT/HP-GL file. Raises InputError (naming the file) when it cannot be used."""
+    name = os.fspath(path)
+    try:
+        with open(path, "rb") as fh:
+            size = os.fstat(fh.fileno()).st_size
+            if size > MAX_FILE_BYTES:
+                raise InputError(name, f"file is larger than {MAX_FILE_BYTES // 2**20} MiB")
+            data = fh.read()
+    except IsADirectoryError as exc:
+        raise InputError(name, "is a folder, not a file") from exc
+    except FileNotFoundError as exc:
+        raise InputError(name, "no such file") from exc
+    except PermissionError as exc:
+        raise InputError(name, "permission denied") from exc
+    except OSError as exc:
+        raise InputError(name, f"cannot be read ({exc.strerror or exc})") from exc
+    drawing = read_bytes(data, os.path.basename(name))
+    return drawing

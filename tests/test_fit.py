@@ -1,0 +1,366 @@
+"""Line + cubic fitting (paper 000 §2–3): the two-sided guarantee, counts, degenerate input."""
+
+from __future__ import annotations
+
+import time
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from galvo_core.drawing import Drawing, Path
+from galvo_core.errors import ParamError
+from galvo_core.fit import (
+    FittedPath,
+    check_fit,
+    control_points,
+    fit_drawing,
+    fit_path,
+    fit_report,
+)
+from galvo_core.geometry import cubic_eval
+
+EPS = 0.02
+
+
+def assert_valid(points, fp: FittedPath, *, e_per=EPS, eps_line=EPS, closed=False):
+    points = np.asarray(points, float)
+    segs = fp.segments
+    assert segs, "no segments"
+    # continuity: each starts exactly where the previous ended
+    for s0, s1 in zip(segs[:-1], segs[1:], strict=True):
+        assert np.array_equal(s0.points[-1], s1.points[0])
+        assert s0.last == s1.first
+    assert segs[0].first == 0
+    assert np.array_equal(segs[0].points[0], points[0])
+    n_ext = len(points) + (1 if closed and not np.array_equal(points[0], points[-1]) else 0)
+    assert segs[-1].last == n_ext - 1
+    if closed:
+        assert fp.closed
+        assert np.array_equal(segs[-1].points[-1], segs[0].points[0])
+    for s in segs:
+        assert s.kind in ("line", "cubic")
+        assert s.points.shape == ((2, 2) if s.kind == "line" else (4, 2))
+        assert s.points.dtype == np.float64
+    tol = max(e_per, eps_line)
+    e_in, e_out = check_fit(points, fp, e_per, eps_line)
+    assert e_in <= tol * (1 + 1e-6), f"input point {e_in} from its segment"
+    assert e_out <= tol * (1 + 1e-6), f"curve {e_out} from the input polyline"
+    assert fp.max_error <= tol * (1 + 1e-6)
+    assert fp.max_error == pytest.approx(e_in, abs=1e-6)
+    return e_in, e_out
+
+
+def ring(p):
+    p = np.asarray(p, float)
+    return np.vstack([p, p[:1]])
+
+
+# --- exact counts ---------------------------------------------------------------------
+
+
+def test_sampled_triangle_cubic_fits_back_to_one_cubic():
+    """A cubic of the paper's family (P1, P2 at the same fraction t of the triangle sides),
+    60 degrees of turning, sampled densely: one cubic, its ends exact, its control points
+    close to the original ones."""
+    p0, q, p3 = np.array([0.0, 0.0]), np.array([150.0, 90.0]), np.array([300.0, 0.0])
+    t = 0.55
+    c = np.array([p0, p0 + t * (q - p0), p3 + t * (q - p3), p3])
+    pts = cubic_eval(c, np.linspace(0, 1, 3000))
+    fp = fit_path(pts, closed=False)
+    assert [s.kind for s in fp.segments] == ["cubic"]
+    assert (fp.segments[0].first, fp.segments[0].last) == (0, 2999)
+    np.testing.assert_array_equal(fp.segments[0].points[[0, 3]], c[[0, 3]])
+    np.testing.assert_allclose(fp.segments[0].points, c, atol=1.0)
+    assert_valid(pts, fp)
+
+
+def test_polygon_keeps_exactly_its_corners_as_lines():
+    corners = np.array([[0, 0], [400, 0], [400, 250], [150, 380], [0, 250]], float)
+    rc = ring(corners)
+    dense = np.vstack(
+        [
+            rc[i] + np.linspace(0, 1, 80, endpoint=False)[:, None] * (rc[i + 1] - rc[i])
+            for i in range(5)
+        ]
+        + [rc[:1]]
+    )
+    fp = fit_path(dense, closed=True)
+    assert [s.kind for s in fp.segments] == ["line"] * 5
+    np.testing.assert_array_equal(np.array([s.points[0] for s in fp.segments]), corners)
+    assert_valid(dense, fp, closed=True)
+
+
+def test_circle_1181_points_paper_sanity(capsys):
+    t = np.linspace(0, 2 * np.pi, 1181)
+    p = np.c_[400 * np.cos(t), 400 * np.sin(t)]
+    p[-1] = p[0]
+    t0 = time.perf_counter()
+    fp = fit_path(p, closed=True)
+    dt = time.perf_counter() - t0
+    cp = control_points(fp)
+    with capsys.disabled():
+        print(
+            f"\ncircle r=400, 1181 points -> {cp} control points ({fp.n_cubics} cubics, "
+            f"{fp.n_lines} lines) in {dt * 1e3:.1f} ms; paper 000: 40"
+        )
+    assert fp.n_lines == 0
+    assert cp <= 40  # at least as good as the paper
+    assert_valid(p, fp, closed=True)
+
+
+# --- shapes ---------------------------------------------------------------------------
+
+
+def ellipse(n=2000, a=300, b=90):
+    t = np.linspace(0, 2 * np.pi, n)
+    p = np.c_[a * np.cos(t), b * np.sin(t)]
+    p[-1] = p[0]
+    return p
+
+
+def spiral(n=3000):
+    t = np.linspace(0.5, 6 * np.pi, n)
+    return np.c_[10 * t * np.cos(t), 10 * t * np.sin(t)]
+
+
+def s_curve(n=1500):
+    x = np.linspace(0, 400, n)
+    return np.c_[x, 60 * np.sin(x / 400 * 2 * np.pi)]
+
+
+def rounded_rect(w=400, h=200, r=40, n_arc=60):
+    pts = []
+    for cx, cy, a0 in [
+        (w - r, r, -np.pi / 2),
+        (w - r, h - r, 0),
+        (r, h - r, np.pi / 2),
+        (r, r, np.pi),
+    ]:
+        a = np.linspace(a0, a0 + np.pi / 2, n_arc)
+        pts.append(np.c_[cx + r * np.cos(a), cy + r * np.sin(a)])
+    return ring(np.vstack(pts))
+
+
+def glyph_d(n=400):
+    """A 'D'-like outline: straight stem with corners, a bowl of half an ellipse."""
+    stem = np.array([[0.0, 0.0], [0.0, 500.0]])
+    a = np.linspace(np.pi / 2, -np.pi / 2, n)
+    bowl = np.c_[0 + 300 * np.cos(a), 250 + 250 * np.sin(a)]
+    return ring(np.vstack([stem[:1], stem[1:], bowl[1:-1]]))
+
+
+@pytest.mark.parametrize(
+    "name,points,closed",
+    [
+        ("ellipse", ellipse(), True),
+        ("spiral", spiral(), False),
+        ("s_curve", s_curve(), False),
+        ("rounded_rect", rounded_rect(), True),
+        ("glyph_d", glyph_d(), True),
+    ],
+)
+def test_shapes_meet_the_guarantee(name, points, closed):
+    fp = fit_path(points, closed=closed)
+    assert_valid(points, fp, closed=closed)
+    assert fp.n_cubics >= 1
+    assert control_points(fp) < len(points) / 5
+
+
+def test_rounded_rectangle_keeps_straight_sides_as_lines_and_corners_as_cubics():
+    p = rounded_rect()
+    fp = fit_path(p, closed=True)
+    long_lines = [
+        s for s in fp.segments if s.kind == "line" and np.hypot(*np.diff(s.points, axis=0)[0]) > 100
+    ]
+    assert len(long_lines) == 4
+    assert fp.n_cubics >= 4
+
+
+def test_glyph_stem_corners_stay_corners():
+    p = glyph_d()
+    fp = fit_path(p, closed=True)
+    starts = np.array([s.points[0] for s in fp.segments])
+    for corner in ([0.0, 0.0], [0.0, 500.0]):
+        assert np.any(np.all(starts == corner, axis=1))
+    # the stem itself is one line
+    assert fp.segments[0].kind == "line"
+    np.testing.assert_array_equal(fp.segments[0].points, [[0, 0], [0, 500]])
+
+
+def test_closed_path_without_closing_point_is_closed():
+    t = np.linspace(0, 2 * np.pi, 500, endpoint=False)
+    p = np.c_[100 * np.cos(t), 100 * np.sin(t)]
+    fp = fit_path(p, closed=True)
+    assert fp.segments[-1].last == len(p)  # index N = point 0 again
+    assert_valid(p, fp, closed=True)
+
+
+# --- random smooth curves (hypothesis) -------------------------------------------------
+
+
+@settings(max_examples=20, deadline=None)
+@given(st.integers(0, 100_000), st.integers(200, 1500), st.sampled_from([0.0, 0.002, 0.005]))
+def test_random_sums_of_sines(seed, n, noise):
+    rng = np.random.default_rng(seed)
+    x = np.sort(rng.uniform(0, rng.uniform(100, 800), n))
+    y = sum(
+        rng.uniform(5, 60) * np.sin(x / rng.uniform(8, 80) + rng.uniform(0, 6)) for _ in range(3)
+    )
+    p = np.c_[x, y] + rng.normal(0, noise, (n, 2)) if noise else np.c_[x, y]
+    fp = fit_path(p, closed=False)
+    assert_valid(p, fp)
+
+
+@settings(max_examples=20, deadline=None)
+@given(st.integers(0, 100_000), st.integers(50, 1500), st.sampled_from([0.0, 0.003]))
+def test_random_beziers_sampled_unevenly(seed, n, noise):
+    rng = np.random.default_rng(seed)
+    c = rng.uniform(-300, 300, (4, 2))
+    t = np.sort(np.concatenate([[0, 1], rng.uniform(0, 1, n) ** rng.uniform(0.5, 2)]))
+    p = cubic_eval(c, t) + (rng.normal(0, noise, (len(t), 2)) if noise else 0)
+    fp = fit_path(p, closed=False)
+    assert_valid(p, fp)
+
+
+@settings(max_examples=10, deadline=None)
+@given(st.integers(0, 100_000), st.sampled_from([0.05, 0.5]), st.sampled_from([0.01, 0.1]))
+def test_other_tolerances(seed, e_per, eps_line):
+    """Any positive tolerances: the guarantee scales with them (sparse points, r = 20)."""
+    rng = np.random.default_rng(seed)
+    n = int(rng.integers(30, 300))
+    t = np.sort(rng.uniform(0, 2 * np.pi, n))
+    p = np.c_[20 * np.cos(t) * rng.uniform(0.5, 2), 20 * np.sin(t)]
+    fp = fit_path(p, closed=False, e_per=e_per, eps_line=eps_line)
+    assert_valid(p, fp, e_per=e_per, eps_line=eps_line)
+
+
+def test_sparse_points_do_not_let_the_curve_bulge():
+    """Few points far apart on a sharp arc: any cubic through them would bulge between
+    them, so the fit must fall back to lines or tight cubics, never a bulging curve."""
+    t = np.linspace(0, np.pi / 2, 6)
+    p = np.c_[100 * np.cos(t), 100 * np.sin(t)]
+    fp = fit_path(p, closed=False)
+    assert_valid(p, fp)
+
+
+# --- parameters -----------------------------------------------------------------------
+
+
+@pytest.mark.parametrize("name", ["eps_line", "e_per", "eps_sum"])
+@pytest.mark.parametrize("bad", [0.0, -1.0, float("nan"), float("inf"), float("-inf")])
+def test_bad_parameters_refused_by_name(name, bad):
+    with pytest.raises(ParamError, match=name):
+        fit_path(np.zeros((3, 2)), closed=False, **{name: bad})
+    with pytest.raises(ParamError, match=name):
+        fit_drawing(Drawing((Path.from_points([[0, 0], [1, 1]]),)), **{name: bad})
+
+
+def test_any_positive_value_accepted():
+    p = s_curve(300)
+    for v in (1e-9, 1e-3, 7.0, 1e6):
+        fp = fit_path(p, closed=False, eps_line=v, e_per=v, eps_sum=v)
+        assert_valid(p, fp, e_per=v, eps_line=v)
+
+
+# --- degenerate input ------------------------------------------------------------------
+
+
+def test_dot_is_one_zero_length_line():
+    fp = fit_path([[5.0, 7.0]], closed=False)
+    assert len(fp.segments) == 1
+    s = fp.segments[0]
+    assert s.kind == "line" and (s.first, s.last) == (0, 0)
+    np.testing.assert_array_equal(s.points, [[5, 7], [5, 7]])
+    assert control_points(fp) == 1
+
+
+def test_repeated_point_and_zero_length_closed_path_are_dots():
+    fp = fit_path([[1.0, 1.0]] * 6, closed=False)
+    assert [(s.kind, s.first, s.last) for s in fp.segments] == [("line", 0, 5)]
+    fpc = fit_path([[2.0, 3.0]] * 4, closed=True)
+    assert fpc.closed and len(fpc.segments) == 1
+    np.testing.assert_array_equal(fpc.segments[0].points, [[2, 3], [2, 3]])
+
+
+def test_two_point_path_and_duplicates():
+    fp = fit_path([[0.0, 0.0], [3.0, 4.0]], closed=False)
+    assert [s.kind for s in fp.segments] == ["line"]
+    p = np.array([[0, 0], [0, 0], [1, 0], [1, 0], [2, 0], [2, 0], [2, 5], [2, 5]], float)
+    fp = fit_path(p, closed=False)
+    # kept: the first of each run of repeats (0, 4, 6); repeats go with the next segment
+    assert [(s.first, s.last) for s in fp.segments] == [(0, 4), (4, 7)]
+    assert_valid(p, fp)
+
+
+def test_collinear_run_is_one_line():
+    x = np.linspace(0, 1000, 5001)
+    fp = fit_path(np.c_[x, 2 * x + 1], closed=False)
+    assert [s.kind for s in fp.segments] == ["line"]
+
+
+@pytest.mark.parametrize("offset", [1e7, -1e7])
+def test_huge_coordinates(offset):
+    t = np.linspace(0, 2 * np.pi, 1500)
+    p = offset + np.c_[300 * np.cos(t), 200 * np.sin(t)]
+    p[-1] = p[0]
+    fp = fit_path(p, closed=True)
+    assert fp.n_cubics >= 4
+    assert_valid(p, fp, closed=True)
+
+
+def test_tiny_spacing():
+    t = np.linspace(0, np.pi, 500)
+    p = 1e-4 * np.c_[np.cos(t), np.sin(t)]  # spacing ~6e-7 units
+    # default tolerance: the whole arc is within 0.02 of one line
+    fp = fit_path(p, closed=False)
+    assert [s.kind for s in fp.segments] == ["line"]
+    assert_valid(p, fp)
+    # tolerances scaled down with the drawing: cubics again
+    fp = fit_path(p, closed=False, eps_line=1e-9, e_per=1e-9, eps_sum=1e-10)
+    assert fp.n_cubics >= 2
+    assert_valid(p, fp, e_per=1e-9, eps_line=1e-9)
+
+
+def test_nan_points_refused():
+    with pytest.raises(ParamError):
+        fit_path([[0.0, 0.0], [np.nan, 1.0]], closed=False)
+
+
+# --- drawing level --------------------------------------------------------------------
+
+
+def test_fit_drawing_and_report():
+    paths = (
+        Path.from_points(ellipse(800), pen=2),
+        Path.from_points([[1.0, 1.0]]),
+        Path.from_points(s_curve(600)),
+    )
+    d = Drawing(paths, name="t.plt")
+    fitted = fit_drawing(d)
+    assert [f.source_index for f in fitted] == [0, 1, 2]
+    assert [f.pen for f in fitted] == [2, 1, 1]
+    assert fitted[0].closed and not fitted[2].closed
+    for f, p in zip(fitted, paths, strict=True):
+        assert f.n_input == len(p.points)
+        assert_valid(p.points, f, closed=p.closed)
+    rep = fit_report(d)
+    assert rep["input_points"] == 800 + 1 + 600
+    assert rep["control_points"] == sum(control_points(f) for f in fitted)
+    assert rep["lines"] + rep["cubics"] == sum(len(f.segments) for f in fitted)
+    assert 0 < rep["thinned_points"] < rep["input_points"]
+    assert rep["max_error"] <= EPS
+    assert rep["seconds"] >= 0
+
+
+def test_core_does_not_import_qt():
+    import subprocess
+    import sys
+
+    code = (
+        "import sys, galvo_core.fit, galvo_core.thin, galvo_core.runs, galvo_core.geometry;"
+        "bad=[m for m in sys.modules if m.startswith(('PySide6','pyqtgraph','PyQt'))];"
+        "assert not bad, bad"
+    )
+    subprocess.run([sys.executable, "-c", code], check=True)

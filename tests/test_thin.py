@@ -1,0 +1,146 @@
+"""Line thinning (paper 000 §2.1): guarantee, near-optimality, degenerate input, speed."""
+
+from __future__ import annotations
+
+import math
+import time
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from galvo_core.errors import ParamError
+from galvo_core.geometry import point_segment_distance
+from galvo_core.thin import thin
+
+
+def assert_thin_guarantee(p, kept, eps):
+    p = np.asarray(p, float)
+    assert kept[0] == 0
+    assert np.all(np.diff(kept) > 0)
+    # no duplicate kept twice in a row
+    assert np.all(np.any(p[kept[1:]] != p[kept[:-1]], axis=1))
+    # last distinct point kept
+    last_distinct = len(p) - 1
+    while last_distinct > 0 and np.array_equal(p[last_distinct], p[last_distinct - 1]):
+        last_distinct -= 1
+    assert kept[-1] == last_distinct
+    for a, b in zip(kept[:-1], kept[1:], strict=True):
+        if b - a > 1:
+            d = point_segment_distance(p[a + 1 : b], p[a], p[b])
+            assert d.max() <= eps * (1 + 1e-9), (a, b, d.max())
+
+
+def imai_iri(q, eps, window=120):
+    """Fewest kept points (exact shortest path over all valid shortcuts within a window)."""
+    n = len(q)
+    best = [math.inf] * n
+    best[0] = 0
+    for j in range(1, n):
+        for i in range(j - 1, max(-1, j - window), -1):
+            if best[i] + 1 < best[j]:
+                if j - i < 2 or point_segment_distance(q[i + 1 : j], q[i], q[j]).max() <= eps:
+                    best[j] = best[i] + 1
+    return best[-1] + 1
+
+
+@pytest.mark.parametrize("bad", [0, 0.0, -0.02, float("nan"), float("inf"), "x", None])
+def test_bad_tolerance_refused_naming_parameter(bad):
+    with pytest.raises(ParamError, match="eps_line"):
+        thin(np.zeros((3, 2)), bad)
+
+
+@settings(max_examples=40, deadline=None)
+@given(
+    st.integers(0, 10_000),
+    st.integers(2, 400),
+    st.sampled_from([0.02, 0.1, 1.0]),
+    st.sampled_from(["walk", "smooth", "grid"]),
+)
+def test_every_dropped_point_within_eps_of_its_line(seed, n, eps, kind):
+    rng = np.random.default_rng(seed)
+    if kind == "walk":
+        p = np.cumsum(rng.normal(0, 0.3, (n, 2)), axis=0)
+    elif kind == "smooth":
+        x = np.sort(rng.uniform(0, 50, n))
+        p = np.c_[x, 10 * np.sin(x / rng.uniform(1, 8))] + rng.normal(0, 0.005, (n, 2))
+    else:  # integer plotter coordinates with many repeats and backtracking
+        p = np.cumsum(rng.integers(-1, 2, (n, 2)), axis=0).astype(float)
+    assert_thin_guarantee(p, thin(p, eps), eps)
+
+
+def test_collinear_run_keeps_two_points_and_corners_are_kept():
+    x = np.linspace(0, 100, 1001)
+    line = np.c_[x, 0.5 * x]
+    assert list(thin(line, 0.02)) == [0, 1000]
+    # a square sampled densely keeps exactly its 4 corners + closing point
+    side = np.linspace(0, 1, 50, endpoint=False)[:, None]
+    c = np.array([[0, 0], [10, 0], [10, 10], [0, 10], [0, 0]], float)
+    sq = np.vstack([c[i] + side * (c[i + 1] - c[i]) for i in range(4)] + [c[:1]])
+    kept = thin(sq, 0.02, closed=True)
+    np.testing.assert_array_equal(sq[kept], c)
+
+
+def test_duplicates_dropped_and_indices_are_original():
+    p = np.array([[0, 0], [0, 0], [1, 0], [1, 0], [1, 0], [2, 1], [2, 1]], float)
+    kept = thin(p, 0.01)
+    assert list(kept) == [0, 2, 5]
+    assert list(thin(np.array([[3.0, 3.0]] * 5), 0.02)) == [0]
+    assert list(thin(np.zeros((0, 2)), 0.02)) == []
+    assert list(thin([[1.0, 2.0], [4.0, 6.0]], 0.02)) == [0, 1]
+
+
+def test_closed_ring_keeps_its_seam():
+    t = np.linspace(0, 2 * np.pi, 400)
+    p = np.c_[50 * np.cos(t), 50 * np.sin(t)]
+    p[-1] = p[0]
+    kept = thin(p, 0.02, closed=True)
+    assert kept[0] == 0 and kept[-1] == len(p) - 1
+    assert_thin_guarantee(p, kept, 0.02)
+
+
+def test_back_and_forth_is_not_hidden():
+    """A path that doubles back on itself must keep the turning point (segment distance)."""
+    p = np.array([[0, 0], [10, 0], [5, 0]], float)
+    assert list(thin(p, 0.02)) == [0, 1, 2]
+
+
+@pytest.mark.parametrize(
+    "offset,scale,eps", [(1e7, 1.0, 0.02), (0.0, 1e-6, 1e-8), (-1e7, 1e-3, 1e-5)]
+)
+def test_huge_and_tiny_coordinates(offset, scale, eps):
+    t = np.linspace(0, 3, 2000)
+    p = offset + scale * np.c_[1000 * t, 200 * np.sin(3 * t)]
+    kept = thin(p, eps)
+    assert 2 < len(kept) < len(p)
+    assert_thin_guarantee(p, kept, eps)
+
+
+def test_near_optimal_against_imai_iri():
+    """Dense noisy smooth curves: within 2 % of the optimum vertex count."""
+    rng = np.random.default_rng(7)
+    total_greedy = total_opt = 0
+    for _ in range(3):
+        n = 700
+        x = np.sort(rng.uniform(0, 100, n))
+        y = np.sin(x * rng.uniform(0.05, 0.3)) * rng.uniform(5, 30) + rng.normal(0, 0.003, n)
+        q = np.c_[x, y]
+        g = len(thin(q, 0.02))
+        o = imai_iri(q, 0.02)
+        assert g <= math.floor(1.02 * o) + 1, (g, o)
+        total_greedy += g
+        total_opt += o
+    assert total_greedy <= 1.02 * total_opt
+
+
+def test_speed_on_dense_curve():
+    """2e6 points/s on a densely sampled smooth curve (generous margin for a busy CI box)."""
+    t = np.linspace(0, 2 * np.pi, 200_000)
+    p = np.c_[400 * np.cos(t), 300 * np.sin(t)]
+    thin(p[:1000], 0.02)
+    t0 = time.perf_counter()
+    kept = thin(p, 0.02)
+    dt = time.perf_counter() - t0
+    assert len(kept) < 1000
+    assert len(p) / dt > 500_000, f"{len(p) / dt:.0f} points/s"
