@@ -101,11 +101,17 @@ def save(name: str, data: bytes, n_points: int | None = None) -> None:
 # --------------------------------------------------------------------------------------
 
 
+#: decimals written for coordinates: 0 = whole plotter units (CorelDRAW/AutoCAD style);
+#: the seal and the 1181-point curve use decimals (pstoedit/Inkscape style), so that a fit
+#: with the paper's e_per = 0.02 units is possible (rounding stays well below e_per).
+DECIMALS = 0
+
+
 def round_contour(pts: list[tuple[float, float]], close: bool = True) -> Contour:
-    """Round to integer plotter units, drop repeated points, close the contour."""
+    """Round to DECIMALS, drop repeated points, close the contour."""
     out: Contour = []
     for x, y in pts:
-        p = (int(round(x)), int(round(y)))
+        p = (round(x, DECIMALS), round(y, DECIMALS)) if DECIMALS else (int(round(x)), int(round(y)))
         if not out or out[-1] != p:
             out.append(p)
     if close and out and out[-1] != out[0]:
@@ -324,6 +330,15 @@ def make_text_outline() -> None:
 
 
 def make_seal() -> None:
+    global DECIMALS
+    DECIMALS = 2
+    try:
+        _make_seal()
+    finally:
+        DECIMALS = 0
+
+
+def _make_seal() -> None:
     cx, cy = 1000, 1000
     contours: list[Contour] = []
     # outer ring: two concentric circles -> the ring region has a hole (~1.2 unit chords)
@@ -491,7 +506,7 @@ def make_curve_1181() -> None:
         targets.sort()
         xs = np.interp(targets, s, F[:, 0])
         ys = np.interp(targets, s, F[:, 1])
-        pts = [(int(round(x)) + 1000, int(round(y)) + 1000) for x, y in zip(xs, ys, strict=True)]
+        pts = [(round(x + 1000, 3), round(y + 1000, 3)) for x, y in zip(xs, ys, strict=True)]
         if all(a != b for a, b in zip(pts, pts[1:] + pts[:1], strict=True)):
             break
     else:
