@@ -113,7 +113,7 @@ def cmd_process(a: argparse.Namespace) -> int:
     _print_json({
         "file": d.name,
         "output": a.output,
-        "magnification": job.field.magnification,
+        "magnification": job.field_map.magnification,
         "stats": job.stats,
         "warnings": [w.as_dict() for w in job.warnings],
     })

@@ -13,7 +13,8 @@ import math
 import os
 import tempfile
 from collections.abc import Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass
+from dataclasses import field as dc_field
 from typing import Any
 
 import numpy as np
@@ -61,24 +62,25 @@ class Stroke:
 class Job:
     source_name: str
     source_sha256: str
-    field: FieldMap
+    field_map: FieldMap
     params: dict[str, Any]
     laser: dict[str, float]
     strokes: tuple[Stroke, ...]
-    stats: dict[str, Any] = field(default_factory=dict)
+    stats: dict[str, Any] = dc_field(default_factory=dict)
     warnings: tuple[Warning, ...] = ()
 
     def to_json(self) -> dict[str, Any]:
         stats = dict(self.stats)
         stats["warnings"] = [w.as_dict() for w in self.warnings]
+        fm = self.field_map
         return {
             "format": FORMAT,
             "version": VERSION,
             "generator": GENERATOR,
             "source": {"name": self.source_name, "sha256": self.source_sha256},
-            "field": {"size_mm": self.field.field_size_mm, "bits": self.field.field_bits},
-            "magnification": self.field.magnification,
-            "offset_bits": [float(self.field.offset_bits[0]), float(self.field.offset_bits[1])],
+            "field": {"size_mm": fm.field_size_mm, "bits": fm.field_bits},
+            "magnification": fm.magnification,
+            "offset_bits": [float(fm.offset_bits[0]), float(fm.offset_bits[1])],
             "params": _jsonable(self.params),
             "laser": dict(self.laser),
             "strokes": [s.to_json() for s in self.strokes],

@@ -125,7 +125,9 @@ class Params:
             if self.max_step_bits < self.min_step_bits:
                 raise ParamError("max_step_bits must be >= min_step_bits")
         if not isinstance(self.field_bits, int) or not 2 <= self.field_bits <= 1 << 24:
-            raise ParamError(f"field_bits must be an integer in 2..16777216, got {self.field_bits!r}")
+            raise ParamError(
+                f"field_bits must be an integer in 2..16777216, got {self.field_bits!r}"
+            )
         if not math.isfinite(self.hatch_angle_deg):
             raise ParamError("hatch_angle_deg must be finite")
         if not isinstance(self.hatch_passes, int) or not 1 <= self.hatch_passes <= 16:

@@ -1,0 +1,32 @@
+"""Small shared helpers for tests (no fixtures with side effects)."""
+
+from __future__ import annotations
+
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+SAMPLES = ROOT / "resources" / "samples"
+
+
+def run_cli(*args: str, timeout: float = 120) -> subprocess.CompletedProcess[str]:
+    """Run ``galvo-core`` in a subprocess, as a user would."""
+    env = dict(os.environ)
+    return subprocess.run(
+        [sys.executable, "-m", "galvo_core.cli", *args],
+        capture_output=True, text=True, timeout=timeout, cwd=ROOT, env=env,
+    )
+
+
+def circle_plt(r: float = 400.0, n: int = 720, *, decimals: int = 3, cx: float = 1000.0,
+               cy: float = 1000.0) -> bytes:
+    """A closed circle written as a dense PD run, like a CAD export."""
+    import numpy as np
+
+    t = np.linspace(0, 2 * np.pi, n, endpoint=False)
+    pts = [(round(cx + r * np.cos(a), decimals), round(cy + r * np.sin(a), decimals)) for a in t]
+    pts.append(pts[0])
+    body = ",".join(f"{x},{y}" for x, y in pts[1:])
+    return f"IN;SP1;PU{pts[0][0]},{pts[0][1]};PD{body};PU;SP0;".encode()
