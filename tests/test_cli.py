@@ -92,7 +92,7 @@ def test_process_writes_a_job_per_spec(tmp_path):
     segs = stroke["segments"]
     assert any(s["type"] == "cubic" for s in segs)
     # continuous segments, marks in their direction starting at the first segment's start
-    for a, b in zip(segs, segs[1:]):
+    for a, b in zip(segs, segs[1:], strict=False):
         assert a["points"][-1] == b["points"][0]
     x0, y0 = segs[0]["points"][0]
     ox, oy = doc["offset_bits"]

@@ -9,7 +9,8 @@ import galvo_core
 names = ['galvo_core'] + [m.name for m in pkgutil.walk_packages(galvo_core.__path__, 'galvo_core.')]
 for n in names:
     importlib.import_module(n)
-bad = sorted(m for m in sys.modules if m.split('.')[0] in ('PySide6', 'PyQt5', 'PyQt6', 'PySide2', 'pyqtgraph', 'shiboken6'))
+QT = ('PySide6', 'PyQt5', 'PyQt6', 'PySide2', 'pyqtgraph', 'shiboken6')
+bad = sorted(m for m in sys.modules if m.split('.')[0] in QT)
 print(len(names), 'modules')
 assert not bad, bad
 """
