@@ -1,0 +1,112 @@
+"""The staged pipeline: caching by the fields each stage reads, parameters, field mapping."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from _util import circle_plt
+
+from galvo_core.drawing import Drawing, Path
+from galvo_core.errors import ParamError
+from galvo_core.field import FIT_MARGIN_BITS, make_field
+from galvo_core.hpgl import read_bytes
+from galvo_core.params import LaserParams, Params
+from galvo_core.pipeline import Cancelled, Pipeline
+
+
+@pytest.fixture(scope="module")
+def circle() -> Drawing:
+    return read_bytes(circle_plt(), "circle.plt")
+
+
+def test_moving_e_per_refits_but_moving_magnification_only_resamples(circle):
+    pipe = Pipeline()
+    p = Params(magnification=20.0)
+    pipe.run(circle, p)
+    assert pipe.last_info.stages_run == ("fit", "sample")
+    pipe.run(circle, p.replace(magnification=30.0))
+    assert pipe.last_info.stages_run == ("sample",)
+    pipe.run(circle, p.replace(chord_tol_bits=3.0))
+    assert pipe.last_info.stages_run == ("sample",)
+    pipe.run(circle, p.replace(e_per=0.1))
+    assert pipe.last_info.stages_run == ("fit", "sample")
+    pipe.run(circle, p)  # back to the first settings: both cached
+    assert pipe.last_info.stages_run == ()
+
+
+def test_cached_results_equal_fresh_ones(circle):
+    a = Pipeline()
+    a.run(circle, Params(magnification=20.0, e_per=0.1))
+    ja = a.run(circle, Params(magnification=36.0, e_per=0.1))
+    jb = Pipeline().run(circle, Params(magnification=36.0, e_per=0.1))
+    assert [s.marks.tolist() for s in ja.strokes] == [s.marks.tolist() for s in jb.strokes]
+    assert ja.stats == jb.stats
+
+
+def test_more_magnification_more_marks_and_looser_tolerance_fewer(circle):
+    pipe = Pipeline()
+    n = [pipe.run(circle, Params(magnification=m)).stats["mark_points"] for m in (10, 20, 40)]
+    assert n[0] < n[1] < n[2]
+    t = [pipe.run(circle, Params(magnification=40, chord_tol_bits=c)).stats["mark_points"]
+         for c in (0.5, 2, 8)]
+    assert t[0] > t[1] > t[2]
+
+
+def test_cancel_stops_a_run(circle):
+    with pytest.raises(Cancelled):
+        Pipeline().run(circle, Params(magnification=20.0), cancel=lambda: True)
+
+
+@pytest.mark.parametrize(
+    "kw",
+    [dict(e_per=0), dict(e_per=-0.1), dict(eps_line=math.nan), dict(eps_sum=math.inf),
+     dict(magnification=0), dict(chord_tol_bits=-1), dict(min_step_bits=-1),
+     dict(interpolation="spline"), dict(kerf_side="left"), dict(fill="dots"),
+     dict(scan_order="random"), dict(field_bits=1), dict(max_step_bits=1, min_step_bits=2),
+     dict(e_per="0.1")],
+)
+def test_bad_parameters_are_refused_with_their_name(kw):
+    with pytest.raises(ParamError) as ei:
+        Params(**kw)
+    assert next(iter(kw)) in str(ei.value)
+
+
+def test_laser_parameters_validated():
+    with pytest.raises(ParamError, match="mark_speed_mm_s"):
+        LaserParams(mark_speed_mm_s=0)
+    with pytest.raises(ParamError, match="power_percent"):
+        LaserParams(power_percent=120)
+
+
+def test_fit_field_uses_the_whole_field_and_centres():
+    fm = make_field((100.0, 200.0, 1100.0, 700.0), magnification=None, fit_field=True)
+    lo = fm.to_bits_float(np.array([[100.0, 200.0]]))[0]
+    hi = fm.to_bits_float(np.array([[1100.0, 700.0]]))[0]
+    assert lo[0] == pytest.approx(FIT_MARGIN_BITS) and hi[0] == pytest.approx(65535 - 16)
+    assert (lo[1] + hi[1]) / 2 == pytest.approx(65535 / 2)
+
+
+def test_out_of_field_refused_unless_clamped():
+    d = Drawing((Path.from_points([(0, 0), (100000, 0)]),), name="wide.plt")
+    with pytest.raises(ParamError, match="field"):
+        Pipeline().run(d, Params(magnification=1.0))
+    job = Pipeline().run(d, Params(magnification=1.0, clamp=True))
+    marks = np.concatenate([s.marks for s in job.strokes])
+    assert marks.min() >= 0 and marks.max() <= 65535
+    assert any("clamped" in w.message for w in job.warnings)
+
+
+def test_integer_coordinates_warn_that_e_per_is_below_their_rounding():
+    d = read_bytes(b"IN;SP1;PU0,0;PD100,3,200,10,300,24,400,41,500,65;PU;", "int.plt")
+    job = Pipeline().run(d, Params())
+    assert any("rounded" in w.message and "e_per" in w.message for w in job.warnings)
+    job = Pipeline().run(d, Params(e_per=0.75))
+    assert not any("rounded" in w.message for w in job.warnings)
+
+
+def test_empty_drawing_gives_an_empty_job():
+    d = read_bytes(b"IN;SP1;LBHELLO\x03;", "label.plt")
+    job = Pipeline().run(d, Params())
+    assert job.strokes == () and job.stats["mark_points"] == 0
