@@ -20,7 +20,15 @@ from galvo_core.errors import GalvoError, ParamError
 from galvo_core.fit import fit_report
 from galvo_core.hpgl import read_file
 from galvo_core.job import write_job
-from galvo_core.params import INTERPOLATIONS, LaserParams, Params
+from galvo_core.params import (
+    FILLS,
+    INTERPOLATIONS,
+    KERF_METHODS,
+    KERF_SIDES,
+    SCAN_ORDERS,
+    LaserParams,
+    Params,
+)
 from galvo_core.pipeline import Pipeline
 
 
@@ -72,6 +80,23 @@ def _add_processing_args(p: argparse.ArgumentParser, *, report: bool = False) ->
     s.add_argument("--chord-tol-bits", type=_finite, default=d.chord_tol_bits)
     s.add_argument("--min-step-bits", type=_finite, default=d.min_step_bits)
     s.add_argument("--max-step-bits", type=_finite, default=None)
+    k = p.add_argument_group("kerf compensation (paper 003)")
+    k.add_argument("--kerf-mm", type=_finite, default=d.kerf_mm,
+                   help="width of the laser trough on the workpiece; 0 = none (default)")
+    k.add_argument("--kerf-side", choices=KERF_SIDES, default=d.kerf_side,
+                   help="outside grows the design's regions, inside shrinks them")
+    k.add_argument("--kerf-method", choices=KERF_METHODS, default=d.kerf_method)
+    k.add_argument("--arc-tol-bits", type=_finite, default=d.arc_tol_bits,
+                   help="largest deviation of the round corners' arcs (galvo bits)")
+    h = p.add_argument_group("fill and order (paper 002)")
+    h.add_argument("--fill", choices=FILLS, default=d.fill)
+    h.add_argument("--hatch-spacing-mm", type=_finite, default=d.hatch_spacing_mm)
+    h.add_argument("--hatch-angle-deg", type=_finite, default=d.hatch_angle_deg)
+    h.add_argument("--hatch-passes", type=int, default=d.hatch_passes)
+    h.add_argument("--hatch-angle-step-deg", type=_finite, default=d.hatch_angle_step_deg)
+    h.add_argument("--hatch-inset-mm", type=_finite, default=d.hatch_inset_mm)
+    h.add_argument("--scan-order", choices=SCAN_ORDERS, default=d.scan_order)
+    h.add_argument("--order-time-budget-s", type=_finite, default=d.order_time_budget_s)
     las = p.add_argument_group("laser")
     for fld in fields(LaserParams):
         las.add_argument("--" + fld.name.replace("_", "-"), type=_finite, default=None,
@@ -91,6 +116,11 @@ def _params_from_args(a: argparse.Namespace) -> Params:
         offset_bits=tuple(a.offset_bits) if a.offset_bits else None, clamp=a.clamp,
         interpolation=a.interpolation, chord_tol_bits=a.chord_tol_bits,
         min_step_bits=a.min_step_bits, max_step_bits=a.max_step_bits,
+        kerf_mm=a.kerf_mm, kerf_side=a.kerf_side, kerf_method=a.kerf_method,
+        arc_tol_bits=a.arc_tol_bits, fill=a.fill, hatch_spacing_mm=a.hatch_spacing_mm,
+        hatch_angle_deg=a.hatch_angle_deg, hatch_passes=a.hatch_passes,
+        hatch_angle_step_deg=a.hatch_angle_step_deg, hatch_inset_mm=a.hatch_inset_mm,
+        scan_order=a.scan_order, order_time_budget_s=a.order_time_budget_s,
         laser=LaserParams(**laser_kw),
     )
 

@@ -80,18 +80,20 @@ def make_field(
     field_bits: int = 65536,
     field_size_mm: float = 110.0,
     offset_bits: tuple[float, float] | None = None,
+    margin_bits: float = 0.0,
 ) -> FieldMap:
     """Choose the mapping for a drawing with bounding box ``bbox`` (input units).
 
     ``fit_field`` picks the largest magnification that fits the drawing in the field with
-    :data:`FIT_MARGIN_BITS` to spare on each side (a given ``magnification`` is ignored then).
+    :data:`FIT_MARGIN_BITS` plus ``margin_bits`` to spare on each side (``margin_bits``: room
+    for what later stages add, e.g. an outward kerf; a given ``magnification`` is ignored).
     Without an offset the drawing's bounding box is centred in the field.
     """
     if bbox is None:
         bbox = (0.0, 0.0, 0.0, 0.0)
     xmin, ymin, xmax, ymax = bbox
     w, h = xmax - xmin, ymax - ymin
-    usable = field_bits - 1 - 2 * FIT_MARGIN_BITS
+    usable = field_bits - 1 - 2 * (FIT_MARGIN_BITS + max(0.0, margin_bits))
     if fit_field or magnification is None:
         if not fit_field:
             raise ParamError("give a magnification (bits per input unit) or ask for fit-field")

@@ -51,13 +51,15 @@ import numpy as np
 from galvo_core.drawing import Drawing
 from galvo_core.errors import ParamError
 from galvo_core.geometry import (
-    cubic_derivative,
     cubic_eval,
     cubic_length,
+    gather_coeffs,
     nearest_on_cubic,
-    nearest_on_cubic_warm,
+    nearest_on_cubics,
+    newton_nearest_many,
     point_polyline_distance,
     point_segment_distance,
+    power_coeffs_many,
 )
 from galvo_core.runs import split_pieces
 from galvo_core.thin import check_positive, thin
@@ -161,61 +163,71 @@ def _seg(kind: str, pts: np.ndarray, first: int, last: int) -> Segment:
     return Segment(kind, arr, int(first), int(last))
 
 
-def _curve_to_polyline_bound(c: np.ndarray, poly: np.ndarray, u: np.ndarray) -> float:
-    """Upper bound of the distance from the curve to ``poly`` (see module doc).
+def _curve_to_polyline_bound_many(
+    cf: tuple[np.ndarray, ...], a: np.ndarray, b: np.ndarray, u0: np.ndarray, u1: np.ndarray
+) -> np.ndarray:
+    """Per pair k: an upper bound of the distance from the curve stretch u0[k]..u1[k] of
+    cubic ``cf`` (per-pair power coefficients) to the segment [a[k], b[k]] (see module doc).
 
-    ``poly`` (n, 2) the input points the cubic replaces, in order; ``u`` (n,) their nearest
-    parameters. For each consecutive pair, the curve over [u_i, u_(i+1)] is compared with
-    segment i: |perpendicular| and overshoot beyond the segment's ends are maximised exactly
-    (end values and roots of their derivatives, quadratics in u).
+    |perpendicular| and overshoot beyond the segment's ends are maximised exactly over the
+    stretch (end values and roots of their derivatives, quadratics in u).
     """
-    if len(poly) < 2:
-        return 0.0
-    lo = np.minimum(u[:-1], u[1:])
-    hi = np.maximum(u[:-1], u[1:])
-    a = poly[:-1]
-    ab = poly[1:] - a
-    ln = np.hypot(ab[:, 0], ab[:, 1])
+    ax, ay, bx, by, dx, dy, ex, ey = cf
+    lo = np.minimum(u0, u1)
+    hi = np.maximum(u0, u1)
+    abx = b[:, 0] - a[:, 0]
+    aby = b[:, 1] - a[:, 1]
+    ln = np.hypot(abx, aby)
     good = ln > 0.0
-    dirn = ab / np.where(good, ln, 1.0)[:, None]
-    nrm = np.stack([-dirn[:, 1], dirn[:, 0]], axis=1)
-    d = np.diff(c, axis=0)  # (3, 2): B'(u) = 3[(1-u)^2 d0 + 2(1-u)u d1 + u^2 d2]
-
-    def roots(v: np.ndarray) -> list[np.ndarray]:
-        g0, g1, g2 = v @ d[0], v @ d[1], v @ d[2]
-        qa = g0 - 2.0 * g1 + g2
-        qb = 2.0 * (g1 - g0)
-        qc = g0
-        out = []
-        disc = qb * qb - 4.0 * qa * qc
-        sq = np.sqrt(np.maximum(disc, 0.0))
-        lin = np.abs(qa) <= 1e-14 * (np.abs(qb) + np.abs(qc) + 1e-300)
-        with np.errstate(divide="ignore", invalid="ignore"):
-            r1 = np.where(lin, -qc / qb, (-qb + sq) / (2.0 * qa))
-            r2 = np.where(lin, -qc / qb, (-qb - sq) / (2.0 * qa))
-        for r in (r1, r2):
-            r = np.where(np.isfinite(r) & (disc >= 0.0) | lin, r, lo)
-            out.append(np.clip(np.nan_to_num(r, nan=0.0), lo, hi))
-        return out
-
-    cands = [lo, hi, 0.5 * (lo + hi), *roots(nrm), *roots(dirn)]
+    inv = 1.0 / np.where(good, ln, 1.0)
+    tx, ty = abx * inv, aby * inv  # direction
+    nx, ny = -ty, tx  # normal
+    # B'(u) = 3a u^2 + 2b u + d
+    cands = [lo, hi, 0.5 * (lo + hi)]
+    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
+        for vx, vy in ((nx, ny), (tx, ty)):
+            qa = 3.0 * (ax * vx + ay * vy)
+            qb = 2.0 * (bx * vx + by * vy)
+            qc = dx * vx + dy * vy
+            disc = qb * qb - 4.0 * qa * qc
+            sq = np.sqrt(np.maximum(disc, 0.0))
+            lin = np.abs(qa) <= 1e-14 * (np.abs(qb) + np.abs(qc) + 1e-300)
+            for sgn in (1.0, -1.0):
+                r = np.where(lin, -qc / qb, (-qb + sgn * sq) / (2.0 * qa))
+                r = np.where((np.isfinite(r) & (disc >= 0.0)) | lin, r, lo)
+                cands.append(np.clip(np.nan_to_num(r, nan=0.0), lo, hi))
     perp = np.zeros(len(a))
     over = np.zeros(len(a))
     for uu in cands:
-        pt = cubic_eval(c, uu) - a
-        s = (pt * dirn).sum(axis=1)
-        p = np.abs((pt * nrm).sum(axis=1))
+        px = ((ax * uu + bx) * uu + dx) * uu + ex - a[:, 0]
+        py = ((ay * uu + by) * uu + dy) * uu + ey - a[:, 1]
+        s = px * tx + py * ty
+        p = np.abs(px * nx + py * ny)
         o = np.maximum(np.maximum(-s, s - ln), 0.0)
         # a zero-length segment is its point
-        p = np.where(good, p, np.hypot(pt[:, 0], pt[:, 1]))
+        p = np.where(good, p, np.hypot(px, py))
         o = np.where(good, o, 0.0)
         np.maximum(perp, p, out=perp)
         np.maximum(over, o, out=over)
-    return float(np.sqrt(perp * perp + over * over).max())
+    return np.sqrt(perp * perp + over * over)
 
 
-class _PieceFitter:
-    """Fits the curve pieces of one path (shared state: points, thinned indices, tangents)."""
+def _ragged(starts: np.ndarray, counts: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(owner, offset) of the flattened ranges: item j of range r -> (r, j)."""
+    total = int(counts.sum())
+    owner = np.repeat(np.arange(len(counts)), counts)
+    off = np.arange(total) - np.repeat(np.cumsum(counts) - counts, counts)
+    return owner, off
+
+
+class _BatchFitter:
+    """Fits all curve pieces of one path together, round by round.
+
+    Each round takes every piece still to do, runs the dichotomy for all of them at once
+    (one set of array operations per step, whatever the number of pieces), tests them all
+    at once, keeps the cubics that pass and splits the others for the next round. The
+    work per round is linear in the points of the pieces still open.
+    """
 
     def __init__(
         self,
@@ -233,130 +245,207 @@ class _PieceFitter:
         self.t_out = t_out
         self.e_per = e_per
         self.eps_sum = eps_sum
-        self.max_err = 0.0  # largest input-point error of the accepted cubics
+        seg = np.hypot(*np.diff(work, axis=0).T)
+        self.arc = np.concatenate(([0.0], np.cumsum(seg)))
+        #: accepted cubics: (a, b, ctrl, bound of the max input error)
+        self.cubics: list[tuple[int, int, np.ndarray, float]] = []
+        self.lines: list[int] = []  # a of line pieces (a, a + 1)
 
-    def _triangle(self, a: int, b: int) -> tuple[np.ndarray, float] | None:
-        p0, p3 = self.q[a], self.q[b]
-        t0, t3 = self.t_out[a], self.t_in[b]
-        det = t0[0] * t3[1] - t0[1] * t3[0]
-        chord = p3 - p0
-        lc = math.hypot(*chord)
-        if lc == 0.0 or abs(det) < 1e-9:
-            return None
-        # p0 + al*t0 = p3 - be*t3  ->  al*t0 + be*t3 = chord
-        al = (chord[0] * t3[1] - chord[1] * t3[0]) / det
-        be = (t0[0] * chord[1] - t0[1] * chord[0]) / det
-        if not (al > 1e-9 * lc and be > 1e-9 * lc) or al > 1e3 * lc or be > 1e3 * lc:
-            return None
-        return p0 + al * t0, math.copysign(1.0, det)
+    # -- the one-parameter family ---------------------------------------------------------
+    def _triangle(self, A: np.ndarray, B: np.ndarray):
+        p0, p3 = self.q[A], self.q[B]
+        t0, t3 = self.t_out[A], self.t_in[B]
+        det = t0[:, 0] * t3[:, 1] - t0[:, 1] * t3[:, 0]
+        ch = p3 - p0
+        lc = np.hypot(ch[:, 0], ch[:, 1])
+        with np.errstate(divide="ignore", invalid="ignore"):
+            al = (ch[:, 0] * t3[:, 1] - ch[:, 1] * t3[:, 0]) / det
+            be = (t0[:, 0] * ch[:, 1] - t0[:, 1] * ch[:, 0]) / det
+        ok = (
+            (lc > 0.0)
+            & (np.abs(det) >= 1e-9)
+            & (al > 1e-9 * lc)
+            & (be > 1e-9 * lc)
+            & (al <= 1e3 * lc)
+            & (be <= 1e3 * lc)
+        )
+        qq = p0 + np.where(ok, al, 0.0)[:, None] * t0
+        return ok, p0, qq, p3, np.sign(det)
 
-    def _data(self, a: int, b: int) -> np.ndarray:
-        i0, i1 = int(self.kept[a]), int(self.kept[b])
-        inner = np.arange(i0 + 1, i1)
-        if len(inner) > _BISECT_SAMPLE:
-            inner = inner[:: math.ceil(len(inner) / _BISECT_SAMPLE)]
-        idx = np.union1d(inner, self.kept[a + 1 : b])
-        return self.work[idx]
+    @staticmethod
+    def _ctrl(p0, qq, p3, t):
+        t = t[:, None]
+        return np.stack([p0, p0 + t * (qq - p0), p3 + t * (qq - p3), p3], axis=1)
 
-    def _dichotomy(self, p0: np.ndarray, p3: np.ndarray, qq: np.ndarray, sig: float, data):
-        chord = p3 - p0
+    def _dichotomy(self, p0, qq, p3, sig, i0, i1) -> np.ndarray:
+        """t per piece: the signed error sum over a sample of each piece's input points
+        crosses zero (Illinois false position inside the bracket [0, 1])."""
+        m = len(p0)
+        L = i1 - i0 - 1
+        stride = np.maximum(1, -(-L // _BISECT_SAMPLE))
+        cnt = -(-L // stride)
+        pid, off = _ragged(np.zeros(m, dtype=np.intp), cnt)
+        idx = i0[pid] + 1 + stride[pid] * off
+        pts = self.work[idx]
+        px, py = pts[:, 0].copy(), pts[:, 1].copy()
+        span = self.arc[i1] - self.arc[i0]
+        u = (self.arc[idx] - self.arc[i0][pid]) / np.where(span > 0, span, 1.0)[pid]
+        chord = (p3 - p0)[pid]
+        chord2 = (chord * chord).sum(axis=1)
+        sg = sig[pid]
+        ustate = u.copy()
 
-        def ctrl(t: float) -> np.ndarray:
-            return np.array([p0, p0 + t * (qq - p0), p3 + t * (qq - p3), p3])
-
-        state: dict[str, np.ndarray] = {}
-
-        def ssum(t: float) -> float:
-            c = ctrl(t)
-            if "u" in state:
-                u, dist = nearest_on_cubic_warm(c, data, state["u"], iters=3)
+        def ssum(t: np.ndarray, pm: np.ndarray | None = None) -> np.ndarray:
+            """Signed error sums of all pieces at ``t`` (only pieces with points ``pm``
+            are evaluated, the others come back 0)."""
+            pp = pid if pm is None else pid[pm]
+            qx = px if pm is None else px[pm]
+            qy = py if pm is None else py[pm]
+            cf = gather_coeffs(power_coeffs_many(self._ctrl(p0, qq, p3, t)), pp)
+            u0 = ustate if pm is None else ustate[pm]
+            uu, d2 = newton_nearest_many(cf, qx, qy, u0, 3)
+            if pm is None:
+                ustate[:] = uu
             else:
-                u, dist = nearest_on_cubic(c, data, seeds=32)
-            state["u"] = u
-            tv = cubic_derivative(c, u)
-            bad = (tv * tv).sum(axis=1) <= 1e-18 * float(chord @ chord)
-            tv[bad] = chord
-            diff = data - cubic_eval(c, u)
-            side = np.sign(tv[:, 0] * diff[:, 1] - tv[:, 1] * diff[:, 0])
-            return float(-sig * (side * dist).sum())
+                ustate[pm] = uu
+            ch = chord if pm is None else chord[pm]
+            ax, ay, bx, by, dx, dy, ex, ey = cf
+            tx = (3.0 * ax * uu + 2.0 * bx) * uu + dx
+            ty = (3.0 * ay * uu + 2.0 * by) * uu + dy
+            bad = tx * tx + ty * ty <= 1e-18 * (chord2 if pm is None else chord2[pm])
+            tx = np.where(bad, ch[:, 0], tx)
+            ty = np.where(bad, ch[:, 1], ty)
+            rx = qx - (((ax * uu + bx) * uu + dx) * uu + ex)
+            ry = qy - (((ay * uu + by) * uu + dy) * uu + ey)
+            side = np.sign(tx * ry - ty * rx)
+            w = (sg if pm is None else sg[pm]) * side * np.sqrt(d2)
+            return -np.bincount(pp, weights=w, minlength=m)
 
-        if len(data) == 0:
-            return ctrl(0.5)
-        tl, th = 0.0, 1.0
-        sl, sh = ssum(tl), ssum(th)
-        if sl <= 0.0:
-            return ctrl(tl)
-        if sh >= 0.0:
-            return ctrl(th)
-        t = 0.5
-        side = 0
+        tl = np.zeros(m)
+        th = np.ones(m)
+        sl = ssum(tl)
+        sh = ssum(th)
+        t = np.full(m, 0.5)
+        done = np.zeros(m, dtype=bool)
+        t[sl <= 0.0] = 0.0
+        done |= sl <= 0.0
+        hi_case = ~done & (sh >= 0.0)
+        t[hi_case] = 1.0
+        done |= hi_case
+        ustate[:] = u
+        side = np.zeros(m)
         for _ in range(_MAX_BISECT):
-            # false position, Illinois-weighted, kept inside the bracket
-            t = (tl * sh - th * sl) / (sh - sl)
-            if not (tl < t < th):
-                t = 0.5 * (tl + th)
-            s = ssum(t)
-            if abs(s) < self.eps_sum or th - tl < 1e-9:
+            if done.all():
                 break
-            if s > 0.0:
-                tl, sl = t, s
-                if side == 1:
-                    sh *= 0.5
-                side = 1
-            else:
-                th, sh = t, s
-                if side == -1:
-                    sl *= 0.5
-                side = -1
-        return ctrl(t)
+            with np.errstate(divide="ignore", invalid="ignore"):
+                tn = (tl * sh - th * sl) / (sh - sl)
+            bad = ~((tl < tn) & (tn < th))
+            tn = np.where(bad, 0.5 * (tl + th), tn)
+            tn = np.where(done, t, tn)
+            s = ssum(tn, np.flatnonzero(~done[pid]))
+            t = tn
+            stop = ~done & ((np.abs(s) < self.eps_sum) | (th - tl < 1e-9))
+            upd = ~done & ~stop
+            pos = upd & (s > 0.0)
+            neg = upd & ~(s > 0.0)
+            sh = np.where(pos & (side == 1), 0.5 * sh, sh)
+            tl = np.where(pos, t, tl)
+            sl = np.where(pos, s, sl)
+            sl = np.where(neg & (side == -1), 0.5 * sl, sl)
+            th = np.where(neg, t, th)
+            sh = np.where(neg, s, sh)
+            side = np.where(pos, 1.0, np.where(neg, -1.0, side))
+            done |= stop
+        return self._ctrl(p0, qq, p3, t)
 
-    def _try(self, a: int, b: int) -> tuple[np.ndarray | None, np.ndarray | None]:
-        """A cubic for piece a..b that meets the guarantee, or (None, errors at thinned
-        interior points) to choose a split."""
-        tri = self._triangle(a, b)
-        if tri is None:
-            return None, None
-        qq, sig = tri
-        p0, p3 = self.q[a], self.q[b]
-        c = self._dichotomy(p0, p3, qq, sig, self._data(a, b))
-        i0, i1 = int(self.kept[a]), int(self.kept[b])
-        pts = self.work[i0 : i1 + 1]
-        u, dist = nearest_on_cubic(c, pts)
-        e_in = float(dist.max())
-        if e_in <= self.e_per and _curve_to_polyline_bound(c, pts, u) <= self.e_per:
-            self.max_err = max(self.max_err, e_in)
-            return c, None
-        return None, dist[self.kept[a + 1 : b] - i0]
+    def _accept(self, ctrl: np.ndarray, i0: np.ndarray, i1: np.ndarray):
+        """Per piece: bound of the max input-point error, pass/fail of both sides of the
+        guarantee, and the flat per-point errors (with the offsets of each piece)."""
+        m = len(ctrl)
+        cnt = i1 - i0 + 1
+        pid, off = _ragged(np.zeros(m, dtype=np.intp), cnt)
+        starts = np.cumsum(cnt) - cnt
+        idx = i0[pid] + off
+        pts = self.work[idx]
+        px, py = pts[:, 0].copy(), pts[:, 1].copy()
+        span = self.arc[i1] - self.arc[i0]
+        u = (self.arc[idx] - self.arc[i0][pid]) / np.where(span > 0, span, 1.0)[pid]
+        cf = gather_coeffs(power_coeffs_many(ctrl), pid)
+        u, d2 = newton_nearest_many(cf, px, py, u, 6)
+        # ends of each piece are the curve's ends
+        ends = np.concatenate([starts, starts + cnt - 1])
+        u[starts] = 0.0
+        u[starts + cnt - 1] = 1.0
+        d2[ends] = 0.0
+        dist = np.sqrt(d2)
+        e2 = self.e_per
+        # Newton may have stopped in a local minimum: seeded search for the points over the
+        # bound, in pieces that miss it by little (a piece far off is a bad fit anyway; the
+        # check only decides between keeping and splitting, never weakens the guarantee)
+        emax0 = np.maximum.reduceat(dist, starts)
+        far = np.flatnonzero((dist > e2) & (emax0[pid] <= 4.0 * e2))
+        if len(far):
+            tu, td = nearest_on_cubics(ctrl, pid[far], pts[far])
+            better = td < dist[far]
+            u[far[better]] = tu[better]
+            dist[far[better]] = td[better]
+        emax = np.maximum.reduceat(dist, starts)
+        ok = emax <= e2
+        # curve-to-polyline side, for the pieces that passed so far
+        pair = np.ones(len(idx), dtype=bool)
+        pair[starts + cnt - 1] = False
+        pair &= ok[pid]
+        j = np.flatnonzero(pair)
+        if len(j):
+            pcf = tuple(c[j] for c in cf)
+            bnd = _curve_to_polyline_bound_many(pcf, pts[j], pts[j + 1], u[j], u[j + 1])
+            worst = np.zeros(m)
+            np.maximum.at(worst, pid[j], bnd)
+            ok &= worst <= e2
+        return ok, emax, dist, starts
 
-    def fit(self, a: int, b: int) -> list[Segment]:
-        out: list[Segment] = []
-        stack = [(a, b)]
-        while stack:
-            a, b = stack.pop()
-            if b - a == 1:
-                out.append(_seg("line", self.q[[a, b]], self.kept[a], self.kept[b]))
+    def fit(self, curve_pieces: list[tuple[int, int]]) -> None:
+        todo = [(a, b) for a, b in curve_pieces]
+        while todo:
+            ab = np.asarray(todo, dtype=np.intp).reshape(-1, 2)
+            todo = []
+            line = ab[:, 1] - ab[:, 0] == 1
+            self.lines.extend(int(a) for a in ab[line, 0])
+            ab = ab[~line]
+            if len(ab) == 0:
+                break
+            A, B = ab[:, 0], ab[:, 1]
+            ok, p0, qq, p3, sig = self._triangle(A, B)
+            for a, b in ab[~ok]:
+                k = (int(a) + int(b)) // 2
+                todo += [(int(a), k), (k, int(b))]
+            A, B = A[ok], B[ok]
+            if len(A) == 0:
                 continue
-            c, err = self._try(a, b)
-            if c is not None:
-                out.append(_seg("cubic", c, self.kept[a], self.kept[b]))
-                continue
-            k = self._split_point(a, b, err)
-            stack.append((k, b))
-            stack.append((a, k))
-        return out
+            i0, i1 = self.kept[A], self.kept[B]
+            ctrl = self._dichotomy(p0[ok], qq[ok], p3[ok], sig[ok], i0, i1)
+            good, emax, dist, starts = self._accept(ctrl, i0, i1)
+            for r in range(len(A)):
+                a, b = int(A[r]), int(B[r])
+                if good[r]:
+                    self.cubics.append((a, b, ctrl[r], float(emax[r])))
+                    continue
+                k = self._split_point(a, b, dist, int(starts[r]))
+                todo += [(a, k), (k, b)]
 
-    def _split_point(self, a: int, b: int, err: np.ndarray | None) -> int:
-        ks = np.arange(a + 1, b)
-        if err is None or len(ks) <= 2:
+    def _split_point(self, a: int, b: int, dist: np.ndarray, start: int) -> int:
+        if b - a <= 3:
             return (a + b) // 2
-        # away from the ends: the middle 60 % of the piece by input index, else the middle
-        i0, i1 = self.kept[a], self.kept[b]
-        frac = (self.kept[ks] - i0) / max(1, i1 - i0)
+        # the interior thinned point with the smallest error, in the middle 60 % of the
+        # piece by input index (the crossing of data and curve), else the middle
+        i0, i1 = int(self.kept[a]), int(self.kept[b])
+        kk = self.kept[a + 1 : b]
+        frac = (kk - i0) / max(1, i1 - i0)
         mid = (frac >= 0.2) & (frac <= 0.8)
         if not mid.any():
             return (a + b) // 2
-        cand = ks[mid]
-        return int(cand[np.argmin(err[mid])])
+        err = dist[start + kk[mid] - i0]
+        return int(a + 1 + np.flatnonzero(mid)[int(np.argmin(err))])
 
 
 def fit_path(
@@ -392,18 +481,44 @@ def fit_path(
         return FittedPath(source_index, pen, bool(closed), (seg,), 0.0, n, 1)
     q = work[kept]
     pieces, t_in, t_out = split_pieces(q, closed=closed)
-    fitter = _PieceFitter(work, kept, t_in, t_out, e_per, eps_sum)
-    segs: list[Segment] = []
+    fitter = _BatchFitter(work, kept, t_in, t_out, e_per, eps_sum)
+    fitter.fit([(pc.a, pc.b) for pc in pieces if pc.kind == "curve"])
+    by_start: dict[int, Segment] = {}
+    for a in fitter.lines:
+        by_start[a] = _seg("line", q[[a, a + 1]], kept[a], kept[a + 1])
     for pc in pieces:
         if pc.kind == "line":
-            segs.append(_seg("line", q[[pc.a, pc.b]], kept[pc.a], kept[pc.b]))
-        else:
-            segs.extend(fitter.fit(pc.a, pc.b))
+            by_start[pc.a] = _seg("line", q[[pc.a, pc.b]], kept[pc.a], kept[pc.b])
+    bounds: dict[int, float] = {}
+    for a, b, c, e in fitter.cubics:
+        by_start[a] = _seg("cubic", c, kept[a], kept[b])
+        bounds[by_start[a].first] = e
+    segs = [by_start[a] for a in sorted(by_start)]
     last = segs[-1]
     if last.last != len(work) - 1:  # trailing repeats of the end point
         segs[-1] = Segment(last.kind, last.points, last.first, len(work) - 1)
-    max_err = max(_max_error(work, segs, cubics=False), fitter.max_err)
+    max_err = max(_max_error(work, segs, cubics=False), _cubic_max_error(work, segs, bounds))
     return FittedPath(source_index, pen, bool(closed), tuple(segs), max_err, n, len(kept))
+
+
+def _cubic_max_error(work: np.ndarray, segs: list[Segment], bound: dict[int, float]) -> float:
+    """Largest true input-point error over the cubics. The fitter's per-cubic values
+    (``bound``, by first index) are upper bounds (distances to some curve point); the cubics
+    are measured exactly (seeded nearest point) in decreasing order of their bound until no
+    bound left can beat the largest exact value."""
+    cubics = [s for s in segs if s.kind == "cubic"]
+    if not cubics:
+        return 0.0
+    bounds = np.array([bound[s.first] for s in cubics])
+    order = np.argsort(-bounds)
+    worst = 0.0
+    for i in order:
+        if bounds[i] <= worst:
+            break
+        s = cubics[int(i)]
+        _, d = nearest_on_cubic(s.points, work[s.first : s.last + 1])
+        worst = max(worst, float(min(d.max(), bounds[i])))
+    return worst
 
 
 def _max_error(work: np.ndarray, segs: list[Segment], *, cubics: bool = True) -> float:

@@ -273,3 +273,94 @@ def _polyline_distance_rtree(p: np.ndarray, q: np.ndarray) -> np.ndarray:
     out = np.full(len(p), np.inf)
     np.minimum.at(out, ip, dist)
     return out
+
+
+# --- many cubics at once --------------------------------------------------------------
+#
+# The fitter works on many pieces at a time: every point k belongs to a cubic ``pid[k]``.
+# A cubic is held in power form per point, eight flat arrays (ax, ay, bx, by, dx, dy, ex,
+# ey) with B(u) = ((a·u + b)·u + d)·u + e, so that each Newton step is a handful of
+# element-wise operations over all points of all pieces together.
+
+
+def power_coeffs_many(ctrl: np.ndarray) -> np.ndarray:
+    """Power-basis coefficients of M cubics: ``ctrl`` (M, 4, 2) -> (M, 4, 2) = [a, b, d, e]."""
+    c = np.asarray(ctrl, dtype=np.float64)
+    p0, p1, p2, p3 = c[:, 0], c[:, 1], c[:, 2], c[:, 3]
+    return np.stack(
+        [-p0 + 3.0 * (p1 - p2) + p3, 3.0 * (p0 + p2) - 6.0 * p1, 3.0 * (p1 - p0), p0], axis=1
+    )
+
+
+def gather_coeffs(coef: np.ndarray, pid: np.ndarray) -> tuple[np.ndarray, ...]:
+    """The eight flat per-point coefficient arrays of cubic ``pid[k]`` (see above)."""
+    g = coef[pid]
+    return tuple(np.ascontiguousarray(g[:, i, j]) for i in range(4) for j in range(2))
+
+
+def newton_nearest_many(
+    cf: tuple[np.ndarray, ...], px: np.ndarray, py: np.ndarray, u: np.ndarray, iters: int
+) -> tuple[np.ndarray, np.ndarray]:
+    """Newton on f(u) = B'(u)·(B(u) − p) for every point with its own cubic, u kept in
+    [0, 1]; a step where f' <= 0 is not taken. Returns ``(u, squared distance)``.
+
+    Any returned u gives an upper bound of the true distance (it is the distance to a point
+    of the curve), so a test ``dist <= tol`` made with it is never too lenient.
+    """
+    ax, ay, bx, by, dx, dy, ex, ey = cf
+    qx = px - ex
+    qy = py - ey
+    a3x, a3y, b2x, b2y = 3.0 * ax, 3.0 * ay, 2.0 * bx, 2.0 * by
+    a6x, a6y = 6.0 * ax, 6.0 * ay
+    u = u.copy()
+    for _ in range(iters):
+        rx = ((ax * u + bx) * u + dx) * u - qx
+        ry = ((ay * u + by) * u + dy) * u - qy
+        d1x = (a3x * u + b2x) * u + dx
+        d1y = (a3y * u + b2y) * u + dy
+        f = d1x * rx + d1y * ry
+        fp = (a6x * u + b2x) * rx + (a6y * u + b2y) * ry + d1x * d1x + d1y * d1y
+        fp[fp <= 0.0] = np.inf
+        u -= f / fp
+        np.clip(u, 0.0, 1.0, out=u)
+    rx = ((ax * u + bx) * u + dx) * u - qx
+    ry = ((ay * u + by) * u + dy) * u - qy
+    return u, rx * rx + ry * ry
+
+
+def nearest_on_cubics(
+    ctrl: np.ndarray, pid: np.ndarray, pts: np.ndarray, *, seeds: int = 48, iters: int = 6
+) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`nearest_on_cubic` for many points, each against its own cubic ``ctrl[pid[k]]``.
+
+    ``ctrl`` (M, 4, 2), ``pid`` (K,) ints, ``pts`` (K, 2) -> ``(t, dist)`` (K,) each. Seeded
+    like :func:`nearest_on_cubic` (``seeds + 1`` samples per cubic, best sample kept when
+    Newton does worse), so it is robust against local minima.
+    """
+    c = np.asarray(ctrl, dtype=np.float64).reshape(-1, 4, 2)
+    p = np.asarray(pts, dtype=np.float64).reshape(-1, 2)
+    k = len(p)
+    if k == 0:
+        return np.zeros(0), np.zeros(0)
+    su = np.linspace(0.0, 1.0, seeds + 1)
+    s = 1.0 - su
+    basis = np.stack([s**3, 3.0 * s * s * su, 3.0 * s * su * su, su**3], axis=1)  # (S, 4)
+    samp = np.einsum("sk,mkd->msd", basis, c)  # (M, S, 2)
+    cf = gather_coeffs(power_coeffs_many(c), pid)
+    t_out = np.empty(k)
+    d_out = np.empty(k)
+    rows = max(1, _CHUNK_CELLS // (seeds + 1))
+    for s0 in range(0, k, rows):
+        sl = slice(s0, s0 + rows)
+        q = p[sl]
+        sp = samp[pid[sl]]
+        d2 = (q[:, 0:1] - sp[:, :, 0]) ** 2 + (q[:, 1:2] - sp[:, :, 1]) ** 2
+        j = np.argmin(d2, axis=1)
+        best = d2[np.arange(len(q)), j]
+        u0 = su[j]
+        ccf = tuple(a[sl] for a in cf)
+        u, dn = newton_nearest_many(ccf, q[:, 0], q[:, 1], u0, iters)
+        better = dn < best
+        t_out[sl] = np.where(better, u, u0)
+        d_out[sl] = np.sqrt(np.where(better, dn, best))
+    return t_out, d_out

@@ -1,29 +1,939 @@
-"""Marking points: from fitted lines and cubics to integer galvo bits (paper 000 §4).
+"""Marking points: from fitted lines and cubics to integer galvo bits (paper 000 §4, 004, 001).
 
-:func:`sample_path` turns one :class:`~galvo_core.fit.FittedPath` into the marks of one
-stroke. ``adaptive`` cuts each cubic into chords whose chord height stays within
-``chord_tol_bits`` (measured on the unrounded marks; rounding to integers adds at most
-√2/2 bit); lines are sent as their end points (split at ``max_step_bits`` when given).
-``raw`` sends the original input points. Consecutive marks closer than ``min_step_bits`` are
-merged, except the last mark of a stroke and marks at corners (segment joints).
+Three methods (``Params.interpolation``):
+
+``adaptive`` (default)
+    Every cubic is cut into chords whose *chord height* — the largest distance between the
+    chord and the curve stretch it replaces — stays within ``chord_tol_bits``, each chord as
+    long as the bound allows (paper 004's step search, see :func:`sample_curve`). Lines are
+    sent as their end points. The chord height is measured for real, not at the parameter
+    midpoint as paper 000 eq. (5) does: for a 2-D cubic the distance of the curve to the
+    chord's line is a cubic polynomial of the parameter, so its extremes come in closed form
+    (:func:`chord_heights`).
+``fixed``
+    Paper 001's legacy method, kept to show the improvement: walk the curve in fixed steps
+    of ``fixed_step_bits`` and end a chord when the slope of A→P_i differs from that of the
+    first chord A→P_1 by more than ``fixed_slope_tol`` (k0). Adapted so that it works where
+    the curve goes vertical (the paper steps in x and compares dy/dx, which breaks there):
+    the step is taken along the axis the curve currently advances on most (the Chebyshev
+    arc length max(|dx|, |dy|) grows by the step — exactly the paper's x step wherever
+    |dy/dx| <= 1), and the slope difference is measured in the frame of the first chord,
+    tan(angle(A→P_i) − angle(A→P_1)), which equals the paper's k_i − k_1 for a horizontal
+    first chord and stays finite everywhere.
+``raw``
+    The original input points, mapped to bits (what a controller fed the PLT would mark).
+
+The step search (:func:`sample_curve`, shared by the 2-D path and by curves in 3-D)
+-----------------------------------------------------------------------------------------
+Paper 004: at the current point take the curvature k (r = 1/k), the target chord height
+H_p = (E_min + E_max)/2, the curvature-circle angle θ = 2·arccos((r − H_p)/r) and the first
+step R = 2r·sin(θ/2); measure the true chord height H of that step (dL/dt = 0, eq. 8) and
+accept it when E_min <= H <= E_max, else double or halve R. Two changes, same guarantee:
+
+* The step is searched in the curve parameter rather than in the sphere radius R: both are
+  monotone along a short arc, and the parameter needs no sphere-curve intersection solve.
+  The first trial is the paper's R turned into a parameter step (R / |P'|).
+* Doubling/halving can jump over the window (H grows like R², so doubling R multiplies H by
+  about 4, more than E_max/E_min): the search keeps a bracket (longest step known to hold,
+  shortest known to fail) and rescales with the measured growth law,
+  Δt ← Δt·(H_p/H)^(1/p), p = 2 at first and then the local exponent of the last two trials,
+  bisecting whenever that leaves the bracket. It needs about 1.5 measurements per mark.
+
+E_max = ``chord_tol_bits``; E_min = :data:`E_MIN_RATIO` · E_max (0.9), so every chord is
+within a few per cent of the longest allowed one (count within about 5 % of the fewest
+possible; see bench/RESULTS.md). A step that reaches the curve's end with H <= E_max ends it.
+
+Minimum and maximum step
+------------------------
+No chord is shorter than ``min_step_bits`` except the last one of a stroke and those ending
+at a corner (a segment joint whose direction turns by more than :data:`CORNER_DEG`): where
+the tolerance would want a shorter step (radius of curvature about a bit) the step is set to
+the minimum instead and counted as a *min-step override* (its chord height is measured and
+reported like any other). A cubic's last chord shorter than the minimum is avoided by moving
+the previous mark to the middle of the last two chords; a mark still closer than the minimum
+to its predecessor (tiny segments, smooth joints) is dropped unless it is a protected mark
+(stroke ends, corners). ``max_step_bits`` (optional) caps every chord and splits lines.
+
+Rounding
+--------
+The chord heights above are for the marks before rounding (``max_chord_height_bits``,
+guaranteed <= ``chord_tol_bits`` except at min-step overrides). Rounding each mark to the
+nearest integer bit moves it by at most √2/2 bit, so every point of a rounded chord lies
+within √2/2 of the unrounded chord (a convex combination of two such moves): the chord
+height of the integer marks is at most the unrounded one + √2/2 ≈ 0.707 bit. It is measured
+too (``max_chord_height_int_bits``) and reported separately.
+
+Units: galvo bits (float before rounding); curve parameters in [0, 1].
 """
 
 from __future__ import annotations
 
+import math
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, field
+
 import numpy as np
 
+from galvo_core.errors import ParamError
 from galvo_core.field import FieldMap
 from galvo_core.fit import FittedPath
-from galvo_core.geometry import flatten_cubic
+from galvo_core.geometry import power_coeffs_many
+from galvo_core.timing import CORNER_DEG
+
+__all__ = [
+    "E_MIN_RATIO",
+    "ROUNDING_BOUND_BITS",
+    "CurveSample",
+    "SampleReport",
+    "SampleResult",
+    "chord_heights",
+    "segment_heights",
+    "sample_curve",
+    "sample_paths",
+    "sample_path",
+]
+
+#: E_min / E_max of the step search window
+E_MIN_RATIO = 0.9
+#: the most that rounding a mark to whole bits adds to a chord height
+ROUNDING_BOUND_BITS = math.sqrt(2.0) / 2.0
+_MAX_TRIALS = 60
+_OVER_SAMPLES = 64
+_TINY = 1e-300
 
 
-def _split_line(a: np.ndarray, b: np.ndarray, max_step: float | None) -> np.ndarray:
-    if max_step is None:
-        return b[None, :]
-    length = float(np.hypot(*(b - a)))
-    n = max(1, int(np.ceil(length / max_step)))
-    t = (np.arange(1, n + 1) / n)[:, None]
-    return a + t * (b - a)
+# =========================================================================== measurement
+def _cross(u: np.ndarray, v: np.ndarray) -> np.ndarray:
+    return u[:, 0] * v[:, 1] - u[:, 1] * v[:, 0]
+
+
+def _dot(u: np.ndarray, v: np.ndarray) -> np.ndarray:
+    return (u * v).sum(axis=1)
+
+
+def _quad_roots(a: np.ndarray, b: np.ndarray, c: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Real roots of a τ² + b τ + c, stable form, clipped to [0, 1] (0 where none)."""
+    disc = b * b - 4.0 * a * c
+    real = disc >= 0.0
+    sq = np.sqrt(np.where(real, disc, 0.0))
+    q = -0.5 * (b + np.where(b >= 0.0, sq, -sq))
+    with np.errstate(divide="ignore", invalid="ignore"):
+        r1 = q / a
+        r2 = c / q
+    r1 = np.where(real & np.isfinite(r1), np.clip(r1, 0.0, 1.0), 0.0)
+    r2 = np.where(real & np.isfinite(r2), np.clip(r2, 0.0, 1.0), 0.0)
+    return r1, r2
+
+
+CF = tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray,
+           np.ndarray, np.ndarray]
+
+
+def _cf(coef: np.ndarray) -> CF:
+    """(K, 4, 2) power coefficients -> eight contiguous (K,) arrays ax, ay, bx, by, dx, dy,
+    ex, ey (element-wise work on strided views is several times slower)."""
+    c = np.asarray(coef, dtype=np.float64)
+    return tuple(np.ascontiguousarray(c[:, i, j]) for i in range(4) for j in range(2))  # type: ignore[return-value]
+
+
+def _taylor(cf: CF, ta: np.ndarray, tb: np.ndarray) -> tuple[np.ndarray, ...]:
+    """x and y of B(ta), q1, q2, q3 with B(ta + hτ) = B(ta) + q1 τ + q2 τ² + q3 τ³."""
+    t = ta
+    h = tb - ta
+    h2 = h * h
+    h3 = h2 * h
+    out = []
+    for a, b, d, e in ((cf[0], cf[2], cf[4], cf[6]), (cf[1], cf[3], cf[5], cf[7])):
+        a3t = 3.0 * a * t
+        out.append((((a * t + b) * t + d) * t + e, ((a3t + 2.0 * b) * t + d) * h,
+                    (a3t + b) * h2, a * h3))
+    (b0x, q1x, q2x, q3x), (b0y, q1y, q2y, q3y) = out
+    return b0x, b0y, q1x, q1y, q2x, q2y, q3x, q3y
+
+
+def chord_heights(coef: np.ndarray | CF, ta: np.ndarray, tb: np.ndarray
+                  ) -> tuple[np.ndarray, np.ndarray]:
+    """True chord heights of 2-D cubic stretches, in closed form.
+
+    ``coef`` (K, 4, 2): power coefficients [a, b, d, e] of the cubic of each chord
+    (B(t) = a t³ + b t² + d t + e; a line is a = b = 0); ``ta``, ``tb`` (K,) the chord's
+    parameters (``coef`` may also be the eight (K,) arrays ax, ay, bx, by, dx, dy, ex, ey).
+    Returns ``(H, L)``: H the largest distance of B([ta, tb]) to the chord
+    B(ta)B(tb), L the chord length (units of ``coef``).
+
+    With t = ta + hτ, D(τ) = B(t) − B(ta) = q1 τ + q2 τ² + q3 τ³ and the chord c = D(1), the
+    signed distance to the chord's line is s(τ) = τ(τ − 1)(c3 τ + c2 + c3) / |c| with
+    c_i = q_i × c; its extremes are the roots of a quadratic. When the curve stays over the
+    chord (its projection on the chord within [0, |c|]) H is exact: the distance to the
+    segment then equals the distance to the line, and the chord is within H of the curve
+    too (the projection passes every point of the chord). When it overshoots an end by o,
+    H = sqrt(H_line² + o²), an upper bound. A chord of zero length gets the bound
+    |q1| + |q2| + |q3|.
+    """
+    cf = coef if isinstance(coef, tuple) else _cf(coef)
+    _, _, q1x, q1y, q2x, q2y, q3x, q3y = _taylor(cf, ta, tb)
+    cx = q1x + q2x + q3x
+    cy = q1y + q2y + q3y
+    L = np.hypot(cx, cy)
+    c2 = q2x * cy - q2y * cx
+    c3 = q3x * cy - q3y * cx
+    r1, r2 = _quad_roots(3.0 * c3, 2.0 * c2, -(c2 + c3))
+    s1 = np.abs(r1 * (r1 - 1.0) * (c3 * r1 + c2 + c3))
+    s2 = np.abs(r2 * (r2 - 1.0) * (c3 * r2 + c2 + c3))
+    good = L > 0.0
+    Ls = np.where(good, L, 1.0)
+    H = np.maximum(s1, s2) / Ls
+    # overshoot of the projection beyond the chord's ends (scaled by |c|)
+    d1 = q1x * cx + q1y * cy
+    d2 = q2x * cx + q2y * cy
+    d3 = q3x * cx + q3y * cy
+    p1, p2 = _quad_roots(3.0 * d3, 2.0 * d2, d1)
+    pv1 = ((d3 * p1 + d2) * p1 + d1) * p1
+    pv2 = ((d3 * p2 + d2) * p2 + d1) * p2
+    L2 = L * L
+    over = np.maximum(np.maximum(np.maximum(-pv1, -pv2), np.maximum(pv1, pv2) - L2), 0.0) / Ls
+    H = np.where(over > 0.0, np.hypot(H, over), H)
+    bound = np.hypot(q1x, q1y) + np.hypot(q2x, q2y) + np.hypot(q3x, q3y)
+    H = np.where(good, H, bound)
+    return H, L
+
+
+def segment_heights(coef: np.ndarray | CF, ta: np.ndarray, tb: np.ndarray, A: np.ndarray,
+                    C: np.ndarray) -> np.ndarray:
+    """Largest distance of cubic stretches B([ta, tb]) to arbitrary segments A→C (K,).
+
+    For chords whose ends are not on the curve: rounded marks, or chords spanning a joint
+    (evaluated piece by piece). The distance is evaluated exactly at τ = 0, 1 and at the
+    critical points of both the perpendicular and the along-chord coordinate (roots of two
+    quadratics); that is the true maximum wherever the curve stays over the segment (the
+    rounding of the ends lets it pass an end by less than a bit; near the end the distance
+    to the end point is then monotone, so the ends and critical points still give it).
+    Where the curve passes an end by more than a bit, :data:`_OVER_SAMPLES` + 1 evenly spaced
+    parameters are added.
+    """
+    cf = coef if isinstance(coef, tuple) else _cf(coef)
+    b0x, b0y, q1x, q1y, q2x, q2y, q3x, q3y = _taylor(cf, ta, tb)
+    q0x = b0x - A[:, 0]
+    q0y = b0y - A[:, 1]
+    cx = C[:, 0] - A[:, 0]
+    cy = C[:, 1] - A[:, 1]
+    cc = cx * cx + cy * cy
+    inv = np.where(cc > 0.0, 1.0 / np.where(cc > 0.0, cc, 1.0), 0.0)
+    cands = [np.zeros(len(ta)), np.ones(len(ta))]
+    cands += list(_quad_roots(3.0 * (q3x * cy - q3y * cx), 2.0 * (q2x * cy - q2y * cx),
+                              q1x * cy - q1y * cx))
+    cands += list(_quad_roots(3.0 * (q3x * cx + q3y * cy), 2.0 * (q2x * cx + q2y * cy),
+                              q1x * cx + q1y * cy))
+    out = np.zeros(len(ta))
+    over = np.zeros(len(ta))
+    for u in cands:
+        dx = ((q3x * u + q2x) * u + q1x) * u + q0x
+        dy = ((q3y * u + q2y) * u + q1y) * u + q0y
+        raw = (dx * cx + dy * cy) * inv
+        np.maximum(over, np.maximum(-raw, raw - 1.0), out=over)
+        sc = np.clip(raw, 0.0, 1.0)
+        np.maximum(out, np.hypot(dx - sc * cx, dy - sc * cy), out=out)
+    big = over * np.sqrt(cc) > 1.0
+    if big.any():  # beyond an end the distance is to the end point: sample densely there
+        i = np.flatnonzero(big)
+        u = np.linspace(0.0, 1.0, _OVER_SAMPLES + 1)[None, :]
+        dx = ((q3x[i, None] * u + q2x[i, None]) * u + q1x[i, None]) * u + q0x[i, None]
+        dy = ((q3y[i, None] * u + q2y[i, None]) * u + q1y[i, None]) * u + q0y[i, None]
+        sc = np.clip((dx * cx[i, None] + dy * cy[i, None]) * inv[i, None], 0.0, 1.0)
+        e = np.hypot(dx - sc * cx[i, None], dy - sc * cy[i, None]).max(axis=1)
+        out[i] = np.maximum(out[i], e)
+    return out
+
+
+# =========================================================================== curves
+class _CubicSet:
+    """Many 2-D cubics in power form (lines are cubics with a = b = 0), stored as eight
+    contiguous coefficient arrays."""
+
+    def __init__(self, coef: np.ndarray) -> None:
+        self.cf = _cf(coef)
+
+    def gather(self, ids: np.ndarray) -> CF:
+        return tuple(x[ids] for x in self.cf)  # type: ignore[return-value]
+
+    def guess_terms(self, ids: np.ndarray, t: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """(|B'|, curvature) at t."""
+        ax, ay, bx, by, dx, dy, _, _ = self.gather(ids)
+        d1x = (3.0 * ax * t + 2.0 * bx) * t + dx
+        d1y = (3.0 * ay * t + 2.0 * by) * t + dy
+        d2x = 6.0 * ax * t + 2.0 * bx
+        d2y = 6.0 * ay * t + 2.0 * by
+        sp = np.hypot(d1x, d1y)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            k = np.abs(d1x * d2y - d1y * d2x) / (sp * sp * sp)
+        return sp, k
+
+    def height(self, ids: np.ndarray, ta: np.ndarray, tb: np.ndarray
+               ) -> tuple[np.ndarray, np.ndarray]:
+        return chord_heights(self.gather(ids), ta, tb)
+
+    def point(self, ids: np.ndarray, t: np.ndarray) -> np.ndarray:
+        ax, ay, bx, by, dx, dy, ex, ey = self.gather(ids)
+        return np.stack((((ax * t + bx) * t + dx) * t + ex, ((ay * t + by) * t + dy) * t + ey),
+                        axis=1)
+
+
+Func = Callable[[np.ndarray], np.ndarray]
+
+
+class _FuncCurve:
+    """One parametric curve in any dimension, given as vectorised f, f', f''.
+
+    Chord heights are measured numerically as paper 004 eq. (7)–(8): the distance L(t) of the
+    curve to the chord's line is sampled at :attr:`seeds` + 1 parameters, and the best
+    sample is refined by Newton steps on dL²/dt = 0 (using f''); an overshoot of the chord's
+    ends adds to H as in :func:`chord_heights`.
+    """
+
+    seeds = 16
+
+    def __init__(self, f: Func, df: Func, ddf: Func) -> None:
+        self.f, self.df, self.ddf = f, df, ddf
+
+    def _v(self, fn: Func, t: np.ndarray) -> np.ndarray:
+        out = np.asarray(fn(np.asarray(t, dtype=np.float64)), dtype=np.float64)
+        return out.reshape(len(t), -1)
+
+    def guess_terms(self, ids: np.ndarray, t: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        d1 = self._v(self.df, t)
+        d2 = self._v(self.ddf, t)
+        s2 = (d1 * d1).sum(axis=1)
+        cr2 = np.maximum(s2 * (d2 * d2).sum(axis=1) - (d1 * d2).sum(axis=1) ** 2, 0.0)
+        sp = np.sqrt(s2)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            k = np.sqrt(cr2) / (sp * s2)
+        return sp, k
+
+    def point(self, ids: np.ndarray, t: np.ndarray) -> np.ndarray:
+        return self._v(self.f, t)
+
+    def height(self, ids: np.ndarray, ta: np.ndarray, tb: np.ndarray
+               ) -> tuple[np.ndarray, np.ndarray]:
+        n, ks = len(ta), self.seeds
+        A = self._v(self.f, ta)
+        C = self._v(self.f, tb)
+        c = C - A
+        L = np.sqrt((c * c).sum(axis=1))
+        u = c / np.where(L > 0, L, 1.0)[:, None]
+        tau = np.linspace(0.0, 1.0, ks + 1)
+        tt = (ta[:, None] + (tb - ta)[:, None] * tau[None, :]).ravel()
+        P = self._v(self.f, tt).reshape(n, ks + 1, -1)
+        D = P - A[:, None, :]
+        along = (D * u[:, None, :]).sum(axis=2)
+        perp = D - along[:, :, None] * u[:, None, :]
+        dist = np.sqrt((perp * perp).sum(axis=2))
+        j = np.argmax(dist, axis=1)
+        H = dist[np.arange(n), j]
+        # Newton on g(t) = perp(t)·P'(t) = 0 (dL²/dt = 0) inside the bracket of the seed
+        h = tb - ta
+        lo = ta + h * tau[np.maximum(j - 1, 0)]
+        hi = ta + h * tau[np.minimum(j + 1, ks)]
+        t = ta + h * tau[j]
+        for _ in range(4):
+            p = self._v(self.f, t) - A
+            p1 = self._v(self.df, t)
+            p2 = self._v(self.ddf, t)
+            al = (p * u).sum(axis=1)
+            pr = p - al[:, None] * u
+            g = (pr * p1).sum(axis=1)
+            gp = (p1 * p1).sum(axis=1) - (p1 * u).sum(axis=1) ** 2 + (pr * p2).sum(axis=1)
+            with np.errstate(divide="ignore", invalid="ignore"):
+                step = np.where(gp < 0.0, g / gp, 0.0)  # a maximum: g' < 0
+            t = np.clip(t - np.nan_to_num(step), lo, hi)
+        p = self._v(self.f, t) - A
+        al = (p * u).sum(axis=1)
+        pr = p - al[:, None] * u
+        H = np.maximum(H, np.sqrt((pr * pr).sum(axis=1)))
+        over = np.maximum(np.maximum(-along.min(axis=1), along.max(axis=1) - L), 0.0)
+        H = np.where(over > 0.0, np.hypot(H, over), H)
+        return H, L
+
+
+# =========================================================================== step search
+def _first_step(curves: _CubicSet | _FuncCurve, ids: np.ndarray, t: np.ndarray,
+                hp: float, max_step: float) -> np.ndarray:
+    """Paper 004's first trial: R = 2r·sin(θ/2), θ = 2·arccos((r − H_p)/r), r = 1/k, as a
+    parameter step R/|P'| (R = the diameter 2r when H_p > r; the whole rest for k = 0)."""
+    sp, k = curves.guess_terms(ids, t)
+    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
+        r = 1.0 / k
+        R = np.where(hp < r, 2.0 * np.sqrt(np.maximum(2.0 * r * hp - hp * hp, 0.0)), 2.0 * r)
+        R = np.minimum(R, max_step)
+        dt = R / sp
+    return np.where(np.isfinite(dt) & (dt > 0.0), dt, np.inf)
+
+
+def _search(curves: _CubicSet | _FuncCurve, ids0: np.ndarray, t0: np.ndarray,
+            t1: np.ndarray, *, e_min: float, e_max: float, min_step: float, max_step: float,
+            cancel: Callable[[], bool] | None = None
+            ) -> tuple[np.ndarray, np.ndarray, np.ndarray, int]:
+    """Greedy chords along many curves at once (lock-step, one trial per curve per round).
+
+    Returns ``(k, t, override, trials)``: for every mark after the start, the index k of its
+    curve in ``ids0`` and its parameter, sorted by (k, t); the last mark of curve k is at
+    t1[k]. ``override`` marks steps set by the minimum step instead of the tolerance.
+    """
+    n = len(ids0)
+    hp = 0.5 * (e_min + e_max)
+    k = np.arange(n)
+    ta = np.asarray(t0, dtype=np.float64).copy()
+    t1 = np.asarray(t1, dtype=np.float64)
+    live = t1 > ta
+    k, ta = k[live], ta[live]
+    dt = _first_step(curves, ids0[k], ta, hp, max_step)
+    lo = np.zeros(len(k))
+    hi = np.full(len(k), np.inf)
+    pdt = np.zeros(len(k))
+    pH = np.full(len(k), np.nan)
+    it = np.zeros(len(k), dtype=np.int64)
+    out_k: list[np.ndarray] = []
+    out_t: list[np.ndarray] = []
+    out_o: list[np.ndarray] = []
+    trials = 0
+    rounds = 0
+    while len(k):
+        rounds += 1
+        if cancel is not None and rounds % 64 == 0 and cancel():
+            from galvo_core.pipeline import Cancelled
+
+            raise Cancelled()
+        ids = ids0[k]
+        te = t1[k]
+        rem = te - ta
+        trial = np.minimum(dt, rem)
+        end = trial >= rem
+        tb = np.where(end, te, ta + trial)
+        H, L = curves.height(ids, ta, tb)
+        trials += len(k)
+        ok = (H <= e_max) & (L <= max_step)
+        acc = ok & (end | (H >= e_min) | (L >= 0.98 * max_step))
+        it += 1
+        lo = np.where(ok, np.maximum(lo, trial), lo)
+        hi = np.where(ok, hi, np.minimum(hi, trial))
+        # the minimum step: a chord shorter than it is only taken at the curve's end
+        short_fail = ~ok & (L < min_step)
+        short_acc = acc & ~end & (L < min_step)
+        stuck = ~acc & ~short_fail & ((np.isfinite(hi) & ((hi - lo) <= 1e-9 * hi))
+                                       | (it >= _MAX_TRIALS))
+        ovr = short_fail | short_acc | (stuck & (lo <= 0.0))
+        take_lo = stuck & (lo > 0.0)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            stretch = trial * (min_step / np.where(L > 0.0, L, 0.0))
+        stretch = np.where(np.isfinite(stretch), stretch, rem)
+        t_new = tb.copy()
+        t_new[take_lo] = (ta + lo)[take_lo]
+        if ovr.any():  # a chord of min_step length: L(Δt) is not linear, correct twice
+            io = np.flatnonzero(ovr)
+            dto = np.maximum(stretch, trial)[io]
+            for _ in range(3):
+                t_try = np.minimum(ta[io] + dto, te[io])
+                d = curves.point(ids[io], t_try) - curves.point(ids[io], ta[io])
+                lo_len = np.sqrt((d * d).sum(axis=1))
+                with np.errstate(divide="ignore", invalid="ignore"):
+                    f = min_step / lo_len
+                grow = np.isfinite(f) & (f > 1.0) & (t_try < te[io])
+                if not grow.any():
+                    break
+                dto = np.where(grow, dto * np.minimum(f, 4.0), dto)
+            t_new[io] = np.minimum(ta[io] + dto, te[io])
+        done = acc | ovr | take_lo
+        if done.any():
+            out_k.append(k[done])
+            out_t.append(t_new[done])
+            out_o.append(ovr[done])
+        # next trial for the rest: rescale by the measured growth law, inside the bracket
+        with np.errstate(divide="ignore", invalid="ignore"):
+            p = np.log(H / pH) / np.log(trial / pdt)
+        p = np.where(np.isfinite(p), np.clip(p, 1.0, 4.0), 2.0)
+        with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
+            nxt = trial * (hp / np.maximum(H, _TINY)) ** (1.0 / p)
+            nxt = np.where(L > max_step, np.minimum(nxt, trial * 0.99 * max_step / L), nxt)
+        inside = (nxt > lo) & (nxt < hi) & np.isfinite(nxt)
+        mid = np.where(np.isfinite(hi), np.where(lo > 0.0, 0.5 * (lo + hi), 0.5 * hi), 2.0 * lo)
+        nxt = np.where(inside, nxt, mid)
+        pdt, pH, dt = trial, H, nxt
+        # accepted: move on (curves that reached their end leave)
+        ta = np.where(done, t_new, ta)
+        fin = done & (t_new >= te)
+        cont = ~fin
+        restart = done & cont
+        if restart.any():
+            dt[restart] = _first_step(curves, ids[restart], ta[restart], hp, max_step)
+            lo[restart] = 0.0
+            hi[restart] = np.inf
+            pH[restart] = np.nan
+            it[restart] = 0
+        k, ta, dt, lo, hi, pdt, pH, it = (x[cont] for x in (k, ta, dt, lo, hi, pdt, pH, it))
+    if not out_k:
+        z = np.zeros(0)
+        return z.astype(np.int64), z, z.astype(bool), trials
+    kk = np.concatenate(out_k)
+    tt = np.concatenate(out_t)
+    oo = np.concatenate(out_o)
+    order = np.argsort(kk, kind="stable")  # rounds emit increasing t per curve
+    return kk[order], tt[order], oo[order], trials
+
+
+def _fix_short_ends(curves: _CubicSet | _FuncCurve, ids0: np.ndarray, t0: np.ndarray,
+                    k: np.ndarray, t: np.ndarray, *, e_max: float, min_step: float) -> None:
+    """A curve's last chord shorter than ``min_step``: move the previous mark to the
+    parameter midpoint of the last two chords when both halves then hold (in place)."""
+    if min_step <= 0.0 or len(k) < 2:
+        return
+    last = np.flatnonzero(np.r_[k[1:] != k[:-1], True])
+    prev = last - 1
+    has = (prev >= 0) & (k[np.maximum(prev, 0)] == k[last])
+    last, prev = last[has], prev[has]
+    if not len(last):
+        return
+    pp = prev - 1
+    t_start = np.where((pp >= 0) & (k[np.maximum(pp, 0)] == k[prev]), t[np.maximum(pp, 0)],
+                       t0[k[prev]])
+    ids = ids0[k[last]]
+    _, Llast = curves.height(ids, t[prev], t[last])
+    bad = Llast < min_step
+    if not bad.any():
+        return
+    last, prev, t_start, ids = last[bad], prev[bad], t_start[bad], ids[bad]
+    tm = 0.5 * (t_start + t[last])
+    H1, L1 = curves.height(ids, t_start, tm)
+    H2, L2 = curves.height(ids, tm, t[last])
+    good = (H1 <= e_max) & (H2 <= e_max) & (L1 >= min_step) & (L2 >= min_step)
+    t[prev[good]] = tm[good]
+
+
+@dataclass(frozen=True)
+class CurveSample:
+    """Marks of one curve: parameters ``t`` (N,), points (N, D), measured chord heights
+    (N − 1,), chord lengths (N − 1,), and the number of min-step overrides and trials."""
+
+    t: np.ndarray
+    points: np.ndarray
+    heights: np.ndarray
+    lengths: np.ndarray
+    overrides: int
+    trials: int
+
+
+def sample_curve(f: Func, df: Func, ddf: Func, t0: float, t1: float, *, e_min: float,
+                 e_max: float, min_step: float = 0.0, max_step: float | None = None
+                 ) -> CurveSample:
+    """Paper 004's step search on a parametric curve in any dimension (2-D, 3-D, ...).
+
+    ``f``, ``df``, ``ddf``: vectorised position, first and second derivative, (K,) -> (K, D).
+    Every chord has a measured chord height <= ``e_max`` and, except the last, >= ``e_min``
+    (or is capped by ``max_step``, or set by ``min_step`` where the curve is tighter than the
+    minimum allows — counted in ``overrides``). The same search cuts the 2-D cubics of
+    :func:`sample_paths`, there with the closed-form chord height.
+    """
+    if not (0.0 <= e_min <= e_max and e_max > 0.0 and math.isfinite(e_max)):
+        raise ParamError("sample_curve: need 0 <= e_min <= e_max, e_max > 0 and finite")
+    if not (math.isfinite(t0) and math.isfinite(t1) and t1 >= t0):
+        raise ParamError("sample_curve: need finite t0 <= t1")
+    ms = math.inf if max_step is None else float(max_step)
+    curve = _FuncCurve(f, df, ddf)
+    ids = np.zeros(1, dtype=np.int64)
+    kk, tt, oo, trials = _search(curve, ids, np.array([t0]), np.array([t1]), e_min=e_min,
+                                 e_max=e_max, min_step=min_step, max_step=ms)
+    _fix_short_ends(curve, ids, np.array([t0]), kk, tt, e_max=e_max, min_step=min_step)
+    t = np.concatenate(([float(t0)], tt))
+    pts = curve.point(np.zeros(len(t), dtype=np.int64), t)
+    if len(t) >= 2:
+        H, L = curve.height(np.zeros(len(t) - 1, dtype=np.int64), t[:-1], t[1:])
+    else:
+        H = L = np.zeros(0)
+    return CurveSample(t, pts, H, L, int(oo.sum()), trials)
+
+
+# =========================================================================== paths
+@dataclass
+class SampleReport:
+    """What the sampler measured, for the job's stats (all in galvo bits)."""
+
+    interpolation: str
+    chord_tol_bits: float
+    max_chord_height_bits: float | None = None  # before rounding; None for raw marks
+    max_chord_height_int_bits: float | None = None  # of the integer marks
+    chords: int = 0
+    chord_violations: int = 0  # chords above chord_tol_bits before rounding
+    min_step_overrides: int = 0
+    trials: int = 0  # chord-height measurements made by the step search
+    outside_points: int = 0  # marks outside 0..field_bits-1 (before any clamping)
+    rounding_bound_bits: float = ROUNDING_BOUND_BITS
+
+    def as_dict(self) -> dict[str, object]:
+        return {
+            "interpolation": self.interpolation,
+            "chord_tol_bits": self.chord_tol_bits,
+            "max_chord_height_bits": self.max_chord_height_bits,
+            "max_chord_height_int_bits": self.max_chord_height_int_bits,
+            "chord_height_violations": self.chord_violations,
+            "min_step_overrides": self.min_step_overrides,
+            "rounding_bound_bits": self.rounding_bound_bits,
+            "outside_points": self.outside_points,
+        }
+
+
+@dataclass
+class SampleResult:
+    marks: list[np.ndarray]
+    report: SampleReport
+    # per stroke, float marks and their (global segment id, t) — for tests and benchmarks
+    float_marks: list[np.ndarray] = field(default_factory=list)
+    params: list[tuple[np.ndarray, np.ndarray]] = field(default_factory=list)
+    coef: np.ndarray | None = None
+
+
+def _round(p: np.ndarray) -> np.ndarray:
+    return np.where(p >= 0, np.floor(p + 0.5), np.ceil(p - 0.5)).astype(np.int64)
+
+
+def _dedup(marks: np.ndarray) -> np.ndarray:
+    """Drop consecutive repeats of the same integer mark (a dot keeps one mark)."""
+    if len(marks) < 2:
+        return marks
+    keep = np.ones(len(marks), dtype=bool)
+    keep[1:] = (marks[1:] != marks[:-1]).any(axis=1)
+    return marks[keep]
+
+
+def _min_step_filter(pts: np.ndarray, prot: np.ndarray, min_step: float) -> np.ndarray:
+    """Indices to keep so that consecutive kept marks are >= min_step apart, protected marks
+    (stroke ends, corners) always kept."""
+    n = len(pts)
+    if min_step <= 0.0 or n < 3:
+        return np.arange(n)
+    d = np.hypot(*np.diff(pts, axis=0).T)
+    if not (d < min_step).any():
+        return np.arange(n)
+    keep = [0]
+    for i in range(1, n):
+        j = keep[-1]
+        if math.hypot(pts[i, 0] - pts[j, 0], pts[i, 1] - pts[j, 1]) >= min_step:
+            keep.append(i)
+            continue
+        if not prot[i]:
+            continue
+        while len(keep) > 1 and not prot[keep[-1]] and math.hypot(
+                pts[i, 0] - pts[keep[-1], 0], pts[i, 1] - pts[keep[-1], 1]) < min_step:
+            keep.pop()
+        keep.append(i)
+    return np.asarray(keep)
+
+
+def _fixed_params(cs: _CubicSet, gid: int, step: float, k0: float) -> np.ndarray:
+    """Paper 001 on one cubic: parameters of the chord ends (without t = 0, with t = 1)."""
+    # points P_i every ``step`` of Chebyshev arc length, found on a dense sampling
+    dense_n = 64
+    for _ in range(8):
+        td = np.linspace(0.0, 1.0, dense_n + 1)
+        pd = cs.point(np.full(len(td), gid), td)
+        dd = np.abs(np.diff(pd, axis=0)).max(axis=1)
+        if dd.max() <= step / 8.0 or dense_n >= 1 << 16:
+            break
+        dense_n = min(1 << 16, int(dense_n * max(2.0, 8.0 * dd.max() / step)))
+    cheb = np.concatenate(([0.0], np.cumsum(dd)))
+    total = cheb[-1]
+    if total <= step:
+        return np.array([1.0])
+    targets = np.arange(step, total, step)
+    ti = np.interp(targets, cheb, td)
+    ti = np.concatenate((ti, [1.0])) if ti[-1] < 1.0 else ti
+    pi = cs.point(np.full(len(ti), gid), ti)
+    allp = np.vstack((pd[:1], pi))  # index 0 = the start A
+    ends: list[int] = []
+    a = 0
+    m = len(allp)
+    while a < m - 1:
+        first = allp[a + 1] - allp[a]
+        rest = allp[a + 2:] - allp[a]
+        if len(rest) == 0:
+            ends.append(m - 1)
+            break
+        cr = first[0] * rest[:, 1] - first[1] * rest[:, 0]
+        dt_ = first[0] * rest[:, 0] + first[1] * rest[:, 1]
+        with np.errstate(divide="ignore", invalid="ignore"):
+            slope = np.abs(cr / dt_)
+        bad = ~(slope <= k0)  # includes turns of 90° or more (dt_ <= 0, nan)
+        if not bad.any():
+            ends.append(m - 1)
+            break
+        i = int(np.argmax(bad)) + a + 2  # the first P_i that breaks the slope threshold
+        ends.append(i - 1)
+        a = i - 1
+    return np.concatenate(([0.0], ti))[ends]
+
+
+def sample_paths(
+    fitted: Sequence[FittedPath],
+    fm: FieldMap,
+    *,
+    interpolation: str = "adaptive",
+    chord_tol_bits: float = 1.0,
+    min_step_bits: float = 2.0,
+    max_step_bits: float | None = None,
+    fixed_step_bits: float = 16.0,
+    fixed_slope_tol: float = 0.05,
+    raw_points: Sequence[np.ndarray] | None = None,
+    cancel: Callable[[], bool] | None = None,
+) -> SampleResult:
+    """Marks of many fitted paths at once (one stroke each, (M, 2) int64 bits, in the
+    direction of the segments; empty for a path without segments), and what was measured.
+
+    All cubics of all paths are searched together, so the cost per mark stays low however
+    many paths there are. ``raw_points[i]`` are the input points of ``fitted[i]`` (needed for
+    ``raw``).
+    """
+    if interpolation not in ("adaptive", "fixed", "raw"):
+        raise ParamError(f"interpolation must be adaptive, fixed or raw; got {interpolation!r}")
+    tol = float(chord_tol_bits)
+    report = SampleReport(interpolation, tol)
+    res = SampleResult([], report)
+    mx = fm.max_bit
+    if interpolation == "raw":
+        for i, _fp in enumerate(fitted):
+            pts = raw_points[i] if raw_points is not None else np.empty((0, 2))
+            m = _dedup(fm.to_bits(np.asarray(pts, dtype=np.float64).reshape(-1, 2)))
+            res.marks.append(m)
+            report.outside_points += int(((m < 0) | (m > mx)).any(axis=1).sum()) if len(m) else 0
+        return res
+    ms_max = math.inf if max_step_bits is None else float(max_step_bits)
+    min_step = float(min_step_bits)
+    # ---- every segment of every path, in bits, in power form
+    ctrls: list[np.ndarray] = []
+    kinds: list[bool] = []  # True for cubics
+    path_first: list[int] = []
+    path_n: list[int] = []
+    for fp in fitted:
+        path_first.append(len(ctrls))
+        path_n.append(len(fp.segments))
+        for s in fp.segments:
+            c = fm.to_bits_float(s.points)
+            if s.kind == "cubic":
+                ctrls.append(c)
+                kinds.append(True)
+            else:
+                ctrls.append(np.vstack((c[0], c[0] + (c[1] - c[0]) / 3.0,
+                                        c[0] + 2.0 * (c[1] - c[0]) / 3.0, c[1])))
+                kinds.append(False)
+    if not ctrls:
+        res.marks = [np.empty((0, 2), dtype=np.int64) for _ in fitted]
+        return res
+    ctrl_all = np.stack(ctrls)
+    coef = power_coeffs_many(ctrl_all)
+    # a line's power form: exactly a = b = 0
+    is_cubic = np.asarray(kinds)
+    coef[~is_cubic, 0] = 0.0
+    coef[~is_cubic, 1] = 0.0
+    coef[~is_cubic, 2] = ctrl_all[~is_cubic, 3] - ctrl_all[~is_cubic, 0]
+    cs = _CubicSet(coef)
+    res.coef = coef
+    g = len(ctrl_all)
+    # ---- marks (segment id, t) per segment, t in (0, 1], last at 1
+    seg_ids: list[np.ndarray] = []
+    seg_ts: list[np.ndarray] = []
+    cub = np.flatnonzero(is_cubic)
+    if len(cub):
+        if interpolation == "adaptive":
+            kk, tt, oo, trials = _search(cs, cub, np.zeros(len(cub)), np.ones(len(cub)),
+                                         e_min=E_MIN_RATIO * tol, e_max=tol,
+                                         min_step=min_step, max_step=ms_max, cancel=cancel)
+            _fix_short_ends(cs, cub, np.zeros(len(cub)), kk, tt, e_max=tol,
+                            min_step=min_step)
+            report.min_step_overrides = int(oo.sum())
+            report.trials = trials
+            seg_ids.append(cub[kk])
+            seg_ts.append(tt)
+        else:
+            for gid in cub:
+                tf = _fixed_params(cs, int(gid), float(fixed_step_bits), float(fixed_slope_tol))
+                seg_ids.append(np.full(len(tf), gid))
+                seg_ts.append(tf)
+    lines = np.flatnonzero(~is_cubic)
+    if len(lines):
+        if math.isfinite(ms_max):
+            ln = np.hypot(*(ctrl_all[lines, 3] - ctrl_all[lines, 0]).T)
+            nseg = np.maximum(1, np.ceil(ln / ms_max - 1e-9)).astype(np.int64)
+            rep = np.repeat(lines, nseg)
+            start = np.cumsum(nseg) - nseg
+            idx = np.arange(len(rep)) - np.repeat(start, nseg) + 1
+            seg_ids.append(rep)
+            seg_ts.append(idx / np.repeat(nseg, nseg))
+        else:
+            seg_ids.append(lines)
+            seg_ts.append(np.ones(len(lines)))
+    # the start mark of every non-empty path: (first segment, t = 0); every other mark has
+    # t > 0
+    seg_path = np.repeat(np.arange(len(fitted)), path_n)
+    firsts = np.asarray([path_first[i] for i in range(len(fitted)) if path_n[i]],
+                        dtype=np.int64)
+    sid = np.concatenate([firsts] + seg_ids).astype(np.int64)
+    st = np.concatenate([np.zeros(len(firsts))] + seg_ts)
+    # each block is sorted by (segment, t) and starts come first: a stable sort by segment
+    # merges the runs (timsort, about linear here)
+    order = np.argsort(sid, kind="stable")
+    sid, st = sid[order], st[order]
+    pos = cs.point(sid, st)
+    at1 = st >= 1.0
+    pos[at1] = ctrl_all[sid[at1], 3]  # segment ends exactly (continuity)
+    at0 = st <= 0.0
+    pos[at0] = ctrl_all[sid[at0], 0]
+    pid = seg_path[sid]
+    # ---- protected marks: stroke ends and corner joints
+    corner = np.zeros(g, dtype=bool)
+    if g > 1:
+        ts, te = _tangents_all(ctrl_all)
+        a, b = te[:-1], ts[1:]
+        cr = a[:, 0] * b[:, 1] - a[:, 1] * b[:, 0]
+        ang = np.degrees(np.abs(np.arctan2(cr, _dot(a, b))))
+        deg = ~(a.any(axis=1) & b.any(axis=1))
+        corner[:-1] = ((ang > CORNER_DEG) | deg) & (seg_path[:-1] == seg_path[1:])
+    first_of = np.r_[True, pid[1:] != pid[:-1]]
+    last_of = np.r_[pid[1:] != pid[:-1], True]
+    prot = first_of | last_of | (at1 & corner[sid])
+    # ---- the minimum step between consecutive marks (rarely needed after the search)
+    if min_step > 0.0 and len(pid) > 2:
+        dd = np.hypot(*np.diff(pos, axis=0).T)
+        short = (dd < min_step) & ~last_of[:-1]
+        if short.any():
+            keep = np.ones(len(pid), dtype=bool)
+            sb = np.searchsorted(pid, np.arange(len(fitted) + 1))
+            for p in np.unique(pid[:-1][short]):
+                a0, a1 = sb[p], sb[p + 1]
+                kp = _min_step_filter(pos[a0:a1], prot[a0:a1], min_step)
+                km = np.zeros(a1 - a0, dtype=bool)
+                km[kp] = True
+                keep[a0:a1] = km
+            sid, st, pos, pid = sid[keep], st[keep], pos[keep], pid[keep]
+            first_of, last_of = first_of[keep], last_of[keep]
+    # ---- rounding to whole bits; consecutive repeats dropped (the stroke's end kept)
+    r = _round(pos)
+    same = np.r_[False, (r[1:] == r[:-1]).all(axis=1) & ~first_of[1:]]
+    if same.any():
+        drop = same.copy()
+        for i in np.flatnonzero(same & last_of):
+            j = i - 1  # keep the true end, drop its twin before it unless that is the start
+            while same[j]:
+                j -= 1
+            if not first_of[j]:
+                drop[i] = False
+                drop[j] = True
+        keep = ~drop
+        sid, st, pos, pid, r = sid[keep], st[keep], pos[keep], pid[keep], r[keep]
+        last_of = last_of[keep] | np.r_[pid[1:] != pid[:-1], True]
+    report.outside_points = int(((r < 0) | (r > mx)).any(axis=1).sum())
+    # ---- measurement of every chord against the true curve
+    pair = ~last_of[:-1] if len(pid) > 1 else np.zeros(0, dtype=bool)
+    if pair.any():
+        i0 = np.flatnonzero(pair)
+        i1 = i0 + 1
+        rf = r.astype(np.float64)
+        hf, hi_int = _measure(cs, sid[i0], st[i0], sid[i1], st[i1], pos[i0], pos[i1],
+                              rf[i0], rf[i1])
+        report.chords = len(hf)
+        report.max_chord_height_bits = float(hf.max())
+        report.max_chord_height_int_bits = float(hi_int.max())
+        report.chord_violations = int((hf > tol * (1.0 + 1e-9)).sum())
+    else:
+        report.max_chord_height_bits = 0.0
+        report.max_chord_height_int_bits = 0.0
+    # ---- one stroke per path
+    cuts = np.searchsorted(pid, np.arange(1, len(fitted)))
+    res.marks = np.split(r, cuts)
+    res.float_marks = np.split(pos, cuts)
+    res.params = list(zip(np.split(sid, cuts), np.split(st, cuts), strict=True))
+    return res
+
+
+def _tangents_all(ctrl: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Start and end tangent directions of every segment (first non-zero control leg)."""
+    p0, p1, p2, p3 = ctrl[:, 0], ctrl[:, 1], ctrl[:, 2], ctrl[:, 3]
+    s = p1 - p0
+    s = np.where(s.any(axis=1)[:, None], s, p2 - p0)
+    s = np.where(s.any(axis=1)[:, None], s, p3 - p0)
+    e = p3 - p2
+    e = np.where(e.any(axis=1)[:, None], e, p3 - p1)
+    e = np.where(e.any(axis=1)[:, None], e, p3 - p0)
+    return s, e
+
+
+def _measure(coef: np.ndarray | _CubicSet, sa: np.ndarray, ta: np.ndarray, sb: np.ndarray,
+             tb: np.ndarray, fa: np.ndarray, fb: np.ndarray, ia: np.ndarray, ib: np.ndarray
+             ) -> tuple[np.ndarray, np.ndarray]:
+    """Chord heights of chords from (sa, ta) to (sb, tb), possibly spanning joints, against
+    the float chord fa→fb and the integer chord ia→ib."""
+    # a chord starting at a segment's end starts at the next segment's start
+    mv = (ta >= 1.0) & (sb > sa)
+    sa = np.where(mv, sa + 1, sa)
+    ta = np.where(mv, 0.0, ta)
+    cs = _CubicSet(coef) if not isinstance(coef, _CubicSet) else coef
+    if (sb == sa).all():  # the usual case: every chord within one segment
+        hf, _ = chord_heights(cs.gather(sa), ta, tb)
+        return hf, _max_int_heights(cs, hf, sa, ta, sb, tb, fa, fb, ia, ib)
+    npieces = sb - sa + 1
+    chord = np.repeat(np.arange(len(sa)), npieces)
+    start = np.cumsum(npieces) - npieces
+    off = np.arange(len(chord)) - np.repeat(start, npieces)
+    seg = np.repeat(sa, npieces) + off
+    t_lo = np.where(off == 0, np.repeat(ta, npieces), 0.0)
+    t_hi = np.where(seg == np.repeat(sb, npieces), np.repeat(tb, npieces), 1.0)
+    c = cs.gather(seg)
+    # chords within one segment (float ends on the curve): the closed form, exact
+    simple = npieces == 1
+    hf_out = np.zeros(len(sa))
+    hf_out[simple], _ = chord_heights(cs.gather(sa[simple]), ta[simple], tb[simple])
+    multi = ~simple[chord]
+    if multi.any():
+        hf = segment_heights(tuple(x[multi] for x in c), t_lo[multi],  # type: ignore[arg-type]
+                             t_hi[multi], fa[chord[multi]], fb[chord[multi]])
+        np.maximum.at(hf_out, chord[multi], hf)
+    return hf_out, _max_int_heights(cs, hf_out, sa, ta, sb, tb, fa, fb, ia, ib)
+
+
+def _max_int_heights(cs: _CubicSet, hf: np.ndarray, sa: np.ndarray, ta: np.ndarray,
+                     sb: np.ndarray, tb: np.ndarray, fa: np.ndarray, fb: np.ndarray,
+                     ia: np.ndarray, ib: np.ndarray) -> np.ndarray:
+    """Chord heights of the integer chords, exact where it matters for their maximum.
+
+    Every point of the integer chord lies within max(|ia − fa|, |ib − fb|) (<= √2/2) of the
+    float chord, so hf + that is an upper bound per chord. The 1024 chords of largest
+    bound are measured exactly, then every chord whose bound still exceeds the largest
+    exact height, until none does; the rest keep their bound. The maximum returned is
+    therefore exact; per-chord values are exact or upper bounds."""
+    da = np.hypot(ia[:, 0] - fa[:, 0], ia[:, 1] - fa[:, 1])
+    db = np.hypot(ib[:, 0] - fb[:, 0], ib[:, 1] - fb[:, 1])
+    out = hf + np.maximum(da, db)
+    done = np.zeros(len(out), dtype=bool)
+    k = min(len(out), 1024)
+    idx = np.argpartition(-out, k - 1)[:k] if k < len(out) else np.arange(len(out))
+    best = -1.0
+    while len(idx):
+        ex = _int_heights_exact(cs, sa[idx], ta[idx], sb[idx], tb[idx], ia[idx], ib[idx])
+        out[idx] = ex
+        done[idx] = True
+        best = max(best, float(ex.max()))
+        idx = np.flatnonzero(~done & (out > best))
+    return out
+
+
+def _int_heights_exact(cs: _CubicSet, sa: np.ndarray, ta: np.ndarray, sb: np.ndarray,
+                       tb: np.ndarray, ia: np.ndarray, ib: np.ndarray) -> np.ndarray:
+    npieces = sb - sa + 1
+    chord = np.repeat(np.arange(len(sa)), npieces)
+    start = np.cumsum(npieces) - npieces
+    off = np.arange(len(chord)) - np.repeat(start, npieces)
+    seg = np.repeat(sa, npieces) + off
+    t_lo = np.where(off == 0, np.repeat(ta, npieces), 0.0)
+    t_hi = np.where(seg == np.repeat(sb, npieces), np.repeat(tb, npieces), 1.0)
+    h = segment_heights(cs.gather(seg), t_lo, t_hi, ia[chord], ib[chord])
+    out = np.zeros(len(sa))
+    np.maximum.at(out, chord, h)
+    return out
 
 
 def sample_path(
@@ -34,55 +944,32 @@ def sample_path(
     chord_tol_bits: float = 1.0,
     min_step_bits: float = 2.0,
     max_step_bits: float | None = None,
+    fixed_step_bits: float = 16.0,
+    fixed_slope_tol: float = 0.05,
     raw_points: np.ndarray | None = None,
 ) -> np.ndarray:
-    """Marks of one stroke, (M, 2) int64 galvo bits, in the direction of the segments."""
-    if interpolation == "raw":
-        pts = raw_points if raw_points is not None else np.empty((0, 2))
-        return _dedup(fm.to_bits(pts))
-    if not fp.segments:
-        return np.empty((0, 2), dtype=np.int64)
-    chunks: list[np.ndarray] = []
-    joints: list[int] = []
-    first = fm.to_bits_float(fp.segments[0].points[:1])
-    chunks.append(first)
-    count = 1
-    for seg in fp.segments:
-        ctrl = fm.to_bits_float(seg.points)
-        if seg.kind == "cubic":
-            pts = flatten_cubic(ctrl, chord_tol_bits)[1:]
-            if max_step_bits is not None and len(pts):
-                prev = np.vstack((ctrl[:1], pts[:-1]))
-                steps = np.hypot(*(pts - prev).T)
-                if steps.max() > max_step_bits:
-                    n = int(np.ceil(len(pts) * steps.max() / max_step_bits))
-                    pts = flatten_cubic(ctrl, chord_tol_bits / max(1.0, (n / len(pts)) ** 2))[1:]
-        else:
-            pts = _split_line(ctrl[0], ctrl[1], max_step_bits)
-        chunks.append(pts)
-        count += len(pts)
-        joints.append(count - 1)
-    allpts = np.concatenate(chunks)
-    keep = np.ones(len(allpts), dtype=bool)
-    if min_step_bits > 0 and len(allpts) > 2:
-        is_joint = np.zeros(len(allpts), dtype=bool)
-        is_joint[joints] = True
-        is_joint[0] = True
-        last = allpts[0]
-        for i in range(1, len(allpts) - 1):
-            if not is_joint[i] and np.hypot(*(allpts[i] - last)) < min_step_bits:
-                keep[i] = False
-            else:
-                last = allpts[i]
-    marks = allpts[keep]
-    r = np.where(marks >= 0, np.floor(marks + 0.5), np.ceil(marks - 0.5)).astype(np.int64)
-    return _dedup(r)
+    """Marks of one stroke, (M, 2) int64 galvo bits (see :func:`sample_paths`)."""
+    res = sample_paths([fp], fm, interpolation=interpolation, chord_tol_bits=chord_tol_bits,
+                       min_step_bits=min_step_bits, max_step_bits=max_step_bits,
+                       fixed_step_bits=fixed_step_bits, fixed_slope_tol=fixed_slope_tol,
+                       raw_points=None if raw_points is None else [raw_points])
+    return res.marks[0]
 
 
-def _dedup(marks: np.ndarray) -> np.ndarray:
-    """Drop consecutive repeats of the same integer mark (a dot keeps one mark)."""
-    if len(marks) < 2:
-        return marks
-    keep = np.ones(len(marks), dtype=bool)
-    keep[1:] = (marks[1:] != marks[:-1]).any(axis=1)
-    return marks[keep]
+def polyline_marks(points: np.ndarray, fm: FieldMap, *, min_step_bits: float,
+                   corner_deg: float = 15.0) -> np.ndarray:
+    """Marks of a polyline laser path (e.g. a hatch stroke, input units) as int64 bits:
+    rounded, consecutive repeats dropped, and marks closer than ``min_step_bits`` to the
+    previous one merged, except the ends and corners (turn above ``corner_deg``)."""
+    pts = fm.to_bits_float(np.asarray(points, dtype=np.float64).reshape(-1, 2))
+    n = len(pts)
+    prot = np.zeros(n, dtype=bool)
+    if n:
+        prot[0] = prot[-1] = True
+    if n >= 3:
+        a = pts[1:-1] - pts[:-2]
+        b = pts[2:] - pts[1:-1]
+        ang = np.degrees(np.abs(np.arctan2(_cross(a, b), _dot(a, b))))
+        prot[1:-1] = ang > corner_deg
+    keep = _min_step_filter(pts, prot, min_step_bits)
+    return _dedup(_round(pts[keep]))

@@ -151,4 +151,75 @@ def thin(points: object, eps_line: float, *, closed: bool = False) -> np.ndarray
         out.append(j)
         chunk = max(32, 2 * (j - i))
         i = j
+    if n < _DP_RATIO * len(out):
+        out = _shortest(q, eps, out)
     return u[np.asarray(out, dtype=np.intp)]
+
+
+#: below this many points per kept line the greedy result is improved by the window DP
+_DP_RATIO = 16
+_DP_WINDOW = 16
+
+
+def _window_table(q: np.ndarray, eps: float, w: int) -> list[list[bool]]:
+    """ok[d][i]: every point strictly between q_i and q_(i+d) within eps of the segment
+    (exact point-to-segment distances, all i at once for each d <= w)."""
+    n = len(q)
+    e2 = eps * eps
+    ok: list[list[bool]] = [[], [True] * (n - 1)]
+    x, y = q[:, 0], q[:, 1]
+    for d in range(2, w + 1):
+        m = n - d
+        if m <= 0:
+            break
+        ax, ay = x[:m], y[:m]
+        bx = x[d : d + m] - ax
+        by = y[d : d + m] - ay
+        den = bx * bx + by * by
+        inv = np.where(den > 0.0, 1.0 / np.where(den > 0.0, den, 1.0), 0.0)
+        worst = np.zeros(m)
+        for k in range(1, d):
+            px = x[k : k + m] - ax
+            py = y[k : k + m] - ay
+            s = np.clip((px * bx + py * by) * inv, 0.0, 1.0)
+            ex = px - s * bx
+            ey = py - s * by
+            np.maximum(worst, ex * ex + ey * ey, out=worst)
+        ok.append((worst <= e2).tolist())
+    return ok
+
+
+def _shortest(q: np.ndarray, eps: float, greedy: list[int]) -> list[int]:
+    """Fewest kept points over the shortcuts of at most ``_DP_WINDOW`` steps plus the
+    greedy ones (so never more than the greedy result): a shortest path (Imai–Iri) in that
+    graph. Every shortcut used is verified exactly, so the guarantee is the same."""
+    n = len(q)
+    ok = _window_table(q, eps, _DP_WINDOW)
+    w = len(ok) - 1
+    extra: dict[int, int] = {}
+    for a, b in zip(greedy[:-1], greedy[1:], strict=True):
+        if b - a > w:
+            extra[b] = a
+    big = n + 1
+    best = [big] * n
+    pred = [0] * n
+    best[0] = 0
+    for j in range(1, n):
+        bj = big
+        pj = j - 1
+        for d in range(min(w, j), 0, -1):
+            if ok[d][j - d]:
+                v = best[j - d]
+                if v < bj:
+                    bj = v
+                    pj = j - d
+        a = extra.get(j)
+        if a is not None and best[a] < bj:
+            bj = best[a]
+            pj = a
+        best[j] = bj + 1
+        pred[j] = pj
+    path = [n - 1]
+    while path[-1] != 0:
+        path.append(pred[path[-1]])
+    return path[::-1]

@@ -1,17 +1,24 @@
 """A delay-aware estimate of marking time, and the dwell check.
 
-Model (the usual galvo controller timing, as in SCANLAB RTC / EZCAD-style boards):
+Model (the usual galvo controller timing, as in SCANLAB RTC / EZCAD-style boards, which
+output one position every point period — 10 µs at the XY2-100 rate):
 
-* every jump (laser off) costs its length over the jump speed plus a jump delay (short, or
-  long past ``long_jump_mm``);
+* every mark vector (consecutive marks of a stroke) takes its length over the mark speed,
+  rounded **up** to whole point periods, and at least one period: the controller steps a
+  vector in whole periods, so a stroke of many tiny steps costs what it really costs (a
+  1-bit step at 100 mm/s would take 17 ns; it takes 10 µs);
+* a dot (a stroke of one mark) fires for one point period;
+* every jump (laser off, from the last mark of a stroke to the first of the next) takes its
+  length over the jump speed, likewise in whole periods, plus a jump delay (short, or long
+  past ``long_jump_mm``);
 * every stroke costs the laser-on delay at its start, and the mark-end delay plus the
-  laser-off delay at its end;
-* every mark vector costs its length over the mark speed, but never less than one point
-  period (10 µs at the XY2-100 rate): a stroke of many tiny steps costs what it really costs;
-* every corner inside a stroke (direction change above :data:`CORNER_DEG`) costs the
-  polygon delay.
+  laser-off delay at its end (one laser switch per stroke);
+* every corner inside a stroke (direction change above :data:`CORNER_DEG` between
+  consecutive mark vectors) costs the polygon delay.
 
-Lengths are on the workpiece (mm), times in seconds.
+No jump is counted before the first stroke (the scanner is assumed to wait at the first mark)
+nor after the last. Lengths are on the workpiece (mm), times in seconds. The estimate does
+not model acceleration (sky-writing, the galvo's own lag); the delays stand in for it.
 """
 
 from __future__ import annotations
@@ -32,19 +39,29 @@ def stroke_lengths_mm(marks: np.ndarray, mm_per_bit: float) -> np.ndarray:
     return np.hypot(d[:, 0], d[:, 1]) * mm_per_bit
 
 
+def _turns_deg(d: np.ndarray) -> np.ndarray:
+    """Direction change (degrees) between consecutive non-zero vectors ``d`` (K, 2)."""
+    if len(d) < 2:
+        return np.zeros(0)
+    a, b = d[:-1], d[1:]
+    cross = a[:, 0] * b[:, 1] - a[:, 1] * b[:, 0]
+    dot = (a * b).sum(axis=1)
+    return np.degrees(np.abs(np.arctan2(cross, dot)))
+
+
 def corners(marks: np.ndarray, corner_deg: float = CORNER_DEG) -> int:
     """Interior vertices where the direction turns by more than ``corner_deg``."""
     if len(marks) < 3:
         return 0
     d = np.diff(marks.astype(np.float64), axis=0)
     d = d[(d != 0).any(axis=1)]
-    if len(d) < 2:
-        return 0
-    a, b = d[:-1], d[1:]
-    cross = a[:, 0] * b[:, 1] - a[:, 1] * b[:, 0]
-    dot = (a * b).sum(axis=1)
-    ang = np.degrees(np.abs(np.arctan2(cross, dot)))
-    return int((ang > corner_deg).sum())
+    return int((_turns_deg(d) > corner_deg).sum())
+
+
+def _periods(length_mm: np.ndarray, speed_mm_s: float, period_s: float) -> np.ndarray:
+    """Whole point periods a vector takes (at least one)."""
+    n = np.ceil(length_mm / (speed_mm_s * period_s) - 1e-9)
+    return np.maximum(n, 1.0)
 
 
 def estimate(
@@ -52,49 +69,64 @@ def estimate(
 ) -> dict[str, float | int]:
     """Time and lengths for strokes of marks (each (M, 2) int bits) in marking order.
 
-    The first jump starts at the field centre's position of the previous job's end: here the
-    first stroke's first mark (no jump is counted before it).
+    Returns mark_length_mm, jump_length_mm, estimated_time_s, corners, laser_switches
+    (= strokes with marks), jumps, mark_points, and the parts of the time (mark_time_s,
+    jump_time_s, delay_time_s).
     """
     us = 1e-6
-    mark_len = 0.0
-    jump_len = 0.0
-    t = 0.0
-    n_corners = 0
-    n_marks = 0
-    n_strokes = 0
-    prev_end: np.ndarray | None = None
-    for m in strokes:
-        if len(m) == 0:
-            continue
-        n_strokes += 1
-        n_marks += len(m)
-        if prev_end is not None:
-            j = float(np.hypot(*(m[0] - prev_end).astype(np.float64))) * mm_per_bit
-            jump_len += j
-            t += j / laser.jump_speed_mm_s
-            t += (laser.jump_delay_long_us if j > laser.long_jump_mm else laser.jump_delay_us) * us
-        seg = stroke_lengths_mm(m, mm_per_bit)
-        mark_len += float(seg.sum())
-        t += float(np.maximum(seg / laser.mark_speed_mm_s, laser.point_period_us * us).sum())
-        if len(m) == 1:  # a dot: the laser fires for one point period
-            t += laser.point_period_us * us
-        c = corners(m)
-        n_corners += c
-        t += c * laser.polygon_delay_us * us
-        t += (laser.laser_on_delay_us + laser.mark_delay_us + laser.laser_off_delay_us) * us
-        prev_end = m[-1]
+    period = laser.point_period_us * us
+    ms = [np.asarray(m, dtype=np.float64).reshape(-1, 2) for m in strokes]
+    ms = [m for m in ms if len(m)]
+    n_strokes = len(ms)
+    if not n_strokes:
+        return {"mark_length_mm": 0.0, "jump_length_mm": 0.0, "estimated_time_s": 0.0,
+                "corners": 0, "laser_switches": 0, "jumps": 0, "mark_points": 0,
+                "mark_time_s": 0.0, "jump_time_s": 0.0, "delay_time_s": 0.0}
+    allm = np.concatenate(ms)
+    sizes = np.array([len(m) for m in ms])
+    sid = np.repeat(np.arange(n_strokes), sizes)
+    d = np.diff(allm, axis=0)
+    inside = sid[1:] == sid[:-1]
+    vec = d[inside]
+    seg_mm = np.hypot(vec[:, 0], vec[:, 1]) * mm_per_bit
+    mark_len = float(seg_mm.sum())
+    mark_t = float(_periods(seg_mm, laser.mark_speed_mm_s, period).sum()) * period
+    mark_t += int((sizes == 1).sum()) * period  # dots
+    # corners: turns between consecutive non-zero vectors of the same stroke
+    vsid = sid[1:][inside]
+    nz = (vec != 0).any(axis=1)
+    vec, vsid = vec[nz], vsid[nz]
+    turn = _turns_deg(vec)
+    n_corners = int(((turn > CORNER_DEG) & (vsid[1:] == vsid[:-1])).sum()) if len(turn) else 0
+    # jumps
+    starts = np.cumsum(sizes) - sizes
+    ends = starts + sizes - 1
+    jv = allm[starts[1:]] - allm[ends[:-1]]
+    jump_mm = np.hypot(jv[:, 0], jv[:, 1]) * mm_per_bit
+    jump_len = float(jump_mm.sum())
+    jump_t = float(_periods(jump_mm, laser.jump_speed_mm_s, period).sum()) * period
+    jdel = np.where(jump_mm > laser.long_jump_mm, laser.jump_delay_long_us,
+                    laser.jump_delay_us).sum() * us
+    delays = (n_strokes * (laser.laser_on_delay_us + laser.mark_delay_us
+                           + laser.laser_off_delay_us) * us
+              + n_corners * laser.polygon_delay_us * us + float(jdel))
     return {
         "mark_length_mm": mark_len,
         "jump_length_mm": jump_len,
-        "estimated_time_s": t,
+        "estimated_time_s": mark_t + jump_t + delays,
         "corners": n_corners,
         "laser_switches": n_strokes,
-        "mark_points": n_marks,
+        "jumps": n_strokes - 1,
+        "mark_points": int(sizes.sum()),
+        "mark_time_s": mark_t,
+        "jump_time_s": jump_t,
+        "delay_time_s": delays,
     }
 
 
 def dwell_count(strokes: Sequence[np.ndarray], laser: LaserParams, mm_per_bit: float) -> int:
-    """Consecutive marks closer than mark speed × point period: the beam stands still there."""
+    """Consecutive marks closer than mark speed × point period: the beam stands still there
+    (the controller cannot move less than one step per period, so it dwells)."""
     limit_mm = laser.mark_speed_mm_s * laser.point_period_us * 1e-6
     n = 0
     for m in strokes:

@@ -85,7 +85,7 @@ _RUN_RE = re.compile(
 _FAST_MIN_BYTES = 256  # shorter runs go command by command
 _SEP_RE = re.compile(rb"[\x00-\x1a\x1c-\x20;,]*")
 _NUM_RE = re.compile(rb"[-+]?(?:\d+\.?\d*|\.\d+)")
-_JUNK_PARAM_RE = re.compile(rb"[^\s,0-9.+\-\x00]")
+_JUNK_PARAM_RE = re.compile(rb"[^\s,0-9.+\-\x00]+")
 _DEVCTL_RE = re.compile(rb"\x1b?\.(?:[()YZBEJKLORU]|[@HIMNPQST][0-9;.\s]{0,80}:?)")
 _PCL_ESC_RE = re.compile(
     rb"\x1b(?:%-12345X"
@@ -117,7 +117,9 @@ class _Reader:
         self.commands: Counter[str] = Counter()
         self._warn: list[tuple[int, str]] = []
         self._warn_count: Counter[str] = Counter()
-        self.recognised = 0
+        self.recognised = 0  # HP-GL commands read (escapes and PCL do not count)
+        self.clipped = 0  # paths changed by the IW window
+        self.first_clip = -1
         self.junk_bytes = 0
         self.pages = 0
         self.labels = 0
@@ -149,6 +151,7 @@ class _Reader:
         self.p1 = DEFAULT_P1
         self.p2 = DEFAULT_P2
         self.hard = (DEFAULT_P1, DEFAULT_P2)
+        self.page_known = False  # PS gave the page (hard-clip limits)
         self.sc: tuple[float, float, float, float] | None = None  # ax, bx, ay, by
         self.sc_params: list[float] | None = None
         self.rot = 0
@@ -243,19 +246,22 @@ class _Reader:
         x = pts[:, 0].copy()
         y = pts[:, 1].copy()
         if r == 90:
-            return np.column_stack((-y, x))
+            return np.column_stack((-y, x)) + 0.0  # + 0.0: no -0.0 coordinates
         if r == 180:
-            return np.column_stack((-x, -y))
-        return np.column_stack((y, -x))
+            return np.column_stack((-x, -y)) + 0.0
+        return np.column_stack((y, -x)) + 0.0
 
     def emit(self, pts: np.ndarray, offset: int, *, closed: bool | None = None) -> None:
         """Add a finished path (plotter units, before rotation and clipping)."""
         if self.window is not None:
             pieces = _clip_polyline(pts, self.window)
+            if len(pieces) != 1 or len(pieces[0]) != len(pts) or not np.array_equal(pieces[0], pts):
+                self.clipped += 1
+                if self.first_clip < 0:
+                    self.first_clip = offset
+                closed = False
             if not pieces:
                 return
-            if len(pieces) > 1 or len(pieces[0]) != len(pts):
-                closed = False
         else:
             pieces = [pts]
         for piece in pieces:
@@ -275,7 +281,7 @@ class _Reader:
 
     def emit_ring(self, ring_pts: np.ndarray, offset: int) -> None:
         """A closed figure (rectangle, circle, wedge): into the polygon buffer in PM."""
-        if len(ring_pts) and (ring_pts[0] != ring_pts[-1]).any():
+        if len(ring_pts) and not _near(ring_pts[0], ring_pts[-1]):
             ring_pts = np.vstack((ring_pts, ring_pts[:1]))
         elif len(ring_pts):
             ring_pts = ring_pts.copy()
@@ -483,6 +489,7 @@ class _Reader:
         arc = arc_points(cx, cy, r, start, max(-360.0, min(360.0, sweep)), ca)
         if abs(sweep) >= 360.0 or r == 0:
             ring = arc
+            ring[-1] = ring[0]
         else:
             ring = np.vstack(([(cx, cy)], arc, [(cx, cy)]))
         self.flush_if_drawing()
@@ -579,11 +586,11 @@ class _Reader:
         if not v:
             self.p1, self.p2 = self.hard
         elif len(v) >= 2:
+            dx, dy = self.p2[0] - self.p1[0], self.p2[1] - self.p1[1]
             self.p1 = (hx1 + w * v[0] / 100.0, hy1 + h * v[1] / 100.0)
             if len(v) >= 4:
                 self.p2 = (hx1 + w * v[2] / 100.0, hy1 + h * v[3] / 100.0)
-            else:
-                dx, dy = self.p2[0] - self.p1[0], self.p2[1] - self.p1[1]
+            else:  # P2 follows P1 (the P1-P2 distance is kept)
                 self.p2 = (self.p1[0] + dx, self.p1[1] + dy)
         self.update_scaling(offset)
 
@@ -601,7 +608,13 @@ class _Reader:
     def do_iw(self, v: list[float], offset: int) -> None:
         self.flush()
         if not v:
-            self.window = None
+            # the hard-clip limits: the page PS gave (unknown without PS, and not
+            # meaningful in this reader's rotate-about-the-origin frame under RO)
+            if self.page_known and self.rot == 0:
+                (x1, y1), (x2, y2) = self.hard
+                self.window = (min(x1, x2), min(y1, y2), max(x1, x2), max(y1, y2))
+            else:
+                self.window = None
             return
         if len(v) < 4:
             self.warn(offset, "IW needs four numbers; ignored", key="args-IW")
@@ -647,6 +660,12 @@ class _Reader:
                 if h is not None:
                     self.recognised += 1
                     params = m.group(2)
+                    jm = _JUNK_PARAM_RE.search(params)
+                    if jm is not None:
+                        bad = jm.group(0)[:8]
+                        self.warn(start + 2 + jm.start(),
+                                  f"{mn}: unexpected {bad!r} in the parameters ignored",
+                                  key=f"param-junk-{mn}")
                     h(params, start, mn)
                 elif mn in KNOWN:
                     self.recognised += 1
@@ -839,6 +858,7 @@ class _Reader:
             else:
                 w, h = DEFAULT_P2[0] - DEFAULT_P1[0], DEFAULT_P2[1] - DEFAULT_P1[1]
             self.hard = ((0.0, 0.0), (w, h))
+            self.page_known = bool(v)
             self.p1, self.p2 = self.hard
             self.update_scaling(off)
 
@@ -866,9 +886,6 @@ class _Reader:
 
         def edge_fill(params: bytes, off: int, mn: str) -> None:
             self.do_edge_fill(mn, off)
-
-        def sm(params: bytes, off: int, mn: str) -> None:  # only reached for 'SM;'
-            pass
 
         return {
             "PA": move(True, None),
@@ -907,7 +924,6 @@ class _Reader:
             "DF": df,
             "PG": pg,
             "LT": lt,
-            "SM": sm,
         }
 
     # ------------------------------------------------------------------ text-like commands
@@ -1010,13 +1026,11 @@ class _Reader:
         data = self.data
         dm = _DEVCTL_RE.match(data, i)
         if dm is not None:
-            self.recognised += 1
             return dm.end()
         m = _PCL_ESC_RE.match(data, i)
         if m is None:
             self.junk_bytes += 1
             return i + 1
-        self.recognised += 1
         if m.group(0) == b"\x1b%-12345X" or m.group(6) == b"E":
             self.flush()
             self.hpgl_mode = False
@@ -1052,7 +1066,6 @@ class _Reader:
         e = _PCL_ESC_RE.match(data, m.start())
         if e is None:
             return m.start() + 1
-        self.recognised += 1
         if e.group(1) == b"%" and e.group(5) == b"B":
             self.hpgl_mode = True
             return e.end()
@@ -1066,7 +1079,14 @@ _SPECIAL: dict[str, Callable[[_Reader, int], int]] = {
     "DT": _Reader.dt,
     "CO": _Reader.co,
     "PE": _Reader.pe,
+    "SM": _Reader.sm,
 }
+
+
+def _near(a: np.ndarray, b: np.ndarray) -> bool:
+    """Equal up to floating-point noise (a ring's end computed by trigonometry)."""
+    scale = max(1.0, float(np.abs(a).max()), float(np.abs(b).max()))
+    return bool(np.abs(a - b).max() <= 1e-9 * scale)
 
 
 def _clip_polyline(pts: np.ndarray, win: tuple[float, float, float, float]) -> list[np.ndarray]:
@@ -1141,25 +1161,28 @@ def read_bytes(data: bytes, name: str = "<bytes>") -> Drawing:
         raise InputError(name, "file too deeply nested to read") from exc
     body = len(data) - data.count(b"\x00")
     if rd.recognised == 0:
-        if not rd.hpgl_mode or _PCL_START_RE.match(data):
+        if not rd.hpgl_mode or _PCL_START_RE.match(data.lstrip(b"\x00")):
             raise InputError(name, "a PCL/PJL print job without HP-GL/2 graphics")
         raise InputError(name, "no HP-GL commands found: not an HP-GL/PLT file")
     if rd.junk_bytes > 0.5 * max(body, 1):
         share = 100.0 * rd.junk_bytes / max(body, 1)
         raise InputError(name, f"not HP-GL: {share:.0f}% of the file is not HP-GL commands")
+    # warnings about the whole file have no position (offset -1 -> line 0, column 0)
+    if rd.clipped:
+        rd.warn(rd.first_clip, f"{rd.clipped} path(s) clipped by the input window (IW)")
     if rd.pages > 1:
-        rd.warn(0, f"the file has {rd.pages} pages (PG); they are overlaid in one field")
+        rd.warn(-1, f"the file has {rd.pages} pages (PG); they are overlaid in one field")
     if rd.labels:
-        rd.warn(0, f"{rd.labels} text label(s) (LB) are not drawn: convert text to curves")
+        rd.warn(-1, f"{rd.labels} text label(s) (LB) are not drawn: convert text to curves")
     if rd.line_types:
-        rd.warn(0, "line types (LT) are not applied: every line is imported solid")
+        rd.warn(-1, "line types (LT) are not applied: every line is imported solid")
     if rd.text_symbols:
-        rd.warn(0, "symbol mode (SM) characters are not drawn")
+        rd.warn(-1, "symbol mode (SM) characters are not drawn")
     if not rd.paths:
-        rd.warn(0, "the file has no pen-down geometry")
+        rd.warn(-1, "the file has no pen-down geometry")
     for key, count in rd._warn_count.items():
         if count > _WARN_CAP:
-            rd._warn.append((rd.n, f"... and {count - _WARN_CAP} more warnings like: {key}"))
+            rd._warn.append((-1, f"... and {count - _WARN_CAP} more warnings like: {key}"))
     # positions
     offsets = [p[3] for p in rd.paths]
     w_offsets = [w[0] for w in rd._warn]
@@ -1169,8 +1192,7 @@ def read_bytes(data: bytes, name: str = "<bytes>") -> Drawing:
         paths.append(Path(pts, pen=pen, closed=closed, start=SourcePos(line, col)))
     warnings = []
     for (off, msg), (line, col) in zip(rd._warn, lc[len(offsets) :], strict=True):
-        if off <= 0 and msg[:1] != "." and off == 0 and msg.startswith(("the file", "line types",
-                                                                          "symbol", "text")):
+        if off < 0:
             line, col = 0, 0
         warnings.append(Warning(line, col, msg))
     warnings.sort(key=lambda w: (w.line == 0, w.line, w.col))

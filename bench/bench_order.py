@@ -1,0 +1,112 @@
+"""Order benchmark (issue 7): travel of greedy / optimized against LKH (elkai) and vpype.
+
+Instances: random short open strokes (reversible) of n = 200, 1000 (LKH can finish these)
+and 10,000 (timing only), plus the zig-zag hatch strokes of seal.plt and text_outline.plt.
+LKH gets the exact problem as a symmetric TSP: two nodes per stroke (its ends) joined by a
+forced zero edge, every other edge = distance + BIG, plus one free dummy node (an open
+path). Run in bench/.venv-fill (elkai, vpype). Prints a markdown table.
+"""
+
+from __future__ import annotations
+
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT))
+
+from galvo_core.fill import hatch  # noqa: E402
+from galvo_core.hpgl import read_file  # noqa: E402
+from galvo_core.order import Placement, order_strokes, travel_length  # noqa: E402
+from galvo_core.params import Params  # noqa: E402
+from galvo_core.pipeline import Pipeline  # noqa: E402
+
+
+def lkh(strokes: list[np.ndarray], runs: int = 1) -> tuple[float, float]:
+    import elkai
+
+    n = len(strokes)
+    ends = np.array([[s[0], s[-1]] for s in strokes]).reshape(-1, 2)  # node 2i, 2i+1
+    scale = 1000.0 / max(1e-9, float(np.ptp(ends)))
+    d = np.hypot(*(ends[:, None, :] - ends[None, :, :]).transpose(2, 0, 1)) * scale
+    big = int(d.max() * 4) + 10
+    m = 2 * n + 1
+    mat = np.full((m, m), big, dtype=np.int64)
+    mat[: 2 * n, : 2 * n] = np.rint(d * 1000).astype(np.int64) + big * 1000
+    mat[2 * n, :] = big * 1000
+    mat[:, 2 * n] = big * 1000
+    for i in range(n):
+        mat[2 * i, 2 * i + 1] = mat[2 * i + 1, 2 * i] = 0
+    np.fill_diagonal(mat, 0)
+    t0 = time.perf_counter()
+    tour = elkai.DistanceMatrix(mat.tolist()).solve_tsp(runs=runs)
+    dt = time.perf_counter() - t0
+    tour = tour[:-1] if tour[0] == tour[-1] else tour
+    k = tour.index(2 * n)
+    seq = tour[k + 1:] + tour[:k]
+    pls = []
+    for a, b in zip(seq[0::2], seq[1::2], strict=True):
+        assert a // 2 == b // 2, "LKH broke a forced edge"
+        pls.append(Placement(a // 2, a % 2 == 1))
+    return travel_length(strokes, pls), dt
+
+
+def vpype_sort(strokes: list[np.ndarray]) -> tuple[float, float]:
+    import vpype as vp
+
+    lc = vp.LineCollection([s[:, 0] + 1j * s[:, 1] for s in strokes])
+    t0 = time.perf_counter()
+    index = vp.LineIndex(lc[1:], reverse=True)
+    new = lc.clone([lc[0]])
+    while len(index) > 0:
+        idx, rev = index.find_nearest(new[-1][-1])
+        line = index.pop(idx)
+        if line is not None:
+            new.append(np.flip(line) if rev else line)
+    dt = time.perf_counter() - t0
+    return float(new.pen_up_length()[0]), dt
+
+
+def instances() -> list[tuple[str, list[np.ndarray]]]:
+    out = []
+    rng = np.random.default_rng(7)
+    for n in (200, 1000, 10000):
+        a = rng.uniform(0, 1000, (n, 2))
+        out.append((f"random {n} segments", list(np.stack([a, a + rng.normal(0, 10, (n, 2))], 1))))
+    for name in ("seal.plt", "text_outline.plt"):
+        d = read_file(ROOT / "resources" / "samples" / name)
+        sp = Pipeline().field_map(d, Params()).mm_to_units(0.05)
+        for fill in ("zigzag", "scanline"):
+            st = [s.points for s in hatch(d, fill=fill, spacing_units=sp, angle_deg=15.0)]
+            out.append((f"{name} {fill} hatch ({len(st)})", st))
+    return out
+
+
+def main() -> None:
+    print("| instance | strokes | file | vpype greedy | greedy (s) | optimized 1 s (s) | "
+          "LKH (s) | optimized / LKH |")
+    print("| --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: |")
+    for name, st in instances():
+        n = len(st)
+        f = travel_length(st, [Placement(i) for i in range(n)])
+        t0 = time.perf_counter()
+        g = travel_length(st, order_strokes(st, method="greedy"))
+        tg = time.perf_counter() - t0
+        t0 = time.perf_counter()
+        o = travel_length(st, order_strokes(st, method="optimized", time_budget_s=1.0))
+        to = time.perf_counter() - t0
+        v, _ = vpype_sort(st)
+        if n <= 1000:
+            lk, tl = lkh(st)
+            lk_s, ratio = f"{lk:.0f} ({tl:.1f})", f"{o / lk:.3f}" if lk > 0 else "-"
+        else:
+            lk_s, ratio = "too large", "-"
+        print(f"| {name} | {n} | {f:.0f} | {v:.0f} | {g:.0f} ({tg:.2f}) | {o:.0f} ({to:.2f}) | "
+              f"{lk_s} | {ratio} |")
+
+
+if __name__ == "__main__":
+    main()

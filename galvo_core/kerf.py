@@ -1,0 +1,662 @@
+"""Kerf (laser trough) compensation: grow or shrink the design's regions (seed paper 003).
+
+The beam marks a trough ``kerf_mm`` wide on the workpiece, so every region boundary is moved
+by ``d = kerf_mm / 2`` (converted to input units with :meth:`FieldMap.mm_to_units`).
+
+Sign convention (explicit, as design/methods.md §5 asks)
+--------------------------------------------------------
+``side="outside"`` **grows** the design's regions: outer rings move outwards, holes move
+inwards (the paper's case: raised characters whose background is burnt away, so the trough
+must run outside the strokes). ``side="inside"`` **shrinks** them (the trough runs inside
+the outline). Regions come from the closed paths of one pen by the even-odd rule: a point
+inside an odd number of rings is in the region (so a ring inside another is a hole, and
+where two rings overlap the overlap is a hole, as a ray-crossing hatch fill would mark it).
+Different pens are different layers and are compensated separately. Open paths, dots and
+closed paths that enclose no area are left as they are (one warning says how many).
+
+Methods
+-------
+``"vector"`` (default, the paper's *parallel movement*): the exact parallel offset of the
+even-odd region by shapely/GEOS ``buffer`` with round joins. At a convex corner the offset
+is an arc of radius ``d`` around the corner (the paper replaces the far-away intersection at
+acute corners by that arc); concave corners are exact intersections. The arcs are drawn
+with ``quad_segs`` segments per quarter circle, chosen so the sagitta of every chord,
+``d (1 - cos(θ/2))``, stays within ``arc_tol_bits`` galvo bits. GEOS handles holes,
+self-touching rings, rings that vanish and rings that merge. Why GEOS and not Clipper2:
+shapely (GEOS) is already a dependency, is well kept, gives the same result within the arc
+tolerance (bench/RESULTS.md, "Kerf (issue 6)"), and works on floating-point coordinates;
+Clipper2's Python bindings ``pyclipr`` ship no wheel for this platform (its source build
+fails), so a Clipper2 dependency would be a build risk for every user.
+
+``"raster"`` (the paper's *zero-point expansion*): rasterise the even-odd region at a
+resolution of ``raster_res_bits`` (default: 1 galvo bit, coarsened so the raster has at most
+about 4 Mpixel and the disc radius is at most 64 pixels), compute the Euclidean distance to
+the nearest kept (``outside``) or removed (``inside``) pixel by two separable passes
+(numpy only), threshold it at ``d`` and trace the level set back to rings by marching
+squares with linear interpolation (vectorised: cycles are linked by pointer jumping), then
+simplify within half a pixel. Accuracy: about one pixel.
+
+``"rectangle"`` (the paper's *solid rectangles*): hatch each region with horizontal scan
+segments ``h <= d / 2`` apart, make each segment a solid rectangle reaching ``d`` beyond it
+on every side, and take the union (GEOS ``union_all``); ``inside`` does the same to the
+complement within a bounding box and subtracts it. A rectangle is the Minkowski sum with a
+square, so edges at 45° move by up to ``d·√2``; each scan segment stands for a strip of
+height ``h``, so horizontal edges are off by up to ``h/2``, and the staircase is simplified
+within ``h/2``: the method's stated tolerance is ``(√2 - 1) d + h`` with ``h = d/4``.
+
+Mapping back to the source paths (``source_index``)
+---------------------------------------------------
+:func:`compensate_indexed` returns the new drawing and ``origin``: ``origin[k]`` is the index
+in the *input* drawing of the path that output path ``k`` came from. The output keeps the
+input's path order: for each input path in turn, an open path is copied unchanged; a closed
+ring is replaced by the compensated rings assigned to it (zero, one or several). A
+compensated ring is assigned to the *lowest index* among the source rings that its vertices
+are nearest to; so a ring that splits into
+two keeps its index for both, and rings that merge take the first (lowest) index. A source
+ring that no output ring touches has vanished (``inside``: narrower than the kerf) or been
+swallowed (``outside``: a hole closed up); each gives a warning naming the path and its
+place in the file. Output rings keep ``pen`` and ``start`` of their source ring, are closed
+(first point == last point), exteriors counter-clockwise, holes clockwise, each starting at
+the vertex nearest to the source ring's first point.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+
+import numpy as np
+import shapely
+from shapely.geometry.base import BaseGeometry
+
+from galvo_core.drawing import Drawing, Path, Warning
+from galvo_core.errors import ParamError
+from galvo_core.field import FieldMap
+from galvo_core.params import KERF_METHODS, KERF_SIDES
+
+#: default raster size limit (pixels) and largest disc radius (pixels) for ``raster``
+RASTER_MAX_PIXELS = 4_000_000
+RASTER_MAX_RADIUS_PX = 64.0
+#: an explicit raster_res_bits may not make a raster larger than this
+RASTER_HARD_LIMIT = 25_000_000
+#: quad_segs bounds for the vector method
+MAX_QUAD_SEGS = 512
+#: scan spacing of the rectangle method as a fraction of d
+RECT_SPACING = 0.25
+
+
+# --------------------------------------------------------------------------- public API
+def compensate(
+    drawing: Drawing,
+    *,
+    kerf_mm: float,
+    side: str,
+    method: str,
+    fm: FieldMap,
+    arc_tol_bits: float = 1.0,
+    raster_res_bits: float | None = None,
+) -> Drawing:
+    """A new drawing whose closed regions are grown (``outside``) or shrunk (``inside``) by
+    ``kerf_mm / 2`` on the workpiece. ``kerf_mm == 0`` returns ``drawing`` itself.
+
+    See the module docstring for the methods, the sign convention and how output paths map
+    to input paths (use :func:`compensate_indexed` to get that mapping).
+    """
+    return compensate_indexed(drawing, kerf_mm=kerf_mm, side=side, method=method, fm=fm,
+                              arc_tol_bits=arc_tol_bits, raster_res_bits=raster_res_bits)[0]
+
+
+def compensate_indexed(
+    drawing: Drawing,
+    *,
+    kerf_mm: float,
+    side: str,
+    method: str,
+    fm: FieldMap,
+    arc_tol_bits: float = 1.0,
+    raster_res_bits: float | None = None,
+) -> tuple[Drawing, tuple[int, ...]]:
+    """Like :func:`compensate`, also returning ``origin``: for each output path, the index
+    of the input path it came from (non-decreasing)."""
+    _check(drawing, kerf_mm, side, method, fm, arc_tol_bits, raster_res_bits)
+    n = len(drawing.paths)
+    if kerf_mm == 0:
+        return drawing, tuple(range(n))
+    d = fm.mm_to_units(kerf_mm / 2.0)
+    tol = fm.bits_to_units(arc_tol_bits)
+    res_auto = raster_res_bits is None
+    res = fm.bits_to_units(1.0 if raster_res_bits is None else raster_res_bits)
+
+    rings, passthrough = _split(drawing)
+    out_by_src: dict[int, list[np.ndarray]] = {}
+    touched: set[int] = set()
+    for idx in _by_pen(drawing, rings).values():
+        region = even_odd_region([drawing.paths[i].points for i in idx])
+        result = _apply(region, d, side, method, tol, res, res_auto)
+        assign, contrib = _assign(result, [drawing.paths[i].points for i in idx])
+        touched.update(idx[j] for j in contrib)
+        for ring, j in assign:
+            out_by_src.setdefault(idx[j], []).append(ring)
+
+    paths: list[Path] = []
+    origin: list[int] = []
+    for i, p in enumerate(drawing.paths):
+        if i in passthrough:
+            paths.append(p)
+            origin.append(i)
+            continue
+        for ring in out_by_src.get(i, []):
+            paths.append(p.with_points(_start_near(ring, p.points[0]), closed=True))
+            origin.append(i)
+
+    warnings: list[Warning] = []
+    if passthrough:
+        first = drawing.paths[min(passthrough)].start
+        warnings.append(Warning(0, 0, (
+            f"kerf compensation: {len(passthrough)} open or degenerate paths (not closed "
+            f"rings enclosing area) were left as they are (the first at {first})")))
+    for i in rings:
+        if i in touched:
+            continue
+        p = drawing.paths[i]
+        what = ("vanished: it is narrower than the kerf" if side == "inside" else
+                "was swallowed: the grown regions cover it (a hole closed up)")
+        warnings.append(Warning(p.start.line, p.start.col, (
+            f"kerf compensation ({side}, {kerf_mm:g} mm): path {i} (pen {p.pen}, "
+            f"{p.start}) {what}")))
+    return drawing.with_paths(paths, warnings=warnings), tuple(origin)
+
+
+def quad_segs_for(d: float, tol: float) -> int:
+    """Segments per quarter circle so that a chord's sagitta on radius ``d`` is <= ``tol``."""
+    if d <= 0 or tol >= d:
+        return 1
+    theta = 2.0 * math.acos(1.0 - tol / d)
+    return int(min(MAX_QUAD_SEGS, max(1, math.ceil((math.pi / 2.0) / theta))))
+
+
+def compensate_geometry(region: BaseGeometry, d: float, *, side: str, method: str,
+                        tol: float, res: float, res_auto: bool = True) -> BaseGeometry:
+    """The compensated region of a valid (Multi)Polygon: offset distance ``d``, arc
+    tolerance ``tol`` and raster pixel ``res`` (coarsened when ``res_auto``), all in input
+    units. Exposed for the benchmark and the tests."""
+    return _apply(region, d, side, method, tol, res, res_auto)
+
+
+# --------------------------------------------------------------------------- checks
+def _check(drawing: Drawing, kerf_mm: float, side: str, method: str, fm: FieldMap,
+           arc_tol_bits: float, raster_res_bits: float | None) -> None:
+    if isinstance(kerf_mm, bool) or not isinstance(kerf_mm, (int, float)) \
+            or not math.isfinite(kerf_mm):
+        raise ParamError(f"kerf_mm must be a finite number, got {kerf_mm!r}")
+    if kerf_mm < 0:
+        raise ParamError(f"kerf_mm must be >= 0 (the trough's width in mm), got {kerf_mm!r}")
+    if side not in KERF_SIDES:
+        raise ParamError(f"kerf_side must be one of {', '.join(KERF_SIDES)}; got {side!r}")
+    if method not in KERF_METHODS:
+        raise ParamError(f"kerf_method must be one of {', '.join(KERF_METHODS)}; got {method!r}")
+    if not (isinstance(arc_tol_bits, (int, float)) and math.isfinite(arc_tol_bits)
+            and arc_tol_bits > 0):
+        raise ParamError(f"arc_tol_bits must be a positive finite number, got {arc_tol_bits!r}")
+    if raster_res_bits is not None and not (
+            isinstance(raster_res_bits, (int, float)) and math.isfinite(raster_res_bits)
+            and raster_res_bits > 0):
+        raise ParamError(
+            f"raster_res_bits must be a positive finite number, got {raster_res_bits!r}")
+    if kerf_mm == 0:
+        return
+    bb = drawing.bbox()
+    size_mm = 0.0 if bb is None else max(bb[2] - bb[0], bb[3] - bb[1]) * fm.mm_per_unit
+    if kerf_mm > size_mm:
+        raise ParamError(
+            f"kerf_mm = {kerf_mm:g} mm is larger than the drawing itself ({size_mm:.3g} mm on "
+            f"the workpiece at magnification {fm.magnification:g}); the kerf is the width of "
+            "the laser's trough, typically 0.02-0.2 mm")
+
+
+# --------------------------------------------------------------------------- inputs
+def _split(drawing: Drawing) -> tuple[list[int], set[int]]:
+    """Indices of closed rings that enclose area, and of everything else."""
+    rings: list[int] = []
+    other: set[int] = set()
+    for i, p in enumerate(drawing.paths):
+        pts = p.points
+        if p.closed and len(pts) >= 4 and abs(_signed_area(pts)) > 0:
+            rings.append(i)
+        else:
+            other.add(i)
+    return rings, other
+
+
+def _by_pen(drawing: Drawing, rings: list[int]) -> dict[int, list[int]]:
+    out: dict[int, list[int]] = {}
+    for i in rings:
+        out.setdefault(drawing.paths[i].pen, []).append(i)
+    return out
+
+
+def _signed_area(pts: np.ndarray) -> float:
+    x, y = pts[:, 0], pts[:, 1]
+    return 0.5 * float(np.dot(x[:-1], y[1:]) - np.dot(x[1:], y[:-1]))
+
+
+def _closed(pts: np.ndarray) -> np.ndarray:
+    pts = np.asarray(pts, dtype=np.float64)
+    if len(pts) and not np.array_equal(pts[0], pts[-1]):
+        pts = np.vstack([pts, pts[:1]])
+    return pts
+
+
+def _segments(rings: Sequence[np.ndarray]) -> tuple[np.ndarray, np.ndarray]:
+    """All edges of closed rings as (S, 2) start and end points."""
+    a = np.concatenate([r[:-1] for r in rings]) if rings else np.zeros((0, 2))
+    b = np.concatenate([r[1:] for r in rings]) if rings else np.zeros((0, 2))
+    return a, b
+
+
+def even_odd_region(rings: Sequence[np.ndarray]) -> BaseGeometry:
+    """The valid (Multi)Polygon that the closed rings enclose by the even-odd rule.
+
+    Rings may touch, cross themselves and each other. Fast path: simple rings that do not
+    touch one another are nested by containment. General path: node all rings (GEOS
+    union of the linework), polygonize the faces and keep the faces whose interior point
+    has an odd ray-crossing count against the original edges.
+    """
+    rings = [_closed(r) for r in rings]
+    rings = [r for r in rings if len(r) >= 4]
+    if not rings:
+        return shapely.Polygon()
+    lrs = _linearrings(rings)
+    polys = shapely.polygons(lrs)
+    simple = bool(shapely.is_valid(polys).all())
+    if simple and len(rings) > 1:
+        tree = shapely.STRtree(lrs)
+        pairs = tree.query(lrs, predicate="intersects")
+        simple = bool((pairs[0] == pairs[1]).all())
+    if simple:
+        return _nest(polys)
+    noded = shapely.union_all(shapely.linestrings(np.concatenate(rings), indices=np.repeat(
+        np.arange(len(rings)), [len(r) for r in rings])))
+    faces = shapely.get_parts(shapely.polygonize(shapely.get_parts(noded)))
+    faces = faces[shapely.area(faces) > 0]
+    if len(faces) == 0:
+        return shapely.Polygon()
+    pts = shapely.get_coordinates(shapely.point_on_surface(faces))
+    a, b = _segments(rings)
+    odd = _crossings(pts, a, b) % 2 == 1
+    keep = faces[odd]
+    if len(keep) == 0:
+        return shapely.Polygon()
+    out = shapely.coverage_union_all(keep)
+    if not shapely.is_valid(out):
+        out = shapely.make_valid(shapely.union_all(keep))
+    return _polygonal(out)
+
+
+def _linearrings(rings: Sequence[np.ndarray]) -> np.ndarray:
+    """An array of LinearRings from closed coordinate arrays of different lengths."""
+    return shapely.linearrings(np.concatenate(rings), indices=np.repeat(
+        np.arange(len(rings)), [len(r) for r in rings]))
+
+
+def _nest(polys: np.ndarray) -> BaseGeometry:
+    """Even-odd of simple, pairwise disjoint rings (as polygons): depth by containment."""
+    n = len(polys)
+    if n == 1:
+        return shapely.orient_polygons(polys[0])
+    tree = shapely.STRtree(polys)
+    reps = shapely.points(shapely.get_coordinates(shapely.get_exterior_ring(polys))[
+        np.cumsum([0] + [int(c) for c in shapely.get_num_coordinates(polys)[:-1]])])
+    # a ring's first vertex lies strictly inside every ring that contains it (no touching)
+    inner, outer = tree.query(reps, predicate="within")
+    keep = inner != outer
+    inner, outer = inner[keep], outer[keep]
+    depth = np.bincount(inner, minlength=n)
+    areas = shapely.area(polys)
+    parent = np.full(n, -1)
+    # parent = the smallest container
+    order = np.argsort(-areas[outer], kind="stable")
+    parent[inner[order]] = outer[order]
+    shells = np.nonzero(depth % 2 == 0)[0]
+    holes: dict[int, list[np.ndarray]] = {}
+    for h in np.nonzero(depth % 2 == 1)[0]:
+        holes.setdefault(int(parent[h]), []).append(
+            shapely.get_coordinates(shapely.get_exterior_ring(polys[h])))
+    out = [shapely.Polygon(shapely.get_coordinates(shapely.get_exterior_ring(polys[s])),
+                           holes.get(int(s), [])) for s in shells]
+    geom = shapely.MultiPolygon(out) if len(out) > 1 else out[0]
+    return shapely.orient_polygons(geom)
+
+
+def _crossings(pts: np.ndarray, a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """For each point, how many edges a horizontal ray to +x crosses (half-open rule)."""
+    n = len(pts)
+    if n == 0 or len(a) == 0:
+        return np.zeros(n, dtype=np.int64)
+    order = np.argsort(pts[:, 1], kind="stable")
+    py = pts[order, 1]
+    ylo = np.minimum(a[:, 1], b[:, 1])
+    yhi = np.maximum(a[:, 1], b[:, 1])
+    lo = np.searchsorted(py, ylo, side="left")
+    hi = np.searchsorted(py, yhi, side="left")
+    cnt = np.maximum(hi - lo, 0)
+    counts = np.zeros(n, dtype=np.int64)
+    chunk = 4_000_000
+    seg_all = np.nonzero(cnt)[0]
+    csum = np.cumsum(cnt[seg_all])
+    start = 0
+    while start < len(seg_all):
+        # take segments until about `chunk` pairs
+        stop = int(np.searchsorted(csum, (csum[start - 1] if start else 0) + chunk,
+                                   side="right"))
+        stop = max(stop, start + 1)
+        segs = seg_all[start:stop]
+        c = cnt[segs]
+        seg = np.repeat(segs, c)
+        off = np.arange(len(seg)) - np.repeat(np.cumsum(c) - c, c)
+        k = lo[seg] + off
+        p = pts[order[k]]
+        ax, ay, bx, by = a[seg, 0], a[seg, 1], b[seg, 0], b[seg, 1]
+        x = ax + (p[:, 1] - ay) * (bx - ax) / (by - ay)
+        hit = x > p[:, 0]
+        counts += np.bincount(order[k[hit]], minlength=n)
+        start = stop
+    return counts
+
+
+def _polygonal(geom: BaseGeometry) -> BaseGeometry:
+    """Keep only the polygons of a geometry (GEOS may return collections)."""
+    parts = [g for g in shapely.get_parts(geom)
+             if g.geom_type in ("Polygon", "MultiPolygon") and not g.is_empty]
+    polys = [q for g in parts for q in shapely.get_parts(g)]
+    if not polys:
+        return shapely.Polygon()
+    return shapely.MultiPolygon(polys) if len(polys) > 1 else polys[0]
+
+
+# --------------------------------------------------------------------------- methods
+def _apply(region: BaseGeometry, d: float, side: str, method: str, tol: float,
+           res: float, res_auto: bool) -> BaseGeometry:
+    if region.is_empty or d <= 0:
+        return region
+    if method == "vector":
+        out = _vector(region, d, side, tol)
+    elif method == "raster":
+        out = _raster(region, d, side, res, res_auto)
+    else:
+        out = _rectangle(region, d, side)
+    out = _polygonal(out)
+    if not out.is_valid:
+        out = _polygonal(shapely.make_valid(out))
+    return shapely.orient_polygons(out)
+
+
+def _vector(region: BaseGeometry, d: float, side: str, tol: float) -> BaseGeometry:
+    q = quad_segs_for(d, tol)
+    dist = d if side == "outside" else -d
+    return shapely.buffer(region, dist, quad_segs=q, join_style="round")
+
+
+def _scan(rings: Sequence[np.ndarray], y0: float, h: float, n: int
+          ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Even-odd intervals of closed rings on the scan lines y = y0 + k h, k = 0..n-1:
+    arrays (k, x_in, x_out), sorted by k then x."""
+    a, b = _segments(rings)
+    ylo = np.minimum(a[:, 1], b[:, 1])
+    yhi = np.maximum(a[:, 1], b[:, 1])
+    k0 = np.clip(np.ceil((ylo - y0) / h).astype(np.int64) - 1, 0, n)
+    k1 = np.clip(np.ceil((yhi - y0) / h).astype(np.int64) + 1, 0, n)
+    cnt = np.maximum(k1 - k0, 0)
+    seg = np.repeat(np.arange(len(a)), cnt)
+    k = k0[seg] + (np.arange(len(seg)) - np.repeat(np.cumsum(cnt) - cnt, cnt))
+    y = y0 + k * h
+    ok = (ylo[seg] <= y) & (y < yhi[seg])
+    seg, k, y = seg[ok], k[ok], y[ok]
+    ax, ay, bx, by = a[seg, 0], a[seg, 1], b[seg, 0], b[seg, 1]
+    x = ax + (y - ay) * (bx - ax) / (by - ay)
+    order = np.lexsort((x, k))
+    k, x = k[order], x[order]
+    # crossings per row are even (half-open rule on closed rings): pair them up
+    return k[0::2], x[0::2], x[1::2]
+
+
+def _geom_rings(geom: BaseGeometry) -> list[np.ndarray]:
+    polys = shapely.get_parts(geom)
+    rings = shapely.get_rings(polys)
+    return [shapely.get_coordinates(r) for r in rings]
+
+
+def _rectangle(region: BaseGeometry, d: float, side: str) -> BaseGeometry:
+    h = d * RECT_SPACING
+    if side == "outside":
+        return _grow_rect(region, d, h).simplify(h / 2.0, preserve_topology=True)
+    x0, y0, x1, y1 = region.bounds
+    m = 2 * d + 2 * h
+    box = shapely.box(x0 - m, y0 - m, x1 + m, y1 + m)
+    comp = box.difference(region)
+    grown = _grow_rect(comp, d, h)
+    return region.difference(grown).simplify(h / 2.0, preserve_topology=True)
+
+
+def _grow_rect(region: BaseGeometry, d: float, h: float) -> BaseGeometry:
+    """The paper's solid rectangles: the hatch segments of the region, ``h`` apart, each
+    standing for a strip of height ``h``, thickened by ``d`` on every side and united."""
+    x0, y0, x1, y1 = region.bounds
+    n = int(math.ceil((y1 - y0) / h)) + 1
+    ys0 = y0 + ((y1 - y0) - (n - 1) * h) / 2.0
+    k, xa, xb = _scan(_geom_rings(region), ys0, h, n)
+    y = ys0 + k * h
+    ext = d + h / 2.0
+    return shapely.union_all(shapely.box(xa - d, y - ext, xb + d, y + ext))
+
+
+def _raster(region: BaseGeometry, d: float, side: str, res: float, auto: bool
+            ) -> BaseGeometry:
+    """Pick the pixel size (``auto``: at least ``res``, coarsened to the pixel and radius
+    limits) and run the raster method."""
+    r = float(res)
+    if auto:
+        x0, y0, x1, y1 = region.bounds
+        w, hgt = (x1 - x0) + 2 * d, (y1 - y0) + 2 * d
+        r = max(r, math.sqrt(w * hgt / RASTER_MAX_PIXELS), d / RASTER_MAX_RADIUS_PX)
+    return _raster_at(region, d, side, r)
+
+
+def _raster_at(region: BaseGeometry, d: float, side: str, r: float) -> BaseGeometry:
+    x0, y0, x1, y1 = region.bounds
+    level = d / r + 0.5  # pixel centres lie on average half a pixel inside the boundary
+    margin = int(math.ceil(level)) + 3
+    W = int(math.ceil((x1 - x0) / r)) + 2 * margin
+    H = int(math.ceil((y1 - y0) / r)) + 2 * margin
+    if W * H > RASTER_HARD_LIMIT:
+        raise ParamError(
+            f"the raster kerf method would need {W} x {H} pixels at {r:g} units per pixel; "
+            "choose a coarser raster_res_bits or the vector method")
+    gx0 = x0 - margin * r
+    gy0 = y0 - margin * r
+    img = _rasterise(_geom_rings(region), gx0, gy0, r, W, H)
+    feature = img if side == "outside" else ~img
+    dist = np.sqrt(_edt2(feature, int(math.ceil(level)) + 2))
+    field = (level - dist) if side == "outside" else (dist - level)
+    rings = _marching_squares(field)
+    if not rings:
+        return shapely.Polygon()
+    rings = [np.column_stack([gx0 + (rr[:, 0] + 0.5) * r, gy0 + (rr[:, 1] + 0.5) * r])
+             for rr in rings]
+    geom = _nest_rings(rings)
+    return geom.simplify(0.5 * r, preserve_topology=True)
+
+
+def _rasterise(rings: list[np.ndarray], gx0: float, gy0: float, r: float, W: int, H: int
+               ) -> np.ndarray:
+    """Even-odd fill at pixel centres: img[i, j] covers (gx0 + (j+.5) r, gy0 + (i+.5) r)."""
+    k, xa, xb = _scan(rings, gy0 + 0.5 * r, r, H)
+    ja = np.clip(np.ceil((xa - gx0) / r - 0.5).astype(np.int64), 0, W)
+    jb = np.clip(np.ceil((xb - gx0) / r - 0.5).astype(np.int64), 0, W)
+    diff = np.zeros(H * (W + 1), dtype=np.int32)
+    diff += np.bincount(k * (W + 1) + ja, minlength=H * (W + 1)).astype(np.int32)
+    diff -= np.bincount(k * (W + 1) + jb, minlength=H * (W + 1)).astype(np.int32)
+    return (np.cumsum(diff.reshape(H, W + 1), axis=1)[:, :W] > 0)
+
+
+def _edt2(feature: np.ndarray, cap: int) -> np.ndarray:
+    """Squared Euclidean distance (pixels) from each pixel centre to the nearest feature
+    pixel, exact up to ``cap`` and at least cap² beyond. Two separable passes: the 1-D
+    distance along each column, then the lower envelope of shifted parabolas along each
+    row, limited to ``|shift| <= cap``."""
+    H, W = feature.shape
+    big = cap + 1
+    idx = np.arange(H)[:, None]
+    prev = np.where(feature, idx, -10 * big - 10)
+    prev = np.maximum.accumulate(prev, axis=0)
+    nxt = np.where(feature, idx, H + 10 * big + 10)
+    nxt = np.minimum.accumulate(nxt[::-1], axis=0)[::-1]
+    g = np.minimum(np.minimum(idx - prev, nxt - idx), big).astype(np.float32)
+    g2 = g * g
+    out = g2.copy()
+    inf = np.float32(big * big)
+    for s in range(1, cap + 1):
+        s2 = np.float32(s * s)
+        if s2 >= inf:
+            break
+        np.minimum(out[:, s:], g2[:, :-s] + s2, out=out[:, s:])
+        np.minimum(out[:, :-s], g2[:, s:] + s2, out=out[:, :-s])
+    return out
+
+
+def _marching_squares(f: np.ndarray) -> list[np.ndarray]:
+    """Closed rings of the level set f = 0 (inside: f > 0) in pixel coordinates (x = column,
+    y = row), exteriors counter-clockwise, holes clockwise. The field is padded with an
+    outside border, so every ring closes. Saddles are resolved by the cell's mean value."""
+    f = np.pad(f.astype(np.float64), 1, constant_values=-1.0)
+    f[f == 0] = -1e-9  # no value exactly on the level
+    H, W = f.shape
+    ins = f > 0
+    c0 = ins[:-1, :-1]  # (i, j)      bottom-left
+    c1 = ins[:-1, 1:]   # (i, j+1)    bottom-right
+    c2 = ins[1:, 1:]    # (i+1, j+1)  top-right
+    c3 = ins[1:, :-1]   # (i+1, j)    top-left
+    case = c0.astype(np.uint8) | (c1 << 1) | (c2 << 2) | (c3 << 3)
+    ci, cj = np.nonzero((case != 0) & (case != 15))
+    if len(ci) == 0:
+        return []
+    b = np.stack([c0[ci, cj], c1[ci, cj], c2[ci, cj], c3[ci, cj]], axis=1)
+    nH = H * W
+    # edge ids of the cell's CCW edges: bottom H(i,j), right V(i,j+1), top H(i+1,j), left V(i,j)
+    e = np.stack([ci * W + cj, nH + ci * W + cj + 1, (ci + 1) * W + cj, nH + ci * W + cj],
+                 axis=1)
+    bn = np.roll(b, -1, axis=1)
+    io = b & ~bn   # edge k goes inside -> outside (CCW)
+    oi = ~b & bn
+    nio = io.sum(axis=1)
+    single = nio == 1
+    src = [e[single][io[single]]]
+    dst = [e[single][oi[single]]]
+    sad = nio == 2
+    if sad.any():
+        si, sj = ci[sad], cj[sad]
+        centre = (f[si, sj] + f[si, sj + 1] + f[si + 1, sj + 1] + f[si + 1, sj]) > 0
+        es, ios = e[sad], io[sad]
+        ks = np.nonzero(ios)[1].reshape(-1, 2)  # the two in->out edges, (0,2) or (1,3)
+        rows = np.arange(len(es))[:, None]
+        step = np.where(centre, 1, -1)[:, None]
+        src.append(es[rows, ks].ravel())
+        dst.append(es[rows, (ks + step) % 4].ravel())
+    s = np.concatenate(src)
+    t = np.concatenate(dst)
+    ids = np.unique(s)
+    si_ = np.searchsorted(ids, s)
+    nxt = np.empty(len(ids), dtype=np.int64)
+    nxt[si_] = np.searchsorted(ids, t)
+    # crossing points
+    horiz = ids < nH
+    loc = np.where(horiz, ids, ids - nH)
+    pi, pj = loc // W, loc % W
+    qi = np.where(horiz, pi, pi + 1)
+    qj = np.where(horiz, pj + 1, pj)
+    fa, fb = f[pi, pj], f[qi, qj]
+    tt = fa / (fa - fb)
+    px = pj + np.where(horiz, tt, 0.0)
+    py = pi + np.where(horiz, 0.0, tt)
+    # cycles: min label by pointer jumping, then rank from the head by list ranking
+    n = len(ids)
+    lab = np.arange(n)
+    p = nxt.copy()
+    m = lab.copy()
+    for _ in range(max(1, int(np.ceil(np.log2(n + 1))) + 1)):
+        m = np.minimum(m, m[p])
+        p = p[p]
+    head = m == lab
+    # break each cycle before its head: the node whose next is a head ends the list
+    nb = np.where(head[nxt], lab, nxt)
+    dist = np.where(nb == lab, 0, 1)
+    p = nb.copy()
+    for _ in range(max(1, int(np.ceil(np.log2(n + 1))) + 1)):
+        dist = dist + dist[p]
+        p = p[p]
+    order = np.lexsort((-dist, m))
+    ms = m[order]
+    cuts = np.nonzero(np.diff(ms))[0] + 1
+    # coordinates: x = column - 1 (undo the pad), y = row - 1
+    xy = np.column_stack([px[order] - 1.0, py[order] - 1.0])
+    out = []
+    for part in np.split(xy, cuts):
+        if len(part) >= 3:
+            out.append(np.vstack([part, part[:1]]))
+    return out
+
+
+def _nest_rings(rings: list[np.ndarray]) -> BaseGeometry:
+    """Polygons from disjoint simple rings (CCW shells, CW holes, as marching squares
+    makes them): each hole goes to the smallest shell containing it."""
+    areas = np.array([_signed_area(r) for r in rings])
+    shells = [i for i in range(len(rings)) if areas[i] > 0]
+    holes = [i for i in range(len(rings)) if areas[i] < 0]
+    if not shells:
+        return shapely.Polygon()
+    shell_polys = shapely.polygons(_linearrings([rings[i] for i in shells]))
+    tree = shapely.STRtree(shell_polys)
+    assigned: dict[int, list[np.ndarray]] = {}
+    if holes:
+        pts = shapely.points(np.array([rings[h][0] for h in holes]))
+        hi, si = tree.query(pts, predicate="within")
+        sa = areas[np.array(shells)][si]
+        best: dict[int, tuple[float, int]] = {}
+        for h, s, a in zip(hi.tolist(), si.tolist(), sa.tolist(), strict=True):
+            if h not in best or a < best[h][0]:
+                best[h] = (a, s)
+        for h, (_, s) in best.items():
+            assigned.setdefault(s, []).append(rings[holes[h]])
+    polys = [shapely.Polygon(rings[shells[k]], assigned.get(k, [])) for k in range(len(shells))]
+    return shapely.MultiPolygon(polys) if len(polys) > 1 else polys[0]
+
+
+# --------------------------------------------------------------------------- output
+def _assign(result: BaseGeometry, sources: list[np.ndarray]
+            ) -> tuple[list[tuple[np.ndarray, int]], set[int]]:
+    """Each output ring with the (local) index of its source ring: the lowest index among
+    the source rings nearest to its vertices. Also the set of source rings that some
+    output vertex is nearest to."""
+    rings = _geom_rings(result) if not result.is_empty else []
+    rings = [r for r in rings if len(r) >= 4]
+    if not rings:
+        return [], set()
+    if len(sources) == 1:
+        return [(r, 0) for r in rings], {0}
+    tree = shapely.STRtree(shapely.linestrings(
+        np.concatenate(sources),
+        indices=np.repeat(np.arange(len(sources)), [len(s) for s in sources])))
+    pts = np.concatenate([r[:-1] for r in rings])
+    which = np.repeat(np.arange(len(rings)), [len(r) - 1 for r in rings])
+    _, near = tree.query_nearest(shapely.points(pts), all_matches=False, return_distance=False)
+    lowest = np.full(len(rings), np.iinfo(np.int64).max)
+    np.minimum.at(lowest, which, near)
+    return [(r, int(j)) for r, j in zip(rings, lowest, strict=True)], set(near.tolist())
+
+
+def _start_near(ring: np.ndarray, p: np.ndarray) -> np.ndarray:
+    """The closed ring rotated to start at its vertex nearest to ``p``."""
+    body = ring[:-1]
+    k = int(np.argmin(((body - p) ** 2).sum(axis=1)))
+    body = np.roll(body, -k, axis=0)
+    return np.vstack([body, body[:1]])

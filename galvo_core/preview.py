@@ -1,0 +1,698 @@
+"""Display geometry for the workstation's views (numpy only, never Qt).
+
+Everything a view draws is computed here, so the GUI only hands arrays to plot items:
+
+* polylines are returned as one ``(N, 2)`` float64 array with a row of NaN between
+  consecutive pieces (one plot item draws them all with ``connect="finite"``), plus an
+  ``ids`` array (``(N,)`` int64, -1 on the NaN rows) naming the source path of each row;
+* positions are in *workpiece millimetres of the field*: a galvo bit ``X`` is at
+  ``X * mm_per_bit`` mm, so the field is the square ``0 .. field_size_mm`` and a point ``p``
+  of the drawing (input units) is at ``(p * magnification + offset_bits) * mm_per_bit``.
+  Both views (original and processed) use the job's :class:`~galvo_core.field.FieldMap`,
+  so they line up on the workpiece whatever the magnification.
+
+Functions take a :class:`~galvo_core.drawing.Drawing`, fitted paths
+(:class:`~galvo_core.fit.FittedPath`) or a :class:`~galvo_core.job.Job` and return arrays;
+:func:`build_preview` assembles them all into one :class:`Preview` (what the GUI's worker
+thread computes after each pipeline run). Geometry that depends only on the fit (flattened
+curves, control points, deviation) is computed in input units and cached by the fitted
+tuple's identity (:class:`PreviewCache`), so a change that only re-samples only rescales it.
+"""
+
+from __future__ import annotations
+
+from collections import OrderedDict
+from collections.abc import Callable, Iterable, Sequence
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from galvo_core.drawing import Drawing, Warning
+from galvo_core.field import FieldMap
+from galvo_core.fit import FittedPath
+from galvo_core.geometry import cubic_eval, flatten_cubic, point_polyline_distance
+from galvo_core.job import Job
+from galvo_core.pipeline import Cancelled
+
+__all__ = [
+    "EMPTY",
+    "Preview",
+    "PreviewCache",
+    "Polylines",
+    "bbox",
+    "bits_to_mm",
+    "build_preview",
+    "control_geometry",
+    "control_layer",
+    "deviation_samples",
+    "display_tolerance",
+    "field_outline_mm",
+    "fitted_curve",
+    "flatten_segments",
+    "hatch_polylines",
+    "jump_segments",
+    "mark_points",
+    "mm_to_bits",
+    "mm_to_units",
+    "nan_join",
+    "nearest_id",
+    "original_polylines",
+    "path_for_position",
+    "path_summary",
+    "stroke_curves",
+    "units_to_mm",
+    "warning_path",
+]
+
+#: An empty (0, 2) point array.
+EMPTY = np.empty((0, 2), dtype=np.float64)
+_NO_IDS = np.empty(0, dtype=np.int64)
+
+
+@dataclass(frozen=True, eq=False)
+class Polylines:
+    """NaN-separated polylines: ``xy`` (N, 2) with NaN rows between pieces, ``ids`` (N,)
+    the source index of each row (-1 on NaN rows)."""
+
+    xy: np.ndarray = field(default_factory=lambda: EMPTY)
+    ids: np.ndarray = field(default_factory=lambda: _NO_IDS)
+
+    def __len__(self) -> int:
+        return len(self.xy)
+
+    @property
+    def n_vertices(self) -> int:
+        return int(np.count_nonzero(self.ids >= 0))
+
+    def scaled(self, scale: float, offset: Sequence[float] = (0.0, 0.0)) -> Polylines:
+        """``xy * scale + offset`` (NaN rows stay NaN), same ids."""
+        return Polylines(self.xy * scale + np.asarray(offset, dtype=np.float64), self.ids)
+
+    def select(self, index: int) -> np.ndarray:
+        """The rows of source ``index`` (NaN-separated when it has several pieces)."""
+        if not len(self.ids):
+            return EMPTY
+        keep = self.ids == index
+        if not keep.any():
+            return EMPTY
+        # keep the NaN row after each selected piece so pieces stay separate
+        nxt = np.zeros_like(keep)
+        nxt[1:] = keep[:-1] & (self.ids[1:] < 0)
+        return self.xy[keep | nxt]
+
+
+# ------------------------------------------------------------------ joining and mapping
+def nan_join(pieces: Iterable[np.ndarray], ids: Iterable[int] | None = None) -> Polylines:
+    """Concatenate (K_i, 2) point arrays with one NaN row between consecutive pieces.
+
+    Empty pieces are skipped. ``ids`` (one per piece, default 0, 1, 2, …) label the rows.
+    """
+    arrays: list[np.ndarray] = []
+    labels: list[int] = []
+    id_iter = iter(ids) if ids is not None else None
+    for i, p in enumerate(pieces):
+        label = next(id_iter) if id_iter is not None else i
+        a = np.asarray(p, dtype=np.float64).reshape(-1, 2)
+        if len(a):
+            arrays.append(a)
+            labels.append(int(label))
+    if not arrays:
+        return Polylines()
+    lengths = np.fromiter((len(a) for a in arrays), dtype=np.int64, count=len(arrays))
+    total = int(lengths.sum()) + len(arrays) - 1
+    xy = np.full((total, 2), np.nan)
+    row_ids = np.full(total, -1, dtype=np.int64)
+    starts = np.concatenate(([0], np.cumsum(lengths + 1)[:-1]))
+    stacked = np.concatenate(arrays)
+    rows = np.repeat(starts - np.concatenate(([0], np.cumsum(lengths)[:-1])), lengths)
+    rows += np.arange(len(stacked))
+    xy[rows] = stacked
+    row_ids[rows] = np.repeat(np.asarray(labels, dtype=np.int64), lengths)
+    return Polylines(xy, row_ids)
+
+
+def units_to_mm(fm: FieldMap, pts: np.ndarray) -> np.ndarray:
+    """(N, 2) input units -> (N, 2) workpiece mm in the field (NaN stays NaN)."""
+    return fm.to_bits_float(np.asarray(pts, dtype=np.float64).reshape(-1, 2)) * fm.mm_per_bit
+
+
+def bits_to_mm(fm: FieldMap, bits: np.ndarray) -> np.ndarray:
+    """(N, 2) galvo bits -> (N, 2) workpiece mm in the field."""
+    return np.asarray(bits, dtype=np.float64).reshape(-1, 2) * fm.mm_per_bit
+
+
+def mm_to_bits(fm: FieldMap, xy_mm: np.ndarray) -> np.ndarray:
+    """Workpiece mm -> float galvo bits (the inverse of :func:`bits_to_mm`)."""
+    return np.asarray(xy_mm, dtype=np.float64).reshape(-1, 2) / fm.mm_per_bit
+
+
+def mm_to_units(fm: FieldMap, xy_mm: np.ndarray) -> np.ndarray:
+    """Workpiece mm -> input units of the drawing (the inverse of :func:`units_to_mm`)."""
+    return (mm_to_bits(fm, xy_mm) - np.asarray(fm.offset_bits)) / fm.magnification
+
+
+def _units_affine(fm: FieldMap) -> tuple[float, tuple[float, float]]:
+    """(scale, offset) with mm = units * scale + offset."""
+    s = fm.magnification * fm.mm_per_bit
+    return s, (fm.offset_bits[0] * fm.mm_per_bit, fm.offset_bits[1] * fm.mm_per_bit)
+
+
+def field_outline_mm(fm: FieldMap) -> np.ndarray:
+    """The field boundary, bits 0 .. field_bits, as a closed (5, 2) ring in mm."""
+    s = fm.field_bits * fm.mm_per_bit
+    return np.array([[0.0, 0.0], [s, 0.0], [s, s], [0.0, s], [0.0, 0.0]])
+
+
+def bbox(xy: np.ndarray) -> tuple[float, float, float, float] | None:
+    """(xmin, ymin, xmax, ymax) of the finite rows of ``xy``, None when there are none."""
+    a = np.asarray(xy, dtype=np.float64).reshape(-1, 2)
+    a = a[np.isfinite(a).all(axis=1)]
+    if not len(a):
+        return None
+    lo, hi = a.min(axis=0), a.max(axis=0)
+    return float(lo[0]), float(lo[1]), float(hi[0]), float(hi[1])
+
+
+# ------------------------------------------------------------------ drawing (original)
+def original_polylines(drawing: Drawing) -> Polylines:
+    """Every path of the drawing as given by the file (input units), ids = path index."""
+    return nan_join((p.points for p in drawing.paths), range(len(drawing.paths)))
+
+
+# ------------------------------------------------------------------ fitted geometry
+def flatten_segments(segments: Sequence[tuple[str, np.ndarray]], tol: float) -> np.ndarray:
+    """One continuous polyline through ``(kind, points)`` segments ("line": (2, 2),
+    "cubic": (4, 2)): every cubic flattened within ``tol`` (units of the points), lines as
+    their end points. Consecutive segments share their joint (it appears once)."""
+    if not segments:
+        return EMPTY
+    chunks = [np.asarray(segments[0][1], dtype=np.float64)[:1]]
+    for kind, pts in segments:
+        p = np.asarray(pts, dtype=np.float64)
+        if kind == "cubic" and p.shape == (4, 2):
+            chunks.append(flatten_cubic(p, tol)[1:])
+        else:
+            chunks.append(p[-1:])
+    return np.concatenate(chunks)
+
+
+def _seg_tuples(fp: FittedPath) -> list[tuple[str, np.ndarray]]:
+    return [(s.kind, s.points) for s in fp.segments]
+
+
+def fitted_curve(fitted: Sequence[FittedPath], tol: float) -> Polylines:
+    """The fitted lines and cubics of every path as polylines (input units, cubics within
+    ``tol``), ids = source_index."""
+    return nan_join((flatten_segments(_seg_tuples(fp), tol) for fp in fitted),
+                    (fp.source_index for fp in fitted))
+
+
+def control_geometry(fitted: Sequence[FittedPath]) -> tuple[Polylines, np.ndarray, np.ndarray]:
+    """Control points of the fit (input units).
+
+    Returns ``(handles, anchors, knots)``: ``handles`` the handle lines of every cubic
+    (P0–P1 and P2–P3, NaN-separated pairs, ids = source_index); ``anchors`` (K, 2) the end
+    points of every segment (each joint once); ``knots`` (L, 2) the inner control points
+    P1, P2 of the cubics.
+    """
+    pairs: list[np.ndarray] = []
+    pair_ids: list[int] = []
+    anchors: list[np.ndarray] = []
+    knots: list[np.ndarray] = []
+    for fp in fitted:
+        if not fp.segments:
+            continue
+        anchors.append(fp.segments[0].points[:1])
+        for s in fp.segments:
+            anchors.append(s.points[-1:])
+            if s.kind == "cubic":
+                pairs.extend((s.points[0:2], s.points[2:4]))
+                pair_ids.extend((fp.source_index, fp.source_index))
+                knots.append(s.points[1:3])
+    return (
+        nan_join(pairs, pair_ids),
+        np.concatenate(anchors) if anchors else EMPTY,
+        np.concatenate(knots) if knots else EMPTY,
+    )
+
+
+def _piece_indices(first: int, last: int, n: int, closed: bool) -> np.ndarray:
+    idx = np.arange(first, last + 1)
+    if closed and n:
+        return idx % n
+    return idx[(idx >= 0) & (idx < n)]
+
+
+def deviation_samples(
+    drawing: Drawing,
+    fitted: Sequence[FittedPath],
+    *,
+    min_samples: int = 4,
+    max_samples: int = 64,
+    cancel: Callable[[], bool] | None = None,
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The true error of the fit, sample by sample along the curve.
+
+    Every fitted segment is sampled at ``k`` parameters (``2 × its input points``, clipped to
+    ``min_samples .. max_samples``); each sample's error is its Euclidean distance to the
+    input polyline that the segment replaces (the points ``first .. last`` of the source
+    path). Returns ``(a, b, err)``: the sample chords as start points ``a`` (K, 2) and end
+    points ``b`` (K, 2) in input units, and ``err`` (K,) the larger error of the chord's two
+    ends, in input units. Segments whose source points are unknown are skipped.
+    """
+    a_out: list[np.ndarray] = []
+    b_out: list[np.ndarray] = []
+    e_out: list[np.ndarray] = []
+    for j, fp in enumerate(fitted):
+        if cancel is not None and j % 32 == 0 and cancel():
+            raise Cancelled()
+        if not 0 <= fp.source_index < len(drawing.paths):
+            continue
+        src = drawing.paths[fp.source_index].points
+        n = len(src)
+        for s in fp.segments:
+            idx = _piece_indices(s.first, s.last, n, fp.closed)
+            if not len(idx):
+                continue
+            piece = src[idx]
+            k = int(np.clip(2 * len(piece), min_samples, max_samples))
+            t = np.linspace(0.0, 1.0, k)
+            if s.kind == "cubic":
+                pts = cubic_eval(s.points, t)
+            else:
+                pts = s.points[0] + t[:, None] * (s.points[-1] - s.points[0])
+            err = point_polyline_distance(pts, piece)
+            a_out.append(pts[:-1])
+            b_out.append(pts[1:])
+            e_out.append(np.maximum(err[:-1], err[1:]))
+    if not a_out:
+        return EMPTY, EMPTY, np.empty(0)
+    return np.concatenate(a_out), np.concatenate(b_out), np.concatenate(e_out)
+
+
+# ------------------------------------------------------------------ job geometry
+def stroke_curves(job: Job, tol: float, kinds: Iterable[str] = ("contour",)) -> Polylines:
+    """The fitted segments stored in the job's strokes of ``kinds`` (input units), flattened
+    within ``tol``; ids = source_index. Strokes without segments contribute nothing."""
+    want = set(kinds)
+    strokes = [s for s in job.strokes if s.kind in want and s.segments]
+    return nan_join((flatten_segments(s.segments, tol) for s in strokes),
+                    (s.source_index for s in strokes))
+
+
+def mark_points(job: Job, kinds: Iterable[str] | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """Every mark of the job's strokes (of ``kinds``; all when None) in marking order:
+    ``(bits (M, 2) int64, ids (M,) source_index)``."""
+    strokes = [s for s in job.strokes if kinds is None or s.kind in set(kinds)]
+    if not strokes:
+        return np.empty((0, 2), dtype=np.int64), _NO_IDS
+    marks = [np.asarray(s.marks, dtype=np.int64).reshape(-1, 2) for s in strokes]
+    ids = np.repeat(np.fromiter((s.source_index for s in strokes), dtype=np.int64,
+                                count=len(strokes)),
+                    [len(m) for m in marks])
+    return np.concatenate(marks), ids
+
+
+def jump_segments(job: Job) -> np.ndarray:
+    """The laser-off moves between consecutive strokes (last mark -> next first mark) as
+    NaN-separated pairs, galvo bits (float)."""
+    ends = [(s.marks[0], s.marks[-1]) for s in job.strokes if len(s.marks)]
+    if len(ends) < 2:
+        return EMPTY
+    starts = np.array([e[0] for e in ends[1:]], dtype=np.float64)
+    stops = np.array([e[1] for e in ends[:-1]], dtype=np.float64)
+    moving = (starts != stops).any(axis=1)
+    starts, stops = starts[moving], stops[moving]
+    out = np.full((3 * len(starts), 2), np.nan)
+    out[0::3] = stops
+    out[1::3] = starts
+    return out[:-1] if len(out) else EMPTY
+
+
+def hatch_polylines(job: Job) -> Polylines:
+    """The marks of the job's hatch strokes as polylines (galvo bits), ids = source_index."""
+    strokes = [s for s in job.strokes if s.kind == "hatch"]
+    return nan_join((np.asarray(s.marks, dtype=np.float64) for s in strokes),
+                    (s.source_index for s in strokes))
+
+
+# ------------------------------------------------------------------ picking
+def nearest_id(xy: np.ndarray, ids: np.ndarray, point: Sequence[float],
+               max_dist: float = np.inf) -> int | None:
+    """The id of the row of ``xy`` nearest to ``point`` (rows with id < 0 or NaN ignored),
+    None when there is none within ``max_dist``."""
+    if not len(ids):
+        return None
+    d = np.hypot(xy[:, 0] - point[0], xy[:, 1] - point[1])
+    d = np.where((ids >= 0) & np.isfinite(d), d, np.inf)
+    i = int(np.argmin(d))
+    if not np.isfinite(d[i]) or d[i] > max_dist:
+        return None
+    return int(ids[i])
+
+
+def path_for_position(drawing: Drawing, line: int, col: int) -> int | None:
+    """The path whose start in the file is nearest to (line, col): fewest lines away, then
+    fewest columns; ties go to the earlier path. None for a drawing without paths or without
+    source positions."""
+    best: tuple[tuple[int, int], int] | None = None
+    for i, p in enumerate(drawing.paths):
+        s = p.start
+        if (s.line, s.col) == (0, 0):
+            continue
+        key = (abs(s.line - line), abs(s.col - col))
+        if best is None or key < best[0]:
+            best = (key, i)
+    return best[1] if best is not None else None
+
+
+# ------------------------------------------------------------------ the whole preview
+def control_layer(fitted: Sequence[FittedPath]) -> tuple[np.ndarray, np.ndarray]:
+    """The control points and handle lines as ONE NaN-separated array for one plot item.
+
+    Returns ``(xy, role)``: rows ``P0, P1, NaN, P2, P3, NaN`` per cubic (the handle lines)
+    followed by every anchor (segment end point, each joint once) as a single row followed
+    by NaN. ``role`` per row: 1 = anchor (draw a marker), 2 = inner control point P1/P2
+    (draw a marker), 0 = an anchor end of a handle line (no marker: the anchor is drawn once
+    from the anchor rows), -1 = NaN separator.
+    """
+    handles, anchors, _ = control_geometry(fitted)
+    hx = handles.xy
+    h_role = np.where(handles.ids >= 0, 0, -1).astype(np.int8)
+    if len(hx):
+        # pairs are (P0, P1) and (P2, P3): the inner point is the 2nd of an even pair and
+        # the 1st of an odd pair (rows are pair, NaN, pair, NaN, ...)
+        pair = np.arange(len(hx)) // 3
+        pos = np.arange(len(hx)) % 3
+        inner = ((pair % 2 == 0) & (pos == 1)) | ((pair % 2 == 1) & (pos == 0))
+        h_role[inner] = 2
+    a = np.full((2 * len(anchors), 2), np.nan)
+    a[0::2] = anchors
+    a_role = np.full(len(a), -1, dtype=np.int8)
+    a_role[0::2] = 1
+    parts = [x for x in (hx, a) if len(x)]
+    if not parts:
+        return EMPTY, np.empty(0, dtype=np.int8)
+    if len(parts) == 2:
+        xy = np.concatenate((hx, np.full((1, 2), np.nan), a))
+        role = np.concatenate((h_role, np.array([-1], dtype=np.int8), a_role))
+    else:
+        xy = parts[0]
+        role = h_role if len(hx) else a_role
+    return xy, role
+
+
+@dataclass(frozen=True, eq=False)
+class Preview:
+    """Everything the two views draw.
+
+    Each layer is given in its *native* space, so a run that changed only the magnification
+    or offset hands the GUI the very same arrays again (cached) and the GUI only changes the
+    affine map to workpiece mm:
+
+    * input units (``original``, ``fitted``, ``control_xy``, ``kerf``, ``deviation_*``):
+      ``mm = units * units_scale + units_offset``;
+    * galvo bits (``marks``, ``jumps``, ``hatch``): ``mm = bits * mm_per_bit``;
+    * ``field_outline`` and ``bounds`` are already in mm.
+
+    ``deviation_level`` is each deviation chord's error as a fraction of the fit tolerance
+    (``max(e_per, eps_line)``), clipped to 0..1 (the colour); ``deviation_err`` the error in
+    input units; ``um_per_unit`` converts it to µm on the workpiece.
+    """
+
+    field_map: FieldMap
+    units_scale: float
+    units_offset: tuple[float, float]
+    mm_per_bit: float
+    field_outline: np.ndarray
+    original: Polylines
+    original_points: np.ndarray
+    original_point_ids: np.ndarray
+    fitted: Polylines
+    control_xy: np.ndarray
+    control_role: np.ndarray
+    marks: np.ndarray
+    mark_ids: np.ndarray
+    jumps: np.ndarray
+    hatch: Polylines
+    kerf: Polylines
+    deviation_a: np.ndarray
+    deviation_b: np.ndarray
+    deviation_err: np.ndarray
+    deviation_level: np.ndarray
+    tolerance_units: float
+    #: bounding box (mm) of everything drawn, None when nothing is
+    bounds: tuple[float, float, float, float] | None
+
+    @property
+    def um_per_unit(self) -> float:
+        return self.units_scale * 1000.0
+
+    @property
+    def tolerance_um(self) -> float:
+        return self.tolerance_units * self.um_per_unit
+
+    @property
+    def max_deviation_um(self) -> float:
+        if not len(self.deviation_err):
+            return 0.0
+        return float(self.deviation_err.max()) * self.um_per_unit
+
+    @property
+    def n_control_points(self) -> int:
+        return int(np.count_nonzero(self.control_role > 0))
+
+    def units_to_mm(self, xy: np.ndarray) -> np.ndarray:
+        return np.asarray(xy, dtype=np.float64) * self.units_scale + np.asarray(
+            self.units_offset)
+
+    def mm_to_units(self, xy_mm: np.ndarray) -> np.ndarray:
+        return (np.asarray(xy_mm, dtype=np.float64) - np.asarray(self.units_offset)
+                ) / self.units_scale
+
+    def mm_to_bits(self, xy_mm: np.ndarray) -> np.ndarray:
+        return np.asarray(xy_mm, dtype=np.float64) / self.mm_per_bit
+
+    def pick(self, x_mm: float, y_mm: float, radius_mm: float) -> int | None:
+        """The source path nearest to (x, y) mm within ``radius_mm``: by the original points
+        and the fitted curve, or by the marks when there is no drawing; None if none."""
+        best: tuple[float, int] | None = None
+        candidates = (
+            (self.original.xy, self.original.ids, "units"),
+            (self.fitted.xy, self.fitted.ids, "units"),
+            (self.marks, self.mark_ids, "bits"),
+        )
+        for xy, ids, space in candidates:
+            if not len(ids):
+                continue
+            if space == "units":
+                p = self.mm_to_units(np.array([[x_mm, y_mm]]))[0]
+                r = radius_mm / self.units_scale
+                scale = self.units_scale
+            else:
+                p = self.mm_to_bits(np.array([[x_mm, y_mm]]))[0]
+                r = radius_mm / self.mm_per_bit
+                scale = self.mm_per_bit
+            d = np.hypot(xy[:, 0] - p[0], xy[:, 1] - p[1])
+            d = np.where((ids >= 0) & np.isfinite(d), d, np.inf)
+            i = int(np.argmin(d))
+            if d[i] <= r and (best is None or d[i] * scale < best[0]):
+                best = (float(d[i]) * scale, int(ids[i]))
+        return best[1] if best is not None else None
+
+    def path_geometry(self, index: int) -> tuple[np.ndarray, np.ndarray]:
+        """The selection highlight of path ``index``: (original polyline in units,
+        processed polyline in units — the fitted curve, else the marks mapped to units)."""
+        left = self.original.select(index)
+        right = self.fitted.select(index)
+        if not len(right) and len(self.mark_ids):
+            m = self.marks[self.mark_ids == index]
+            right = self.mm_to_units(m * self.mm_per_bit) if len(m) else EMPTY
+        return left, right
+
+    def path_bounds(self, index: int) -> tuple[float, float, float, float] | None:
+        """Bounding box (mm) of path ``index`` in either view, None when it draws nothing."""
+        left, right = self.path_geometry(index)
+        b = _union(bbox(left), bbox(right))
+        return _affine_box(b, self.units_scale, self.units_offset)
+
+
+class PreviewCache:
+    """Fit-only geometry (input units) by the identity of the objects it came from (a small
+    LRU; each value holds those objects, so an id cannot be reused while cached)."""
+
+    def __init__(self, size: int = 6) -> None:
+        self.size = size
+        self._data: OrderedDict[tuple[Any, ...], tuple[Any, ...]] = OrderedDict()
+
+    def get(self, key: tuple[Any, ...], make: Callable[[], tuple[Any, ...]]) -> tuple[Any, ...]:
+        if key in self._data:
+            self._data.move_to_end(key)
+            return self._data[key]
+        value = make()
+        self._data[key] = value
+        while len(self._data) > self.size:
+            self._data.popitem(last=False)
+        return value
+
+
+def _union(*boxes: tuple[float, float, float, float] | None
+           ) -> tuple[float, float, float, float] | None:
+    bs = [b for b in boxes if b is not None]
+    if not bs:
+        return None
+    return (min(b[0] for b in bs), min(b[1] for b in bs), max(b[2] for b in bs),
+            max(b[3] for b in bs))
+
+
+def _affine_box(b: tuple[float, float, float, float] | None, scale: float,
+                off: tuple[float, float]) -> tuple[float, float, float, float] | None:
+    if b is None:
+        return None
+    return (b[0] * scale + off[0], b[1] * scale + off[1], b[2] * scale + off[0],
+            b[3] * scale + off[1])
+
+
+def display_tolerance(job_params: dict[str, Any], drawing: Drawing | None) -> float:
+    """How closely flattened cubics follow the fit for display, in input units: a quarter of
+    the fit tolerance (so the deviation shown is the fit's, not the flattening's), but not
+    finer than a millionth of the drawing's diagonal."""
+    e = [float(job_params.get(k, 0.0) or 0.0) for k in ("e_per", "eps_line")]
+    e = [v for v in e if v > 0] or [0.02]
+    tol = min(e) / 4.0
+    bb = drawing.bbox() if drawing is not None else None
+    if bb is not None:
+        tol = max(tol, float(np.hypot(bb[2] - bb[0], bb[3] - bb[1])) * 1e-6)
+    return tol
+
+
+def build_preview(
+    job: Job,
+    drawing: Drawing | None = None,
+    fitted: tuple[FittedPath, ...] | None = None,
+    *,
+    cache: PreviewCache | None = None,
+    cancel: Callable[[], bool] | None = None,
+) -> Preview:
+    """All display geometry of a run (or of a loaded job file: no drawing, no fit).
+
+    Without ``fitted`` the fitted-curve layer is taken from the job's contour strokes' stored
+    segments (no control points, no deviation). The kerf layer shows the job's contour-stroke
+    segments when the job's ``kerf_mm`` > 0, else nothing; the hatch layer the marks of its
+    hatch strokes (nothing when there are none). Fit-only geometry is cached in ``cache`` by
+    the identity of ``drawing`` and ``fitted``: a run that only re-sampled costs little.
+    """
+    fm = job.field_map
+    scale, offset = _units_affine(fm)
+    cache = cache if cache is not None else PreviewCache()
+    e_tol = max(float(job.params.get("e_per", 0.0) or 0.0),
+                float(job.params.get("eps_line", 0.0) or 0.0))
+    tol_units = display_tolerance(job.params, drawing)
+
+    if drawing is not None:
+        def make_original() -> tuple[Any, ...]:
+            orig = original_polylines(drawing)
+            finite = orig.ids >= 0
+            return drawing, orig, orig.xy[finite], orig.ids[finite], bbox(orig.xy)
+
+        _, original, o_pts, o_ids, o_box = cache.get(("original", id(drawing)), make_original)
+    else:
+        original, o_pts, o_ids, o_box = Polylines(), EMPTY, _NO_IDS, None
+
+    if fitted is not None:
+        fit_tuple = fitted
+
+        def make_fit() -> tuple[Any, ...]:
+            curve = fitted_curve(fit_tuple, tol_units)
+            c_xy, c_role = control_layer(fit_tuple)
+            if drawing is not None:
+                da, db, de = deviation_samples(drawing, fit_tuple, cancel=cancel)
+            else:
+                da, db, de = EMPTY, EMPTY, np.empty(0)
+            return fit_tuple, drawing, curve, bbox(curve.xy), c_xy, c_role, da, db, de
+
+        (_, _, curve, c_box, c_xy, c_role, dev_a, dev_b, dev_e) = cache.get(
+            ("fit", id(fit_tuple), id(drawing), round(tol_units, 12)), make_fit)
+        (_, dev_level) = cache.get(
+            ("level", id(dev_e), e_tol),
+            lambda: (dev_e, np.clip(dev_e / e_tol, 0.0, 1.0) if e_tol > 0 else dev_e * 0.0))
+    else:
+        curve = stroke_curves(job, tol_units)
+        c_box = bbox(curve.xy)
+        c_xy, c_role = EMPTY, np.empty(0, dtype=np.int8)
+        dev_a, dev_b, dev_e, dev_level = EMPTY, EMPTY, np.empty(0), np.empty(0)
+
+    kerf_on = float(job.params.get("kerf_mm", 0.0) or 0.0) > 0.0
+    kerf = stroke_curves(job, tol_units) if kerf_on else Polylines()
+
+    marks_bits, mark_ids = mark_points(job)
+    marks = marks_bits.astype(np.float64)
+    jumps = jump_segments(job)
+    hatch = hatch_polylines(job)
+
+    bounds = _union(_affine_box(_union(o_box, c_box, bbox(kerf.xy)), scale, offset),
+                    _affine_box(_union(bbox(marks), bbox(hatch.xy)), fm.mm_per_bit, (0, 0)))
+    return Preview(
+        field_map=fm,
+        units_scale=scale,
+        units_offset=offset,
+        mm_per_bit=fm.mm_per_bit,
+        field_outline=field_outline_mm(fm),
+        original=original,
+        original_points=o_pts,
+        original_point_ids=o_ids,
+        fitted=curve,
+        control_xy=c_xy,
+        control_role=c_role,
+        marks=marks,
+        mark_ids=mark_ids,
+        jumps=jumps,
+        hatch=hatch,
+        kerf=kerf,
+        deviation_a=dev_a,
+        deviation_b=dev_b,
+        deviation_err=dev_e,
+        deviation_level=dev_level,
+        tolerance_units=e_tol,
+        bounds=bounds,
+    )
+
+
+def path_summary(index: int, job: Job | None, drawing: Drawing | None = None,
+                 fitted: Sequence[FittedPath] | None = None) -> dict[str, Any]:
+    """Counts of one source path (for the selection read-out): input points, lines, cubics,
+    control points, largest fit error (µm), mark points, hatch marks, mark length (mm)."""
+    from galvo_core.fit import control_points
+
+    out: dict[str, Any] = {"path": index}
+    if drawing is not None and 0 <= index < len(drawing.paths):
+        p = drawing.paths[index]
+        out["input_points"] = len(p.points)
+        out["closed"] = bool(p.closed)
+    fm = job.field_map if job is not None else None
+    for fp in fitted or ():
+        if fp.source_index == index:
+            out["lines"] = fp.n_lines
+            out["cubics"] = fp.n_cubics
+            out["control_points"] = control_points(fp)
+            if fm is not None:
+                out["max_fit_error_um"] = fp.max_error * fm.mm_per_unit * 1000.0
+    if job is not None and fm is not None:
+        for s in job.strokes:
+            if s.source_index != index:
+                continue
+            key = "hatch_marks" if s.kind == "hatch" else "mark_points"
+            out[key] = out.get(key, 0) + len(s.marks)
+            if s.kind != "hatch" and len(s.marks) > 1:
+                step = np.diff(np.asarray(s.marks, dtype=np.float64), axis=0)
+                out["mark_length_mm"] = out.get("mark_length_mm", 0.0) + float(
+                    np.hypot(step[:, 0], step[:, 1]).sum() * fm.mm_per_bit)
+    return out
+
+
+def warning_path(drawing: Drawing | None, warning: Warning) -> int | None:
+    """The path a warning points at (by its file position), None when it has none."""
+    if drawing is None or not warning.line:
+        return None
+    return path_for_position(drawing, warning.line, warning.col)

@@ -1,0 +1,328 @@
+"""Marking points (issue 5): chord heights measured against the true curve, minimum and
+maximum step, counts, the 3-D step search, the fixed and raw baselines."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from _util import SAMPLES, circle_plt
+from hypothesis import HealthCheck, assume, given, settings
+from hypothesis import strategies as st
+
+from galvo_core.errors import ParamError
+from galvo_core.field import FieldMap
+from galvo_core.fit import FittedPath, Segment
+from galvo_core.hpgl import read_bytes, read_file
+from galvo_core.params import Params
+from galvo_core.pipeline import Pipeline
+from galvo_core.sample import (
+    E_MIN_RATIO,
+    ROUNDING_BOUND_BITS,
+    chord_heights,
+    sample_curve,
+    sample_path,
+    sample_paths,
+)
+
+FM = FieldMap(1.0, (0.0, 0.0), 1 << 20, 110.0 * 16)  # 1 input unit = 1 bit, a huge field
+
+
+def _path(*segs: tuple[str, list[list[float]]], closed: bool = False) -> FittedPath:
+    return FittedPath(0, 1, closed, tuple(Segment(k, np.asarray(p, float), 0, 1)
+                                          for k, p in segs), 0.0, 0)
+
+
+def _bezier(ctrl: np.ndarray, t: np.ndarray) -> np.ndarray:
+    """Independent Bernstein evaluation (any dimension)."""
+    t = t[:, None]
+    s = 1.0 - t
+    return s**3 * ctrl[0] + 3 * s * s * t * ctrl[1] + 3 * s * t * t * ctrl[2] + t**3 * ctrl[3]
+
+
+def _brute_heights(fp: FittedPath, res, fm: FieldMap = FM, n: int = 400) -> np.ndarray:
+    """Chord heights of one sampled path by dense sampling of the true curve (float marks)."""
+    sid, t = res.params[0]
+    pos = res.float_marks[0]
+    ctrl = [fm.to_bits_float(s.points) for s in fp.segments]
+    out = []
+    for i in range(len(t) - 1):
+        pts = []
+        for g in range(int(sid[i]), int(sid[i + 1]) + 1):
+            lo = t[i] if g == sid[i] else 0.0
+            hi = t[i + 1] if g == sid[i + 1] else 1.0
+            if hi <= lo:
+                continue
+            c = ctrl[g]
+            if len(c) == 2:
+                c = np.array([c[0], c[0] + (c[1] - c[0]) / 3, c[0] + 2 * (c[1] - c[0]) / 3,
+                              c[1]])
+            pts.append(_bezier(c, np.linspace(lo, hi, n)))
+        p = np.vstack(pts)
+        a, b = pos[i], pos[i + 1]
+        ab = b - a
+        den = ab @ ab
+        s = np.clip(((p - a) @ ab) / den, 0, 1) if den > 0 else np.zeros(len(p))
+        out.append(np.hypot(*(p - a - s[:, None] * ab).T).max())
+    return np.asarray(out)
+
+
+coord = st.floats(-3000, 3000, allow_nan=False)
+
+
+@settings(max_examples=60, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(ctrl=st.lists(st.tuples(coord, coord), min_size=4, max_size=4),
+       tol=st.sampled_from([0.25, 1.0, 3.0]))
+def test_chord_height_within_bound_on_random_cubics(ctrl, tol):
+    c = np.asarray(ctrl, float) + 5000.0
+    assume(np.ptp(c, axis=0).max() > 20.0)
+    fp = _path(("cubic", c.tolist()))
+    # a minimum step >= √2 means no two marks round to the same bit (no dedup changes the
+    # chords); only the minimum step may exceed the tolerance, at cusps, and is counted
+    res = sample_paths([fp], FM, chord_tol_bits=tol, min_step_bits=1.5)
+    rep = res.report
+    h = _brute_heights(fp, res)
+    assert (h > tol * (1 + 1e-9) + 1e-9).sum() <= rep.min_step_overrides
+    assert rep.chord_violations <= rep.min_step_overrides
+    if rep.min_step_overrides == 0:
+        assert rep.max_chord_height_bits <= tol * (1 + 1e-9)
+    # the closed form is never below the truth
+    assert rep.max_chord_height_bits >= h.max(initial=0.0) - 1e-6
+    # rounding adds at most √2/2
+    assert rep.max_chord_height_int_bits <= rep.max_chord_height_bits + ROUNDING_BOUND_BITS + 1e-9
+    # first and last marks are the curve's ends, exactly (rounded)
+    m = res.marks[0]
+    assert m[0].tolist() == FM.to_bits(c[:1])[0].tolist()
+    assert m[-1].tolist() == FM.to_bits(c[3:])[0].tolist()
+
+
+def test_closed_form_chord_height_matches_dense_sampling():
+    rng = np.random.default_rng(7)
+    ctrl = rng.uniform(0, 1000, (300, 4, 2))
+    coef = np.stack([-ctrl[:, 0] + 3 * ctrl[:, 1] - 3 * ctrl[:, 2] + ctrl[:, 3],
+                     3 * ctrl[:, 0] - 6 * ctrl[:, 1] + 3 * ctrl[:, 2],
+                     3 * (ctrl[:, 1] - ctrl[:, 0]), ctrl[:, 0]], axis=1)
+    ta = rng.uniform(0, 1, 300)
+    tb = np.minimum(1, ta + rng.uniform(0, 0.3, 300))
+    H, L = chord_heights(coef, ta, tb)
+    for i in range(300):
+        p = _bezier(ctrl[i], np.linspace(ta[i], tb[i], 3001))
+        a, b = p[0], p[-1]
+        ab = b - a
+        raw = ((p - a) @ ab) / (ab @ ab)
+        s = np.clip(raw, 0, 1)
+        true = np.hypot(*(p - a - s[:, None] * ab).T).max()
+        assert H[i] >= true - 1e-9  # never optimistic
+        assert L[i] == pytest.approx(np.hypot(*ab))
+        if raw.min() >= 0 and raw.max() <= 1:  # the curve stays over its chord: exact
+            assert H[i] == pytest.approx(true, rel=1e-4, abs=1e-6)
+
+
+def _circle_funcs(r: float):
+    def f(t):
+        return np.stack([r * np.cos(t), r * np.sin(t)], axis=1)
+
+    def df(t):
+        return np.stack([-r * np.sin(t), r * np.cos(t)], axis=1)
+
+    def ddf(t):
+        return np.stack([-r * np.cos(t), -r * np.sin(t)], axis=1)
+
+    return f, df, ddf
+
+
+@pytest.mark.parametrize("r,tol", [(50.0, 1.0), (1000.0, 1.0), (20000.0, 0.25), (3.0, 0.5)])
+def test_circle_chord_heights_have_their_closed_form(r, tol):
+    s = sample_curve(*_circle_funcs(r), 0.0, 2 * math.pi, e_min=E_MIN_RATIO * tol, e_max=tol)
+    dth = np.diff(s.t)
+    exact = r * (1 - np.cos(dth / 2))  # chord height of an arc of angle Δθ
+    np.testing.assert_allclose(s.heights, exact, rtol=1e-6, atol=1e-9)
+    assert exact.max() <= tol * (1 + 1e-9)
+    assert (exact[:-1] >= E_MIN_RATIO * tol * (1 - 1e-9)).all()  # every step but the last long
+    # the fewest chords of height <= tol: ceil(2π / θmax), θmax = 2·arccos(1 − tol/r)
+    best = math.ceil(2 * math.pi / (2 * math.acos(max(-1.0, 1 - tol / r))))
+    assert best <= len(dth) <= math.ceil(best * 1.06)
+
+
+def test_helix_in_3d():
+    r, c = 200.0, 30.0  # curvature r / (r² + c²)
+
+    def f(t):
+        return np.stack([r * np.cos(t), r * np.sin(t), c * t], axis=1)
+
+    def df(t):
+        return np.stack([-r * np.sin(t), r * np.cos(t), np.full_like(t, c)], axis=1)
+
+    def ddf(t):
+        return np.stack([-r * np.cos(t), -r * np.sin(t), np.zeros_like(t)], axis=1)
+
+    s = sample_curve(f, df, ddf, 0.0, 6 * math.pi, e_min=0.9, e_max=1.0, min_step=2.0)
+    assert s.points.shape[1] == 3
+    dt = np.diff(s.t)
+    # by symmetry the farthest point of a helix arc from its chord is the arc's middle,
+    # at distance r(1 − cos(Δ/2)) (the radial offset, perpendicular to the chord)
+    exact = r * (1 - np.cos(dt / 2))
+    np.testing.assert_allclose(s.heights, exact, rtol=1e-6)
+    assert s.heights.max() <= 1.0 and (s.heights[:-1] >= 0.9).all()
+    assert s.points[0] == pytest.approx([r, 0, 0]) and s.t[-1] == 6 * math.pi
+    # a uniform helix gets (nearly) uniform steps
+    assert np.ptp(dt[:-1]) < 0.05 * dt[:-1].mean()
+
+
+def test_3d_cubic_and_2d_cubic_through_the_generic_search():
+    ctrl3 = np.array([[0, 0, 0], [300, 900, 100], [900, -400, 600], [1200, 500, -200.0]])
+    p = ctrl3
+    d1 = 3 * np.array([p[1] - p[0], p[2] - p[1], p[3] - p[2]])
+    d2 = 6 * np.array([p[2] - 2 * p[1] + p[0], p[3] - 2 * p[2] + p[1]])
+
+    def f(t):
+        return _bezier(p, t)
+
+    def df(t):
+        t = t[:, None]
+        return (1 - t) ** 2 * d1[0] + 2 * (1 - t) * t * d1[1] + t * t * d1[2]
+
+    def ddf(t):
+        t = t[:, None]
+        return (1 - t) * d2[0] + t * d2[1]
+
+    s = sample_curve(f, df, ddf, 0.0, 1.0, e_min=0.45, e_max=0.5)
+    # every chord checked against a dense sampling in 3-D
+    for i in range(len(s.t) - 1):
+        q = f(np.linspace(s.t[i], s.t[i + 1], 800))
+        a, b = q[0], q[-1]
+        u = (b - a) / np.linalg.norm(b - a)
+        dd = q - a
+        perp = dd - (dd @ u)[:, None] * u
+        assert np.linalg.norm(perp, axis=1).max() <= 0.5 + 1e-9
+    # the 2-D projection, sampled by the generic search and by the closed-form path sampler,
+    # gives the same marks: one step search, two measurements of the same chord height
+    p = ctrl3[:, :2]
+    d1 = d1[:, :2]
+    d2 = d2[:, :2]
+    s2 = sample_curve(f, df, ddf, 0.0, 1.0, e_min=0.45, e_max=0.5)
+    res = sample_paths([_path(("cubic", p.tolist()))], FM, chord_tol_bits=0.5,
+                       min_step_bits=0.0)
+    np.testing.assert_allclose(res.params[0][1], s2.t, atol=1e-6)
+
+
+def test_min_step_respected_and_overrides_counted_at_a_tight_bend():
+    # a bend of radius 3 bits between two long lines: at tol 0.05 the tolerance would want
+    # 0.8-bit chords there
+    k = 0.5523 * 3
+    fp = _path(("line", [[0, 0], [1000, 0]]),
+               ("cubic", [[1000, 0], [1000 + k, 0], [1003, 3 - k], [1003, 3]]),
+               ("line", [[1003, 3], [1003, 1000]]))
+    res = sample_paths([fp], FM, chord_tol_bits=0.05, min_step_bits=2.0)
+    steps = np.hypot(*np.diff(res.float_marks[0], axis=0).T)
+    assert (steps[:-1] >= 2.0 * 0.999).all()
+    assert res.report.min_step_overrides > 0
+    assert res.report.chord_violations <= res.report.min_step_overrides
+    res0 = sample_paths([fp], FM, chord_tol_bits=0.05, min_step_bits=0.0)
+    steps0 = np.hypot(*np.diff(res0.float_marks[0], axis=0).T)
+    assert steps0.min() < 1.5  # (0.8-bit chords, some merged by rounding to whole bits)
+    # the generic search on a circle of radius 1.5: the same rule
+    s = sample_curve(*_circle_funcs(1.5), 0.0, 2 * math.pi, e_min=0.045, e_max=0.05,
+                     min_step=2.0)
+    assert (s.lengths[:-1] >= 2.0 * 0.999).all() and s.overrides > 0
+
+
+def test_min_step_keeps_corners_and_drops_smooth_joint_marks():
+    # a tiny line between two lines at right angles: its ends are corners, kept
+    fp = _path(("line", [[0, 0], [1000, 0]]), ("line", [[1000, 0], [1000, 1]]),
+               ("line", [[1000, 1], [0, 1]]))
+    m = sample_path(fp, FM, min_step_bits=2.0)
+    assert m.tolist() == [[0, 0], [1000, 0], [1000, 1], [0, 1]]
+    # a straight run cut into short collinear pieces: the inner joints go
+    fp = _path(*[("line", [[i, 0.0], [i + 1.0, 0.0]]) for i in range(10)])
+    m = sample_path(fp, FM, min_step_bits=2.5)
+    steps = np.hypot(*np.diff(m, axis=0).T)
+    assert (steps[:-1] >= 2.5).all() and m[0].tolist() == [0, 0] and m[-1].tolist() == [10, 0]
+
+
+def test_lines_are_their_end_points_and_max_step_splits():
+    fp = _path(("line", [[0, 0], [1000, 0]]), ("line", [[1000, 0], [1000, 1000]]))
+    assert sample_path(fp, FM).tolist() == [[0, 0], [1000, 0], [1000, 1000]]
+    m = sample_path(fp, FM, max_step_bits=300.0)
+    steps = np.hypot(*np.diff(m, axis=0).T)
+    assert len(m) == 1 + 4 + 4 and steps.max() <= 300
+    # chords of a cubic are capped too
+    big = _path(("cubic", [[0, 0], [4000, 3000], [8000, 3000], [12000, 0]]))
+    res = sample_paths([big], FM, max_step_bits=500.0)
+    steps = np.hypot(*np.diff(res.float_marks[0], axis=0).T)
+    assert steps.max() <= 500 * (1 + 1e-9)
+    assert res.report.max_chord_height_bits <= 1.0
+
+
+def test_counts_grow_with_magnification_and_shrink_with_tolerance():
+    d = read_bytes(circle_plt(), "circle.plt")
+    pipe = Pipeline()
+    n = [pipe.run(d, Params(magnification=m)).stats["mark_points"] for m in (5, 10, 20, 40)]
+    assert n == sorted(n) and len(set(n)) == 4
+    # chords scale like sqrt(r / tol): four times the magnification, about twice the marks
+    assert 1.7 < n[3] / n[1] < 2.3
+    t = [pipe.run(d, Params(magnification=30, chord_tol_bits=c)).stats["mark_points"]
+         for c in (0.25, 1.0, 4.0)]
+    assert t[0] > t[1] > t[2]
+    assert 1.7 < t[0] / t[1] < 2.3
+
+
+def test_paper_000_table_1_counts():
+    """Paper 000 Table 1: curve_1181 gives 207 marks at 36x and 288 at 72x."""
+    d = read_file(SAMPLES / "curve_1181.plt")
+    pipe = Pipeline()
+    for mag, paper in ((36, 207), (72, 288)):
+        job = pipe.run(d, Params(magnification=mag))
+        st_ = job.stats
+        assert abs(st_["mark_points"] - paper) <= 0.05 * paper
+        assert st_["max_chord_height_bits"] <= 1.0 and st_["chord_height_violations"] == 0
+        assert st_["max_chord_height_int_bits"] <= 1.0 + ROUNDING_BOUND_BITS
+
+
+def test_fixed_baseline_handles_vertical_curves_and_raw_is_the_input():
+    # a semicircle-like cubic that goes vertical at both ends (slope dy/dx infinite)
+    fp = _path(("cubic", [[0, 0], [0, 1000], [1000, 1000], [1000, 0]]))
+    res = sample_paths([fp], FM, interpolation="fixed", fixed_step_bits=16,
+                       fixed_slope_tol=0.05)
+    m = res.marks[0]
+    assert 5 < len(m) < 300 and np.isfinite(res.report.max_chord_height_bits)
+    assert m[0].tolist() == [0, 0] and m[-1].tolist() == [1000, 0]
+    # a tighter slope threshold gives more, shorter chords
+    tight = sample_paths([fp], FM, interpolation="fixed", fixed_slope_tol=0.01)
+    assert len(tight.marks[0]) > len(m)
+    assert tight.report.max_chord_height_bits < res.report.max_chord_height_bits
+    raw = np.array([[0.4, 0.2], [10.6, 0.0], [10.6, 0.2], [20, 5]])
+    r = sample_paths([fp], FM, interpolation="raw", raw_points=[raw])
+    assert r.marks[0].tolist() == [[0, 0], [11, 0], [20, 5]]
+    assert r.report.max_chord_height_bits is None
+    with pytest.raises(ParamError):
+        sample_paths([fp], FM, interpolation="spline")
+
+
+def test_empty_paths_and_dots():
+    dot = _path(("line", [[5, 5], [5, 5]]))
+    empty = FittedPath(1, 1, False, (), 0.0, 0)
+    res = sample_paths([dot, empty, dot], FM)
+    assert [m.tolist() for m in res.marks] == [[[5, 5]], [], [[5, 5]]]
+
+
+def test_outside_points_counted_before_clamping():
+    fm = FieldMap(1.0, (0.0, 0.0), 1000, 110.0)
+    fp = _path(("line", [[10, 10], [1500, 10]]))
+    res = sample_paths([fp], fm)
+    assert res.report.outside_points == 1
+
+
+def test_pipeline_stats_carry_the_measurements():
+    d = read_file(SAMPLES / "curve_1181.plt")
+    stats = Pipeline().run(d, Params(magnification=36)).stats
+    for key in ("mark_points", "control_points", "strokes", "laser_switches",
+                "mark_length_mm", "jump_length_mm", "estimated_time_s",
+                "max_chord_height_bits", "max_chord_height_int_bits", "max_fit_error",
+                "dwell_points", "outside_points", "min_step_overrides"):
+        assert key in stats
+    raw = Pipeline().run(d, Params(magnification=36, interpolation="raw")).stats
+    assert raw["mark_points"] == 1181 and raw["max_chord_height_bits"] is None
+    fixed = Pipeline().run(d, Params(magnification=36, interpolation="fixed")).stats
+    assert fixed["max_chord_height_bits"] > 1.0  # the legacy method has no height bound
