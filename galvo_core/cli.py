@@ -17,6 +17,7 @@ from typing import Any, NoReturn
 
 from galvo_core import __version__
 from galvo_core.errors import GalvoError, ParamError
+from galvo_core.export import write_plt, write_svg
 from galvo_core.fit import fit_report
 from galvo_core.hpgl import read_file
 from galvo_core.job import write_job
@@ -80,6 +81,11 @@ def _add_processing_args(p: argparse.ArgumentParser, *, report: bool = False) ->
     s.add_argument("--chord-tol-bits", type=_finite, default=d.chord_tol_bits)
     s.add_argument("--min-step-bits", type=_finite, default=d.min_step_bits)
     s.add_argument("--max-step-bits", type=_finite, default=None)
+    s.add_argument("--fixed-step-bits", type=_finite, default=d.fixed_step_bits,
+                   help="paper 001 baseline (--interpolation fixed): step along the curve's "
+                        "main axis")
+    s.add_argument("--fixed-slope-tol", type=_finite, default=d.fixed_slope_tol,
+                   help="paper 001 baseline: slope threshold k0")
     k = p.add_argument_group("kerf compensation (paper 003)")
     k.add_argument("--kerf-mm", type=_finite, default=d.kerf_mm,
                    help="width of the laser trough on the workpiece; 0 = none (default)")
@@ -116,6 +122,7 @@ def _params_from_args(a: argparse.Namespace) -> Params:
         offset_bits=tuple(a.offset_bits) if a.offset_bits else None, clamp=a.clamp,
         interpolation=a.interpolation, chord_tol_bits=a.chord_tol_bits,
         min_step_bits=a.min_step_bits, max_step_bits=a.max_step_bits,
+        fixed_step_bits=a.fixed_step_bits, fixed_slope_tol=a.fixed_slope_tol,
         kerf_mm=a.kerf_mm, kerf_side=a.kerf_side, kerf_method=a.kerf_method,
         arc_tol_bits=a.arc_tol_bits, fill=a.fill, hatch_spacing_mm=a.hatch_spacing_mm,
         hatch_angle_deg=a.hatch_angle_deg, hatch_passes=a.hatch_passes,
@@ -140,6 +147,10 @@ def cmd_process(a: argparse.Namespace) -> int:
     d = read_file(a.file)
     job = Pipeline().run(d, params)
     write_job(job, a.output)
+    if a.plt:
+        write_plt(job, a.plt, what=a.plt_what)
+    if a.svg:
+        write_svg(job, a.svg, marks=a.svg_marks)
     _print_json({
         "file": d.name,
         "output": a.output,
@@ -223,6 +234,13 @@ def build_parser() -> argparse.ArgumentParser:
                                     "summary with stats.")
     pp.add_argument("file")
     pp.add_argument("-o", "--output", required=True, help="job file to write (JSON)")
+    ex = pp.add_argument_group("export")
+    ex.add_argument("--plt", metavar="OUT.plt", help="also write the job as HP-GL")
+    ex.add_argument("--plt-what", choices=("marks", "segments"), default="marks",
+                    help="marks: the marks in galvo bits (default); segments: the fitted "
+                         "lines and Béziers (BZ) in input units")
+    ex.add_argument("--svg", metavar="OUT.svg", help="also write the fitted geometry as SVG (mm)")
+    ex.add_argument("--svg-marks", action="store_true", help="draw the marks in the SVG too")
     _add_processing_args(pp)
     pp.set_defaults(func=cmd_process)
     pr = sub.add_parser("report", help="paper 000's Table 1 for a file",

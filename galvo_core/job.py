@@ -108,6 +108,15 @@ def atomic_write_bytes(path: str | os.PathLike[str], data: bytes) -> None:
         raise GalvoError(f"{target}: the folder {folder} does not exist")
     fd, tmp = tempfile.mkstemp(prefix=".tmp-", suffix=os.path.basename(target)[-16:], dir=folder)
     try:
+        # mkstemp makes the file private (0600): give it the mode a plain open() would, or
+        # keep the mode of the file it replaces
+        try:
+            mode = os.stat(target).st_mode & 0o7777
+        except OSError:
+            umask = os.umask(0)
+            os.umask(umask)
+            mode = 0o666 & ~umask
+        os.chmod(tmp, mode)
         with os.fdopen(fd, "wb") as fh:
             fh.write(data)
             fh.flush()

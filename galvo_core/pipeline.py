@@ -20,7 +20,7 @@ import time
 from collections import OrderedDict
 from collections.abc import Callable, Hashable
 from dataclasses import dataclass
-from typing import Any, TypeVar
+from typing import Any, TypeVar, cast
 
 import numpy as np
 
@@ -216,8 +216,8 @@ class Pipeline:
                                   work.paths[h.source_index].pen))
         if cancel is not None and cancel():
             raise Cancelled()
-        strokes = order_job_strokes(strokes, fm, method=params.scan_order,
-                                    time_budget_s=params.order_time_budget_s)
+        strokes = cast(list[Stroke], order_job_strokes(
+            strokes, fm, method=params.scan_order, time_budget_s=params.order_time_budget_s))
         stats = self.stats(drawing, params, fitted, fm, strokes)
         if clamped:
             warnings.append(Warning(0, 0, f"{clamped} marks were outside the field and clamped"))

@@ -816,12 +816,12 @@ def sample_paths(
     same = np.r_[False, (r[1:] == r[:-1]).all(axis=1) & ~first_of[1:]]
     if same.any():
         drop = same.copy()
-        for i in np.flatnonzero(same & last_of):
-            j = i - 1  # keep the true end, drop its twin before it unless that is the start
+        for e in np.flatnonzero(same & last_of).tolist():
+            j = e - 1  # keep the true end, drop its twin before it unless that is the start
             while same[j]:
                 j -= 1
             if not first_of[j]:
-                drop[i] = False
+                drop[e] = False
                 drop[j] = True
         keep = ~drop
         sid, st, pos, pid, r = sid[keep], st[keep], pos[keep], pid[keep], r[keep]

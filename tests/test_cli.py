@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import re
 
 import pytest
 from _util import SAMPLES, circle_plt, run_cli
@@ -132,3 +133,35 @@ def test_report_prints_table1_and_magnifications():
     m36, m72 = rep["magnifications"]
     assert m36["raw"]["mark_points"] == m72["raw"]["mark_points"]
     assert m36["adaptive"]["mark_points"] < m72["adaptive"]["mark_points"] < 1181
+
+
+def test_process_exports_plt_and_svg_that_read_back(tmp_path):
+    out = tmp_path / "job.json"
+    r = run_cli("process", str(SAMPLES / "curve_1181.plt"), "-o", str(out), "--magnification",
+                "36", "--plt", str(tmp_path / "job.plt"), "--svg", str(tmp_path / "job.svg"))
+    assert r.returncode == 0, r.stderr
+    doc = json.loads(out.read_text())
+    info = json.loads(run_cli("info", str(tmp_path / "job.plt")).stdout)
+    assert info["points"] == sum(len(s["marks"]) for s in doc["strokes"])
+    svg = (tmp_path / "job.svg").read_text()
+    assert svg.lstrip().startswith(("<?xml", "<svg"))
+    assert re.search(r"<path[^>]* d=\"M[^\"]*C", svg), "fitted cubics are written as C commands"
+
+
+def test_kerf_fill_and_order_options_reach_the_job(tmp_path):
+    out = tmp_path / "job.json"
+    base = ("process", str(SAMPLES / "seal.plt"), "-o", str(out), "--fit-field")
+    r = run_cli(*base, "--fill", "scanline", "--hatch-spacing-mm", "0.3")
+    assert r.returncode == 0, r.stderr
+    scan = json.loads(r.stdout)["stats"]
+    r = run_cli(*base, "--fill", "zigzag", "--hatch-spacing-mm", "0.3", "--scan-order",
+                "greedy", "--kerf-mm", "0.2")
+    assert r.returncode == 0, r.stderr
+    zig = json.loads(r.stdout)["stats"]
+    assert zig["laser_switches"] < scan["laser_switches"]
+    doc = json.loads(out.read_text())
+    assert doc["params"]["kerf_mm"] == 0.2 and doc["params"]["fill"] == "zigzag"
+    assert doc["params"]["scan_order"] == "greedy"
+    assert {s["kind"] for s in doc["strokes"]} == {"contour", "hatch"}
+    r = run_cli(*base, "--kerf-mm", "-0.1")
+    assert r.returncode == 2 and r.stderr.startswith("error:") and "kerf_mm" in r.stderr
