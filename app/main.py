@@ -1,10 +1,13 @@
-"""``galvo-workstation [FILE] [--screenshot OUT.png [--size WxH]]``.
+"""``galvo-workstation [FILE] [--screenshot OUT.png [--size WxH]] [--set NAME=VALUE …]``.
 
 Without ``--screenshot`` the window opens on FILE (if given). With ``--screenshot`` the
-window is rendered offscreen (when there is no display), written as a PNG and the program
-exits: 0 on success, 2 with one ``error: ...`` line on stderr for bad arguments or a
+window is rendered offscreen (when there is no display) once the pipeline has finished,
+written as a PNG and the program exits: 0 on success, 2 with one ``error: ...`` line on
+stderr for bad arguments, a bad ``--set`` (unknown name or a value Params refuses) or a
 refused file. Without FILE, ``--screenshot`` uses the first bundled sample
-(``resources/samples/*.plt``).
+(``resources/samples/*.plt``). ``--set`` takes any Params field (``e_per=0.05``,
+``magnification=36``, ``fit_field=true``, ``fill=zigzag``) or LaserParams field
+(``mark_speed_mm_s=500``); screenshots ignore the saved settings.
 """
 
 from __future__ import annotations
@@ -48,6 +51,69 @@ def parse_size(text: str) -> tuple[int, int]:
     return w, h
 
 
+def _convert(name: str, text: str, current: object, annotation: str) -> object:
+    t = text.strip()
+    low = t.lower()
+    if low in ("none", "null", "auto") and "None" in annotation:
+        return None
+    if "bool" in annotation:
+        if low in ("1", "true", "yes", "on"):
+            return True
+        if low in ("0", "false", "no", "off"):
+            return False
+        raise UsageError(f"--set {name}: expected true or false, got {text!r}")
+    if "tuple" in annotation:
+        parts = [p for p in re.split(r"[,\s]+", t) if p]
+        try:
+            return tuple(float(p) for p in parts)
+        except ValueError:
+            raise UsageError(f"--set {name}: expected two numbers X,Y, got {text!r}") from None
+    if annotation.startswith("int") or isinstance(current, int) and not isinstance(current, bool):
+        try:
+            return int(t)
+        except ValueError:
+            raise UsageError(f"--set {name}: expected an integer, got {text!r}") from None
+    if annotation.startswith("str"):
+        return t
+    try:
+        return float(t)
+    except ValueError:
+        raise UsageError(f"--set {name}: expected a number, got {text!r}") from None
+
+
+def params_from_sets(sets: Sequence[str]):
+    """Params() with ``NAME=VALUE`` changes, validated by Params; UsageError otherwise."""
+    from dataclasses import fields
+
+    from galvo_core.errors import ParamError
+    from galvo_core.params import LaserParams, Params
+
+    pfields = {f.name: f for f in fields(Params) if f.name != "laser"}
+    lfields = {f.name: f for f in fields(LaserParams)}
+    base = Params()
+    changes: dict[str, object] = {}
+    laser: dict[str, object] = {}
+    for item in sets:
+        if "=" not in item:
+            raise UsageError(f"--set needs NAME=VALUE, got {item!r}")
+        name, value = (x.strip() for x in item.split("=", 1))
+        name = name.removeprefix("laser.")
+        if name in pfields:
+            f = pfields[name]
+            changes[name] = _convert(name, value, getattr(base, name), str(f.type))
+        elif name in lfields:
+            f = lfields[name]
+            laser[name] = _convert(name, value, getattr(base.laser, name), str(f.type))
+        else:
+            raise UsageError(f"--set: unknown parameter {name!r} (see galvo_core.params.Params)")
+    try:
+        if laser:
+            changes["laser"] = LaserParams(**{**base.laser.as_dict(), **laser})
+        return base.replace(**changes)
+    except (ParamError, TypeError, ValueError) as exc:
+        raise UsageError(f"--set: {exc}") from None
+
+
 def build_parser() -> argparse.ArgumentParser:
     p = _Parser(
         prog="galvo-workstation",
@@ -59,6 +125,14 @@ def build_parser() -> argparse.ArgumentParser:
         metavar="OUT.png",
         help="render the window (offscreen when there is no display), write a PNG and exit; "
         "without FILE a bundled sample is shown",
+    )
+    p.add_argument(
+        "--set",
+        dest="sets",
+        action="append",
+        default=[],
+        metavar="NAME=VALUE",
+        help="a processing parameter (any Params or LaserParams field), repeatable",
     )
     p.add_argument(
         "--size",
@@ -94,11 +168,15 @@ def _qapp(argv: Sequence[str]):
 
 
 def render_screenshot(window, out: FsPath, size: tuple[int, int]) -> None:
-    """Lay ``window`` out at ``size``, fit the views, and write it to ``out`` as PNG."""
+    """Lay ``window`` out at ``size``, wait for the pipeline, fit the views, and write it to
+    ``out`` as PNG."""
     from PySide6.QtWidgets import QApplication
 
     window.resize(*size)
     window.show()
+    for _ in range(3):
+        QApplication.processEvents()
+    window.wait_for_result(120.0)
     for _ in range(3):
         QApplication.processEvents()
     window.fit()  # after the final layout: the views know their real size now
@@ -127,6 +205,7 @@ def _screenshot(args: argparse.Namespace, size: tuple[int, int]) -> int:
 
     from .window import bundled_sample, describe_load_error, load_drawing
 
+    params = params_from_sets(args.sets)
     path = FsPath(args.file) if args.file else bundled_sample()
     drawing = None
     if path is not None:
@@ -141,7 +220,8 @@ def _screenshot(args: argparse.Namespace, size: tuple[int, int]) -> int:
     _qapp([])
     from .window import MainWindow
 
-    window = MainWindow()
+    window = MainWindow(restore=False)
+    window.set_params(params, run=False)
     if drawing is not None:
         window.set_drawing(drawing, path)
     try:
@@ -164,7 +244,10 @@ def _gui(args: argparse.Namespace) -> int:
     from .window import MainWindow
 
     window = MainWindow()
-    window.resize(*DEFAULT_SIZE)
+    if args.sets:
+        window.set_params(params_from_sets(args.sets), run=False)
+    if not window.settings.value("window/geometry"):
+        window.resize(*DEFAULT_SIZE)
     window.show()
     if args.file:
         # after the event loop starts, so an error dialog appears over the window
@@ -178,6 +261,8 @@ def main(argv: Sequence[str] | None = None) -> int:
         args = build_parser().parse_args(argv)
         if args.size is not None and not args.screenshot:
             raise UsageError("--size needs --screenshot")
+        if args.sets and not args.screenshot:
+            params_from_sets(args.sets)  # validate before opening a window
         size = parse_size(args.size) if args.size is not None else DEFAULT_SIZE
         if args.screenshot:
             return _screenshot(args, size)

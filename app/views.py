@@ -1,102 +1,390 @@
-"""Plot views of a drawing: one pyqtgraph item per layer, never one per path.
+"""The two plot views: one pyqtgraph item per layer, never one per path.
 
-Coordinates stay in input units (HP-GL plotter units, 40 per mm) inside the plots, so a
-point under the cursor is the point in the file; only the axis tick labels are scaled to
-millimetres.
+Both views are in *workpiece millimetres of the galvo field* (bit ``X`` at
+``X * mm_per_bit`` mm; the field is the square 0 .. field_size_mm), so the original drawing
+(at the current magnification) and the processed result line up point for point.
 
-Layers of a :class:`DrawingView`:
+The arrays come from :mod:`galvo_core.preview` in their native space (input units or galvo
+bits); each item gets the affine map to mm as its QTransform. A run that only changed the
+magnification therefore changes transforms, not data: no geometry is computed here.
 
-``lines``
-    Every path as one NaN-separated polyline (``connect="finite"``): one item whatever
-    the number of paths.
-``markers``
-    The points themselves as small dots, drawn only while the drawing has fewer than
-    :data:`MAX_MARKER_POINTS` points (an item with no data above that, so the number of
-    items never changes).
+Layers (key: what, view):
+
+``original``          the file's polylines (left)
+``original_points``   the file's points, small orange dots (left)
+``fitted``            fitted lines and cubics (right)
+``control``           control points: anchors (blue squares), inner control points (hollow
+                      blue circles) and their handle lines (right)
+``marks``             marking points, red dots (right)
+``jumps``             laser-off moves, dashed grey (right)
+``hatch``             fill lines (right)
+``kerf``              the kerf-compensated outline (right)
+``deviation``         the fitted curve coloured by its true error to the original points,
+                      with a colour bar in µm (right)
 """
 
 from __future__ import annotations
 
-from collections.abc import Iterable
+from dataclasses import dataclass
 
 import numpy as np
 import pyqtgraph as pg
-
-from galvo_core.drawing import UNITS_PER_MM, Drawing, Path
-
-#: Point markers are drawn only below this many points (scatter rendering gets slow).
-MAX_MARKER_POINTS = 200_000
-#: Lines are antialiased only below this many points (speed on big drawings).
-MAX_ANTIALIAS_POINTS = 300_000
-
-#: Anything :meth:`DrawingView.set_polylines` accepts: a Drawing, or an iterable of
-#: :class:`Path` objects and/or (N, 2) arrays of points in input units.
-Polylines = Drawing | Iterable[Path | np.ndarray]
+from PySide6.QtCore import QPointF, QRectF, Qt
+from PySide6.QtGui import QColor, QPainterPath, QPen, QTransform
 
 # --- palette (light background, dark ink: legible on screen and in print) -------------
 BACKGROUND = "#ffffff"
 FOREGROUND = "#2b2b2b"
-GRID_ALPHA = 0.12
-ORIGINAL_LINE = "#1f3f73"  # dark blue
-PROCESSED_LINE = "#0f5f4f"  # dark teal
-MARKER = "#e0531f"  # orange-red
-MARKER_ALPHA = 210
+GRID_ALPHA = 0.10
+ORIGINAL_LINE = "#4a5a6e"  # slate
+ORIGINAL_POINT = "#e67e00"  # orange
+FITTED_LINE = "#0b7a55"  # green-teal
+CONTROL = "#1f5fbf"  # blue
+MARK = "#d7191c"  # red
+JUMP = "#7a7a7a"  # grey, dashed
+HATCH = "#8e44ad"  # purple
+KERF = "#e6007e"  # magenta
+FIELD = "#9aa5b1"
+SELECTION = "#ffc400"  # amber underlay
 TITLE_SIZE = "11pt"
 
-#: Smallest span a fit zooms to, in input units (1 mm).
-MIN_FIT_SPAN = UNITS_PER_MM
+#: Deviation colours, from "well inside the tolerance" to "at the tolerance".
+DEVIATION_STOPS = ("#1a9850", "#a6d96a", "#fee08b", "#f46d43", "#a50026")
+DEVIATION_BINS = 16
 
-#: Range shown when a view is empty: an A4 landscape sheet (297 x 210 mm).
-EMPTY_RANGE_MM = (297.0, 210.0)
+#: Point markers of the original drawing are drawn only below this many points.
+MAX_MARKER_POINTS = 200_000
+#: Lines and markers are antialiased only below this many vertices: the software rasteriser
+#: spends most of a frame antialiasing big layers (bench/bench_gui.py).
+MAX_ANTIALIAS_POINTS = 20_000
 
-
-def _marker_brush():
-    colour = pg.mkColor(MARKER)
-    colour.setAlpha(MARKER_ALPHA)
-    return pg.mkBrush(colour)
-
-
-def _as_point_arrays(polylines: Polylines) -> list[np.ndarray]:
-    if isinstance(polylines, Drawing):
-        polylines = polylines.paths
-    out: list[np.ndarray] = []
-    for item in polylines:
-        pts = item.points if isinstance(item, Path) else np.asarray(item, dtype=np.float64)
-        pts = pts.reshape(-1, 2)
-        if len(pts):
-            out.append(pts)
-    return out
+#: Smallest span a fit zooms to, in mm.
+MIN_FIT_SPAN_MM = 0.5
 
 
-def nan_separated(polylines: Polylines) -> tuple[np.ndarray, np.ndarray]:
-    """x and y arrays of all polylines, one NaN row between consecutive polylines.
-
-    Suitable for one ``PlotDataItem(x, y, connect="finite")``.
-    """
-    arrays = _as_point_arrays(polylines)
-    if not arrays:
-        return np.empty(0), np.empty(0)
-    total = sum(len(a) for a in arrays) + len(arrays) - 1
-    xy = np.full((total, 2), np.nan)
-    i = 0
-    for a in arrays:
-        xy[i : i + len(a)] = a
-        i += len(a) + 1
-    return xy[:, 0].copy(), xy[:, 1].copy()
+@dataclass(frozen=True)
+class LayerSpec:
+    key: str
+    label: str
+    view: str  # "original" or "processed"
+    default_on: bool
+    tip: str
 
 
-def all_points(polylines: Polylines) -> np.ndarray:
-    """Every point of every polyline as one (N, 2) array."""
-    arrays = _as_point_arrays(polylines)
-    if not arrays:
-        return np.empty((0, 2))
-    return np.concatenate(arrays)
+LAYERS: tuple[LayerSpec, ...] = (
+    LayerSpec("original", "Original path", "original", True,
+              "the file's pen-down paths as written (left view)"),
+    LayerSpec("original_points", "Original points", "original", True,
+              "every point the file gives: orange dots (left view)"),
+    LayerSpec("fitted", "Fitted curve", "processed", True,
+              "lines and cubic Béziers of the fit (right view)"),
+    LayerSpec("control", "Control points", "processed", True,
+              "segment ends (blue squares), Bézier handles (hollow circles) and handle lines"),
+    LayerSpec("marks", "Marks", "processed", True,
+              "mark points: the galvo positions the laser is sent to (red dots)"),
+    LayerSpec("jumps", "Jumps", "processed", True, "laser-off moves between strokes (dashed)"),
+    LayerSpec("hatch", "Hatch", "processed", True, "fill lines (when a fill is chosen)"),
+    LayerSpec("kerf", "Kerf", "processed", True,
+              "the kerf-compensated outline the laser follows (when a kerf width is set)"),
+    LayerSpec("deviation", "Deviation", "processed", False,
+              "the fitted curve coloured by its true distance to the original points (µm)"),
+)
+LAYER_KEYS = tuple(spec.key for spec in LAYERS)
 
 
-class DrawingView(pg.PlotWidget):
-    """One titled, equal-aspect, y-up plot of polylines in input units, mm on the axes."""
+def deviation_colormap() -> pg.ColorMap:
+    return pg.ColorMap(np.linspace(0.0, 1.0, len(DEVIATION_STOPS)),
+                       [pg.mkColor(c) for c in DEVIATION_STOPS])
 
-    def __init__(self, title: str, line_colour: str, parent=None) -> None:
+
+def _pen(colour: str, width: float = 1.0, alpha: int = 255, style=Qt.PenStyle.SolidLine) -> QPen:
+    c = pg.mkColor(colour)
+    c.setAlpha(alpha)
+    pen = pg.mkPen(c, width=width, style=style)
+    pen.setCosmetic(True)
+    return pen
+
+
+def _brush(colour: str, alpha: int = 255):
+    c = pg.mkColor(colour)
+    c.setAlpha(alpha)
+    return pg.mkBrush(c)
+
+
+class DeviationItem(pg.GraphicsObject):
+    """Chords coloured by a level in 0..1: ONE item, one QPainterPath per colour bin."""
+
+    def __init__(self, width: float = 3.2) -> None:
+        super().__init__()
+        self._paths: list[tuple[QPen, QPainterPath]] = []
+        self._rect = QRectF()
+        self._width = width
+        cmap = deviation_colormap()
+        self._pens = []
+        for i in range(DEVIATION_BINS):
+            colour = cmap.map((i + 0.5) / DEVIATION_BINS, mode="qcolor")
+            pen = QPen(colour, width)
+            pen.setCosmetic(True)
+            pen.setCapStyle(Qt.PenCapStyle.FlatCap)
+            self._pens.append(pen)
+        self.n_chords = 0
+
+    def setData(self, a: np.ndarray, b: np.ndarray, level: np.ndarray) -> None:  # noqa: N802
+        self.prepareGeometryChange()
+        self._paths = []
+        self.n_chords = len(level)
+        if not len(level):
+            self._rect = QRectF()
+            self.update()
+            return
+        bins = np.minimum((level * DEVIATION_BINS).astype(np.int64), DEVIATION_BINS - 1)
+        for k in np.unique(bins):
+            sel = bins == k
+            n = int(sel.sum())
+            x = np.empty(2 * n)
+            y = np.empty(2 * n)
+            x[0::2], x[1::2] = a[sel, 0], b[sel, 0]
+            y[0::2], y[1::2] = a[sel, 1], b[sel, 1]
+            self._paths.append((self._pens[int(k)], pg.arrayToQPath(x, y, connect="pairs")))
+        lo = np.minimum(a.min(axis=0), b.min(axis=0))
+        hi = np.maximum(a.max(axis=0), b.max(axis=0))
+        self._rect = QRectF(QPointF(lo[0], lo[1]), QPointF(hi[0], hi[1]))
+        self.update()
+
+    def boundingRect(self) -> QRectF:  # noqa: N802 - Qt API
+        return self._rect
+
+    def dataBounds(self, ax, frac=1.0, orthoRange=None):  # noqa: N802, N803 - pyqtgraph API
+        if self._rect.isNull():
+            return None, None
+        if ax == 0:
+            return self._rect.left(), self._rect.right()
+        return self._rect.top(), self._rect.bottom()
+
+    def paint(self, p, *args) -> None:
+        small = self.n_chords < MAX_ANTIALIAS_POINTS
+        p.setRenderHint(p.RenderHint.Antialiasing, small)
+        for pen, path in self._paths:
+            if not small:  # a wide pen is stroked in software: thin it on big layers
+                pen = QPen(pen)
+                pen.setWidthF(2.0)
+            p.setPen(pen)
+            p.drawPath(path)
+
+
+def _polygon(xy: np.ndarray):
+    """(N, 2) finite points -> QPolygonF (filled through a numpy view, no Python loop)."""
+    import pyqtgraph.functions as fn
+
+    poly = fn.create_qpolygonf(len(xy))
+    if len(xy):
+        fn.ndarray_from_qpolygonf(poly)[:] = xy
+    return poly
+
+
+def _finite_rect(xy: np.ndarray) -> QRectF:
+    if not len(xy):
+        return QRectF()
+    lo, hi = xy.min(axis=0), xy.max(axis=0)
+    return QRectF(QPointF(lo[0], lo[1]), QPointF(hi[0], hi[1]))
+
+
+def draw_points(p, xy: np.ndarray, poly, pen: QPen, grid: float = 2.0) -> None:
+    """Draw markers at ``xy`` (item coordinates) with ``pen``. Small sets: antialiased, as
+    they are. Large sets: culled to the viewport and thinned to one marker per ``grid``
+    device pixels (what the eye can tell apart anyway), drawn without antialiasing — this
+    keeps a 100,000-point layer in the tens of milliseconds."""
+    if len(xy) < MAX_ANTIALIAS_POINTS:
+        p.setRenderHint(p.RenderHint.Antialiasing, True)
+        p.setPen(pen)
+        p.drawPoints(poly)
+        return
+    t = p.transform()
+    dx = xy[:, 0] * t.m11() + xy[:, 1] * t.m21() + t.dx()
+    dy = xy[:, 0] * t.m12() + xy[:, 1] * t.m22() + t.dy()
+    dev = p.device()
+    w, h = (dev.width(), dev.height()) if dev is not None else (1 << 15, 1 << 15)
+    m = 8.0
+    keep = (dx > -m) & (dx < w + m) & (dy > -m) & (dy < h + m)
+    ix = np.floor(dx[keep] / grid).astype(np.int64)
+    iy = np.floor(dy[keep] / grid).astype(np.int64)
+    cells = np.unique((ix + 64) * (1 << 22) + (iy + 64))
+    pts = np.empty((len(cells), 2))
+    pts[:, 0] = (cells // (1 << 22) - 64 + 0.5) * grid
+    pts[:, 1] = (cells % (1 << 22) - 64 + 0.5) * grid
+    p.save()
+    p.resetTransform()
+    p.setRenderHint(p.RenderHint.Antialiasing, False)
+    p.setPen(pen)
+    p.drawPoints(_polygon(pts))
+    p.restore()
+
+
+class _FastItem(pg.GraphicsObject):
+    """Base of the point layers: drawn with QPainter.drawPoints and cosmetic pens, so tens
+    of thousands of markers cost milliseconds (pyqtgraph's scatter builds one object per
+    spot)."""
+
+    def __init__(self) -> None:
+        super().__init__()
+        self._rect = QRectF()
+        self._pad = 0.0
+
+    def boundingRect(self) -> QRectF:  # noqa: N802 - Qt API
+        if self._rect.isNull():
+            return QRectF()
+        # markers have a size in pixels: pad by a few pixels in item coordinates
+        px = self.pixelLength(pg.Point(1, 0)) or 0.0
+        pad = 6.0 * px
+        return self._rect.adjusted(-pad, -pad, pad, pad)
+
+    def dataBounds(self, ax, frac=1.0, orthoRange=None):  # noqa: N802, N803 - pyqtgraph API
+        if self._rect.isNull():
+            return None, None
+        if ax == 0:
+            return self._rect.left(), self._rect.right()
+        return self._rect.top(), self._rect.bottom()
+
+
+class PointsItem(_FastItem):
+    """Round (or square) dots of a fixed pixel size at (N, 2) points: ONE item."""
+
+    def __init__(self, colour: str, size: float, alpha: int = 235, square: bool = False) -> None:
+        super().__init__()
+        self.pen = _pen(colour, size, alpha)
+        self.pen.setCapStyle(Qt.PenCapStyle.SquareCap if square else Qt.PenCapStyle.RoundCap)
+        self._xy = np.empty((0, 2))
+        self._poly = _polygon(self._xy)
+
+    def setData(self, xy: np.ndarray) -> None:  # noqa: N802 - like pyqtgraph
+        xy = np.asarray(xy, dtype=np.float64).reshape(-1, 2)
+        xy = xy[np.isfinite(xy).all(axis=1)]
+        self.prepareGeometryChange()
+        self._xy = xy
+        self._poly = _polygon(xy)
+        self._rect = _finite_rect(xy)
+        self.update()
+
+    def getData(self) -> tuple[np.ndarray, np.ndarray]:  # noqa: N802 - like pyqtgraph
+        return self._xy[:, 0], self._xy[:, 1]
+
+    def paint(self, p, *args) -> None:
+        if len(self._xy):
+            draw_points(p, self._xy, self._poly, self.pen)
+
+
+class ControlItem(_FastItem):
+    """Control points: handle lines, anchors (filled squares), inner control points (hollow
+    circles) — ONE item. Data: (xy, role) from galvo_core.preview.control_layer."""
+
+    def __init__(self) -> None:
+        super().__init__()
+        self.line_pen = _pen(CONTROL, 1.0, alpha=170)
+        self.anchor_pen = _pen(CONTROL, 5.5)
+        self.anchor_pen.setCapStyle(Qt.PenCapStyle.SquareCap)
+        self.knot_pen = _pen(CONTROL, 6.5)
+        self.knot_pen.setCapStyle(Qt.PenCapStyle.RoundCap)
+        self.hole_pen = _pen("#ffffff", 3.6)
+        self.hole_pen.setCapStyle(Qt.PenCapStyle.RoundCap)
+        self._lines = QPainterPath()
+        self._xy_anchors = self._xy_knots = np.empty((0, 2))
+        self._anchors = _polygon(self._xy_anchors)
+        self._knots = _polygon(self._xy_knots)
+        self._xy = np.empty((0, 2))
+        self._role = np.empty(0, dtype=np.int8)
+
+    def setData(self, xy: np.ndarray, role: np.ndarray) -> None:  # noqa: N802
+        self.prepareGeometryChange()
+        self._xy = xy = np.asarray(xy, dtype=np.float64).reshape(-1, 2)
+        self._role = role = np.asarray(role)
+        handles = role[: len(xy)] != 1
+        hx = xy.copy()
+        hx[~handles] = np.nan
+        if len(xy):
+            self._lines = pg.arrayToQPath(hx[:, 0], hx[:, 1], connect="finite")
+        else:
+            self._lines = QPainterPath()
+        self._xy_anchors = xy[role == 1]
+        self._xy_knots = xy[role == 2]
+        self._anchors = _polygon(self._xy_anchors)
+        self._knots = _polygon(self._xy_knots)
+        self._rect = _finite_rect(xy[role >= 0])
+        self.update()
+
+    def getData(self) -> tuple[np.ndarray, np.ndarray]:  # noqa: N802
+        pts = self._xy[self._role > 0]
+        return pts[:, 0], pts[:, 1]
+
+    def paint(self, p, *args) -> None:
+        if not len(self._xy):
+            return
+        small = len(self._xy) < MAX_ANTIALIAS_POINTS
+        p.setRenderHint(p.RenderHint.Antialiasing, small)
+        p.setPen(self.line_pen)
+        p.drawPath(self._lines)
+        knots, anchors = self._xy_knots, self._xy_anchors
+        draw_points(p, knots, self._knots, self.knot_pen, grid=3.0)
+        draw_points(p, knots, self._knots, self.hole_pen, grid=3.0)
+        draw_points(p, anchors, self._anchors, self.anchor_pen, grid=3.0)
+
+
+class ColourBar(pg.GraphicsWidgetAnchor, pg.GraphicsWidget):
+    """A vertical colour bar of the deviation colours with labels in µm (one overlay item)."""
+
+    W, H = 92, 150
+
+    def __init__(self) -> None:
+        pg.GraphicsWidget.__init__(self)
+        pg.GraphicsWidgetAnchor.__init__(self)
+        self.setFlag(self.GraphicsItemFlag.ItemIgnoresTransformations)
+        self.setZValue(50)
+        self.top_um = 1.0
+        self.setMinimumSize(self.W, self.H)
+        self.setMaximumSize(self.W, self.H)
+        self.label = "deviation [µm]"
+
+    def set_range(self, top_um: float) -> None:
+        self.top_um = float(top_um)
+        self.update()
+
+    def boundingRect(self) -> QRectF:  # noqa: N802 - Qt API
+        return QRectF(0, 0, self.W, self.H)
+
+    def tick_labels(self) -> list[str]:
+        return [f"{self.top_um * f:.3g}" for f in (1.0, 0.5, 0.0)]
+
+    def paint(self, p, *args) -> None:
+        from PySide6.QtGui import QBrush, QFont, QLinearGradient
+
+        p.setRenderHint(p.RenderHint.Antialiasing, True)
+        p.setPen(pg.mkPen("#c8ccd0"))
+        p.setBrush(pg.mkBrush(255, 255, 255, 215))
+        p.drawRect(QRectF(0, 0, self.W - 1, self.H - 1))
+        font = QFont()
+        font.setPointSizeF(7.5)
+        p.setFont(font)
+        p.setPen(pg.mkPen(FOREGROUND))
+        p.drawText(QRectF(4, 2, self.W - 8, 14), Qt.AlignmentFlag.AlignCenter, self.label)
+        x0, y0, w, h = 10, 20, 14, self.H - 30
+        grad = QLinearGradient(0, y0 + h, 0, y0)
+        for i, c in enumerate(DEVIATION_STOPS):
+            grad.setColorAt(i / (len(DEVIATION_STOPS) - 1), pg.mkColor(c))
+        p.setBrush(QBrush(grad))
+        p.setPen(pg.mkPen("#6b7580"))
+        p.drawRect(QRectF(x0, y0, w, h))
+        for f, text in zip((0.0, 0.5, 1.0), self.tick_labels(), strict=True):
+            y = y0 + f * h
+            p.drawLine(QPointF(x0 + w, y), QPointF(x0 + w + 3, y))
+            p.drawText(QRectF(x0 + w + 5, y - 7, self.W - x0 - w - 8, 14),
+                       Qt.AlignmentFlag.AlignLeft | Qt.AlignmentFlag.AlignVCenter,
+                       text + (" = tol." if f == 0.0 else ""))
+
+
+class WorkView(pg.PlotWidget):
+    """One titled, equal-aspect, y-up plot in workpiece mm with a field outline, layers,
+    a selection highlight and a legend."""
+
+    def __init__(self, title: str, layer_keys: tuple[str, ...], parent=None) -> None:
         super().__init__(parent=parent, background=BACKGROUND)
         self.setAcceptDrops(False)  # let file drops reach the main window
         self.view_title = title
@@ -105,89 +393,203 @@ class DrawingView(pg.PlotWidget):
         pi.setMenuEnabled(False)
         pi.hideButtons()
         pi.showGrid(x=True, y=True, alpha=GRID_ALPHA)
-        pi.layout.setContentsMargins(6, 4, 14, 6)
+        pi.layout.setContentsMargins(4, 2, 10, 4)
         for name, label in (("bottom", "x"), ("left", "y")):
             axis = pi.getAxis(name)
-            axis.setScale(1.0 / UNITS_PER_MM)  # data in input units, ticks in mm
             axis.enableAutoSIPrefix(False)
             axis.setLabel(f"{label} [mm]", color=FOREGROUND)
             axis.setPen(pg.mkPen(FOREGROUND))
             axis.setTextPen(pg.mkPen(FOREGROUND))
-        pi.getAxis("left").setWidth(58)
+        pi.getAxis("left").setWidth(52)
         vb = pi.getViewBox()
         vb.setAspectLocked(True, ratio=1.0)  # y up is the ViewBox default
         vb.setDefaultPadding(0.04)
 
-        self.lines = pg.PlotDataItem(
-            [], [], connect="finite", pen=pg.mkPen(line_colour, width=1.4), name="lines"
-        )
-        self.markers = pg.PlotDataItem(
-            [],
-            [],
-            pen=None,
-            symbol="o",
-            symbolSize=3.2,
-            symbolPen=None,
-            symbolBrush=_marker_brush(),
-            name="markers",
-        )
-        # markers under the lines: on dense curves the line stays readable on top
-        self.markers.setZValue(1)
-        self.lines.setZValue(2)
-        pi.addItem(self.lines)
-        pi.addItem(self.markers)
-        self.markers_shown = False
-        self.n_polylines = 0
-        self.n_points = 0
-        #: (xmin, ymin, xmax, ymax) of the data in input units, None when empty.
+        self.field = pg.PlotDataItem([], [], pen=_pen(FIELD, 1.2, style=Qt.PenStyle.DashLine),
+                                     name="field")
+        self.field.setZValue(-10)
+        pi.addItem(self.field)
+        self.field_label = pg.TextItem("", color=FIELD, anchor=(0, 1))
+        self.field_label.setZValue(-10)
+        pi.addItem(self.field_label, ignoreBounds=True)
+
+        self.highlight = pg.PlotDataItem([], [], connect="finite",
+                                         pen=_pen(SELECTION, 7.0, alpha=200), name="selection")
+        self.highlight.setZValue(-5)
+        pi.addItem(self.highlight)
+
+        self.layers: dict[str, pg.GraphicsObject] = {}
+        self.legend_samples: dict[str, pg.PlotDataItem] = {}
+        for key in layer_keys:
+            item, sample = _make_layer(key)
+            item.setZValue(_Z[key])
+            pi.addItem(item)
+            self.layers[key] = item
+            self.legend_samples[key] = sample
+
+        self.legend = pg.LegendItem(offset=(0, 0), labelTextColor=FOREGROUND,
+                                    brush=pg.mkBrush(255, 255, 255, 215),
+                                    pen=pg.mkPen("#c8ccd0"), labelTextSize="8pt",
+                                    verSpacing=-6, horSpacing=8)
+        self.legend.setParentItem(vb)
+        self.legend.sigSampleClicked.connect(self._on_sample_clicked)
+        self.legend.anchor((0, 0), (0, 0), offset=(4, 4))
+        self.colorbar: ColourBar | None = None
+
+        #: (xmin, ymin, xmax, ymax) in mm of what the view shows, None when empty.
         self.bounds: tuple[float, float, float, float] | None = None
-        self._empty_range()
+        self.counts: dict[str, int] = dict.fromkeys(layer_keys, 0)
+        self._data_ids: dict[str, int] = {}
+        self.set_empty_range()
 
-    # --- data --------------------------------------------------------------------------
-    def set_polylines(self, polylines: Polylines, *, auto_range: bool = True) -> None:
-        """Replace what the view shows; a fixed number of items whatever the input size."""
-        arrays = _as_point_arrays(polylines)
-        x, y = nan_separated(arrays)
-        pts = all_points(arrays)
-        self.n_polylines = len(arrays)
-        self.n_points = len(pts)
-        self.bounds = (*pts.min(axis=0).tolist(), *pts.max(axis=0).tolist()) if len(pts) else None
-        self.lines.setData(x, y, connect="finite", antialias=len(pts) < MAX_ANTIALIAS_POINTS)
-        self.markers_shown = 0 < len(pts) < MAX_MARKER_POINTS
-        if self.markers_shown:
-            self.markers.setData(pts[:, 0], pts[:, 1])
+    # --- data ----------------------------------------------------------------------------
+    def set_layer(self, key: str, *arrays: np.ndarray, transform: QTransform,
+                  count: int | None = None, **extra) -> bool:
+        """Give a layer its data (native space) and the transform to mm. The data are only
+        re-sent when the first array is another object than last time. Returns True when
+        the data changed."""
+        item = self.layers[key]
+        item.setTransform(transform)
+        ident = id(arrays[0]) if arrays else 0
+        if self._data_ids.get(key) == ident and ident:
+            return False
+        self._data_ids[key] = ident
+        # keep the arrays alive so the id stays theirs
+        item._galvo_data = arrays
+        if isinstance(item, DeviationItem):
+            item.setData(*arrays)
+            self.counts[key] = item.n_chords
+            return True
+        xy = arrays[0]
+        if isinstance(item, (PointsItem, ControlItem)):
+            item.setData(*arrays)
+        elif not len(xy):
+            item.setData([], [])
         else:
-            self.markers.setData([], [])
-        if auto_range:
-            self.fit()
+            big = len(xy) >= MAX_ANTIALIAS_POINTS
+            if not hasattr(item, "_galvo_pen"):
+                item._galvo_pen = item.opts["pen"]
+            # big layers: 1-pixel lines without antialiasing (a wide pen is stroked in
+            # software, many times slower); small ones keep their width
+            pen = QPen(item._galvo_pen)
+            if big:
+                pen.setWidthF(1.0)
+            item.setData(xy[:, 0], xy[:, 1], connect="finite", antialias=not big, pen=pen)
+        self.counts[key] = count if count is not None else len(xy)
+        return True
 
-    def clear_drawing(self) -> None:
-        self.set_polylines([])
+    def set_highlight(self, xy: np.ndarray, transform: QTransform) -> None:
+        self.highlight.setTransform(transform)
+        if len(xy):
+            self.highlight.setData(xy[:, 0], xy[:, 1], connect="finite")
+        else:
+            self.highlight.setData([], [])
 
-    def data_items(self) -> list[pg.PlotDataItem]:
-        return self.getPlotItem().listDataItems()
+    def set_field(self, outline_mm: np.ndarray | None, label: str = "") -> None:
+        if outline_mm is None or not len(outline_mm):
+            self.field.setData([], [])
+            self.field_label.setText("")
+            return
+        self.field.setData(outline_mm[:, 0], outline_mm[:, 1])
+        self.field_label.setText(label)
+        self.field_label.setPos(float(outline_mm[:, 0].min()), float(outline_mm[:, 1].max()))
 
-    def fit(self, bounds: tuple[float, float, float, float] | None = None) -> None:
-        """Zoom to ``bounds`` (default: the data), or to an empty sheet when there is none."""
+    def set_layer_visible(self, key: str, visible: bool) -> None:
+        if key in self.layers:
+            self.layers[key].setVisible(visible)
+            self.update_legend()
+
+    def update_legend(self) -> None:
+        """Legend entries for the visible layers that have something to show."""
+        want = [k for k, item in self.layers.items()
+                if item.isVisible() and k != "deviation" and self.counts.get(k, 0) > 0]
+        if want == getattr(self, "_legend_keys", None):
+            return
+        self._legend_keys = want
+        self.legend.clear()
+        for key in want:
+            label = next(s.label for s in LAYERS if s.key == key)
+            self.legend.addItem(self.legend_samples[key], label)
+        self._legend_columns()
+        self.legend.setVisible(bool(want))
+
+    def _legend_columns(self) -> None:
+        n = len(getattr(self, "_legend_keys", ()) or ())
+        fits = max(1, int(self.getPlotItem().getViewBox().width() // 125))
+        cols = max(1, min(n, fits))
+        if self.legend.columnCount != cols:
+            self.legend.setColumnCount(cols)
+
+    def resizeEvent(self, ev) -> None:  # noqa: N802 - Qt API
+        super().resizeEvent(ev)
+        if hasattr(self, "legend"):
+            self._legend_columns()
+
+    #: called with a layer key when its legend sample is clicked (the window toggles it)
+    on_legend_toggle = None
+
+    def _on_sample_clicked(self, sample_item) -> None:
+        sample_item.setVisible(True)  # the legend toggled its stand-in: undo, toggle the layer
+        for key, s in self.legend_samples.items():
+            if s is sample_item and self.on_legend_toggle is not None:
+                self.on_legend_toggle(key)
+
+    def set_colorbar(self, visible: bool, top_um: float = 1.0) -> None:
+        """The deviation colour bar (0 .. ``top_um`` µm), inside the plot at the right."""
+        if visible and self.colorbar is None:
+            self.colorbar = ColourBar()
+            self.colorbar.setParentItem(self.getPlotItem().getViewBox())
+            self.colorbar.anchor((1, 0), (1, 0), offset=(-6, 4))
+        if self.colorbar is not None:
+            if visible:
+                self.colorbar.set_range(top_um)
+            else:
+                self.colorbar.setParentItem(None)
+                if self.colorbar.scene() is not None:
+                    self.colorbar.scene().removeItem(self.colorbar)
+                self.colorbar = None
+
+    def repaint_now(self) -> None:
+        """Render the view synchronously (benchmark: 'redrawn')."""
+        self.viewport().repaint()
+
+    def data_items(self) -> list[pg.GraphicsObject]:
+        return [self.layers[k] for k in self.layers]
+
+    # --- range ---------------------------------------------------------------------------
+    def legend_height(self) -> float:
+        """Pixels the legend strip covers at the top of the plot (0 when hidden)."""
+        if not self.legend.isVisible():
+            return 0.0
+        return float(self.legend.boundingRect().height()) + 6.0
+
+    def fit(self, bounds: tuple[float, float, float, float] | None = None,
+            top_px: float | None = None) -> None:
+        """Zoom to ``bounds`` (mm; default: the data), or to the empty sheet; ``top_px``
+        pixels at the top are kept free for legends (default: this view's legend)."""
         bounds = bounds if bounds is not None else self.bounds
         if bounds is None:
-            self._empty_range()
+            self.set_empty_range()
             return
         x0, y0, x1, y1 = bounds
         cx, cy = (x0 + x1) / 2, (y0 + y1) / 2
-        # at least 1 mm across, so a single dot or a straight line still gets a sane view
-        w = max(x1 - x0, MIN_FIT_SPAN)
-        h = max(y1 - y0, MIN_FIT_SPAN)
-        self.getPlotItem().getViewBox().setRange(
-            xRange=(cx - w / 2, cx + w / 2), yRange=(cy - h / 2, cy + h / 2), padding=0.04
-        )
+        w = max(x1 - x0, MIN_FIT_SPAN_MM) * 1.08
+        h = max(y1 - y0, MIN_FIT_SPAN_MM) * 1.08
+        vb = self.getPlotItem().getViewBox()
+        W, H = max(vb.width(), 1.0), max(vb.height(), 1.0)  # noqa: N806
+        # leave room at the top for the legend strip (it sits inside the plot)
+        top_px = self.legend_height() if top_px is None else top_px
+        top = min(0.3, top_px / H) if H > 50 else 0.0
+        h_free = H * (1.0 - top)
+        s = max(w / W, h / h_free)  # mm per pixel so that the box fits below the legend
+        bottom = cy - h_free * s / 2
+        vb.setRange(xRange=(cx - W * s / 2, cx + W * s / 2), yRange=(bottom, bottom + H * s),
+                    padding=0.0)
 
-    def _empty_range(self) -> None:
-        w, h = EMPTY_RANGE_MM
-        self.getPlotItem().getViewBox().setRange(
-            xRange=(0, w * UNITS_PER_MM), yRange=(0, h * UNITS_PER_MM), padding=0.02
-        )
+    def set_empty_range(self) -> None:
+        self.getPlotItem().getViewBox().setRange(xRange=(0, 110), yRange=(0, 110), padding=0.03)
 
+    # --- pixel helpers (tests, picking) --------------------------------------------------
     def view_rect_in(self, widget) -> tuple[int, int, int, int]:
         """The plotting area (ViewBox) as (x, y, w, h) in ``widget`` pixel coordinates."""
         vb = self.getPlotItem().getViewBox()
@@ -195,24 +597,95 @@ class DrawingView(pg.PlotWidget):
         top_left = self.mapTo(widget, rect.topLeft())
         return top_left.x(), top_left.y(), rect.width(), rect.height()
 
-    def data_to_widget(self, widget, x: float, y: float) -> tuple[int, int]:
-        """Pixel in ``widget`` of the point (x, y) in input units."""
+    def data_to_widget(self, widget, x_mm: float, y_mm: float) -> tuple[int, int]:
+        """Pixel in ``widget`` of the point (x, y) in mm."""
         vb = self.getPlotItem().getViewBox()
-        scene_pt = vb.mapViewToScene(pg.Point(x, y))
+        scene_pt = vb.mapViewToScene(pg.Point(x_mm, y_mm))
         p = self.mapTo(widget, self.mapFromScene(scene_pt))
         return p.x(), p.y()
 
+    def mm_per_pixel(self) -> float:
+        vb = self.getPlotItem().getViewBox()
+        (x0, x1), _ = vb.viewRange()
+        w = max(vb.width(), 1.0)
+        return (x1 - x0) / w
 
-def cursor_text(x: float, y: float) -> str:
-    """Status-bar text for a cursor position in input units."""
-    return f"x {x / UNITS_PER_MM:9.3f} mm  y {y / UNITS_PER_MM:9.3f} mm   ({x:.0f}, {y:.0f} units)"
+
+_Z = {
+    "deviation": 4.5,
+    "hatch": 2,
+    "kerf": 3,
+    "original": 3,
+    "fitted": 4,
+    "jumps": 5,
+    "control": 6,
+    "original_points": 6,
+    "marks": 7,
+}
+
+
+def _make_layer(key: str) -> tuple[pg.GraphicsObject, pg.PlotDataItem]:
+    """The layer's item and a legend sample (a styled stand-in, never added to a plot)."""
+    if key == "original":
+        kw = dict(pen=_pen(ORIGINAL_LINE, 1.3))
+    elif key == "original_points":
+        kw = dict(pen=None, symbol="o", symbolSize=4.0, symbolPen=None,
+                  symbolBrush=_brush(ORIGINAL_POINT, 230))
+    elif key == "fitted":
+        kw = dict(pen=_pen(FITTED_LINE, 1.6))
+    elif key == "control":
+        kw = dict(pen=_pen(CONTROL, 1.0, alpha=170))
+    elif key == "marks":
+        kw = dict(pen=None, symbol="o", symbolSize=4.0, symbolPen=None,
+                  symbolBrush=_brush(MARK, 235))
+    elif key == "jumps":
+        kw = dict(pen=_pen(JUMP, 1.0, style=Qt.PenStyle.DashLine))
+    elif key == "hatch":
+        kw = dict(pen=_pen(HATCH, 1.0, alpha=200))
+    elif key == "kerf":
+        kw = dict(pen=_pen(KERF, 1.5))
+    elif key == "deviation":
+        item = DeviationItem()
+        return item, pg.PlotDataItem([], [], pen=_pen(DEVIATION_STOPS[0], 3))
+    else:  # pragma: no cover - a programming error
+        raise KeyError(key)
+    if key == "original_points":
+        item = PointsItem(ORIGINAL_POINT, 4.0, 230)
+    elif key == "marks":
+        item = PointsItem(MARK, 4.0, 235)
+    elif key == "control":
+        item = ControlItem()
+    else:
+        item = pg.PlotDataItem([], [], name=key, **kw)
+    # samples get one point so that pyqtgraph hands their symbol style to the legend
+    if key == "control":
+        sample = pg.PlotDataItem([0.0], [0.0], pen=_pen(CONTROL, 1.0, alpha=170), symbol="s",
+                                 symbolSize=5.5, symbolBrush=_brush(CONTROL),
+                                 symbolPen=_pen(CONTROL, 1.3))
+    else:
+        sample = pg.PlotDataItem([0.0], [0.0], **kw)
+    return item, sample
+
+
+def units_transform(scale: float, offset: tuple[float, float]) -> QTransform:
+    """QTransform of ``mm = units * scale + offset``."""
+    return QTransform(scale, 0.0, 0.0, scale, float(offset[0]), float(offset[1]))
+
+
+def scale_transform(scale: float) -> QTransform:
+    return QTransform(scale, 0.0, 0.0, scale, 0.0, 0.0)
+
+
+def colour_of(name: str) -> QColor:
+    return pg.mkColor(name)
 
 
 __all__ = [
-    "DrawingView",
-    "MAX_MARKER_POINTS",
-    "Polylines",
-    "all_points",
-    "cursor_text",
-    "nan_separated",
+    "LAYERS",
+    "LAYER_KEYS",
+    "DeviationItem",
+    "LayerSpec",
+    "WorkView",
+    "scale_transform",
+    "units_transform",
 ]

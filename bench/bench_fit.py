@@ -269,9 +269,9 @@ def main() -> dict:
         row = dict(set=name, ours=o)
         if r is not None:
             row["circle_min"] = circle_min_cubics(r, E_PER)
-        big = sum(len(p) for p, _ in paths) > 30_000
+        big = sum(len(p) for p, _ in paths) > 15_000
         for lib in ("fit-curve", "paper"):
-            if big:  # the speed curve: peers' error search would take minutes
+            if big:  # large sets: the peers' error search would take many minutes
                 continue
             row[lib] = best_peer(lib, paths)
         rows.append(row)

@@ -57,7 +57,7 @@ BENCH_DATE = "2026-11-23"
 FALLBACK_PROFILE_MM = (250.0, 180.0)
 
 
-EXPLANATION = """\\
+EXPLANATION = """\
 ### Why the paths differ (looked at case by case, ezhpgl 0.1.0a2)
 
 Every unmatched path in the files ezhpgl parses in strict mode falls into one of the
@@ -92,8 +92,9 @@ same classes. Minimal inputs that reproduce each are given so they can be re-che
    HP-GL does move the pen to the end of the label, so here ezhpgl is right (bug 3 below).
    Neither parser draws letters: ezhpgl returns labels as glyph boxes in a substitute font
    (TEXT_APPROXIMATION, "labels" column), and we warn that labels are not drawn.
-5. **IW clipping (input-window.hpgl 4 paths, fill.plt 25).** We cut pen-down lines at the
-   IW window. ezhpgl keeps the whole line and attaches the window to the operation
+5. **IW clipping (input-window.hpgl 4 paths, fill.plt 25, iw.hp 1).** We cut pen-down
+   lines at the IW window. `IW;` with no parameters means the hard-clip limits, i.e. the
+   page that PS gave (iw.hp). ezhpgl keeps the whole line and attaches the window to the operation
    (`op.clip`) for its renderer. Our pieces lie on their lines ("on their lines" column) and
    theirs reach outside the window ("beyond IW" column).
 6. **RO origin (felixfischer arcs.hpgl 1 path; 286x192.5_qh2.hpg all 108 paths agree after
@@ -134,24 +135,22 @@ same classes. Minimal inputs that reproduce each are given so they can be re-che
 
 ### Importer bugs found (galvo_core; reported, not fixed here)
 
-1. **IR with only P1 leaves P2 where it was (the picture is stretched).**
-   `galvo_core/hpgl/reader.py`, `_Reader.do_ir`, `len(v) == 2` branch. The offset
-   `dx, dy = self.p2 - self.p1` is taken *after* `self.p1` has been overwritten, so
-   `p2 = p1_new + (p2_old - p1_new) = p2_old`. HP-GL/2 (like our own `do_ip`) keeps P2 at
-   the same distance and direction from P1. Check:
+1. **IR with only P1 left P2 where it was, which stretched the picture. Found here; already
+   fixed in the tree (commit f39873e) before this run.** In `_Reader.do_ir` the offset
+   P2 - P1 was taken after P1 had been overwritten.
    `read_bytes(b"IN;PS10000,7200;SP1;IP0,0,1000,1000;IR50,50;SC0,10,0,10;PU0,0;PD10,10;")`
-   gives (5000,3600)->(1000,1000); right is (5000,3600)->(6000,4600), which is ezhpgl's
-   answer. Files affected: jem-green test-model_orig / _utf8mangled / test3-model (`IR0,100`):
-   the PE square of test3-model comes out 1595 x 4170 units instead of 1595 x 1595. Fix:
-   compute dx, dy from the old P1 before assigning the new one.
+   gave (5000,3600)->(1000,1000). It now gives (5000,3600)->(6000,4600), which is also
+   ezhpgl's answer. It affected the jem-green files that use `IR0,100`: the PE square of
+   test3-model was 1595 x 4170 units and is now 1595 x 1595.
 2. **After PM1, the move to the next subpolygon's first point is drawn when the pen is
    down.** `dgtlrift__hp2xx__pm.hp` is the HP manual's receptacle example:
    `PA2000,2000;PM0;PD3000,2000,3000,3000;PD2000,3000;PM1;PD2080,2160,...;PM1;PD2080,2660,...`.
-   We return rings 2-4 as `(2000,3000),(2080,2160),...,(2080,2160),(2000,3000)`,
-   i.e. with a spike from the previous subpolygon's last vertex to the new one's start and
-   back. The HP PCL5/HP-GL/2 reference (PM): "the point after (PM1) becomes the first
-   point of the next subpolygon ... When drawing the polygon, the pen always moves to this
-   point in the up position, regardless of the current pen status." Right:
+   We return ring 2 as `(2000,3000),(2080,2160),...,(2080,2160),(2000,3000)`: a spike
+   runs from where the pen was to the new subpolygon's start and back. Rings 3 and 4 start
+   the same way, at (2080,2160) and (2080,2660). The HP PCL5/HP-GL/2 reference (PM):
+   "the point after (PM1) becomes the first point of the next subpolygon ... When drawing
+   the polygon, the pen always moves to this point in the up position, regardless of the
+   current pen status." Right:
    `(2080,2160),(2480,2160),(2480,2340),(2080,2340),(2080,2160)`. ezhpgl does it this way.
    Check: `python -c "from galvo_core.hpgl import read_file;
    print(read_file('/work/shared/corpus/plt/dgtlrift__hp2xx__pm.hp').paths[1].points)"`.
@@ -781,9 +780,15 @@ def report(machine, speed, speed_bytes, n_points, runs, corpus, reps) -> str:
             )
             L.append("")
         ok = n_points / ours.median >= 1e6
+        cpu_rate = n_points / statistics.median(ours.cpu)
         L.append(
-            f"Target ≥ 1,000,000 points/s: **{'met' if ok else 'NOT met'}** "
-            f"({n_points / ours.median:,.0f} points/s median)."
+            f"Target ≥ 1,000,000 points/s (wall-clock median): **{'met' if ok else 'NOT met'}** "
+            f"in this run ({n_points / ours.median:,.0f} points/s; best run "
+            f"{n_points / min(ours.runs):,.0f}). Per CPU second: {cpu_rate:,.0f} points/s. "
+            f"The machine has {machine['nproc']} cores and the load average was "
+            f"{machine['load']} at the start, so the wall time includes time spent waiting for "
+            "a core: rerun on a quiet machine before reading the wall-clock numbers as the "
+            "parser's speed."
         )
         L.append("")
     if corpus:

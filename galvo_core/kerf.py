@@ -133,7 +133,8 @@ def compensate_indexed(
     for idx in _by_pen(drawing, rings).values():
         region = even_odd_region([drawing.paths[i].points for i in idx])
         result = _apply(region, d, side, method, tol, res, res_auto)
-        assign, contrib = _assign(result, [drawing.paths[i].points for i in idx])
+        reach = d + 2 * tol if method == "vector" else 1.5 * d + 2 * res
+        assign, contrib = _assign(result, [drawing.paths[i].points for i in idx], reach)
         touched.update(idx[j] for j in contrib)
         for ring, j in assign:
             out_by_src.setdefault(idx[j], []).append(ring)
@@ -632,23 +633,50 @@ def _nest_rings(rings: list[np.ndarray]) -> BaseGeometry:
 
 
 # --------------------------------------------------------------------------- output
-def _assign(result: BaseGeometry, sources: list[np.ndarray]
+def _nearest_segment(tree: shapely.STRtree, pts: np.ndarray, a: np.ndarray, b: np.ndarray,
+                     reach: float) -> np.ndarray:
+    """Index of the segment (a[k], b[k]) nearest to each point. Candidates within ``reach``
+    come from one bulk STRtree query (much faster than GEOS nearest-neighbour queries);
+    points with none fall back to the nearest-neighbour query."""
+    n = len(pts)
+    pi, si = tree.query(shapely.points(pts), predicate="dwithin", distance=reach)
+    best = np.full(n, -1, dtype=np.int64)
+    if len(pi):
+        p = pts[pi]
+        ab = b[si] - a[si]
+        ll = np.einsum("ij,ij->i", ab, ab)
+        t = np.clip(np.einsum("ij,ij->i", p - a[si], ab) / np.where(ll > 0, ll, 1.0), 0, 1)
+        dd = ((a[si] + t[:, None] * ab - p) ** 2).sum(axis=1)
+        order = np.lexsort((si, dd, pi))  # per point: smallest distance first
+        first = np.ones(len(order), dtype=bool)
+        first[1:] = pi[order][1:] != pi[order][:-1]
+        best[pi[order][first]] = si[order][first]
+    miss = np.nonzero(best < 0)[0]
+    if len(miss):
+        _, seg = tree.query_nearest(shapely.points(pts[miss]), all_matches=False)
+        best[miss] = seg
+    return best
+
+
+def _assign(result: BaseGeometry, sources: list[np.ndarray], reach: float
             ) -> tuple[list[tuple[np.ndarray, int]], set[int]]:
     """Each output ring with the (local) index of its source ring: the lowest index among
     the source rings nearest to its vertices. Also the set of source rings that some
-    output vertex is nearest to."""
+    output vertex is nearest to. ``reach``: how far output vertices lie from their source
+    (the offset distance plus the method's tolerance), used to find candidates fast."""
     rings = _geom_rings(result) if not result.is_empty else []
     rings = [r for r in rings if len(r) >= 4]
     if not rings:
         return [], set()
     if len(sources) == 1:
         return [(r, 0) for r in rings], {0}
-    tree = shapely.STRtree(shapely.linestrings(
-        np.concatenate(sources),
-        indices=np.repeat(np.arange(len(sources)), [len(s) for s in sources])))
+    # a tree of short pieces (a whole ring would make every distance O(ring size))
+    a, b = _segments(sources)
+    owner = np.repeat(np.arange(len(sources)), [len(s) - 1 for s in sources])
+    tree = shapely.STRtree(shapely.linestrings(np.stack([a, b], axis=1)))
     pts = np.concatenate([r[:-1] for r in rings])
     which = np.repeat(np.arange(len(rings)), [len(r) - 1 for r in rings])
-    _, near = tree.query_nearest(shapely.points(pts), all_matches=False, return_distance=False)
+    near = owner[_nearest_segment(tree, pts, a, b, reach)]
     lowest = np.full(len(rings), np.iinfo(np.int64).max)
     np.minimum.at(lowest, which, near)
     return [(r, int(j)) for r, j in zip(rings, lowest, strict=True)], set(near.tolist())

@@ -158,7 +158,7 @@ def thin(points: object, eps_line: float, *, closed: bool = False) -> np.ndarray
 
 #: below this many points per kept line the greedy result is improved by the window DP
 _DP_RATIO = 16
-_DP_WINDOW = 16
+_DP_WINDOW = 24
 
 
 def _window_table(q: np.ndarray, eps: float, w: int) -> list[list[bool]]:

@@ -67,10 +67,18 @@ def shown(qtbot, win: MainWindow) -> MainWindow:
     win.resize(*SIZE)
     win.show()
     qtbot.waitExposed(win)
+    assert win.wait_for_result(60)
     qtbot.wait(20)
     win.fit()
     qtbot.wait(20)
     return win
+
+
+def load(qtbot, win: MainWindow, drawing: Drawing, path=None) -> None:
+    win.set_drawing(drawing, path)
+    assert win.wait_for_result(60)
+    win.fit()
+    qtbot.wait(20)
 
 
 def left_view_ink(win: MainWindow) -> tuple[np.ndarray, tuple[int, int, int, int]]:
@@ -80,9 +88,15 @@ def left_view_ink(win: MainWindow) -> tuple[np.ndarray, tuple[int, int, int, int
     return ink_mask(rgb[y + m : y + h - m, x + m : x + w - m]), (x, y, w, h)
 
 
+def units_px(win: MainWindow, ux: float, uy: float, view=None) -> tuple[int, int]:
+    """Pixel in the window of a drawing point (input units), via the job's field map."""
+    x_mm, y_mm = win.result.preview.units_to_mm(np.array([ux, uy]))
+    return (view or win.original).data_to_widget(win, x_mm, y_mm)
+
+
 def ink_near(win: MainWindow, ux: float, uy: float, radius: int = 3) -> bool:
     rgb = rgb_array(win.grab().toImage())
-    px, py = win.original.data_to_widget(win, ux, uy)
+    px, py = units_px(win, ux, uy)
     patch = rgb[max(py - radius, 0) : py + radius + 1, max(px - radius, 0) : px + radius + 1]
     return bool(ink_mask(patch).any())
 
@@ -145,19 +159,36 @@ def test_view_has_ink_where_the_paths_are(qtbot):
     assert not ink_near(win, s / 2, s / 2, radius=20)
 
 
+def test_both_views_are_in_workpiece_mm_of_the_field(qtbot):
+    win = shown(qtbot, MainWindow(square_drawing(side_mm=50.0)))
+    pv = win.result.preview
+    fm = win.result.job.field_map
+    # true size by default: 50 mm on the drawing is 50 mm on the workpiece, centred in the field
+    b = pv.bounds
+    assert b[2] - b[0] == pytest.approx(50.0, rel=0.01)
+    assert (b[0] + b[2]) / 2 == pytest.approx(fm.field_size_mm / 2, abs=0.1)
+    # field outline: bits 0 .. field_bits in mm
+    x, y = win.original.field.getData()
+    assert x.max() == pytest.approx(fm.field_size_mm)
+    # the mark of the first corner is drawn where the original corner is
+    first_mark_mm = win.result.job.strokes[0].marks[0] * fm.mm_per_bit
+    corner_mm = pv.units_to_mm(np.array([0.0, 0.0]))
+    assert first_mark_mm == pytest.approx(corner_mm, abs=2 * fm.mm_per_bit)
+
+
 def test_views_are_linked_equal_aspect_and_y_up(qtbot):
     win = shown(qtbot, MainWindow(square_drawing()))
     vb_l = win.original.getPlotItem().getViewBox()
     vb_r = win.processed.getPlotItem().getViewBox()
     assert vb_l.state["aspectLocked"] == 1.0 and vb_r.state["aspectLocked"] == 1.0
     assert not vb_l.state["yInverted"] and not vb_r.state["yInverted"]
-    vb_l.setRange(xRange=(1000, 2000), yRange=(1000, 2000), padding=0)
+    vb_l.setRange(xRange=(20, 40), yRange=(20, 40), padding=0)
     qtbot.wait(10)
     (lx, ly), (rx, ry) = vb_l.viewRange(), vb_r.viewRange()
     assert lx == pytest.approx(rx, rel=0.01) and ly == pytest.approx(ry, rel=0.01)
     # y up: a point with a larger y is drawn higher (smaller pixel row)
-    _, py_low = win.original.data_to_widget(win, 1500, 1200)
-    _, py_high = win.original.data_to_widget(win, 1500, 1800)
+    _, py_low = win.original.data_to_widget(win, 30, 22)
+    _, py_high = win.original.data_to_widget(win, 30, 38)
     assert py_high < py_low
 
 
@@ -173,52 +204,46 @@ def test_titles_axes_and_icon(qtbot):
         assert not win.windowIcon().isNull()
 
 
-@pytest.mark.parametrize("n_paths", [1, 500, 5000])
+def _plot_items(view) -> list:
+    return [i for i in view.getPlotItem().items
+            if isinstance(i, (pg.PlotDataItem, views.DeviationItem, views.PointsItem,
+                              views.ControlItem))]
+
+
+@pytest.mark.parametrize("n_paths", [1, 500, 3000])
 def test_number_of_plot_items_is_fixed(qtbot, n_paths):
     win = shown(qtbot, MainWindow(many_paths_drawing(n_paths)))
-    for view in (win.original, win.processed):
-        assert len(view.data_items()) == 2
-        items = [i for i in view.getPlotItem().items if isinstance(i, pg.PlotDataItem)]
-        assert len(items) == 2
-    scene_items = [i for i in win.original.scene().items() if isinstance(i, pg.PlotDataItem)]
-    assert len(scene_items) == 2
-    assert win.original.n_polylines == n_paths
-    assert win.original.n_points == 4 * n_paths
-
-
-def test_lines_layer_is_nan_separated():
-    d = Drawing(
-        paths=(Path.from_points([(0, 0), (1, 1)]), Path.from_points([(5, 5), (6, 5), (7, 7)]))
-    )
-    x, y = views.nan_separated(d)
-    assert len(x) == 2 + 1 + 3
-    assert np.isnan(x[2]) and np.isnan(y[2])
-    assert x[:2].tolist() == [0, 1] and x[3:].tolist() == [5, 6, 7]
-    assert views.nan_separated([])[0].size == 0
+    n_left = len([s for s in views.LAYERS if s.view == "original"])
+    n_right = len([s for s in views.LAYERS if s.view == "processed"])
+    # one item per layer, plus the field outline and the selection highlight
+    assert len(_plot_items(win.original)) == n_left + 2
+    assert len(_plot_items(win.processed)) == n_right + 2
+    kinds = (pg.PlotDataItem, views.PointsItem)
+    scene_items = [i for i in win.original.scene().items() if isinstance(i, kinds)]
+    assert len(scene_items) == n_left + 2
+    assert win.original.counts["original"] == 4 * n_paths
+    assert win.original.counts["original_points"] == 4 * n_paths
 
 
 def test_markers_drawn_only_below_the_limit(qtbot, monkeypatch):
     win = shown(qtbot, MainWindow(many_paths_drawing(50)))
-    assert win.original.markers_shown
-    assert len(win.original.markers.getData()[0]) == 200
+    assert win.markers_shown
+    assert len(win.original.layers["original_points"].getData()[0]) == 200
     monkeypatch.setattr(views, "MAX_MARKER_POINTS", 100)
-    win.set_drawing(many_paths_drawing(50))
-    assert not win.original.markers_shown
-    x, _ = win.original.markers.getData()
+    load(qtbot, win, many_paths_drawing(50))
+    assert not win.markers_shown
+    x, _ = win.original.layers["original_points"].getData()
     assert x is None or len(x) == 0
-    assert len(win.original.data_items()) == 2
+    assert win.original.counts["original"] == 200
 
 
-def test_set_processed_replaces_only_the_right_view(qtbot):
+def test_processed_view_shows_fit_controls_and_marks(qtbot):
     win = shown(qtbot, MainWindow(square_drawing()))
-    before = win.original.lines.getData()[0].copy()
-    win.set_processed([np.array([[0, 0], [4000, 4000]]), np.array([[0, 4000], [4000, 0]])])
-    assert win.processed.n_polylines == 2
-    assert win.processed.n_points == 4
-    assert np.array_equal(win.original.lines.getData()[0], before, equal_nan=True)
-    win.set_processed(Drawing(paths=()))
-    assert win.processed.n_points == 0
-    assert len(win.processed.data_items()) == 2
+    c = win.processed.counts
+    assert c["fitted"] >= 5 and c["marks"] >= 5 and c["control"] >= 5
+    assert c["hatch"] == 0 and c["kerf"] == 0  # features off: the layers are simply empty
+    stats = win.result.job.stats
+    assert win.stats_panel.shown_number("mark_points") == stats["mark_points"]
 
 
 def test_status_bar_counts(qtbot):
@@ -245,7 +270,7 @@ def test_status_bar_counts(qtbot):
 # --- loading: refused files and crashes become dialogs, the drawing stays -----------------------
 def test_refused_file_shows_dialog_and_keeps_drawing(qtbot, monkeypatch, dialogs, tmp_path):
     win = shown(qtbot, MainWindow())
-    win.set_drawing(square_drawing("keep.plt"), "keep.plt")
+    load(qtbot, win, square_drawing("keep.plt"), "keep.plt")
     kept = win.drawing
 
     def refuse(path):
@@ -260,7 +285,7 @@ def test_refused_file_shows_dialog_and_keeps_drawing(qtbot, monkeypatch, dialogs
     assert "Traceback" not in box.informativeText()
     assert win.drawing is kept
     assert "keep.plt" in win.windowTitle()
-    assert win.original.n_points == 5
+    assert win.original.counts["original"] == 5
 
 
 def test_unexpected_exception_becomes_dialog(qtbot, monkeypatch, dialogs, tmp_path):
@@ -299,6 +324,7 @@ def test_error_dialog_is_buildable(qtbot):
 def test_window_opens_on_a_file(qtbot, importer, square_plt):
     win = shown(qtbot, MainWindow())
     assert win.load_file(square_plt) is True
+    assert win.wait_for_result(60)
     assert "square.plt" in win.windowTitle()
     assert "100.00 × 100.00 mm" in win.status_summary()
     win.fit()
@@ -347,6 +373,7 @@ def test_quit_closes_window(qtbot):
 def test_drop_a_file_loads_it(qtbot, monkeypatch, tmp_path):
     win = shown(qtbot, MainWindow())
     monkeypatch.setattr(window_mod, "load_drawing", lambda p: square_drawing(FsPath(p).name))
+    win.settings.remove("recent_files")
     target = tmp_path / "dropped.plt"
     target.write_bytes(SQUARE_PLT)
     mime = QMimeData()
@@ -361,6 +388,7 @@ def test_drop_a_file_loads_it(qtbot, monkeypatch, tmp_path):
     win.dropEvent(ev)
     assert win.drawing is not None
     assert "dropped.plt" in win.windowTitle()
+    assert win.recent_files()[0].endswith("dropped.plt")
     # drops of non-files are ignored
     text_mime = QMimeData()
     text_mime.setText("hello")

@@ -144,3 +144,19 @@ def test_speed_on_dense_curve():
     dt = time.perf_counter() - t0
     assert len(kept) < 1000
     assert len(p) / dt > 500_000, f"{len(p) / dt:.0f} points/s"
+
+
+def test_near_optimal_on_integer_staircase():
+    """Integer plotter coordinates at a tolerance of half a unit (few points per kept line,
+    where the plain greedy sleeve was up to 20 % over): within 2 % of the optimum."""
+    total_g = total_o = 0
+    for r in (40, 90, 150):
+        t = np.linspace(0, 2 * np.pi, int(6 * r))
+        p = np.round(np.c_[r * np.cos(t), 0.6 * r * np.sin(t)])
+        keep = np.concatenate(([True], np.any(p[1:] != p[:-1], axis=1)))
+        q = p[keep]
+        kept = thin(q, 0.5)
+        assert_thin_guarantee(q, kept, 0.5)
+        total_g += len(kept)
+        total_o += imai_iri(q, 0.5)
+    assert total_g <= 1.02 * total_o, (total_g, total_o)

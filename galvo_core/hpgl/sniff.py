@@ -24,6 +24,23 @@ _DXF_RE = re.compile(rb"\A\s*0\s*\r?\n\s*SECTION\b")
 _XML_RE = re.compile(rb"\A\s*<(\?xml|svg|!DOCTYPE|html)", re.I)
 _DMPL_RE = re.compile(rb"\A[\s\x00]*(?:\x1b;@:|;:[A-Z ])|;:H ?A\b")
 _GCODE_RE = re.compile(rb"\A(\s*(\(.*\)|;.*)?\s*\n)*\s*[GM]\d+\b[^\n]*\n\s*[GMXYZF]", re.M)
+_PCL_HEAD_RE = re.compile(rb"[\x00-\x20]*(?:\x1b|@PJL)")
+# control bytes that neither HP-GL text nor PE data contain (TAB LF FF CR ESC ETX excluded)
+_CONTROL = bytes(b for b in range(32) if b not in (3, 9, 10, 12, 13, 27))
+
+
+def _looks_binary(head: bytes) -> bool:
+    """Random-looking binary: many control bytes *and* many high bytes.
+
+    Real files have one or the other (labels with control bytes; 8-bit PE data with high
+    bytes), never both in quantity. PCL/PJL jobs are left to the reader (raster data).
+    """
+    if len(head) < 256 or _PCL_HEAD_RE.match(head):
+        return False
+    n = len(head)
+    controls = n - len(head.translate(None, _CONTROL))
+    high = n - len(head.translate(None, bytes(range(128, 256))))
+    return controls > 0.07 * n and high > 0.25 * n
 
 
 def refusal_reason(head: bytes) -> str | None:
@@ -44,4 +61,6 @@ def refusal_reason(head: bytes) -> str | None:
         return "a Summa DM/PL cutter file (';:' header): that dialect is not HP-GL"
     if _GCODE_RE.match(head):
         return "a G-code program, not HP-GL"
+    if _looks_binary(head):
+        return "binary data (not text): not an HP-GL/PLT file"
     return None

@@ -1,0 +1,225 @@
+"""The job panel: statistics of the current job (whatever keys its ``stats`` has, with units)
+and its warnings (click one to zoom to its place)."""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+from PySide6.QtCore import Qt, Signal
+from PySide6.QtGui import QBrush, QColor, QFont
+from PySide6.QtWidgets import (
+    QAbstractItemView,
+    QHeaderView,
+    QLabel,
+    QListWidget,
+    QListWidgetItem,
+    QTableWidget,
+    QTableWidgetItem,
+    QVBoxLayout,
+    QWidget,
+)
+
+from galvo_core.drawing import Warning
+
+#: Known stats keys: label, in display order. Unknown keys follow, labelled from their name.
+STAT_LABELS: dict[str, str] = {
+    "input_points": "Input points",
+    "control_points": "Control points",
+    "lines": "Lines",
+    "cubics": "Cubics",
+    "mark_points": "Mark points",
+    "strokes": "Strokes",
+    "laser_switches": "Laser switches",
+    "corners": "Corners",
+    "mark_length_mm": "Mark length",
+    "jump_length_mm": "Jump length",
+    "estimated_time_s": "Estimated time",
+    "max_fit_error_um": "Largest fit error",
+    "max_fit_error": "Largest fit error (units)",
+    "max_deviation_um": "Deviation (overlay)",
+    "max_chord_height_um": "Largest chord height",
+    "max_chord_height_bits": "Largest chord height (bits)",
+    "dwell_points": "Dwell points",
+}
+#: Quantity/value column pairs side by side in the table.
+STAT_COLUMNS = 3
+#: Shown in bold: what an operator checks first.
+KEY_STATS = ("control_points", "mark_points", "laser_switches", "estimated_time_s",
+             "max_fit_error_um")
+
+
+def _int(n: int) -> str:
+    return f"{n:,}".replace(",", "\u2009")
+
+
+def format_stat(key: str, value: Any) -> str:
+    """A stats value with its unit, from the key's suffix."""
+    if isinstance(value, bool) or value is None:
+        return str(value)
+    if isinstance(value, int):
+        return _int(value)
+    if isinstance(value, float):
+        if not math.isfinite(value):
+            return "—"
+        if key.endswith("_s"):
+            if value >= 60:
+                m, s = divmod(value, 60)
+                return f"{int(m)} min {s:04.1f} s"
+            return f"{value:.3f} s" if value < 10 else f"{value:.2f} s"
+        if key.endswith("_mm"):
+            return f"{value:,.2f} mm".replace(",", "\u2009")
+        if key.endswith("_um"):
+            return f"{value:.3g} µm" if value < 1000 else f"{value / 1000:.3f} mm"
+        if key.endswith("_bits"):
+            return f"{value:.3g} bits"
+        if key.endswith("_deg"):
+            return f"{value:.1f}°"
+        if value.is_integer() and abs(value) < 1e15:
+            return _int(int(value))
+        return f"{value:.4g} u" if "error" in key else f"{value:.4g}"
+    if isinstance(value, (list, tuple)):
+        return ", ".join(format_stat(key, v) for v in value)
+    if isinstance(value, dict):
+        return f"{len(value)} entries"
+    return str(value)
+
+
+def stat_label(key: str) -> str:
+    if key in STAT_LABELS:
+        return STAT_LABELS[key]
+    words = key
+    for suffix in ("_mm", "_um", "_s", "_bits", "_deg"):
+        if words.endswith(suffix):
+            words = words[: -len(suffix)]
+    return words.replace("_", " ").capitalize()
+
+
+def ordered_stats(stats: dict[str, Any]) -> list[tuple[str, Any]]:
+    known = [(k, stats[k]) for k in STAT_LABELS if k in stats]
+    rest = sorted((k, v) for k, v in stats.items() if k not in STAT_LABELS and k != "warnings")
+    return known + rest
+
+
+class StatsPanel(QWidget):
+    """A two-column table of the job's stats, and the selected path's counts."""
+
+    def __init__(self, parent: QWidget | None = None) -> None:
+        super().__init__(parent)
+        self.table = QTableWidget(0, 2 * STAT_COLUMNS)
+        self.table.setObjectName("stats_table")
+        self.table.verticalHeader().setVisible(False)
+        for c in range(STAT_COLUMNS):
+            self.table.horizontalHeader().setSectionResizeMode(
+                2 * c, QHeaderView.ResizeMode.Stretch)
+            self.table.horizontalHeader().setSectionResizeMode(
+                2 * c + 1, QHeaderView.ResizeMode.ResizeToContents)
+        self.table.horizontalHeader().setVisible(False)
+        self.table.setEditTriggers(QAbstractItemView.EditTrigger.NoEditTriggers)
+        self.table.setSelectionMode(QAbstractItemView.SelectionMode.NoSelection)
+        self.table.setFocusPolicy(Qt.FocusPolicy.NoFocus)
+        self.table.setShowGrid(False)
+        self.table.setAlternatingRowColors(True)
+        self.table.verticalHeader().setDefaultSectionSize(19)
+        self.selection = QLabel("Click a path to see its counts.")
+        self.selection.setObjectName("selection_label")
+        self.selection.setWordWrap(True)
+        self.selection.setStyleSheet("color: #3d4853; padding: 2px;")
+        self.selection.setTextInteractionFlags(Qt.TextInteractionFlag.TextSelectableByMouse)
+        lay = QVBoxLayout(self)
+        lay.setContentsMargins(4, 2, 4, 2)
+        lay.setSpacing(3)
+        lay.addWidget(self.table, 1)
+        lay.addWidget(self.selection)
+        #: the text shown per key (tests read the window's numbers from here)
+        self.shown: dict[str, str] = {}
+        self.values: dict[str, Any] = {}
+
+    def set_stats(self, stats: dict[str, Any] | None, extra: dict[str, Any] | None = None
+                  ) -> None:
+        rows = ordered_stats(dict(stats or {}))
+        rows += list((extra or {}).items())
+        per_col = (len(rows) + STAT_COLUMNS - 1) // STAT_COLUMNS
+        self.table.clearContents()
+        self.table.setRowCount(per_col)
+        self.shown = {}
+        self.values = {}
+        bold = QFont()
+        bold.setBold(True)
+        for r, (key, value) in enumerate(rows):
+            text = format_stat(key, value)
+            self.shown[key] = text
+            self.values[key] = value
+            a = QTableWidgetItem(stat_label(key))
+            a.setToolTip(key)
+            b = QTableWidgetItem(text)
+            b.setTextAlignment(Qt.AlignmentFlag.AlignRight | Qt.AlignmentFlag.AlignVCenter)
+            if key in KEY_STATS:
+                a.setFont(bold)
+                b.setFont(bold)
+            if key == "dwell_points" and value:
+                b.setForeground(QBrush(QColor("#b35c00")))
+            row, col = r % per_col, 2 * (r // per_col)
+            self.table.setItem(row, col, a)
+            self.table.setItem(row, col + 1, b)
+
+    def shown_number(self, key: str) -> float:
+        """The number the panel shows for ``key`` (parsed back from the text)."""
+        text = self.shown[key].replace("\u2009", "").replace(",", "")
+        return float(text.split()[0])
+
+    def set_selection(self, text: str) -> None:
+        self.selection.setText(text)
+
+
+class WarningsPanel(QWidget):
+    """The job's warnings (and a processing error, first, in red). Clicking one emits its
+    index in :attr:`warnings` (-1 for the error line)."""
+
+    activated = Signal(int)
+
+    def __init__(self, parent: QWidget | None = None) -> None:
+        super().__init__(parent)
+        self.list = QListWidget()
+        self.list.setObjectName("warnings_list")
+        self.list.setWordWrap(True)
+        self.list.setAlternatingRowColors(True)
+        self.list.itemClicked.connect(self._clicked)
+        self.list.itemActivated.connect(self._clicked)
+        lay = QVBoxLayout(self)
+        lay.setContentsMargins(4, 2, 4, 2)
+        lay.addWidget(self.list)
+        self.warnings: tuple[Warning, ...] = ()
+        self.error: str | None = None
+
+    def set_warnings(self, warnings: tuple[Warning, ...] | list[Warning],
+                     error: str | None = None) -> None:
+        self.warnings = tuple(warnings)
+        self.error = error
+        self.list.clear()
+        if error:
+            item = QListWidgetItem(f"✖ {error}")
+            item.setForeground(QBrush(QColor("#b00020")))
+            item.setData(Qt.ItemDataRole.UserRole, -1)
+            item.setToolTip(error)
+            self.list.addItem(item)
+        for i, w in enumerate(self.warnings):
+            where = f"line {w.line}, col {w.col}: " if w.line else ""
+            item = QListWidgetItem(f"⚠ {where}{w.message}")
+            item.setForeground(QBrush(QColor("#8a4b00")))
+            item.setData(Qt.ItemDataRole.UserRole, i)
+            item.setToolTip(str(w))
+            self.list.addItem(item)
+        if not error and not self.warnings:
+            item = QListWidgetItem("✓ no warnings")
+            item.setForeground(QBrush(QColor("#2e7d32")))
+            item.setData(Qt.ItemDataRole.UserRole, None)
+            self.list.addItem(item)
+
+    def texts(self) -> list[str]:
+        return [self.list.item(i).text() for i in range(self.list.count())]
+
+    def _clicked(self, item: QListWidgetItem) -> None:
+        idx = item.data(Qt.ItemDataRole.UserRole)
+        if idx is not None:
+            self.activated.emit(int(idx))
