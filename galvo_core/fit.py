@@ -30,8 +30,14 @@ with the smallest error, away from the ends) and both halves are fitted again; a
 two thinned points is a line (always within ``eps_line``). So the guarantee holds whatever
 the dichotomy does, and lines are the last resort.
 
-The bisection uses the thinned points of the piece plus up to 256 of its input points; the
-acceptance test uses every input point.
+All curve pieces of a path are fitted together, round by round (:class:`_BatchFitter`): one
+set of array operations per dichotomy step for every open piece, one vectorised acceptance
+test, the failures split for the next round. The bisection uses up to 128 of the piece's
+input points (every k-th); the acceptance test uses every input point, with nearest points
+from Newton steps seeded by arc length (a seeded search only for points over the bound).
+Any curve parameter gives an upper bound of the true distance, so the acceptance is never
+too lenient; ``max_error`` is made exact by re-measuring the worst cubics with the seeded
+nearest-point search.
 
 ``eps_sum`` default: 0.002 input units (one tenth of the paper's e_per). The paper gives no
 value; it only decides when the bisection stops, the acceptance is decided by ``e_per``. A

@@ -19,6 +19,11 @@ The paper walks the points, growing a line P1→P2 while every point between sta
   costs a fixed number of numpy calls, so sparse input (few points per kept line) is slower
   per point than dense input.
 
+Near-optimal count: where the greedy leaves fewer than 16 points per kept line (integer
+coordinates, sparse points), the greedy is not within 2 % of the optimum (up to 20 % over on
+glyph outlines); there the kept points are a shortest path (Imai–Iri) over every exactly
+verified shortcut of at most 24 steps plus the greedy shortcuts, so never worse than greedy.
+
 Guarantee (tested): every dropped point lies within ``eps_line`` (input units) of the kept
 segment that replaces it, and the first and last points are always kept.
 """
