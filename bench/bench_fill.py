@@ -5,8 +5,13 @@ meerk40t are imported there only. Hatch strokes only (contours are the same for 
 method and are left out), spacing 0.05 mm at true size (magnification = field bits / field mm
 / 40), hatch angle 0 degrees and 15 degrees.
 
-Every method's strokes are timed with galvo_core.timing.estimate (default LaserParams:
-mark 100 mm/s, and a fast variant: mark 1000 mm/s). Prints a markdown table.
+Baselines: the issue's scan-line fill in plain raster order (one set of lines across the
+whole drawing, row after row, alternating direction, one stroke per piece: paper 002 Fig.
+1(a)), the same lines per region (galvo_core's ``fill="scanline"`` in file order), and the
+per-region lines ordered greedily. Every method's strokes are timed with the same
+galvo_core.timing.estimate (default LaserParams: mark 100 mm/s, and a fast variant: mark
+1000 mm/s). Prints markdown tables and, per sample, the zig-zag's time against each baseline
+and against the best peer; bench/out/fill.json has everything.
 """
 
 from __future__ import annotations
@@ -43,6 +48,31 @@ LASERS = {"100": LaserParams(), "1000": LaserParams(mark_speed_mm_s=1000.0)}
 def ordered(lines: list[np.ndarray], method: str = "greedy") -> list[np.ndarray]:
     pl = order_strokes(lines, method=method, time_budget_s=2.0)
     return [lines[p.index][::-1] if p.reverse else lines[p.index] for p in pl]
+
+
+def raster_fill(region, spacing_units: float, angle: float) -> list[np.ndarray]:
+    """The issue's baseline ("scanline: parallel hatch lines, one stroke per segment,
+    alternating direction", in plain raster order), as paper 002 Fig. 1(a): one set of lines
+    across the whole drawing, row after row, every row's pieces in the row's direction."""
+    import shapely
+
+    a = np.radians(angle)
+    rot = np.array([[np.cos(a), -np.sin(a)], [np.sin(a), np.cos(a)]])
+    g = shapely.transform(region, lambda q: q @ rot)  # rotated frame: rows are y = const
+    x0, y0, x1, y1 = g.bounds
+    n = max(1, int(np.ceil((y1 - y0) / spacing_units - 1e-9)))
+    ys = y0 + ((y1 - y0) - (n - 1) * spacing_units) / 2 + spacing_units * 1.3e-7 \
+        + np.arange(n) * spacing_units
+    rows = shapely.intersection(shapely.linestrings(
+        [[(x0 - 1, y), (x1 + 1, y)] for y in ys]), g)
+    out = []
+    for k, r in enumerate(rows):
+        segs = [np.asarray(ln.coords) for ln in getattr(r, "geoms", [r])
+                if not ln.is_empty and ln.length > 0]
+        segs = [sg[np.argsort(sg[:, 0])][[0, -1]] for sg in segs]
+        segs.sort(key=lambda sg: sg[0, 0], reverse=bool(k % 2))
+        out.extend(sg[::-1] if k % 2 else sg for sg in segs)
+    return [p @ rot.T for p in out]
 
 
 def vpype_fill(lines: list[np.ndarray], mm_per_unit: float) -> list[np.ndarray]:
@@ -122,10 +152,14 @@ def main() -> None:
             cells = monotone_cells(d, spacing_units=sp, angle_deg=angle)
             rows = []
             t0 = time.perf_counter()
+            raster = raster_fill(region, sp, angle)
+            rows.append(measure("scanline, plain raster (issue baseline)", raster, fm, region,
+                                sp, time.perf_counter() - t0))
+            t0 = time.perf_counter()
             scan = [s.points for s in hatch(d, fill="scanline", spacing_units=sp,
                                              angle_deg=angle)]
             t_scan = time.perf_counter() - t0
-            rows.append(measure("scanline (file order)", scan, fm, region, sp, t_scan))
+            rows.append(measure("scanline, raster per region", scan, fm, region, sp, t_scan))
             t0 = time.perf_counter()
             scan_g = ordered(scan)
             rows.append(measure("scanline + greedy order", scan_g, fm, region, sp,
@@ -153,6 +187,22 @@ def main() -> None:
                                     time.perf_counter() - t0))
             results.append({"sample": sample, "angle": angle, "cells": cells, "rows": rows})
     (ROOT / "bench" / "out").mkdir(exist_ok=True)
+    for res in results:
+        by = {r["method"]: r for r in res["rows"]}
+        zz = by["zigzag + optimized order"]
+        base = by["scanline, plain raster (issue baseline)"]
+        peers = [r for m, r in by.items() if m.startswith(("vpype", "MeerK40t"))]
+        res["summary"] = {}
+        for k in LASERS:
+            res["summary"][k] = {
+                "vs_raster": zz[f"time_{k}"] / base[f"time_{k}"] - 1.0,
+                "vs_region_raster": zz[f"time_{k}"] / by["scanline, raster per region"][
+                    f"time_{k}"] - 1.0,
+                "vs_scan_greedy": zz[f"time_{k}"] / by["scanline + greedy order"][
+                    f"time_{k}"] - 1.0,
+                "vs_best_peer": zz[f"time_{k}"] / min(r[f"time_{k}"] for r in peers)
+                if peers else float("nan"),
+            }
     (ROOT / "bench" / "out" / "fill.json").write_text(json.dumps(results, indent=1))
     for res in results:
         print(f"\n{res['sample']}, hatch angle {res['angle']:g} deg, spacing {SPACING_MM} mm, "
@@ -164,6 +214,12 @@ def main() -> None:
             print(f"| {r['method']} | {r['strokes']} | {r['jump_mm']:.0f} | {r['mark_mm']:.0f} | "
                   f"{r['retraced_mm']:.1f} | {100 * r['coverage']:.2f} % | {r['time_100']:.2f} | "
                   f"{r['time_1000']:.2f} | {r['seconds']:.2f} |")
+        for k, v in res["summary"].items():
+            print(f"\n@{k} mm/s zigzag+optimized: {100 * v['vs_raster']:+.0f} % vs plain raster, "
+                  f"{100 * v['vs_region_raster']:+.0f} % vs raster per region, "
+                  f"{100 * v['vs_scan_greedy']:+.0f} % vs scanline+greedy, "
+                  f"{v['vs_best_peer']:.2f}x best peer", end="")
+        print()
 
 
 if __name__ == "__main__":

@@ -14,13 +14,18 @@ horizontal, ``spacing`` apart, centred in each region's height.
   lines themselves: two line pieces on neighbouring lines belong to one cell when the part of
   the region between the two lines that joins them touches no other piece). Inside a cell
   the pieces are joined end to end by the region's boundary between them, alternating right
-  and left side (the laser stays on: one stroke per cell). Cells that meet along the same
-  strip of region are joined into one stroke when the exit corner of one cell is joined to
-  an entry corner of the next by a piece of the boundary that runs through their common
-  strip; the walk through the cell graph is a path that visits each cell once
-  (semi-Hamiltonian), searched greedily over all start corners within an effort bound.
-  Nothing is marked twice: every piece of boundary is used at most once and no hatch line is
-  traced twice; every connection runs along the region's boundary.
+  and left side (the laser stays on). Cells are joined into one stroke along a path that
+  visits each cell once (a semi-Hamiltonian path of the cell graph, searched depth-first with
+  Warnsdorff's rule within an effort bound); the join from one cell to the next is the piece
+  of boundary between the exit corner and the next cell's corner. Theorem 2 of the paper (a
+  convex cell can be covered from any boundary point to any other) makes the exit corner a
+  free choice: a cell whose zig-zag would end on the wrong side gets one more hatch line
+  half-way between two of its lines (in its narrowest strip), and a cell entered and left at
+  the same end (a U-turn) is covered by a run along one side on the boundary up to its far
+  end and the zig-zag back, whose lines stop ``UTURN_OFFSET`` spacings short of that side and
+  are joined there by chords (the boundary shifted inward). Nothing is marked twice: every
+  piece of boundary is used at most once, no hatch line is traced twice, the joins between
+  cells run along the boundary, and no stroke leaves the region or crosses a hole.
 
 Everything here is in input units; the caller converts ``hatch_spacing_mm`` and
 ``hatch_inset_mm`` with :meth:`FieldMap.mm_to_units` and the points to bits with
@@ -29,8 +34,8 @@ Everything here is in input units; the caller converts ``hatch_spacing_mm`` and
 
 from __future__ import annotations
 
-import heapq
 import math
+import sys
 from collections.abc import Sequence
 from dataclasses import dataclass
 
@@ -44,6 +49,11 @@ from galvo_core.drawing import Drawing
 FILL_METHODS = ("scanline", "zigzag")
 #: upper bound on chain steps spent searching for long cell paths, per region piece
 MAX_EFFORT = 400_000
+#: a U-turn cell's lines stop this many spacings short of the side run along the boundary
+#: (horizontally); below 1, so every point between them stays within half a spacing of a mark
+UTURN_OFFSET = 0.9
+#: search steps spent looking for a cheaper cover once one stroke covers a whole piece
+FULL_COVER_EXTRA = 3000
 
 
 @dataclass(frozen=True, eq=False)
@@ -332,61 +342,331 @@ class _Hatch:
         self.cell_of = cell_of
         self.cell_segs = cell_segs
 
-    def _run(self, cell: int, from_top: bool, side: int) -> tuple[int, int]:
-        """Exit crossing and exit direction (1 up / 0 down) of a cell entered at a corner."""
-        segs = self.cell_segs[cell]
-        n = len(segs)
-        last = segs[0] if from_top else segs[-1]
-        exit_side = side if n % 2 == 0 else 1 - side
-        return int(self.seg_cross[last, exit_side]), 0 if from_top else 1
+    # ---------------------------------------------------------- cell walk (paper 002, Thm 2)
+    def _prepare_walk(self) -> None:
+        a = np.concatenate(self.rings)
+        b = np.concatenate([np.roll(r, -1, axis=0) for r in self.rings])
+        self._ea, self._eb = a, b
+        self._tiny = 1e-9 * max(1.0, float(np.abs(a).max()))
+        self._rungs: dict[tuple[int, bool], tuple | None] = {}
+        self._uok: dict[tuple[int, int, int, bool, bool], bool] = {}
+        self._extra_cost: dict[int, float | None] = {}
+        self._opt_cache: dict[tuple[int, int, int | None], list[tuple]] = {}
 
-    def _step(self, exit_c: int, direction: int) -> tuple[int, bool, int] | None:
-        """The cell reached through the boundary from an exit corner: (cell, from_top, side)."""
-        q = int(self.nbr[exit_c, direction])
-        g = int(self.seg[q])
-        y = int(self.cell_of[g])
-        segs = self.cell_segs[y]
-        same_line = self.k[q] == self.k[exit_c]
-        # q's segment faces the strip from below (same line going up / line above going
-        # down) -> it is the top of its cell; else the bottom
-        from_top = bool(same_line) if direction == 1 else not bool(same_line)
-        if (segs[-1] if from_top else segs[0]) != g:
+    def _base_rungs(self, c: int) -> tuple:
+        """(y (N,), xs (N, 2), pieces[side][j]: boundary points between rung j and j+1, up)."""
+        segs = self.cell_segs[c]
+        sa = np.array(segs, dtype=np.int64)
+        y = self.y0 + self.seg_k[sa] * self.s
+        xs = np.stack([self.x[self.seg_cross[sa, 0]], self.x[self.seg_cross[sa, 1]]], 1)
+        pcs = [[self.piece_points(int(self.seg_cross[g, side]), 1) for g in segs[:-1]]
+               for side in (0, 1)]
+        return y, xs, pcs
+
+    def _split(self, p0: np.ndarray, piece: np.ndarray, p1: np.ndarray, ym: float
+               ) -> tuple[float, np.ndarray, np.ndarray] | None:
+        poly = np.vstack([p0[None], piece, p1[None]])
+        cr = np.flatnonzero((poly[:-1, 1] < ym) != (poly[1:, 1] < ym))
+        if len(cr) != 1:
             return None
-        return y, from_top, int(self.end[q])
+        i = int(cr[0])
+        pa, pb = poly[i], poly[i + 1]
+        t = (ym - pa[1]) / (pb[1] - pa[1])
+        return float(pa[0] + t * (pb[0] - pa[0])), poly[1:i + 1], poly[i + 1:-1]
 
-    def chain(self, cell: int, from_top: bool, side: int, visited: np.ndarray,
-              budget: list[int]) -> list[tuple[int, bool, int]]:
-        out = [(cell, from_top, side)]
-        seen = {cell}
-        while budget[0] > 0:
-            budget[0] -= 1
-            c, d = self._run(*out[-1])
-            nx = self._step(c, d)
-            if nx is None or visited[nx[0]] or nx[0] in seen:
+    def _with_extra(self, c: int) -> tuple | None:
+        """The cell's rungs with one more hatch line half-way between two of its lines, in
+        the narrowest strip where that line meets the cell's two sides once each and nothing
+        else: the zig-zag then has one line more, so it ends on the other side (the parity
+        fix that lets a cell be left at the corner the next cell needs)."""
+        key = (c, True)
+        if key in self._rungs:
+            return self._rungs[key]
+        y, xs, pcs = self._base_rungs(c)
+        out = None
+        n = len(y)
+        if n >= 2:
+            w = xs[:, 1] - xs[:, 0]
+            approx = np.minimum(w[:-1], w[1:])
+            for j in np.argsort(approx, kind="stable")[:6].tolist():
+                ym = 0.5 * (y[j] + y[j + 1])
+                sl = self._split(np.array([xs[j, 0], y[j]]), pcs[0][j],
+                                 np.array([xs[j + 1, 0], y[j + 1]]), ym)
+                sr = self._split(np.array([xs[j, 1], y[j]]), pcs[1][j],
+                                 np.array([xs[j + 1, 1], y[j + 1]]), ym)
+                if sl is None or sr is None or not sl[0] < sr[0]:
+                    continue
+                xa, xb = sl[0], sr[0]
+                ea, eb = self._ea, self._eb
+                cr = (ea[:, 1] < ym) != (eb[:, 1] < ym)
+                if cr.any():
+                    t = (ym - ea[cr, 1]) / (eb[cr, 1] - ea[cr, 1])
+                    xc = ea[cr, 0] + t * (eb[cr, 0] - ea[cr, 0])
+                    if ((xc > xa + self._tiny) & (xc < xb - self._tiny)).any():
+                        continue
+                y2 = np.insert(y, j + 1, ym)
+                xs2 = np.insert(xs, j + 1, [xa, xb], axis=0)
+                p2 = [pcs[0][:j] + [sl[1], sl[2]] + pcs[0][j + 1:],
+                      pcs[1][:j] + [sr[1], sr[2]] + pcs[1][j + 1:]]
+                out = (y2, xs2, p2)
+                self._extra_cost[c] = xb - xa
                 break
-            out.append(nx)
-            seen.add(nx[0])
+        self._rungs[key] = out
         return out
 
-    def stroke_points(self, chain: list[tuple[int, bool, int]]) -> np.ndarray:
+    def _rungs_of(self, c: int, extra: bool) -> tuple | None:
+        if extra:
+            return self._with_extra(c)
+        key = (c, False)
+        if key not in self._rungs:
+            self._rungs[key] = self._base_rungs(c)
+        return self._rungs[key]
+
+    @staticmethod
+    def _oriented(r: tuple, from_top: bool) -> tuple:
+        y, xs, pcs = r
+        if not from_top:
+            return r
+        return (y[::-1], xs[::-1], [[p[::-1] for p in reversed(pcs[sd])] for sd in (0, 1)])
+
+    def _uturn_ok(self, c: int, e: int, s: int, extra: bool, cap: bool) -> bool:
+        """Can the cell be entered at corner (end e, side s) and left at (e, 1 - s)?
+
+        Theorem 2 of paper 002: a run along side s (the boundary) to the far end, then the
+        zig-zag back, its lines kept half a spacing off side s and joined there by chords
+        (the boundary shifted inward), so nothing is marked twice."""
+        key = (c, e, s, extra, cap)
+        if key in self._uok:
+            return self._uok[key]
+        r = self._rungs_of(c, extra)
+        ok = r is not None
+        if ok:
+            y, xs, pcs = self._oriented(r, e == 1)  # type: ignore[arg-type]
+            n = len(y)
+            ok = (n % 2 == 0) if cap else (n % 2 == 1)
+            if ok and n > 1:
+                a = UTURN_OFFSET * self.s
+                sign = 1.0 if s == 0 else -1.0
+                m = n if cap else n - 1  # rungs 0..m-1 are shortened on side s
+                ok = bool(((xs[:m, 1] - xs[:m, 0]) > a * 1.05).all())
+                for j in range(m - 1):
+                    if not ok:
+                        break
+                    ox0, ox1 = xs[j, s] + sign * a, xs[j + 1, s] + sign * a
+                    for sd, want in ((s, 1.0), (1 - s, -1.0)):
+                        p = pcs[sd][j]
+                        if len(p) == 0:
+                            continue
+                        t = (p[:, 1] - y[j]) / (y[j + 1] - y[j])
+                        cx = ox0 + t * (ox1 - ox0)
+                        if not bool((want * sign * (cx - p[:, 0]) > self._tiny).all()):
+                            ok = False
+                            break
+        self._uok[key] = ok
+        return ok
+
+    def _target(self, c: int, end: int, side: int) -> tuple[int, int, int] | None:
+        """Where the boundary piece from the corner (end, side) of cell c leads:
+        (cell, end, side) of the corner at its other end; None when that is no cell end."""
+        segs = self.cell_segs[c]
+        g0 = segs[-1] if end == 1 else segs[0]
+        q = int(self.seg_cross[g0, side])
+        q2 = int(self.nbr[q, end])
+        g = int(self.seg[q2])
+        c2 = int(self.cell_of[g])
+        e2 = end if self.k[q2] == self.k[q] else 1 - end
+        segs2 = self.cell_segs[c2]
+        if (segs2[-1] if e2 == 1 else segs2[0]) != g:
+            return None
+        return c2, e2, int(self.end[q2])
+
+    def _is_cap(self, c: int, end: int) -> bool:
+        t = self._target(c, end, 0)
+        return t is not None and t[0] == c and t[1] == end
+
+    def _cost(self, c: int, extra: bool, uturn: bool) -> float:
+        cost = 0.0
+        if extra:
+            self._with_extra(c)
+            cost += float(self._extra_cost.get(c) or 0.0)
+        if uturn:
+            cost += 2.0 * self.s
+        return cost
+
+    def _options(self, c: int, e: int, s: int | None) -> list[tuple]:
+        """Ways to leave cell c entered at (e, s) (s None: the stroke starts here):
+        (next (cell, end, side), exit end, exit side, uturn, extra, cap, cost)."""
+        key = (c, e, s)
+        hit = self._opt_cache.get(key)
+        if hit is not None:
+            return hit
+        n = len(self.cell_segs[c])
+        out = []
+        for t in (0, 1):  # through: leave at the other end, side t
+            extra = s is not None and t != (s if n % 2 == 0 else 1 - s)
+            if extra and self._with_extra(c) is None:
+                continue
+            nx = self._target(c, 1 - e, t)
+            if nx is None or nx[0] == c:
+                continue
+            out.append((nx, 1 - e, t, False, extra, False, self._cost(c, extra, False)))
+        if s is not None:  # U-turn: leave at the same end, other side
+            nx = self._target(c, e, 1 - s)
+            if nx is not None and nx[0] != c:
+                far_cap = self._is_cap(c, 1 - e)
+                for extra in (False, True):
+                    for cap in ((False, True) if far_cap else (False,)):
+                        if self._uturn_ok(c, e, s, extra, cap):
+                            out.append((nx, e, 1 - s, True, extra, cap,
+                                        self._cost(c, extra, True)))
+                            break
+                    else:
+                        continue
+                    break
+        self._opt_cache[key] = out
+        return out
+
+    def walk(self, max_effort: int) -> list[list[tuple]]:
+        """Cover the cells by few paths (semi-Hamiltonian paths of the cell graph, depth-first
+        with an effort bound): each path is one stroke. A path element is
+        (cell, entry end, entry side, uturn, extra, cap, exit side)."""
+        self.cells()
+        nc = len(self.cell_segs)
+        if nc == 0:
+            return []
+        self._prepare_walk()
+        nbrs: list[set[int]] = [set() for _ in range(nc)]
+        for c in range(nc):
+            for end in (0, 1):
+                for side in (0, 1):
+                    t = self._target(c, end, side)
+                    if t is not None and t[0] != c:
+                        nbrs[c].add(t[0])
+                        nbrs[t[0]].add(c)
+        visited = np.zeros(nc, dtype=bool)
+        total = max(1000, int(max_effort))
+        paths: list[list[tuple]] = []
+        depth_cap = max(50, sys.getrecursionlimit() - 200)
+        # search state of the current stroke: cells left, best path, path so far, effort
+        st: dict = {}
+
+        def free_nbrs(c: int) -> int:
+            seen = st["seen"]
+            return sum(1 for d in nbrs[c] if not seen[d])
+
+        def dfs(c: int, e: int, s: int | None, cost: float, depth: int) -> bool:
+            seen, cur = st["seen"], st["cur"]
+            st["budget"] -= 1
+            seen[c] = True
+            opts = []
+            if st["budget"] > 0 and depth < depth_cap:
+                opts = [o for o in self._options(c, e, s) if not seen[o[0][0]]]
+                # Warnsdorff: the neighbour with the fewest free neighbours first
+                opts.sort(key=lambda o: (free_nbrs(o[0][0]), o[6]))
+            done = False
+            for nx, _ee, t, ut, extra, cap, oc in opts:
+                cur.append((c, e, s, ut, extra, cap, t))
+                done = dfs(nx[0], nx[1], nx[2], cost + oc, depth + 1)
+                cur.pop()
+                if done or st["budget"] <= 0:
+                    break
+            if not done:
+                n_cells = len(cur) + 1
+                best = st["best"]
+                if n_cells > best[0] or (n_cells == best[0] and cost < best[1]):
+                    st["best"] = (n_cells, cost, [*cur, (c, e, s, False, False, False, None)])
+                if n_cells == st["left"] and st["full_at"] < 0:
+                    st["full_at"] = st["budget"]
+                # a full cover: stop when it costs nothing or after a little more search
+                done = n_cells == st["left"] and (
+                    cost == 0.0 or st["full_at"] - st["budget"] > FULL_COVER_EXTRA)
+            seen[c] = False
+            return done
+
+        while not visited.all():
+            starts = [c for c in range(nc) if not visited[c]]
+            st.update(left=len(starts), best=(0, 0.0, []), cur=[], seen=visited.copy(),
+                      full_at=-1, budget=0)
+            starts.sort(key=free_nbrs)
+            fin = False
+            for k, c0 in enumerate(starts):
+                for e0 in (0, 1):
+                    if total <= 0:
+                        break
+                    allow = min(total, max(200, total // max(1, 2 * (len(starts) - k))))
+                    st["budget"] = allow
+                    st["full_at"] = -1 if st["best"][0] < st["left"] else allow
+                    fin = dfs(c0, e0, None, 0.0, 0)
+                    total -= allow - max(0, st["budget"])
+                    if fin:
+                        break
+                if fin or total <= 0:
+                    break
+            best = st["best"]
+            if not best[0]:  # out of effort: one cell per stroke for the rest
+                best = (1, 0.0, [(starts[0], 0, None, False, False, False, None)])
+            for el in best[2]:
+                visited[el[0]] = True
+            paths.append(best[2])
+        return paths
+
+    def stroke_points(self, path: list[tuple]) -> np.ndarray:
         pts: list[np.ndarray] = []
-        prev_exit: tuple[int, int] | None = None
-        for cell, from_top, side in chain:
-            segs = self.cell_segs[cell]
-            order = segs[::-1] if from_top else segs
-            direction = 0 if from_top else 1
-            sd = side
-            if prev_exit is not None:
-                pts.append(self.piece_points(*prev_exit))
-            for i, s in enumerate(order):
-                a = int(self.seg_cross[s, sd])
-                b = int(self.seg_cross[s, 1 - sd])
-                pts.append(self.point(a)[None])
-                pts.append(self.point(b)[None])
-                if i + 1 < len(order):
-                    pts.append(self.piece_points(b, direction))
-                sd = 1 - sd
-                prev_exit = (b, direction)
+        a = UTURN_OFFSET * self.s
+        for i, (c, e, s, ut, extra, cap, t) in enumerate(path):
+            n0 = len(self.cell_segs[c])
+            n = n0 + (1 if extra else 0)
+            if s is None:  # first cell: pick the entry side that ends at the exit side t
+                if t is None:
+                    s = 0
+                else:
+                    s = t if n % 2 == 0 else 1 - t
+            r = self._oriented(self._rungs_of(c, extra), e == 1)  # type: ignore[arg-type]
+            y, xs, pcs = r
+
+            def pt(j: int, sd: int, y: np.ndarray = y, xs: np.ndarray = xs) -> np.ndarray:
+                return np.array([[xs[j, sd], y[j]]])
+
+            if not ut:
+                sd = s
+                for j in range(n):
+                    pts += [pt(j, sd), pt(j, 1 - sd)]
+                    if j + 1 < n:
+                        pts.append(pcs[1 - sd][j])
+                    sd = 1 - sd
+                exit_end, exit_side = 1 - e, sd
+            else:
+                sign = 1.0 if s == 0 else -1.0
+
+                def o(j: int, sd: int = s, y: np.ndarray = y, xs: np.ndarray = xs,
+                      sign: float = sign) -> np.ndarray:
+                    return np.array([[xs[j, sd] + sign * a, y[j]]])
+
+                pts.append(pt(0, s))
+                for j in range(n - 1):  # the run along side s
+                    pts += [pcs[s][j], pt(j + 1, s)]
+                if cap:
+                    segs = self.cell_segs[c]
+                    g = segs[0] if e == 1 else segs[-1]
+                    pts += [self.piece_points(int(self.seg_cross[g, s]), 1 - e),
+                            pt(n - 1, 1 - s), o(n - 1)]
+                    cur = s
+                else:
+                    pts.append(pt(n - 1, 1 - s))
+                    cur = 1 - s
+                for j in range(n - 2, -1, -1):
+                    if cur == 1 - s:
+                        pts += [pcs[1 - s][j][::-1], pt(j, 1 - s), o(j)]
+                        cur = s
+                    else:
+                        pts += [o(j), pt(j, 1 - s)]
+                        cur = 1 - s
+                exit_end, exit_side = e, cur
+            if i + 1 < len(path):
+                segs = self.cell_segs[c]
+                g = segs[-1] if exit_end == 1 else segs[0]
+                assert t is None or exit_side == t
+                pts.append(self.piece_points(int(self.seg_cross[g, exit_side]), exit_end))
         arr = np.concatenate(pts)
         keep = np.r_[True, (np.diff(arr, axis=0) != 0).any(axis=1)]
         return arr[keep]
@@ -405,61 +685,6 @@ def _rings_rotated(poly: Polygon, rot: np.ndarray) -> list[np.ndarray]:
         pts = np.asarray(r.coords, dtype=np.float64)[:-1]
         if len(pts) >= 3:
             out.append(pts @ rot)  # q = R^T p  (row vectors: p @ R)
-    return out
-
-
-def _zigzag(h: _Hatch, max_effort: int) -> list[tuple[list[tuple[int, bool, int]], int]]:
-    """Cover the cell graph by paths; returns (chain, number of cells) per stroke.
-
-    From a start corner the walk is forced (the boundary leads from a cell's exit corner to
-    exactly one corner of a neighbouring cell), so every one of the 4 start corners of every
-    cell gives one path; the longest still unvisited path is taken, its cells are marked
-    visited, the others are cut short at the first visited cell, and so on. Chains are
-    searched at most ``max_effort`` steps in all (longer ones are followed to their end only
-    when taken).
-    """
-    h.cells()
-    nc = len(h.cell_segs)
-    if nc == 0:
-        return []
-    visited = np.zeros(nc, dtype=bool)
-    starts = [(c, ft, sd) for c in range(nc) for ft in (False, True) for sd in (0, 1)]
-    cap = max(8, max_effort // len(starts))
-    chains: list[list[tuple[int, bool, int]]] = []
-    capped: list[bool] = []
-    users: list[list[int]] = [[] for _ in range(nc)]
-    heap: list[tuple[int, int]] = []
-    for i, st in enumerate(starts):
-        ch = h.chain(*st, visited, [cap])
-        chains.append(ch)
-        capped.append(len(ch) >= cap)
-        for c, _, _ in ch:
-            users[c].append(i)
-        heap.append((-len(ch), i))
-    heapq.heapify(heap)
-    lengths = [len(ch) for ch in chains]
-    out = []
-    while heap:
-        neg, i = heapq.heappop(heap)
-        if -neg != lengths[i] or lengths[i] == 0:
-            continue
-        ch = chains[i][: lengths[i]]
-        if capped[i] and lengths[i] == len(chains[i]):
-            ch = h.chain(*ch[0], visited, [nc + 1])
-        for c, _, _ in ch:
-            visited[c] = True
-        out.append((ch, len(ch)))
-        for c, _, _ in ch:
-            for j in users[c]:
-                if lengths[j] == 0:
-                    continue
-                pos = next((p for p in range(lengths[j]) if visited[chains[j][p][0]]),
-                           lengths[j])
-                if pos != lengths[j]:
-                    lengths[j] = pos
-                    capped[j] = False
-                    if pos:
-                        heapq.heappush(heap, (-pos, j))
     return out
 
 
@@ -518,9 +743,9 @@ def _hatch_piece(poly: Polygon, src: int, pass_index: int, rot: np.ndarray, fill
                 continue
             out.append(HatchStroke(src, np.array([a, b]) @ rot.T, pass_index, 1))
         return out
-    for chain, ncells in _zigzag(h, max_effort):
-        pts = h.stroke_points(chain)
-        out.append(HatchStroke(src, pts @ rot.T, pass_index, ncells))
+    for path in h.walk(max_effort):
+        pts = h.stroke_points(path)
+        out.append(HatchStroke(src, pts @ rot.T, pass_index, len(path)))
     return out
 
 

@@ -25,6 +25,7 @@ from __future__ import annotations
 
 import math
 import time
+from collections import deque
 from collections.abc import Sequence
 from dataclasses import dataclass
 
@@ -406,99 +407,212 @@ def _neighbours(prob: _Problem, k: int, window: int = 6) -> list[np.ndarray]:
 
 
 def _improve(prob: _Problem, tour: _Tour, before: Sequence[tuple[int, int]],
-             deadline: float) -> None:
+             deadline: float, seed: int = 0) -> None:
+    """Local search, then iterated local search until the deadline.
+
+    Local search (queue of strokes to look at, "don't-look bits"): 2-opt over the candidate
+    lists (a block reversal: every open stroke in it is marked the other way round) and
+    Or-opt (a block of 1-3 strokes moved next to a candidate neighbour, either way round).
+    Then, while time is left: a double-bridge kick (three cuts close together, the middle
+    blocks swapped), local search around the cuts, keep the result if it is shorter, else go
+    back to the best tour. Precedence pairs are checked after every move (a move that breaks
+    one is undone)."""
     n = len(tour.cand)
     if n < 3:
         return
-    nb = _neighbours(prob, NEIGHBOURS)
+    nb = [x.tolist() for x in _neighbours(prob, NEIGHBOURS)]
     pa = np.array([a for a, _ in before], dtype=np.int64)
     pb = np.array([b for _, b in before], dtype=np.int64)
-    partners: dict[int, list[tuple[int, int]]] = {}
-    for a, b in before:
-        partners.setdefault(a, []).append((a, b))
-        partners.setdefault(b, []).append((a, b))
-    d = tour.d
+    has_cons = len(pa) > 0
+    rng = np.random.default_rng(seed)
+    hyp = math.hypot
+    # plain-list mirrors of the tour (fast scalar access), refreshed after every change
+    L: dict[str, list] = {}
 
-    def block_ok(lo: int, hi: int) -> bool:
-        if len(pa) == 0:
-            return True
-        x = tour.pos[pa]
-        y = tour.pos[pb]
-        return not bool(np.any((x >= lo) & (x <= hi) & (y >= lo) & (y <= hi)))
+    def refresh() -> None:
+        L["sx"], L["sy"] = tour.S[:, 0].tolist(), tour.S[:, 1].tolist()
+        L["ex"], L["ey"] = tour.E[:, 0].tolist(), tour.E[:, 1].tolist()
+        L["pos"] = tour.pos.tolist()
 
-    def move_ok(stroke: int, newpos_fn: object) -> bool:
-        for a, b in partners.get(stroke, ()):
-            if newpos_fn(a) >= newpos_fn(b):  # type: ignore[operator]
+    refresh()
+
+    def d(p: int, q: int) -> float:  # exit of position p to entry of position q
+        if p < 0 or q >= n:
+            return 0.0
+        return hyp(L["ex"][p] - L["sx"][q], L["ey"][p] - L["sy"][q])
+
+    def cons_ok() -> bool:
+        return not has_cons or bool((tour.pos[pa] < tour.pos[pb]).all())
+
+    def snapshot() -> tuple:
+        return (tour.cand.copy(), tour.stroke.copy(), tour.S.copy(), tour.E.copy(),
+                tour.pos.copy())
+
+    def restore(sn: tuple) -> None:
+        tour.cand[:], tour.stroke[:], tour.S[:], tour.E[:], tour.pos[:] = sn
+        refresh()
+
+    def rev_delta(lo: int, hi: int) -> float:
+        """Gain of reversing positions lo..hi."""
+        old = d(lo - 1, lo) + d(hi, hi + 1)
+        new = 0.0
+        ex, ey, sx, sy = L["ex"], L["ey"], L["sx"], L["sy"]
+        if lo > 0:
+            new += hyp(ex[lo - 1] - ex[hi], ey[lo - 1] - ey[hi])
+        if hi + 1 < n:
+            new += hyp(sx[lo] - sx[hi + 1], sy[lo] - sy[hi + 1])
+        return old - new
+
+    def apply_block(i: int, ln: int, at: int, flip: bool) -> None:
+        """Move positions i..i+ln-1 to sit before position `at` (outside the block)."""
+        order = np.arange(n)
+        blk = order[i:i + ln]
+        rest = np.concatenate([order[:i], order[i + ln:]])
+        k = at if at < i else at - ln
+        new = np.concatenate([rest[:k], blk, rest[k:]])
+        tour.cand[:] = tour.cand[new]
+        tour.stroke[:] = tour.stroke[new]
+        tour.S[:] = tour.S[new]
+        tour.E[:] = tour.E[new]
+        tour.pos[tour.stroke] = np.arange(n)
+        if flip:
+            tour.reverse(k, k + ln - 1)
+
+    def try_at(s: int) -> list[int] | None:
+        """Best improving move around stroke s; applies it, returns strokes to re-examine."""
+        pos = L["pos"]
+        ex, ey, sx, sy = L["ex"], L["ey"], L["sx"], L["sy"]
+        i = pos[s]
+        best: tuple[float, tuple | None] = (1e-9, None)
+        # Or-opt blocks of 1..3 strokes starting or ending at s: removal gain, ends
+        blocks = []
+        for ln in (1, 2, 3):
+            for st in ((i,) if ln == 1 else (i, i - ln + 1)):
+                j2 = st + ln - 1
+                if st < 0 or j2 >= n:
+                    continue
+                rem = d(st - 1, st) + d(j2, j2 + 1)
+                if st > 0 and j2 + 1 < n:
+                    rem -= d(st - 1, j2 + 1)
+                blocks.append((st, ln, rem, sx[st], sy[st], ex[j2], ey[j2]))
+        for c in nb[s]:
+            j = pos[c]
+            if j < 0 or j == i:
+                continue
+            # 2-opt: the four block reversals that make s and c neighbours
+            for lo, hi in ((i + 1, j), (j + 1, i), (i, j - 1), (j, i - 1)):
+                if 0 <= lo <= hi < n:
+                    g = rev_delta(lo, hi)
+                    if g > best[0]:
+                        best = (g, ("r", lo, hi))
+            # Or-opt: a block next to c (before or after it), either way round
+            for at in (j, j + 1):
+                p, q = at - 1, at
+                hp = p >= 0
+                hq = q < n
+                base = hyp(ex[p] - sx[q], ey[p] - sy[q]) if hp and hq else 0.0
+                for st, ln, rem, ax, ay, bx, by in blocks:
+                    if st <= at <= st + ln or rem <= best[0]:
+                        continue
+                    for flip in (False, True):
+                        if flip:
+                            fx, fy, tx, ty = bx, by, ax, ay  # enters at the old exit
+                        else:
+                            fx, fy, tx, ty = ax, ay, bx, by
+                        add = -base
+                        if hp:
+                            add += hyp(ex[p] - fx, ey[p] - fy)
+                        if hq:
+                            add += hyp(tx - sx[q], ty - sy[q])
+                        g = rem - add
+                        if g > best[0]:
+                            best = (g, ("m", st, ln, at, flip))
+        mv = best[1]
+        if mv is None:
+            return None
+        sn = snapshot() if has_cons else None
+        if mv[0] == "r":
+            _, lo, hi = mv
+            touched = [lo - 1, lo, hi, hi + 1]
+            tour.reverse(lo, hi)
+            refresh()
+        else:
+            _, st, ln, at, flip = mv
+            touched = [st - 1, st, st + ln - 1, st + ln, at - 1, at]
+            ids = [int(tour.stroke[p]) for p in touched if 0 <= p < n]
+            apply_block(st, ln, at, flip)
+            refresh()
+            if sn is not None and not cons_ok():
+                restore(sn)
+                return None
+            return ids
+        if sn is not None and not cons_ok():
+            restore(sn)
+            return None
+        return [int(tour.stroke[p]) for p in touched if 0 <= p < n]
+
+    def local_search(queue: list[int]) -> bool:
+        inq = np.zeros(prob.n, dtype=bool)
+        dq: deque[int] = deque()
+        for s in queue:
+            if not inq[s]:
+                inq[s] = True
+                dq.append(s)
+        steps = 0
+        while dq:
+            steps += 1
+            if (steps & 31) == 0 and time.perf_counter() > deadline:
                 return False
+            s = dq.popleft()
+            inq[s] = False
+            got = try_at(s)
+            if got is not None:
+                for t in [s, *got]:
+                    for u in (t, *nb[t][:3]):
+                        if not inq[u] and tour.pos[u] >= 0:
+                            inq[u] = True
+                            dq.append(u)
         return True
 
-    improved = True
-    while improved and time.perf_counter() < deadline:
-        improved = False
-        for i in range(n):
-            if (i & 63) == 0 and time.perf_counter() > deadline:
-                return
-            s_i = int(tour.stroke[i])
-            for c in nb[s_i].tolist():
-                j = int(tour.pos[c])
-                if j < 0 or j == i:
-                    continue
-                # 2-opt: reverse i+1..j (j > i) joins exit of i to the exit of j
-                if j > i:
-                    lo, hi = i + 1, j
-                else:
-                    lo, hi = j, i - 1
-                if lo > hi or lo < 0:
-                    continue
-                before_e = tour.E[lo - 1] if lo > 0 else None
-                after_s = tour.S[hi + 1] if hi + 1 < n else None
-                old = (d(before_e, tour.S[lo]) if before_e is not None else 0.0) + (
-                    d(tour.E[hi], after_s) if after_s is not None else 0.0)
-                new = (d(before_e, tour.E[hi]) if before_e is not None else 0.0) + (
-                    d(tour.S[lo], after_s) if after_s is not None else 0.0)
-                if new < old - 1e-9 and block_ok(lo, hi):
-                    tour.reverse(lo, hi)
-                    improved = True
-                    continue
-                # Or-opt: move stroke i next to stroke c (before or after it, either way)
-                pe = tour.E[i - 1] if i > 0 else None
-                ns = tour.S[i + 1] if i + 1 < n else None
-                gain = (d(pe, tour.S[i]) if pe is not None else 0.0) + (
-                    d(tour.E[i], ns) if ns is not None else 0.0) - (
-                    d(pe, ns) if pe is not None and ns is not None else 0.0)
-                best = None
-                for at in (j, j + 1):  # insert before position `at`
-                    if at in (i, i + 1):
-                        continue
-                    a_e = tour.E[at - 1] if at - 1 >= 0 else None
-                    b_s = tour.S[at] if at < n else None
-                    base = d(a_e, b_s) if a_e is not None and b_s is not None else 0.0
-                    for flip in (False, True):
-                        if flip and tour.prob.ccode[tour.cand[i]] >= 2:
-                            continue
-                        ss, ee = (tour.E[i], tour.S[i]) if flip else (tour.S[i], tour.E[i])
-                        cost = (d(a_e, ss) if a_e is not None else 0.0) + (
-                            d(ee, b_s) if b_s is not None else 0.0) - base
-                        if cost < gain - 1e-9 and (best is None or cost < best[0]):
-                            best = (cost, at, flip)
-                if best is not None:
-                    at = best[1]
-
-                    def newpos(s: int, at: int = at, i: int = i, s_i: int = s_i) -> int:
-                        p = int(tour.pos[s])
-                        if s == s_i:
-                            return at if at < i else at - 1
-                        if at <= p < i:
-                            return p + 1
-                        if i < p < at:
-                            return p - 1
-                        return p
-
-                    if move_ok(s_i, newpos):
-                        tour.move(i, at, best[2])
-                        improved = True
-                s_i = int(tour.stroke[i])
-        _rotate_closed(prob, tour)
+    if not local_search([int(s) for s in tour.stroke]):
+        return
+    _rotate_closed(prob, tour)
+    best_len = tour.length()
+    best = snapshot()
+    if n < 8:
+        return
+    while time.perf_counter() < deadline:
+        # double bridge over three cuts near each other: A B C D -> A C B D
+        span = int(min(n - 1, 60))
+        a = int(rng.integers(0, n - 3))
+        l1 = int(rng.integers(1, span))
+        l2 = int(rng.integers(1, span))
+        b, c = min(a + l1, n - 2), min(a + l1 + l2, n - 1)
+        if not a < b < c:
+            continue
+        order = np.arange(n)
+        new = np.concatenate([order[:a], order[b:c], order[a:b], order[c:]])
+        tour.cand[:] = tour.cand[new]
+        tour.stroke[:] = tour.stroke[new]
+        tour.S[:] = tour.S[new]
+        tour.E[:] = tour.E[new]
+        tour.pos[tour.stroke] = np.arange(n)
+        refresh()
+        if has_cons and not cons_ok():
+            restore(best)
+            continue
+        around = [p for p in (a - 1, a, b - 1, b, c - 1, c, a + c - b - 1, a + c - b)
+                  if 0 <= p < n]
+        finished = local_search([int(tour.stroke[p]) for p in around])
+        ln = tour.length()
+        if ln < best_len - 1e-9:
+            best_len = ln
+            best = snapshot()
+        else:
+            restore(best)
+        if not finished:
+            break
+    restore(best)
 
 
 def _rotate_closed(prob: _Problem, tour: _Tour) -> None:

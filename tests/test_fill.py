@@ -16,6 +16,7 @@ from galvo_core.fill import (
     find_regions,
     hatch,
     monotone_cells,
+    region_polygons,
     retraced_length,
 )
 from galvo_core.hpgl.reader import read_file
@@ -75,8 +76,30 @@ def test_cell_counts_annulus_and_e() -> None:
         st = hatch(d, fill="zigzag", spacing_units=2.0, angle_deg=ang)
         assert 1 <= len(st) <= cells
         assert sum(s.cells for s in st) == cells
-    # the E's cell graph is a star (spine + 3 arms): no path visits all 4, 2 strokes needed
-    assert len(hatch(E_SHAPE, fill="zigzag", spacing_units=2.0, angle_deg=90.0)) == 2
+    # the E's cell graph is a star (spine + 3 arms): a path through it needs U-turns in the
+    # arms (paper 002, Theorem 2); with them the whole E is one stroke
+    assert len(hatch(E_SHAPE, fill="zigzag", spacing_units=2.0, angle_deg=90.0)) == 1
+
+
+@pytest.mark.parametrize("angle", [0.0, 30.0, 45.0, 71.0, 90.0, 137.0])
+@pytest.mark.parametrize("shape", ["square", "disc", "annulus", "E"])
+def test_cells_joined_into_one_stroke(shape: str, angle: float) -> None:
+    """Theorem 2 of paper 002: a cell can be left at whichever corner the next cell needs,
+    so a connected region (convex, with a hole, or an E) is one stroke: inside, covering,
+    nothing marked twice, not even a crossing of the stroke with itself."""
+    d = SHAPES[shape]
+    cells = monotone_cells(d, spacing_units=2.0, angle_deg=angle)
+    st = hatch(d, fill="zigzag", spacing_units=2.0, angle_deg=angle)
+    assert len(st) <= cells
+    if shape in ("square", "disc", "annulus"):
+        assert len(st) == 1
+    assert len(st) == 1 or shape == "E"
+    assert sum(s.cells for s in st) == cells
+    check_inside(d, st)
+    m = fill_metrics(d, st, spacing_units=2.0)
+    assert m["retraced_length"] == 0.0
+    assert m["coverage"] >= 0.995
+    assert all(LineString(s.points).is_simple for s in st)
 
 
 @pytest.mark.parametrize("fill", ["scanline", "zigzag"])
@@ -101,6 +124,10 @@ def test_seal_and_text_samples() -> None:
         s = hatch(d, fill="scanline", spacing_units=sp, angle_deg=15.0)
         cells = monotone_cells(d, spacing_units=sp, angle_deg=15.0)
         assert len(z) <= cells < len(s)
+        # one stroke per connected piece of region is the least possible; cells are joined
+        # into paths (seal: one stroke per piece; text: 18 for 14 pieces at 15 degrees)
+        pieces = len(region_polygons(find_regions(d)))
+        assert pieces <= len(z) <= pieces + 4
         check_inside(d, z)
         mz = fill_metrics(d, z, spacing_units=sp)
         assert mz["retraced_length"] == 0.0
