@@ -25,7 +25,7 @@ import numpy as np
 sys.path.insert(0, os.path.join(os.path.dirname(__file__), ".."))
 
 from galvo_core.hpgl import read_file  # noqa: E402
-from galvo_core.thin import dedup_indices, thin  # noqa: E402
+from galvo_core.thin import dedup_indices, thin, thin_many  # noqa: E402
 
 ROOT = os.path.join(os.path.dirname(__file__), "..")
 CORPUS = os.environ.get("GALVO_CORPUS", os.path.join(ROOT, "..", "shared", "corpus", "plt"))
@@ -163,12 +163,16 @@ def sparse_walk(n: int = 20_000, seed: int = 2) -> np.ndarray:
     return np.cumsum(rng.normal(0, 0.5, (n, 2)), axis=0)
 
 
-def timed(paths: list[np.ndarray], eps: float, reps: int = 5) -> tuple[float, int]:
+def timed(paths: list[np.ndarray], eps: float, reps: int = 5, many: bool = False):
+    """Best wall time of thinning all ``paths`` (one thin() per path, or one thin_many())."""
     best = math.inf
     kept = 0
     for _ in range(reps):
         t0 = time.perf_counter()
-        kept = sum(len(thin(p, eps)) for p in paths)
+        if many:
+            kept = sum(len(k) for k in thin_many(paths, eps))
+        else:
+            kept = sum(len(thin(p, eps)) for p in paths)
         best = min(best, time.perf_counter() - t0)
     return best, kept
 
@@ -185,6 +189,7 @@ def main() -> dict:
             dp = sum(shapely_dp(p, eps) for p in paths)
             opt = sum(imai_iri(p[dedup_indices(p)], eps) for p in paths)
             dt, _ = timed(paths, eps, reps=3)
+            dtm, _ = timed(paths, eps, reps=3, many=True)
             row = dict(
                 set=name,
                 eps=eps,
@@ -196,12 +201,13 @@ def main() -> dict:
                 ratio=ours / opt,
                 dp_ratio=dp / opt,
                 pts_per_s=n_in / dt,
+                pts_per_s_many=n_in / dtm,
             )
             rows.append(row)
             print(
                 f"{name:38s} eps={eps:<5} n={n_in:7d} ours={ours:6d} DP={dp:6d} "
                 f"opt={opt:6d} ours/opt={ours / opt:.4f} DP/opt={dp / opt:.3f} "
-                f"{n_in / dt:,.0f} pts/s",
+                f"{n_in / dt:,.0f} pts/s (thin_many {n_in / dtm:,.0f})",
                 flush=True,
             )
     speed = []
@@ -217,6 +223,22 @@ def main() -> dict:
         opt = imai_iri(p[dedup_indices(p)], 0.02) if len(p) <= 100_000 else None
         speed.append(dict(set=name, points=len(p), kept=kept, opt=opt, pts_per_s=len(p) / dt))
         print(f"speed {name:18s} kept={kept:6d} opt={opt} {len(p) / dt:,.0f} pts/s", flush=True)
+    # whole drawings through thin_many (how the fitter thins): many small paths
+    for name, fp, eps in [
+        ("seal.plt", os.path.join(ROOT, "resources", "samples", "seal.plt"), 0.02),
+        ("text_outline.plt", os.path.join(ROOT, "resources", "samples", "text_outline.plt"), 0.5),
+        ("noten.hpgl", os.path.join(CORPUS, "h42i__monoplots__noten.hpgl"), 0.02),
+    ]:
+        if not os.path.exists(fp):
+            continue
+        ps = paths_of(fp)
+        n = sum(len(p) for p in ps)
+        dt, kept = timed(ps, eps, reps=3, many=True)
+        speed.append(dict(set=name, eps=eps, paths=len(ps), points=n, kept=kept, pts_per_s=n / dt))
+        print(
+            f"speed {name:18s} eps={eps} paths={len(ps)} kept={kept} {n / dt:,.0f} pts/s",
+            flush=True,
+        )
     res = dict(rows=rows, speed=speed)
     if args.json:
         with open(args.json, "w") as f:

@@ -50,6 +50,7 @@ from __future__ import annotations
 
 import math
 import time
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -68,7 +69,7 @@ from galvo_core.geometry import (
     power_coeffs_many,
 )
 from galvo_core.runs import split_pieces
-from galvo_core.thin import check_positive, thin
+from galvo_core.thin import check_positive, thin_many
 
 __all__ = [
     "DEFAULT_EPS_LINE",
@@ -77,6 +78,8 @@ __all__ = [
     "Segment",
     "FittedPath",
     "fit_path",
+    "fit_paths",
+    "FitCancelled",
     "fit_drawing",
     "fit_report",
     "check_fit",
@@ -243,6 +246,7 @@ class _BatchFitter:
         t_out: np.ndarray,
         e_per: float,
         eps_sum: float,
+        arc: np.ndarray | None = None,
     ) -> None:
         self.work = work
         self.kept = kept
@@ -251,8 +255,11 @@ class _BatchFitter:
         self.t_out = t_out
         self.e_per = e_per
         self.eps_sum = eps_sum
-        seg = np.hypot(*np.diff(work, axis=0).T)
-        self.arc = np.concatenate(([0.0], np.cumsum(seg)))
+        if arc is None:
+            seg = np.hypot(*np.diff(work, axis=0).T)
+            arc = np.concatenate(([0.0], np.cumsum(seg)))
+        #: cumulative arc length (per path when several paths are concatenated)
+        self.arc = arc
         #: accepted cubics: (a, b, ctrl, bound of the max input error)
         self.cubics: list[tuple[int, int, np.ndarray, float]] = []
         self.lines: list[int] = []  # a of line pieces (a, a + 1)
@@ -471,40 +478,206 @@ def fit_path(
     (a dot). A closed path whose last point differs from its first is closed with an extra
     segment ending exactly at the first point (its ``last`` index is N, meaning point 0).
     """
+    return fit_paths(
+        [points],
+        [closed],
+        eps_line=eps_line,
+        e_per=e_per,
+        eps_sum=eps_sum,
+        source_indices=[source_index],
+        pens=[pen],
+    )[0]
+
+
+def _maybe_curvy(
+    qs: list[np.ndarray], cos_join: float = 0.95, length_ratio: float = 3.0
+) -> list[bool]:
+    """Per thinned path: False when it certainly has no curve run (no two consecutive
+    smooth interior vertices, the rule of :func:`galvo_core.runs.smooth_vertices`), so
+    every piece is a line; one vectorised pass over all paths."""
+    lens = np.array([len(q) for q in qs], dtype=np.intp)
+    out = [False] * len(qs)
+    if not len(qs) or lens.max() < 4:
+        return out
+    q = np.concatenate(qs)
+    s = np.diff(q, axis=0)
+    ln = np.hypot(s[:, 0], s[:, 1])
+    with np.errstate(invalid="ignore", divide="ignore"):
+        cos = (s[:-1] * s[1:]).sum(axis=1) / (ln[:-1] * ln[1:])  # at vertex k + 1
+    ends = np.cumsum(lens)
+    firsts = ends - lens
+    bad = np.zeros(len(q), dtype=bool)  # vertex index k not interior
+    bad[firsts] = True
+    bad[ends - 1] = True
+    la, lb = ln[:-1], ln[1:]
+    ratio_ok = (lb <= length_ratio * la) & (la <= length_ratio * lb)
+    # the path's last vertex: a short tail does not count (as in runs.smooth_vertices)
+    tail = np.zeros(len(q), dtype=bool)
+    tail[ends - 2] = True
+    ratio_ok |= tail[1:-1] & (lb < la)
+    sm = np.zeros(len(q), dtype=bool)
+    sm[1:-1] = (cos > cos_join) & ratio_ok
+    sm &= ~bad
+    pair = sm[:-1] & sm[1:]
+    owner = np.repeat(np.arange(len(qs)), lens)[:-1]
+    hit = np.bincount(owner[pair], minlength=len(qs)) > 0
+    return (hit & (lens >= 4)).tolist()
+
+
+def fit_paths(
+    paths: Sequence[object],
+    closed: Sequence[bool],
+    *,
+    eps_line: float = DEFAULT_EPS_LINE,
+    e_per: float = DEFAULT_E_PER,
+    eps_sum: float = DEFAULT_EPS_SUM,
+    source_indices: Sequence[int] | None = None,
+    pens: Sequence[int] | None = None,
+) -> list[FittedPath]:
+    """:func:`fit_path` for many paths at once (the same result as one call per path).
+
+    The thinning runs for all paths in one go (:func:`galvo_core.thin.thin_many`), paths
+    without any curve run skip the tangents, and the curve pieces of ALL paths are fitted
+    together by one :class:`_BatchFitter` (concatenated points; pieces never cross a path),
+    so the fixed cost per path is a few Python operations, not a few hundred array calls.
+    """
     eps_line, e_per, eps_sum = _check_params(eps_line, e_per, eps_sum)
-    pts = np.asarray(points, dtype=np.float64).reshape(-1, 2)
-    n = len(pts)
-    if not np.isfinite(pts).all():
-        raise ParamError("points must be finite numbers (found NaN or infinity)")
-    if n == 0:
-        return FittedPath(source_index, pen, bool(closed), (), 0.0, 0, 0)
-    work = pts
-    if closed and n >= 2 and not np.array_equal(pts[0], pts[-1]):
-        work = np.vstack([pts, pts[:1]])
-    kept = thin(work, eps_line, closed=closed)
-    if len(kept) == 1:
-        seg = _seg("line", work[[0, 0]], 0, len(work) - 1)
-        return FittedPath(source_index, pen, bool(closed), (seg,), 0.0, n, 1)
-    q = work[kept]
-    pieces, t_in, t_out = split_pieces(q, closed=closed)
-    fitter = _BatchFitter(work, kept, t_in, t_out, e_per, eps_sum)
-    fitter.fit([(pc.a, pc.b) for pc in pieces if pc.kind == "curve"])
-    by_start: dict[int, Segment] = {}
+    npth = len(paths)
+    if len(closed) != npth:
+        raise ValueError("fit_paths: one closed flag per path")
+    src = list(range(npth)) if source_indices is None else [int(i) for i in source_indices]
+    pen = [1] * npth if pens is None else [int(p) for p in pens]
+    works: list[np.ndarray] = []
+    ns: list[int] = []
+    for pts0 in paths:
+        pts = np.asarray(pts0, dtype=np.float64).reshape(-1, 2)
+        if not np.isfinite(pts).all():
+            raise ParamError("points must be finite numbers (found NaN or infinity)")
+        ns.append(len(pts))
+        works.append(pts)
+    for k in range(npth):
+        pts = works[k]
+        if closed[k] and len(pts) >= 2 and not np.array_equal(pts[0], pts[-1]):
+            works[k] = np.vstack([pts, pts[:1]])
+    kept_all = thin_many(works, eps_line)
+    out: list[FittedPath | None] = [None] * npth
+    todo: list[int] = []
+    for k in range(npth):
+        if ns[k] == 0:
+            out[k] = FittedPath(src[k], pen[k], bool(closed[k]), (), 0.0, 0, 0)
+        elif len(kept_all[k]) == 1:
+            w = works[k]
+            seg = _seg("line", w[[0, 0]], 0, len(w) - 1)
+            out[k] = FittedPath(src[k], pen[k], bool(closed[k]), (seg,), 0.0, ns[k], 1)
+        else:
+            todo.append(k)
+    if not todo:
+        return out  # type: ignore[return-value]
+    qs = [works[k][kept_all[k]] for k in todo]
+    curvy = _maybe_curvy(qs)
+    # one concatenated work array; kept indices and thinned indices made global
+    wlen = np.array([len(works[k]) for k in todo], dtype=np.intp)
+    woff = np.concatenate(([0], np.cumsum(wlen)))
+    klen = np.array([len(kept_all[k]) for k in todo], dtype=np.intp)
+    koff = np.concatenate(([0], np.cumsum(klen)))
+    W = np.concatenate([works[k] for k in todo]) if len(todo) > 1 else works[todo[0]]
+    K = np.concatenate([kept_all[k] + woff[t] for t, k in enumerate(todo)])
+    Q = W[K]
+    t_in = np.zeros((len(K), 2))
+    t_out = np.zeros((len(K), 2))
+    # per path: (a, b) pieces in global thinned indices; lines and curves
+    line_pieces: list[list[tuple[int, int]]] = [[] for _ in todo]
+    curve_pieces: list[tuple[int, int]] = []
+    for t, k in enumerate(todo):
+        o = int(koff[t])
+        m = int(klen[t])
+        if not curvy[t]:
+            line_pieces[t] = [(o + i, o + i + 1) for i in range(m - 1)]
+            continue
+        pieces, ti, to = split_pieces(qs[t], closed=bool(closed[k]))
+        t_in[o : o + m] = ti
+        t_out[o : o + m] = to
+        for pc in pieces:
+            if pc.kind == "curve":
+                curve_pieces.append((o + pc.a, o + pc.b))
+            else:
+                line_pieces[t].append((o + pc.a, o + pc.b))
+    # arc length restarted at every path (the same numbers as for one path alone)
+    arc = np.zeros(len(W))
+    for t in range(len(todo)) if curve_pieces else ():
+        if not curvy[t]:
+            continue
+        w = W[woff[t] : woff[t + 1]]
+        np.cumsum(np.hypot(*np.diff(w, axis=0).T), out=arc[woff[t] + 1 : woff[t + 1]])
+    fitter = _BatchFitter(W, K, t_in, t_out, e_per, eps_sum, arc)
+    owner_of = np.repeat(np.arange(len(todo)), klen)
+    if curve_pieces:
+        with np.errstate(invalid="ignore", divide="ignore"):
+            fitter.fit(curve_pieces)
+    # distribute the fitter's results to their paths (global thinned index -> path)
+    cub_by: list[list[tuple[int, int, np.ndarray, float]]] = [[] for _ in todo]
+    for c in fitter.cubics:
+        cub_by[int(owner_of[c[0]])].append(c)
     for a in fitter.lines:
-        by_start[a] = _seg("line", q[[a, a + 1]], kept[a], kept[a + 1])
-    for pc in pieces:
-        if pc.kind == "line":
-            by_start[pc.a] = _seg("line", q[[pc.a, pc.b]], kept[pc.a], kept[pc.b])
-    bounds: dict[int, float] = {}
-    for a, b, c, e in fitter.cubics:
-        by_start[a] = _seg("cubic", c, kept[a], kept[b])
-        bounds[by_start[a].first] = e
-    segs = [by_start[a] for a in sorted(by_start)]
-    last = segs[-1]
-    if last.last != len(work) - 1:  # trailing repeats of the end point
-        segs[-1] = Segment(last.kind, last.points, last.first, len(work) - 1)
-    max_err = max(_max_error(work, segs, cubics=False), _cubic_max_error(work, segs, bounds))
-    return FittedPath(source_index, pen, bool(closed), tuple(segs), max_err, n, len(kept))
+        line_pieces[int(owner_of[a])].append((a, a + 1))
+    # all line segments at once: their points (read-only views) and their true max error
+    la = np.array([a for lp in line_pieces for a, _ in lp], dtype=np.intp)
+    lb = np.array([b for lp in line_pieces for _, b in lp], dtype=np.intp)
+    lpts = np.stack([Q[la], Q[lb]], axis=1) if len(la) else np.zeros((0, 2, 2))
+    lpts.setflags(write=False)
+    lfirst = K[la]
+    llast = K[lb]
+    # a line ending at the path's last thinned point also takes its trailing repeats
+    is_end = np.isin(lb, koff[1:] - 1)
+    llast[is_end] = woff[owner_of[lb[is_end]] + 1] - 1
+    lerr = _line_errors(W, lpts, lfirst, llast)
+    lfirst_l = lfirst.tolist()
+    llast_l = llast.tolist()
+    la_l = la.tolist()
+    lerr_l = lerr.tolist()
+    pos = 0
+    for t, k in enumerate(todo):
+        o_w = int(woff[t])
+        items: list[tuple[int, Segment]] = []
+        worst = 0.0
+        for _ in range(len(line_pieces[t])):
+            items.append(
+                (la_l[pos], Segment("line", lpts[pos], lfirst_l[pos] - o_w, llast_l[pos] - o_w))
+            )
+            worst = max(worst, lerr_l[pos])
+            pos += 1
+        bounds: dict[int, float] = {}
+        for a, b, ctl, e in cub_by[t]:
+            sg = _seg("cubic", ctl, int(K[a]) - o_w, int(K[b]) - o_w)
+            items.append((a, sg))
+            bounds[sg.first] = e
+        items.sort(key=lambda it: it[0])
+        segs = [it[1] for it in items]
+        work = works[k]
+        last = segs[-1]
+        if last.last != len(work) - 1:  # trailing repeats of the end point
+            segs[-1] = Segment(last.kind, last.points, last.first, len(work) - 1)
+        if bounds:
+            worst = max(worst, _cubic_max_error(work, segs, bounds))
+        out[k] = FittedPath(
+            src[k], pen[k], bool(closed[k]), tuple(segs), worst, ns[k], int(klen[t])
+        )
+    return out  # type: ignore[return-value]
+
+
+def _line_errors(
+    work: np.ndarray, pts: np.ndarray, first: np.ndarray, last: np.ndarray
+) -> np.ndarray:
+    """Per line segment: the largest distance of the input points first..last (indices into
+    ``work``) to the segment ``pts[k]`` (true distances, all segments at once)."""
+    if len(first) == 0:
+        return np.zeros(0)
+    cnt = last - first + 1
+    starts = np.cumsum(cnt) - cnt
+    own = np.repeat(np.arange(len(first)), cnt)
+    idx = first[own] + np.arange(int(cnt.sum())) - starts[own]
+    d = point_segment_distance(work[idx], pts[own, 0], pts[own, 1])
+    return np.maximum.reduceat(d, starts)
 
 
 def _cubic_max_error(work: np.ndarray, segs: list[Segment], bound: dict[int, float]) -> float:
@@ -555,21 +728,33 @@ def fit_drawing(
     eps_line: float = DEFAULT_EPS_LINE,
     e_per: float = DEFAULT_E_PER,
     eps_sum: float = DEFAULT_EPS_SUM,
+    batch: int = 4096,
+    cancel: Callable[[], bool] | None = None,
 ) -> tuple[FittedPath, ...]:
-    """:func:`fit_path` for every path of the drawing, in order (``source_index`` = position)."""
+    """:func:`fit_path` for every path of the drawing, in order (``source_index`` = position),
+    fitted ``batch`` paths at a time (:func:`fit_paths`). ``cancel`` is called between
+    batches; when it returns True, :class:`FitCancelled` is raised."""
     _check_params(eps_line, e_per, eps_sum)
-    return tuple(
-        fit_path(
-            p.points,
-            closed=p.closed,
+    paths = drawing.paths
+    out: list[FittedPath] = []
+    for b0 in range(0, len(paths), max(1, int(batch))):
+        if cancel is not None and cancel():
+            raise FitCancelled()
+        chunk = paths[b0 : b0 + batch]
+        out += fit_paths(
+            [p.points for p in chunk],
+            [p.closed for p in chunk],
             eps_line=eps_line,
             e_per=e_per,
             eps_sum=eps_sum,
-            source_index=i,
-            pen=p.pen,
+            source_indices=range(b0, b0 + len(chunk)),
+            pens=[p.pen for p in chunk],
         )
-        for i, p in enumerate(drawing.paths)
-    )
+    return tuple(out)
+
+
+class FitCancelled(Exception):
+    """Raised by :func:`fit_drawing` when its ``cancel`` callback says stop."""
 
 
 def fit_report(

@@ -12,11 +12,13 @@ from hypothesis import strategies as st
 from galvo_core.drawing import Drawing, Path
 from galvo_core.errors import ParamError
 from galvo_core.fit import (
+    FitCancelled,
     FittedPath,
     check_fit,
     control_points,
     fit_drawing,
     fit_path,
+    fit_paths,
     fit_report,
 )
 from galvo_core.geometry import cubic_eval
@@ -352,6 +354,93 @@ def test_fit_drawing_and_report():
     assert 0 < rep["thinned_points"] < rep["input_points"]
     assert rep["max_error"] <= EPS
     assert rep["seconds"] >= 0
+
+
+def _same_fit(a: FittedPath, b: FittedPath) -> bool:
+    if (a.source_index, a.pen, a.closed, a.n_input, a.n_thinned, a.max_error) != (
+        b.source_index,
+        b.pen,
+        b.closed,
+        b.n_input,
+        b.n_thinned,
+        b.max_error,
+    ) or len(a.segments) != len(b.segments):
+        return False
+    return all(
+        x.kind == y.kind
+        and x.first == y.first
+        and x.last == y.last
+        and np.array_equal(x.points, y.points)
+        and not x.points.flags.writeable
+        for x, y in zip(a.segments, b.segments, strict=True)
+    )
+
+
+def _mixed_drawing(seed: int) -> list[tuple[np.ndarray, bool]]:
+    rng = np.random.default_rng(seed)
+    out: list[tuple[np.ndarray, bool]] = [
+        (np.zeros((0, 2)), False),
+        (np.array([[1.0, 1.0]]), False),
+        (np.array([[2.0, 2.0]] * 3), True),
+        (np.array([[0.0, 0.0], [5.0, 0.0], [5.0, 0.0]]), False),
+    ]
+    for _ in range(20):
+        kind = int(rng.integers(0, 4))
+        if kind == 0:
+            p = ellipse(int(rng.integers(50, 600)))
+            out.append((p[:-1] if rng.random() < 0.5 else p, True))
+        elif kind == 1:
+            out.append((s_curve(int(rng.integers(100, 800))), False))
+        elif kind == 2:  # integer staircase
+            n = int(rng.integers(5, 60))
+            out.append((np.cumsum(rng.integers(-3, 4, (n, 2)), axis=0).astype(float), False))
+        else:  # an s-curve ending on repeats of its last point
+            p = s_curve(300)
+            out.append((np.vstack([p, p[-1:], p[-1:]]), False))
+    return out
+
+
+@pytest.mark.parametrize("seed", [0, 1])
+@pytest.mark.parametrize("e_per", [0.02, 0.75])
+def test_fit_paths_is_fit_path_per_path(seed, e_per):
+    items = _mixed_drawing(seed)
+    pts = [p for p, _ in items]
+    cl = [c for _, c in items]
+    many = fit_paths(
+        pts,
+        cl,
+        e_per=e_per,
+        source_indices=range(5, 5 + len(items)),
+        pens=[1 + i % 3 for i in range(len(items))],
+    )
+    for i, ((p, c), f) in enumerate(zip(items, many, strict=True)):
+        one = fit_path(p, closed=c, e_per=e_per, source_index=5 + i, pen=1 + i % 3)
+        assert _same_fit(f, one), i
+        if len(p):
+            assert_valid(p, f, e_per=e_per, closed=c)
+
+
+def test_fit_drawing_batches_and_cancel():
+    items = _mixed_drawing(3)
+    d = Drawing(
+        tuple(
+            Path.from_points(p, closed=c) if len(p) else Path.from_points([[0.0, 0.0]])
+            for p, c in items
+        )
+    )
+    whole = fit_drawing(d)
+    small = fit_drawing(d, batch=3)
+    assert all(_same_fit(a, b) for a, b in zip(whole, small, strict=True))
+    assert [f.source_index for f in small] == list(range(len(items)))
+    calls = []
+
+    def cancel() -> bool:
+        calls.append(1)
+        return len(calls) > 2
+
+    with pytest.raises(FitCancelled):
+        fit_drawing(d, batch=3, cancel=cancel)
+    assert len(calls) == 3
 
 
 def test_core_does_not_import_qt():
