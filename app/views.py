@@ -25,12 +25,14 @@ Layers (key: what, view):
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
 import pyqtgraph as pg
 from PySide6.QtCore import QPointF, QRectF, Qt
-from PySide6.QtGui import QColor, QPainterPath, QPen, QTransform
+from PySide6.QtGui import QColor, QImage, QPainterPath, QPen, QPixmapCache, QTransform
+from PySide6.QtWidgets import QGraphicsItem
 
 # --- palette (light background, dark ink: legible on screen and in print) -------------
 BACKGROUND = "#ffffff"
@@ -57,6 +59,15 @@ MAX_MARKER_POINTS = 200_000
 #: Lines and markers are antialiased only below this many vertices: the software rasteriser
 #: spends most of a frame antialiasing big layers (bench/bench_gui.py).
 MAX_ANTIALIAS_POINTS = 20_000
+
+#: Layers that a change of the mark points (chord tolerance, magnification, ...) redraws
+#: every time; every other layer and the axes (with their grid) are kept as device pixmaps
+#: (QGraphicsItem.DeviceCoordinateCache): a repaint that did not change them only copies
+#: the pixmap instead of rasterising 100,000 vertices again in software.
+UNCACHED_LAYERS = frozenset({"marks", "jumps"})
+#: QPixmapCache size (KiB) so that the cached layers of both views fit (the default 10 MiB
+#: holds about two full-window layers; an evicted pixmap is simply drawn again).
+PIXMAP_CACHE_KB = 256 * 1024
 
 #: Smallest span a fit zooms to, in mm.
 MIN_FIT_SPAN_MM = 0.5
@@ -182,6 +193,12 @@ def _polygon(xy: np.ndarray):
     return poly
 
 
+def _small_polygon(xy: np.ndarray):
+    """The QPolygonF of a marker set that :func:`draw_points` draws as points (a small
+    one); None for a large one (rasterised from the array, no polygon needed)."""
+    return _polygon(xy) if len(xy) < MAX_ANTIALIAS_POINTS else None
+
+
 def _finite_rect(xy: np.ndarray) -> QRectF:
     if not len(xy):
         return QRectF()
@@ -189,34 +206,83 @@ def _finite_rect(xy: np.ndarray) -> QRectF:
     return QRectF(QPointF(lo[0], lo[1]), QPointF(hi[0], hi[1]))
 
 
+def _footprint(width: float, square: bool, frac: float) -> tuple[np.ndarray, np.ndarray]:
+    """Pixel offsets (dx, dy) covered by a marker of ``width`` pixels centred at
+    ``k + frac`` (k an integer; pixel i covers [i, i + 1], its centre at i + 0.5): a disk
+    (round cap) or a square (square cap), as the raster engine draws a wide point without
+    antialiasing. At least the centre pixel."""
+    r = width / 2.0
+    n = int(math.ceil(r)) + 1
+    o = np.arange(-n, n + 1)
+    dx, dy = np.meshgrid(o, o)
+    cx = dx + 0.5 - frac
+    cy = dy + 0.5 - frac
+    if square:
+        inside = (np.abs(cx) <= r) & (np.abs(cy) <= r)
+    else:
+        inside = cx * cx + cy * cy <= r * r
+    if not inside.any():
+        inside = (np.abs(cx) <= 0.5) & (np.abs(cy) <= 0.5)
+    return dx[inside].ravel(), dy[inside].ravel()
+
+
+def _premultiplied(colour: QColor) -> np.uint32:
+    a = colour.alpha()
+    r, g, b = (c * a // 255 for c in (colour.red(), colour.green(), colour.blue()))
+    return np.uint32((a << 24) | (r << 16) | (g << 8) | b)
+
+
 def draw_points(p, xy: np.ndarray, poly, pen: QPen, grid: float = 2.0) -> None:
     """Draw markers at ``xy`` (item coordinates) with ``pen``. Small sets: antialiased, as
-    they are. Large sets: culled to the viewport and thinned to one marker per ``grid``
-    device pixels (what the eye can tell apart anyway), drawn without antialiasing — this
-    keeps a 100,000-point layer in the tens of milliseconds."""
+    they are. Large sets: culled to the device and thinned to one marker per ``grid``
+    device pixels (what the eye can tell apart anyway), then rasterised here: each marker's
+    footprint (the pen's disk or square, no antialiasing) is written into one ARGB image
+    with numpy and the image is drawn once. The raster engine would stroke every wide point
+    as a path; this keeps a 100,000-point layer at a few milliseconds."""
     if len(xy) < MAX_ANTIALIAS_POINTS:
         p.setRenderHint(p.RenderHint.Antialiasing, True)
         p.setPen(pen)
-        p.drawPoints(poly)
+        p.drawPoints(poly if poly is not None else _polygon(xy))
+        return
+    dev = p.device()
+    if dev is None:  # pragma: no cover - painting always has a device
+        return
+    dpr = float(dev.devicePixelRatioF()) if hasattr(dev, "devicePixelRatioF") else 1.0
+    w, h = int(math.ceil(dev.width() * dpr)), int(math.ceil(dev.height() * dpr))
+    if w <= 0 or h <= 0:
         return
     t = p.transform()
-    dx = xy[:, 0] * t.m11() + xy[:, 1] * t.m21() + t.dx()
-    dy = xy[:, 0] * t.m12() + xy[:, 1] * t.m22() + t.dy()
-    dev = p.device()
-    w, h = (dev.width(), dev.height()) if dev is not None else (1 << 15, 1 << 15)
-    m = 8.0
-    keep = (dx > -m) & (dx < w + m) & (dy > -m) & (dy < h + m)
-    ix = np.floor(dx[keep] / grid).astype(np.int64)
-    iy = np.floor(dy[keep] / grid).astype(np.int64)
-    cells = np.unique((ix + 64) * (1 << 22) + (iy + 64))
-    pts = np.empty((len(cells), 2))
-    pts[:, 0] = (cells // (1 << 22) - 64 + 0.5) * grid
-    pts[:, 1] = (cells % (1 << 22) - 64 + 0.5) * grid
+    dx = (xy[:, 0] * t.m11() + xy[:, 1] * t.m21() + t.dx()) * dpr
+    dy = (xy[:, 0] * t.m12() + xy[:, 1] * t.m22() + t.dy()) * dpr
+    g = max(1, int(round(grid * dpr)))
+    width = max(pen.widthF(), 1.0) * dpr
+    pad = int(math.ceil(width / 2.0 / g)) + 1  # cells off the device whose marker shows
+    gw, gh = w // g + 1 + 2 * pad, h // g + 1 + 2 * pad
+    with np.errstate(invalid="ignore"):
+        ix = np.floor(dx / g)
+        iy = np.floor(dy / g)
+        keep = (ix >= -pad) & (ix < gw - pad) & (iy >= -pad) & (iy < gh - pad)
+    occ = np.zeros((gh, gw), dtype=bool)  # one marker per grid cell
+    occ[iy[keep].astype(np.int64) + pad, ix[keep].astype(np.int64) + pad] = True
+    cy, cx = np.nonzero(occ)
+    # cell centres (cell + 0.5) * g: all share one fractional part
+    centre = 0.5 * g
+    frac = centre - math.floor(centre)
+    ox, oy = _footprint(width, pen.capStyle() == Qt.PenCapStyle.SquareCap, frac)
+    bx = (cx - pad) * g + int(math.floor(centre))
+    by = (cy - pad) * g + int(math.floor(centre))
+    img = np.zeros((h, w), dtype=np.uint32)
+    value = _premultiplied(pen.color())
+    for ddx, ddy in zip(ox.tolist(), oy.tolist(), strict=True):
+        px = bx + ddx
+        py = by + ddy
+        ok = (px >= 0) & (px < w) & (py >= 0) & (py < h)
+        img[py[ok], px[ok]] = value
+    qimg = QImage(img.data, w, h, 4 * w, QImage.Format.Format_ARGB32_Premultiplied)
+    qimg.setDevicePixelRatio(dpr)
     p.save()
     p.resetTransform()
-    p.setRenderHint(p.RenderHint.Antialiasing, False)
-    p.setPen(pen)
-    p.drawPoints(_polygon(pts))
+    p.drawImage(QPointF(0.0, 0.0), qimg)
     p.restore()
 
 
@@ -258,10 +324,11 @@ class PointsItem(_FastItem):
 
     def setData(self, xy: np.ndarray) -> None:  # noqa: N802 - like pyqtgraph
         xy = np.asarray(xy, dtype=np.float64).reshape(-1, 2)
-        xy = xy[np.isfinite(xy).all(axis=1)]
+        if not np.isfinite(xy).all():
+            xy = xy[np.isfinite(xy).all(axis=1)]
         self.prepareGeometryChange()
         self._xy = xy
-        self._poly = _polygon(xy)
+        self._poly = _small_polygon(xy)
         self._rect = _finite_rect(xy)
         self.update()
 
@@ -306,8 +373,8 @@ class ControlItem(_FastItem):
             self._lines = QPainterPath()
         self._xy_anchors = xy[role == 1]
         self._xy_knots = xy[role == 2]
-        self._anchors = _polygon(self._xy_anchors)
-        self._knots = _polygon(self._xy_knots)
+        self._anchors = _small_polygon(self._xy_anchors)
+        self._knots = _small_polygon(self._xy_knots)
         self._rect = _finite_rect(xy[role >= 0])
         self.update()
 
@@ -401,6 +468,11 @@ class WorkView(pg.PlotWidget):
             axis.setPen(pg.mkPen(FOREGROUND))
             axis.setTextPen(pg.mkPen(FOREGROUND))
         pi.getAxis("left").setWidth(52)
+        if QPixmapCache.cacheLimit() < PIXMAP_CACHE_KB:
+            QPixmapCache.setCacheLimit(PIXMAP_CACHE_KB)
+        cache = QGraphicsItem.CacheMode.DeviceCoordinateCache
+        for name in ("left", "bottom"):  # ticks, labels and the grid: redrawn on zoom only
+            pi.getAxis(name).setCacheMode(cache)
         vb = pi.getViewBox()
         vb.setAspectLocked(True, ratio=1.0)  # y up is the ViewBox default
         vb.setDefaultPadding(0.04)
@@ -425,6 +497,9 @@ class WorkView(pg.PlotWidget):
             item.setZValue(_Z[key])
             pi.addItem(item)
             self.layers[key] = item
+            if key not in UNCACHED_LAYERS:
+                for it in _painting_items(item):
+                    it.setCacheMode(cache)
             self.legend_samples[key] = sample
 
         self.legend = pg.LegendItem(offset=(0, 0), labelTextColor=FOREGROUND,
@@ -449,7 +524,8 @@ class WorkView(pg.PlotWidget):
         re-sent when the first array is another object than last time. Returns True when
         the data changed."""
         item = self.layers[key]
-        item.setTransform(transform)
+        if item.transform() != transform:  # an equal transform would still repaint
+            item.setTransform(transform)
         ident = id(arrays[0]) if arrays else 0
         if self._data_ids.get(key) == ident and ident:
             return False
@@ -552,6 +628,13 @@ class WorkView(pg.PlotWidget):
     def repaint_now(self) -> None:
         """Render the view synchronously (benchmark: 'redrawn')."""
         self.viewport().repaint()
+
+    #: viewport paints so far (the benchmark tells whether a result was drawn already)
+    paint_count = 0
+
+    def paintEvent(self, ev) -> None:  # noqa: N802 - Qt API
+        super().paintEvent(ev)
+        self.paint_count += 1
 
     def data_items(self) -> list[pg.GraphicsObject]:
         return [self.layers[k] for k in self.layers]
@@ -665,6 +748,14 @@ def _make_layer(key: str) -> tuple[pg.GraphicsObject, pg.PlotDataItem]:
     else:
         sample = pg.PlotDataItem([0.0], [0.0], **kw)
     return item, sample
+
+
+def _painting_items(item: pg.GraphicsObject) -> list[pg.GraphicsObject]:
+    """The items that paint a layer: a PlotDataItem draws through its curve and scatter
+    children, the other layer items themselves."""
+    if isinstance(item, pg.PlotDataItem):
+        return [item.curve, item.scatter]
+    return [item]
 
 
 def units_transform(scale: float, offset: tuple[float, float]) -> QTransform:

@@ -1051,6 +1051,14 @@ class MainWindow(QMainWindow):
         else:
             self.setWindowTitle(f"{name or 'untitled'} — {APP_NAME}")
 
+    def _size_mm(self, d: Drawing) -> tuple[float, float]:
+        """``d.size_mm()``, kept per drawing (a bbox over every point: too slow per run)."""
+        cached = getattr(self, "_size_mm_of", None)
+        if cached is None or cached[0] is not d:
+            cached = (d, d.size_mm())
+            self._size_mm_of = cached
+        return cached[1]
+
     def status_summary(self) -> str:
         """The counts shown in the status bar, as plain text."""
         d = self.drawing
@@ -1058,7 +1066,7 @@ class MainWindow(QMainWindow):
             if self.job_path is not None:
                 return f"job file {self.job_path.name}"
             return "No file — File ▸ Open… or drop an HP-GL file onto the window"
-        w, h = d.size_mm()
+        w, h = self._size_mm(d)
         return "   ·   ".join(
             [
                 f"{_fmt_int(len(d.paths))} paths",

@@ -334,8 +334,10 @@ def main() -> int:
     lines += ["", "### Speed", "",
               "Best of 3. *search*: the step search alone (marks as curve parameters); "
               "*sample_paths*: everything the pipeline's sample stage does — search, segment "
-              "ends, min-step filter, rounding, and the closed-form measurement of every "
-              "chord before and after rounding.", "",
+              "ends, min-step filter, rounding, and the measurement of every chord against "
+              "the true curve before and after rounding (a chord that is exactly one the "
+              "search measured keeps that closed-form measurement, the others are measured "
+              "again; the largest height after rounding is refined until exact).", "",
               "| input | marks | search (M marks/s) | sample_paths (M marks/s) | height "
               "measurements per mark |", "| --- | ---: | ---: | ---: | ---: |"]
     speed_rows(lines, args.quick)

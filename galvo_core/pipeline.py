@@ -27,13 +27,13 @@ import numpy as np
 from galvo_core.drawing import Drawing, Warning
 from galvo_core.field import FieldMap, check_in_field, make_field
 from galvo_core.fill import HatchStroke, hatch
-from galvo_core.fit import FittedPath, control_points, fit_path
+from galvo_core.fit import FitCancelled, FittedPath, control_points, fit_drawing
 from galvo_core.job import Job, Stroke
 from galvo_core.kerf import compensate_indexed
 from galvo_core.order import order_job_strokes
 from galvo_core.params import STAGE_FIELDS, Params
 from galvo_core.sample import ROUNDING_BOUND_BITS, SampleReport, polyline_marks, sample_paths
-from galvo_core.timing import dwell_count, estimate
+from galvo_core.timing import estimate_with_dwell
 
 T = TypeVar("T")
 
@@ -81,7 +81,26 @@ class Pipeline:
         self._fit = _LRU(cache_size)
         self._fill = _LRU(cache_size)
         self._marks = _LRU(cache_size)
+        # facts of a drawing or a fit that every run needs (bbox, coordinate quantum,
+        # counts, the stroke segments): computed once per object, not per run
+        self._facts = _LRU(4 * cache_size)
         self.last_info = RunInfo((), 0.0)
+
+    def _fact(self, obj: Any, name: str, make: Callable[[], T]) -> T:
+        """``make()`` cached by ``obj``'s identity (the entry keeps ``obj`` alive, so the id
+        cannot be reused while it is cached; drawings and fits are immutable)."""
+        if not isinstance(obj, (tuple, Drawing)):  # a mutable sequence: not cached
+            return make()
+        held, value = self._facts.get((id(obj), name), lambda: (obj, make()))
+        if held is not obj:  # pragma: no cover - an id reused after eviction
+            value = make()
+            with self._facts.lock:
+                self._facts.data[(id(obj), name)] = (obj, value)
+        return cast(T, value)
+
+    def bbox(self, drawing: Drawing) -> tuple[float, float, float, float] | None:
+        """``drawing.bbox()``, cached."""
+        return self._fact(drawing, "bbox", drawing.bbox)
 
     # ---------------------------------------------------------------- stages
     def compensated(self, drawing: Drawing, params: Params,
@@ -122,14 +141,12 @@ class Pipeline:
 
         def make() -> tuple[FittedPath, ...]:
             self._ran.append("fit")
-            out = []
-            for i, p in enumerate(drawing.paths):
-                if cancel is not None and i % 64 == 0 and cancel():
-                    raise Cancelled()
-                out.append(fit_path(p.points, closed=p.closed, eps_line=params.eps_line,
-                                    e_per=params.e_per, eps_sum=params.eps_sum,
-                                    source_index=i, pen=p.pen))
-            return tuple(out)
+            # all paths of a batch are thinned and fitted together; cancel() between batches
+            try:
+                return fit_drawing(drawing, eps_line=params.eps_line, e_per=params.e_per,
+                                   eps_sum=params.eps_sum, batch=512, cancel=cancel)
+            except FitCancelled:
+                raise Cancelled() from None
 
         return self._fit.get(key, make)
 
@@ -141,7 +158,7 @@ class Pipeline:
         # an outward kerf grows the drawing by kerf/2 on the workpiece: leave room for it
         grow_bits = (params.kerf_mm / 2 if params.kerf_side == "outside" else 0.0) / (
             params.field_size_mm / params.field_bits)
-        return make_field(drawing.bbox(), magnification=mag, fit_field=params.fit_field,
+        return make_field(self.bbox(drawing), magnification=mag, fit_field=params.fit_field,
                           field_bits=params.field_bits, field_size_mm=params.field_size_mm,
                           offset_bits=params.offset_bits, margin_bits=grow_bits)
 
@@ -182,14 +199,14 @@ class Pipeline:
         work, origin = self.compensated(drawing, params, fm)
         fitted = self.fitted(work, params, cancel)
         warnings: list[Warning] = list(work.warnings)
-        quantum = coordinate_quantum(drawing)
+        quantum = self._fact(drawing, "quantum", lambda: coordinate_quantum(drawing))
         if quantum is not None and params.e_per < 0.5 * quantum:
             warnings.append(Warning(0, 0, (
                 f"the file's coordinates are whole multiples of {quantum:g} unit: its points "
                 f"are rounded by up to {0.5 * quantum:g} unit, more than e_per = "
                 f"{params.e_per:g}, so smooth runs stay as lines; an e_per of about "
                 f"{0.75 * quantum:g} lets curves be fitted")))
-        out_msg = check_in_field(fm, work.bbox(), clamp=params.clamp)
+        out_msg = check_in_field(fm, self.bbox(work), clamp=params.clamp)
         if out_msg:
             warnings.append(Warning(0, 0, out_msg))
         marks = self.marks(work, params, fitted, fm, cancel)
@@ -204,11 +221,13 @@ class Pipeline:
             clamped += int((c != m).any(axis=1).sum())
             return c
 
-        for fp, m in zip(fitted, marks, strict=True):
+        segs = self._fact(fitted, "segments", lambda: [
+            tuple((s.kind, s.points) for s in fp.segments) for fp in fitted])
+        for fp, m, sg in zip(fitted, marks, segs, strict=True):
             if len(m) == 0:
                 continue
             strokes.append(Stroke("contour", origin[fp.source_index], fp.closed, clamp(m),
-                                  tuple((s.kind, s.points) for s in fp.segments), fp.pen))
+                                  sg, fp.pen))
         for h in self.hatched(work, params, fm):
             src = origin[h.source_index]
             hm = polyline_marks(h.points, fm, min_step_bits=params.min_step_bits)
@@ -238,14 +257,19 @@ class Pipeline:
         the true curve; None for raw marks), chords above the tolerance, min-step
         overrides, marks outside the field (before clamping), dwell points."""
         ms = [s.marks for s in strokes]
-        t = estimate(ms, params.laser, fm.mm_per_bit)
+        t, dwell = estimate_with_dwell(ms, params.laser, fm.mm_per_bit)
         rep = getattr(self, "sample_report", None)
-        fit_err = max((f.max_error for f in fitted), default=0.0)
+        n_input = self._fact(drawing, "n_points", lambda: drawing.n_points)
+        fit_err, n_control, n_lines, n_cubics = self._fact(fitted, "counts", lambda: (
+            max((f.max_error for f in fitted), default=0.0),
+            sum(control_points(f) for f in fitted),
+            sum(1 for f in fitted for s in f.segments if s.kind == "line"),
+            sum(1 for f in fitted for s in f.segments if s.kind == "cubic")))
         out: dict[str, Any] = {
-            "input_points": drawing.n_points,
-            "control_points": sum(control_points(f) for f in fitted),
-            "lines": sum(1 for f in fitted for s in f.segments if s.kind == "line"),
-            "cubics": sum(1 for f in fitted for s in f.segments if s.kind == "cubic"),
+            "input_points": n_input,
+            "control_points": n_control,
+            "lines": n_lines,
+            "cubics": n_cubics,
             "mark_points": t["mark_points"],
             "strokes": len(strokes),
             "laser_switches": t["laser_switches"],
@@ -266,7 +290,7 @@ class Pipeline:
             "min_step_overrides": 0,
             "rounding_bound_bits": ROUNDING_BOUND_BITS,
             "outside_points": 0,
-            "dwell_points": dwell_count(ms, params.laser, fm.mm_per_bit),
+            "dwell_points": dwell,
         }
         if rep is not None:
             out.update({

@@ -554,14 +554,16 @@ def _affine_box(b: tuple[float, float, float, float] | None, scale: float,
             b[3] * scale + off[1])
 
 
-def display_tolerance(job_params: dict[str, Any], drawing: Drawing | None) -> float:
+def display_tolerance(job_params: dict[str, Any], drawing: Drawing | None,
+                      bbox: tuple[float, float, float, float] | None = None) -> float:
     """How closely flattened cubics follow the fit for display, in input units: a quarter of
     the fit tolerance (so the deviation shown is the fit's, not the flattening's), but not
-    finer than a millionth of the drawing's diagonal."""
+    finer than a millionth of the drawing's diagonal (``bbox``: the drawing's, when the
+    caller has it)."""
     e = [float(job_params.get(k, 0.0) or 0.0) for k in ("e_per", "eps_line")]
     e = [v for v in e if v > 0] or [0.02]
     tol = min(e) / 4.0
-    bb = drawing.bbox() if drawing is not None else None
+    bb = bbox if bbox is not None else drawing.bbox() if drawing is not None else None
     if bb is not None:
         tol = max(tol, float(np.hypot(bb[2] - bb[0], bb[3] - bb[1])) * 1e-6)
     return tol
@@ -588,7 +590,9 @@ def build_preview(
     cache = cache if cache is not None else PreviewCache()
     e_tol = max(float(job.params.get("e_per", 0.0) or 0.0),
                 float(job.params.get("eps_line", 0.0) or 0.0))
-    tol_units = display_tolerance(job.params, drawing)
+    d_box = cache.get(("bbox", id(drawing)), lambda: (drawing, drawing.bbox()))[1] \
+        if drawing is not None else None
+    tol_units = display_tolerance(job.params, drawing, d_box)
 
     if drawing is not None:
         def make_original() -> tuple[Any, ...]:

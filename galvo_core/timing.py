@@ -73,34 +73,49 @@ def estimate(
     (= strokes with marks), jumps, mark_points, and the parts of the time (mark_time_s,
     jump_time_s, delay_time_s).
     """
+    return estimate_with_dwell(strokes, laser, mm_per_bit)[0]
+
+
+def estimate_with_dwell(
+    strokes: Sequence[np.ndarray], laser: LaserParams, mm_per_bit: float
+) -> tuple[dict[str, float | int], int]:
+    """:func:`estimate` and :func:`dwell_count` in one pass over all strokes at once (one
+    concatenated array; stroke boundaries by offsets, no loop per stroke)."""
     us = 1e-6
     period = laser.point_period_us * us
-    ms = [np.asarray(m, dtype=np.float64).reshape(-1, 2) for m in strokes]
-    ms = [m for m in ms if len(m)]
+    ms = [m for m in strokes if len(m)]
     n_strokes = len(ms)
     if not n_strokes:
         return {"mark_length_mm": 0.0, "jump_length_mm": 0.0, "estimated_time_s": 0.0,
                 "corners": 0, "laser_switches": 0, "jumps": 0, "mark_points": 0,
-                "mark_time_s": 0.0, "jump_time_s": 0.0, "delay_time_s": 0.0}
-    allm = np.concatenate(ms)
-    sizes = np.array([len(m) for m in ms])
-    sid = np.repeat(np.arange(n_strokes), sizes)
-    d = np.diff(allm, axis=0)
-    inside = sid[1:] == sid[:-1]
-    vec = d[inside]
-    seg_mm = np.hypot(vec[:, 0], vec[:, 1]) * mm_per_bit
+                "mark_time_s": 0.0, "jump_time_s": 0.0, "delay_time_s": 0.0}, 0
+    allm = np.concatenate([np.asarray(m).reshape(-1, 2) for m in ms]).astype(np.float64)
+    sizes = np.fromiter((len(m) for m in ms), dtype=np.int64, count=n_strokes)
+    starts = np.cumsum(sizes) - sizes
+    ends = starts + sizes - 1
+    dx = allm[1:, 0] - allm[:-1, 0]
+    dy = allm[1:, 1] - allm[:-1, 1]
+    # vectors inside a stroke: all but those from a stroke's last mark to the next's first
+    inside = np.ones(len(dx), dtype=bool)
+    inside[ends[:-1]] = False
+    vx, vy = dx[inside], dy[inside]
+    seg_mm = np.hypot(vx, vy) * mm_per_bit
     mark_len = float(seg_mm.sum())
     mark_t = float(_periods(seg_mm, laser.mark_speed_mm_s, period).sum()) * period
     mark_t += int((sizes == 1).sum()) * period  # dots
+    dwell = int(np.count_nonzero(
+        seg_mm < laser.mark_speed_mm_s * laser.point_period_us * 1e-6))
     # corners: turns between consecutive non-zero vectors of the same stroke
-    vsid = sid[1:][inside]
-    nz = (vec != 0).any(axis=1)
-    vec, vsid = vec[nz], vsid[nz]
-    turn = _turns_deg(vec)
-    n_corners = int(((turn > CORNER_DEG) & (vsid[1:] == vsid[:-1])).sum()) if len(turn) else 0
+    vsid = np.repeat(np.arange(n_strokes), np.maximum(sizes - 1, 0))
+    nz = (vx != 0) | (vy != 0)
+    vx, vy, vsid = vx[nz], vy[nz], vsid[nz]
+    n_corners = 0
+    if len(vx) >= 2:
+        cross = vx[:-1] * vy[1:] - vy[:-1] * vx[1:]
+        dot = vx[:-1] * vx[1:] + vy[:-1] * vy[1:]
+        turn = np.degrees(np.abs(np.arctan2(cross, dot)))
+        n_corners = int(np.count_nonzero((turn > CORNER_DEG) & (vsid[1:] == vsid[:-1])))
     # jumps
-    starts = np.cumsum(sizes) - sizes
-    ends = starts + sizes - 1
     jv = allm[starts[1:]] - allm[ends[:-1]]
     jump_mm = np.hypot(jv[:, 0], jv[:, 1]) * mm_per_bit
     jump_len = float(jump_mm.sum())
@@ -121,15 +136,10 @@ def estimate(
         "mark_time_s": mark_t,
         "jump_time_s": jump_t,
         "delay_time_s": delays,
-    }
+    }, dwell
 
 
 def dwell_count(strokes: Sequence[np.ndarray], laser: LaserParams, mm_per_bit: float) -> int:
     """Consecutive marks closer than mark speed × point period: the beam stands still there
     (the controller cannot move less than one step per period, so it dwells)."""
-    limit_mm = laser.mark_speed_mm_s * laser.point_period_us * 1e-6
-    n = 0
-    for m in strokes:
-        if len(m) >= 2:
-            n += int((stroke_lengths_mm(m, mm_per_bit) < limit_mm).sum())
-    return n
+    return estimate_with_dwell(strokes, laser, mm_per_bit)[1]

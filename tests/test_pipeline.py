@@ -110,3 +110,31 @@ def test_empty_drawing_gives_an_empty_job():
     d = read_bytes(b"IN;SP1;LBHELLO\x03;", "label.plt")
     job = Pipeline().run(d, Params())
     assert job.strokes == () and job.stats["mark_points"] == 0
+
+
+def test_facts_of_a_drawing_are_computed_once(circle, monkeypatch):
+    """The coordinate quantum and the bbox (every point of the drawing) are kept per
+    drawing: a re-sample does not scan the points again."""
+    import galvo_core.pipeline as pl
+
+    calls = {"quantum": 0, "bbox": 0}
+    real_q = pl.coordinate_quantum
+
+    def counting_q(d):
+        calls["quantum"] += 1
+        return real_q(d)
+
+    monkeypatch.setattr(pl, "coordinate_quantum", counting_q)
+    real_bbox = Drawing.bbox
+
+    def counting_bbox(self):
+        calls["bbox"] += 1
+        return real_bbox(self)
+
+    monkeypatch.setattr(Drawing, "bbox", counting_bbox)
+    pipe = Pipeline()
+    jobs = [pipe.run(circle, Params(magnification=m, chord_tol_bits=c))
+            for m in (10.0, 12.0) for c in (1.0, 0.5)]
+    assert calls == {"quantum": 1, "bbox": 1}
+    fresh = Pipeline().run(circle, Params(magnification=12.0, chord_tol_bits=0.5))
+    assert jobs[-1].stats == fresh.stats and jobs[-1].warnings == fresh.warnings

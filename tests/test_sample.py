@@ -326,3 +326,98 @@ def test_pipeline_stats_carry_the_measurements():
     assert raw["mark_points"] == 1181 and raw["max_chord_height_bits"] is None
     fixed = Pipeline().run(d, Params(magnification=36, interpolation="fixed")).stats
     assert fixed["max_chord_height_bits"] > 1.0  # the legacy method has no height bound
+
+
+def _greedy_min_step(pts: np.ndarray, prot: np.ndarray, min_step: float) -> list[int]:
+    """The minimum-step rule written as the plain loop over every mark (reference)."""
+    keep = [0]
+    for i in range(1, len(pts)):
+        if math.dist(pts[i], pts[keep[-1]]) >= min_step:
+            keep.append(i)
+        elif prot[i]:
+            while (len(keep) > 1 and not prot[keep[-1]]
+                   and math.dist(pts[i], pts[keep[-1]]) < min_step):
+                keep.pop()
+            keep.append(i)
+    return keep
+
+
+def test_min_step_filter_walks_only_near_short_chords_with_the_same_result():
+    from galvo_core.sample import _min_step_filter
+
+    rng = np.random.default_rng(11)
+    for trial in range(300):
+        sizes = rng.integers(1, 40, rng.integers(1, 6))
+        strokes, prots = [], []
+        for n in sizes:
+            steps = np.where(rng.random((n, 1)) < 0.3, rng.uniform(0, 2, (n, 2)),
+                             rng.uniform(-8, 8, (n, 2)))
+            strokes.append(np.cumsum(steps, axis=0))
+            pr = rng.random(n) < 0.15
+            pr[0] = pr[-1] = True
+            prots.append(pr)
+        pts = np.concatenate(strokes)
+        prot = np.concatenate(prots)
+        first = np.zeros(len(pts), dtype=bool)
+        first[np.cumsum(sizes) - sizes] = True
+        want = []
+        for s0, s, pr in zip(np.cumsum(sizes) - sizes, strokes, prots, strict=True):
+            want += [s0 + k for k in (_greedy_min_step(s, pr, 3.0) if len(s) >= 3
+                                      else range(len(s)))]
+        got = _min_step_filter(pts, prot, 3.0, first=first)
+        assert got.tolist() == want, trial
+        if len(sizes) == 1 and len(pts) >= 3:  # one stroke, no `first`
+            assert _min_step_filter(pts, prot, 3.0).tolist() == want
+
+
+def test_reported_heights_equal_a_fresh_closed_form_measurement():
+    """The sampler reuses the step search's own measurement of each chord (and takes 0 for
+    a chord on a line): the report must be what measuring every chord again gives."""
+    rng = np.random.default_rng(3)
+    paths = []
+    for i in range(40):
+        c = rng.uniform(0, 3000, (4, 2)) + 5000.0
+        segs = [("cubic", c.tolist()), ("line", [c[3].tolist(), (c[3] + [40.0, 3.0]).tolist()])]
+        paths.append(FittedPath(i, 1, False, tuple(Segment(k, np.asarray(p, float), 0, 1)
+                                                  for k, p in segs), 0.0, 0))
+    for tol, ms, mx in ((1.0, 2.0, None), (0.25, 0.0, 7.0), (0.5, 6.0, None)):
+        res = sample_paths(paths, FM, chord_tol_bits=tol, min_step_bits=ms, max_step_bits=mx)
+        hs, spanning = [], 0
+        for sid, t in res.params:
+            for i in range(len(t) - 1):
+                sa, ta = int(sid[i]), float(t[i])
+                if ta >= 1.0 and sid[i + 1] > sa:
+                    sa, ta = sa + 1, 0.0
+                if sa != sid[i + 1]:
+                    spanning += 1
+                    continue
+                h, _ = chord_heights(res.coef[sa:sa + 1], np.array([ta]), np.array([t[i + 1]]))
+                hs.append(float(h[0]))
+        assert res.report.chords == sum(len(t) - 1 for _, t in res.params)
+        assert res.report.max_chord_height_bits >= max(hs)
+        if not spanning:
+            assert res.report.max_chord_height_bits == max(hs)
+            assert res.report.chord_violations == sum(h > tol * (1 + 1e-9) for h in hs)
+        brute = max(_brute_heights(fp, _Single(res, i)).max(initial=0.0)
+                    for i, fp in enumerate(paths))
+        assert res.report.max_chord_height_bits >= brute - 1e-6
+
+
+class _Single:
+    """One stroke of a multi-path result, shaped like a one-path result for _brute_heights
+    (segment ids made local to the path)."""
+
+    def __init__(self, res, i: int) -> None:
+        sid, t = res.params[i]
+        self.params = [(sid - 2 * i, t)]
+        self.float_marks = [res.float_marks[i]]
+
+
+def test_resampling_a_cached_fit_gives_what_a_fresh_fit_gives():
+    """Geometry and field-mapped arrays are kept per fit; results must not depend on it."""
+    d = read_bytes(circle_plt(), "circle.plt")
+    pipe = Pipeline()
+    runs = [(m, c) for m in (10.0, 20.0, 10.0) for c in (1.0, 0.3)]
+    for m, c in runs:
+        p = Params(magnification=m, chord_tol_bits=c)
+        assert pipe.run(d, p).stats == Pipeline().run(d, p).stats

@@ -72,3 +72,30 @@ def test_dwell_counts_marks_closer_than_speed_times_period():
     m = np.array([[0, 0], [1, 0], [2, 0], [6, 0], [10, 0]])
     assert dwell_count([m], fast, MMB) == 2
     assert dwell_count([m], L, MMB) == 0  # 100 mm/s: 1 µm < one bit
+
+
+def test_all_strokes_at_once_equal_the_per_stroke_definitions():
+    """estimate/dwell_count work on one concatenated array; check them against the rules
+    applied stroke by stroke."""
+    from galvo_core.timing import estimate_with_dwell, stroke_lengths_mm
+
+    rng = np.random.default_rng(5)
+    limit = L.mark_speed_mm_s * L.point_period_us * 1e-6
+    for _ in range(200):
+        strokes = []
+        for _ in range(int(rng.integers(0, 7))):
+            m = rng.integers(0, 60, (int(rng.integers(0, 7)), 2))
+            if len(m) > 2 and rng.random() < 0.4:
+                m[1] = m[0]  # a repeated mark: a zero vector, a dwell
+            strokes.append(m)
+        t, dwell = estimate_with_dwell(strokes, L, MMB)
+        assert t == estimate(strokes, L, MMB)
+        assert dwell == dwell_count(strokes, L, MMB)
+        assert dwell == sum(int((stroke_lengths_mm(m, MMB) < limit).sum())
+                            for m in strokes if len(m) >= 2)
+        assert t["corners"] == sum(corners(m) for m in strokes if len(m))
+        assert t["mark_points"] == sum(len(m) for m in strokes)
+        marked = [m for m in strokes if len(m)]
+        assert t["mark_length_mm"] == pytest.approx(
+            sum(stroke_lengths_mm(m, MMB).sum() for m in marked))
+        assert t["laser_switches"] == len(marked)
