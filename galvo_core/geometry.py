@@ -143,6 +143,9 @@ def _newton_nearest(
     return u
 
 
+_NEAREST_CANDIDATES = 3  # local minima of the sampled distance refined by Newton
+
+
 def nearest_on_cubic(
     ctrl: object, pts: object, *, seeds: int = 48, iters: int = 6
 ) -> tuple[np.ndarray, np.ndarray]:
@@ -174,19 +177,30 @@ def nearest_on_cubic(
     for s0 in range(0, k, rows):
         q = p[s0 : s0 + rows]
         d2 = (q[:, 0:1] - sp[None, :, 0]) ** 2 + (q[:, 1:2] - sp[None, :, 1]) ** 2
-        j = np.argmin(d2, axis=1)
-        best_d2 = d2[np.arange(len(q)), j]
-        u0 = su[j]
-        lo = su[np.maximum(j - 1, 0)]
-        hi = su[np.minimum(j + 1, ns)]
-        u = _newton_nearest(c, q, u0, lo, hi, iters)
-        r = cubic_eval(c, u) - q
-        dn = r[:, 0] * r[:, 0] + r[:, 1] * r[:, 1]
-        better = dn < best_d2
-        u = np.where(better, u, u0)
-        dd = np.where(better, dn, best_d2)
-        t_out[s0 : s0 + rows] = u
-        d_out[s0 : s0 + rows] = np.sqrt(dd)
+        # refine the best few local minima of the sampled distance, not only the smallest
+        # sample: near a cusp or loop the true nearest point can lie in the bracket of a
+        # sample that is slightly farther than the best one
+        local = np.ones_like(d2, dtype=bool)
+        local[:, 1:] &= d2[:, 1:] <= d2[:, :-1]
+        local[:, :-1] &= d2[:, :-1] <= d2[:, 1:]
+        masked = np.where(local, d2, np.inf)
+        ncand = min(_NEAREST_CANDIDATES, ns + 1)
+        cand = np.argpartition(masked, ncand - 1, axis=1)[:, :ncand]
+        rowi = np.arange(len(q))
+        best_u = su[np.argmin(d2, axis=1)]
+        best_d2 = d2.min(axis=1)
+        for m in range(ncand):
+            j = cand[:, m]
+            ok = np.isfinite(masked[rowi, j])
+            u = _newton_nearest(c, q, su[j], su[np.maximum(j - 1, 0)],
+                                su[np.minimum(j + 1, ns)], iters)
+            r = cubic_eval(c, u) - q
+            dn = r[:, 0] * r[:, 0] + r[:, 1] * r[:, 1]
+            better = ok & (dn < best_d2)
+            best_u = np.where(better, u, best_u)
+            best_d2 = np.where(better, dn, best_d2)
+        t_out[s0 : s0 + rows] = best_u
+        d_out[s0 : s0 + rows] = np.sqrt(best_d2)
     return t_out, d_out
 
 

@@ -53,7 +53,7 @@ def load(name: str):
 
 
 def note(name: str) -> str:
-    return MANIFEST[name]["notes"]
+    return MANIFEST.get(name, {}).get("notes", "")
 
 
 def noted_pairs(name: str) -> int | None:
@@ -216,10 +216,13 @@ def test_pe_geometry_is_sane() -> None:
         assert bound[0] <= bb[0] and bound[1] <= bb[1], (name, bb)
         assert bb[2] <= bound[2] and bb[3] <= bound[3], (name, bb)
     g = load("artifexsoftware__ghostpdl__grashopp.pcl")
-    assert g.commands["PE"] > 9000 and len(g.paths) > 10000
+    assert g.commands["PE"] > 9000 and len(g.paths) > 7000
     assert abs(g.n_points - 127998) <= 0.1 * 127998
+    assert not [p for p in g.paths if len(p.points) == 1]  # no dots from pen-up PE moves
     x = load("jem-green__hpgl2__xanadu-plt-test.plt")
-    assert x.n_points == 646  # pen-up via '<' and pen select via ':' only
+    # pen-up via "<" and pen select via ":" only; a PE ending in a pen-up move draws no dot
+    assert abs(x.n_points - 646) <= 3
+    assert not [p for p in x.paths if len(p.points) == 1]
     assert load("jem-green__hpgl2__xanadu-plt-test2.plt").commands["PE"] >= 1
 
 

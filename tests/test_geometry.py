@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from hypothesis import given, settings
+from hypothesis import example, given, settings
 from hypothesis import strategies as st
 
 from galvo_core.geometry import (
@@ -56,6 +56,8 @@ def test_cubic_length_of_straight_cubic():
 
 @settings(max_examples=40, deadline=None)
 @given(ctrl_st, st.lists(st.tuples(coord, coord), min_size=1, max_size=20).map(np.array))
+# a cusp: the nearest point lies in the bracket of a sample farther than the best one
+@example(c=np.array([(0.0, 2.0), (0.0, 0.0), (0.5, -5.0), (0.0, 1.0)]), pts=np.array([[0.0, 0.0]]))
 def test_nearest_on_cubic_is_the_true_nearest(c, pts):
     """Agrees with brute force over 200k samples (loops and cusps included)."""
     t, d = nearest_on_cubic(c, pts)

@@ -72,6 +72,19 @@ def test_pe_relative_moves_with_pen_up_and_absolute_flags() -> None:
     np.testing.assert_array_equal(pts(d, 1), [[1600, 2050], [1590, 2040]])
 
 
+def test_pe_ending_with_a_pen_up_move_draws_nothing_there() -> None:
+    d = read(b"IN;PE<=" + pe_pair(0, 0) + pe_pair(10, 0) + b"<" + pe_pair(50, 50) + b";"
+             + b"PE<" + pe_pair(5, 5) + b";")
+    assert len(d.paths) == 1
+    np.testing.assert_array_equal(pts(d), [[0, 0], [10, 0]])
+
+
+def test_pe_out_of_range_number_is_clamped() -> None:
+    d = read(b"IN;PE<=" + pe_pair(0, 0) + encode_number(10**30) + encode_number(0) + b";")
+    assert np.isfinite(pts(d)).all() and pts(d)[-1, 0] == 1e15
+    assert any("out of range" in m for m in messages(d))
+
+
 def test_pe_seven_bit_mode() -> None:
     data = b"IN;PE7<=" + pe_pair(-300, 40, seven=True) + pe_pair(25, -5, seven=True) + b";"
     d = read(data)
@@ -496,3 +509,20 @@ def test_read_file_errors_name_the_path(tmp_path) -> None:
         read_file(tmp_path / "missing.plt")
     with pytest.raises(InputError, match="folder"):
         read_file(tmp_path)
+
+
+def test_first_move_after_pm1_starts_the_next_subpolygon_with_the_pen_up():
+    # hp2xx pm.hp: the pen is down when PM1 comes; the next PD's first point must not be
+    # joined to the previous sub-polygon (that spike would be marked by the laser)
+    d = read_bytes(b"IN;SP1;PA0,0;PM0;PD100,0,100,100,0,100;PM1;"
+                   b"PD20,20,80,20,80,80,20,80,20,20;PM2;EP;", "pm.plt")
+    assert len(d.paths) == 2
+    inner = d.paths[1].points
+    assert inner[0].tolist() == [20.0, 20.0] and inner[-1].tolist() == [20.0, 20.0]
+    assert len(inner) == 5 and d.paths[1].closed
+
+
+def test_drawing_with_pen_zero_is_imported_with_a_warning():
+    d = read_bytes(b"IN;SP0;PU0,0;PD100,0;PU;", "pen0.plt")
+    assert len(d.paths) == 1 and d.paths[0].pen == 0
+    assert any("pen 0" in w.message for w in d.warnings)

@@ -77,6 +77,36 @@ def tokenize_run(buf: bytes | memoryview) -> RunTokens | None:
     return RunTokens(cmd_pos, cmd_code.astype(np.int8), num_cmd.astype(np.int64), val)
 
 
+def segmented_cumsum(values: np.ndarray, starts: np.ndarray) -> np.ndarray:
+    """Running sums of ``values`` that restart at each index in ``starts`` (``starts[0]``
+    must be 0), added left to right exactly as a loop would (the same float rounding as the
+    command-by-command reader: ``x = x + dx`` per pair).
+
+    Segments are padded to the next power of two and summed as rows of a 2-D block per
+    width, so the work stays linear and vectorised however many segments there are.
+    """
+    n = len(values)
+    out = values.astype(np.float64, copy=True)
+    lengths = np.diff(np.append(starts, n))
+    multi = lengths > 1
+    if not multi.any():
+        return out
+    seg_start = starts[multi]
+    seg_len = lengths[multi]
+    width_exp = np.ceil(np.log2(seg_len)).astype(np.int64)
+    for e in np.unique(width_exp).tolist():
+        sel = width_exp == e
+        s0 = seg_start[sel]
+        ln = seg_len[sel]
+        cols = np.arange(1 << e)
+        idx = s0[:, None] + cols[None, :]
+        valid = cols[None, :] < ln[:, None]
+        block = np.where(valid, out[np.minimum(idx, n - 1)], 0.0)
+        np.cumsum(block, axis=1, out=block)
+        out[idx[valid]] = block[valid]
+    return out
+
+
 def ffill_state(setter: np.ndarray, initial: int) -> np.ndarray:
     """Forward-fill: ``setter`` holds the new state or -1 (keep); returns the state per slot."""
     idx = np.where(setter >= 0, np.arange(len(setter)), -1)

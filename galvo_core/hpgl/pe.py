@@ -19,6 +19,11 @@ run at a number boundary when what follows is not a complete number: a run of co
 digits that reaches a byte which is neither a digit nor an ignorable byte (for instance ``0``
 or ``;``) before it reaches a terminating digit cannot be a number, so the PE ends there and
 the letters are read as commands.
+
+Linear time: that look-ahead may scan far (``PEPEPE...`` is all continuation digits), so
+the caller passes a cache (:class:`PECache`) remembering the stretch a failed look-ahead
+crossed; a later look-ahead starting inside it fails at once, so each byte is scanned by
+failed look-aheads at most once per mode.
 """
 
 from __future__ import annotations
@@ -29,6 +34,7 @@ from dataclasses import dataclass, field
 _IGNORABLE_8 = frozenset(list(range(0, 33)) + list(range(127, 191)) + [255])
 _IGNORABLE_7 = frozenset(list(range(0, 33)) + list(range(127, 256)))
 _FLAGS = frozenset(b":<>=7")
+MAX_VALUE = 10**15  # larger numbers are clamped (as the reader clamps ASCII numbers)
 
 
 @dataclass
@@ -58,8 +64,19 @@ def _is_term(b: int, seven: bool) -> bool:
     return 95 <= b <= 126 if seven else 191 <= b <= 254
 
 
-def _looks_like_number(data: bytes, pos: int, seven: bool) -> bool:
+@dataclass
+class PECache:
+    """Stretches ``[start, end)`` (per mode) where no complete number can start."""
+
+    fail: dict[bool, tuple[int, int]] = field(default_factory=dict)
+
+
+def _looks_like_number(data: bytes, pos: int, seven: bool, cache: PECache | None = None) -> bool:
     """True when a complete number (continuations then a terminator) starts at ``pos``."""
+    if cache is not None:
+        span = cache.fail.get(seven)
+        if span is not None and span[0] <= pos < span[1]:
+            return False
     ign = _IGNORABLE_7 if seven else _IGNORABLE_8
     n = len(data)
     i = pos
@@ -70,12 +87,17 @@ def _looks_like_number(data: bytes, pos: int, seven: bool) -> bool:
         if _is_cont(b, seven) or b in ign:
             i += 1
             continue
-        return False
+        break
+    if cache is not None:
+        cache.fail[seven] = (pos, i)
     return False
 
 
-def decode_pe(data: bytes, pos: int) -> PEResult:
-    """Decode a PE run starting at ``pos`` (just after the ``PE`` mnemonic)."""
+def decode_pe(data: bytes, pos: int, cache: PECache | None = None) -> PEResult:
+    """Decode a PE run starting at ``pos`` (just after the ``PE`` mnemonic).
+
+    Pass the same ``cache`` for every PE of one file to keep the whole read linear.
+    """
     res = PEResult()
     n = len(data)
     seven = False
@@ -108,7 +130,7 @@ def decode_pe(data: bytes, pos: int) -> PEResult:
             i += 1
             continue
         if _is_cont(b, seven) or _is_term(b, seven):
-            if not _looks_like_number(data, i, seven):
+            if not _looks_like_number(data, i, seven, cache):
                 # an unterminated PE run followed by ordinary commands
                 break
             # read one number
@@ -130,6 +152,9 @@ def decode_pe(data: bytes, pos: int) -> PEResult:
                 else:  # cannot happen after _looks_like_number
                     break
             num = -(value >> 1) if value & 1 else value >> 1
+            if abs(num) > MAX_VALUE:
+                res.problems.append((i, "PE number out of range; clamped"))
+                num = MAX_VALUE if num > 0 else -MAX_VALUE
             if pending_flag == 0x3A:  # ':'
                 res.items.append(PEItem("pen", value=num))
                 pending_flag = None

@@ -13,7 +13,8 @@ What it reads
   one region, not two).
 * Geometry state: IN DF IP IR SC (types 0, 1, 2) RO IW PS SP; user units are converted to
   plotter units, RO rotates about the plotter origin (x, y) -> (-y, x) for 90 degrees,
-  IW clips pen-down lines to the window.
+  IW clips pen-down lines to the window (one warning says how many paths were clipped).
+  IR with two numbers moves P1 and keeps the P1-P2 distance (P2 moves along).
 * Recorded, not drawn: LT VS FS PW LA PT FT and the like; labels LB/BL/WD (skipped to their
   terminator, DT honoured), CO comments, SM symbols, vendor ``!XX`` commands.
 * Wrappers: PCL (ESC E, ESC%#A / ESC%#B, parameterised escapes with binary data), PJL
@@ -24,22 +25,37 @@ Syntax decisions (where the standard is ambiguous or files break it)
 --------------------------------------------------------------------
 * A command is two letters (any case); its parameters end at ``;``, at the next letter or at
   ESC. Numbers are separated by commas, white space, or a sign; a trailing comma is fine.
+  Anything else among the parameters (``PD:``) is skipped with a warning.
+* Numbers are clamped to +-1e15 (MAX_NUMBER); a path that still ends up with a non-finite
+  coordinate is dropped with a warning. AA/AR sweeps beyond +-360 degrees draw a circle.
+* Relative moves add up pair by pair, left to right (``x = x + dx``): the vectorised fast
+  path and the command-by-command path give bit-identical points, so a relative figure that
+  returns to its start is ``closed`` on both.
 * A command with an odd coordinate count drops the last number with a warning.
 * A label without its terminator ends at the end of its line (warning), so that one broken
   label does not swallow the rest of the file.
 * An unquoted CO comment ends at ``;``, at the label terminator or at the end of the line.
 * Default P1/P2 (for SC without IP, and IR) are those of an HP 7475A on ANSI A paper:
   (250, 596) and (10250, 7796); after PS w,h they are (0, 0) and (w, h).
-* SP, IN, RO, IP, SC, IW lift the pen: a pen-down path ends there.
+* SP and IN lift the pen; RO and IW end the current path (the pen stays down, the next
+  pen-down move starts a new path); IP and SC only change later coordinates.
+* IW without numbers is the hard-clip window: the page PS gave, (0, 0)-(w, h), when RO is
+  0; without PS (a galvo has no paper) or under RO there is no window.
+* PE: a pair without ``<`` puts the pen down; a PE that ends with a pen-up move leaves the
+  pen up and draws no dot there.
+* SM takes the next character as its symbol (``SMY;``), not as a command letter.
 * Pages (PG) are overlaid: a galvo has one field; a warning says how many pages there were.
+* Warnings about the whole file (labels not drawn, pages, line types...) have line 0,
+  column 0; every other warning points at its line and column (both from 1).
 * A path is ``closed`` when its last point equals its first and it has at least 4 points.
 
 Errors
 ------
 A file that is not HP-GL (empty, binary, SVG, DXF, Summa DM/PL, G-code, a PCL job without
-HP-GL/2, mostly unreadable) raises :class:`~galvo_core.errors.InputError`. A malformed or
-unknown command inside a good file is skipped with a warning naming line and column. Time
-and memory are linear in the file size.
+HP-GL/2 -- escapes alone do not count as HP-GL --, mostly unreadable) raises
+:class:`~galvo_core.errors.InputError`. A malformed or unknown command inside a good file is
+skipped with a warning naming line and column. Time and memory are linear in the file size
+(also for ``PEPEPE...``: see :mod:`.pe`).
 """
 
 from __future__ import annotations
@@ -55,8 +71,16 @@ import numpy as np
 from galvo_core.drawing import Drawing, Path, SourcePos, Warning, sha256_hex
 from galvo_core.errors import InputError
 from galvo_core.hpgl.arcs import arc_points, bezier_points, chord_angle, circle_through
-from galvo_core.hpgl.fastrun import CODE_A, CODE_D, CODE_R, CODE_U, ffill_state, tokenize_run
-from galvo_core.hpgl.pe import decode_pe
+from galvo_core.hpgl.fastrun import (
+    CODE_A,
+    CODE_D,
+    CODE_R,
+    CODE_U,
+    ffill_state,
+    segmented_cumsum,
+    tokenize_run,
+)
+from galvo_core.hpgl.pe import PECache, decode_pe
 from galvo_core.hpgl.sniff import refusal_reason
 
 #: largest file the reader accepts (bytes); larger files are refused, not half-read.
@@ -101,8 +125,16 @@ _PCL_START_RE = re.compile(rb"[\x00-\x20]*(?:\x1bE|\x1b%-12345X|@PJL|\x1b[&*(]|\
 _WARN_CAP = 20  # warnings of one kind kept verbatim; the rest are counted
 
 
+#: numbers are clamped to +-MAX_NUMBER (HP-GL's own ranges are far smaller); the fast path
+#: reads at most 15 digits, so it never sees a larger number and both paths agree
+MAX_NUMBER = 1e15
+
+
 def _nums(params: bytes) -> list[float]:
-    return [float(t) for t in _NUM_RE.findall(params)]
+    out = [float(t) for t in _NUM_RE.findall(params)]
+    if any(abs(v) > MAX_NUMBER for v in out):
+        out = [min(max(v, -MAX_NUMBER), MAX_NUMBER) for v in out]
+    return out
 
 
 class _Reader:
@@ -128,6 +160,7 @@ class _Reader:
         # lexer state
         self.term = ETX
         self._no_term_after: dict[int, int] = {}
+        self._pe_cache = PECache()
         self.hpgl_mode = True
         # geometry state
         self.reset()
@@ -162,6 +195,7 @@ class _Reader:
         self.poly_ring: list[tuple[float, float]] = []
         self.poly_buffer: list[list[tuple[float, float]]] = []
         self.poly_emitted = True
+        self.poly_fresh = False
         self.poly_offset = 0
         self.tick = (0.5, 0.5)
         self.cur: list[float] = []  # current pen-down path, flat x, y (plotter units)
@@ -253,6 +287,9 @@ class _Reader:
 
     def emit(self, pts: np.ndarray, offset: int, *, closed: bool | None = None) -> None:
         """Add a finished path (plotter units, before rotation and clipping)."""
+        if not np.isfinite(pts).all():
+            self.warn(offset, "path with coordinates out of range dropped", key="non-finite")
+            return
         if self.window is not None:
             pieces = _clip_polyline(pts, self.window)
             if len(pieces) != 1 or len(pieces[0]) != len(pts) or not np.array_equal(pieces[0], pts):
@@ -337,9 +374,8 @@ class _Reader:
             if self.sc is not None:
                 arr[:, 0] *= self.sc[0]
                 arr[:, 1] *= self.sc[2]
-            arr = np.cumsum(arr, axis=0)
-            arr[:, 0] += self.x
-            arr[:, 1] += self.y
+            # x = x + dx pair by pair (the same rounding as one-pair commands)
+            arr = np.cumsum(np.vstack(([(self.x, self.y)], arr)), axis=0)[1:]
         return arr
 
     def move_params(self, params: bytes, offset: int, mn: str) -> None:
@@ -381,6 +417,12 @@ class _Reader:
 
     # ------------------------------------------------------------------ polygon mode
     def _poly_move(self, x: float, y: float) -> None:
+        if self.poly_fresh:
+            # the first move after PM1 starts the next sub-polygon: it is a pen-up move
+            # whatever the pen state (HP-GL/2 PM; hp2xx and ezhpgl read it so too)
+            self.poly_fresh = False
+            self.poly_ring = [(x, y)]
+            return
         if self.pen_down:
             self.poly_ring.append((x, y))
         else:
@@ -405,6 +447,7 @@ class _Reader:
             self.poly = []
             self.poly_buffer = []
             self.poly_ring = [(self.x, self.y)]
+            self.poly_fresh = False
             self.poly_emitted = False
             self.poly_offset = offset
         elif mode == 1:
@@ -412,6 +455,7 @@ class _Reader:
                 self.warn(offset, "PM1 outside polygon mode ignored")
                 return
             self._poly_close_ring()
+            self.poly_fresh = True
         elif mode == 2:
             if self.poly is None:
                 self.warn(offset, "PM2 outside polygon mode ignored")
@@ -438,8 +482,9 @@ class _Reader:
         """Arc around user-unit centre (cx, cy) starting at the current position."""
         ux, uy = self.to_user(self.x, self.y)
         r = math.hypot(ux - cx, uy - cy)
-        if r == 0 or sweep == 0:
+        if r == 0 or sweep == 0 or not math.isfinite(r):
             return
+        sweep = max(-360.0, min(360.0, sweep))  # more than a full turn draws a circle
         start = math.degrees(math.atan2(uy - cy, ux - cx))
         ca = chord_angle(chord_arg, r, tolerance_mode=self.ct_tol)
         pts = arc_points(cx, cy, r, start, sweep, ca)[1:]
@@ -746,16 +791,11 @@ class _Reader:
         q = np.empty((K + 1, 2))
         q[0] = (self.x, self.y)
         if K:
-            dx = np.where(absolute, 0.0, xs)
-            dy = np.where(absolute, 0.0, ys)
-            cx = np.cumsum(dx)
-            cy = np.cumsum(dy)
-            base = np.where(absolute, np.arange(K), -1)
-            np.maximum.accumulate(base, out=base)
-            has = base >= 0
-            b0 = np.maximum(base, 0)
-            q[1:, 0] = np.where(has, xs[b0] - cx[b0], self.x) + cx
-            q[1:, 1] = np.where(has, ys[b0] - cy[b0], self.y) + cy
+            # positions: an absolute pair starts a segment, relative pairs add up after it
+            # (left to right, the rounding of the command-by-command reader)
+            starts = np.flatnonzero(np.concatenate(([True], absolute)))
+            q[:, 0] = segmented_cumsum(np.concatenate(([self.x], xs)), starts)
+            q[:, 1] = segmented_cumsum(np.concatenate(([self.y], ys)), starts)
         # paths: one per up->down transition; pairs drawn where the pen is down
         trans = np.flatnonzero((pen_before == 0) & (pen_after == 1))
         drawn = pen_after[pair_cmd] == 1 if K else np.zeros(0, dtype=bool)
@@ -767,6 +807,9 @@ class _Reader:
         # continuation of a path open before the run
         cont = d_idx[d_path < 0]
         if len(cont):
+            if not self.cur:  # the pen is down but the path was ended (CI, SP, IW...)
+                self.cur = [self.x, self.y]
+                self.cur_offset = start + int(tok.cmd_pos[pair_cmd[cont[0]]])
             self.cur.extend(q[cont + 1].ravel().tolist())
         elif self.pen_down and not self.cur:
             pass
@@ -994,7 +1037,7 @@ class _Reader:
         return min(k + 1, n)
 
     def pe(self, pos: int) -> int:
-        res = decode_pe(self.data, pos)
+        res = decode_pe(self.data, pos, self._pe_cache)
         for off, msg in res.problems:
             self.warn(off, msg, key="pe")
         saved_abs = self.absolute
@@ -1013,12 +1056,9 @@ class _Reader:
                 dx, dy = self.delta_to_plotter(item.x, item.y)
                 x, y = self.x + dx, self.y + dy
             self.pen_to(x, y, pos)
-            if item.pen_up:
-                # after a pen-up move, later pairs draw: the pen goes down at this point
-                self.set_pen_down(True, pos)
+            # after a pen-up move the next pair (without '<') puts the pen down again; a
+            # PE that ends with a pen-up move leaves the pen up (and draws no dot there)
         self.absolute = saved_abs
-        if res.items and res.items[-1].kind == "pair" and res.items[-1].pen_up:
-            self.set_pen_down(False, pos)
         return res.end
 
     # ------------------------------------------------------------------ escapes and PCL
@@ -1120,13 +1160,14 @@ def _clip_polyline(pts: np.ndarray, win: tuple[float, float, float, float]) -> l
     for k in np.flatnonzero(visible):
         s = a[k] + t0[k] * d[k]
         e = a[k] + t1[k] * d[k]
-        if cur and t0[k] == 0.0 and k > 0 and visible[k - 1] and t1[k - 1] == 1.0 and last_k == k - 1:
+        # segment k goes on from segment k-1 when that one was visible up to its end
+        # and this one is visible from its start
+        if cur and k > 0 and visible[k - 1] and t1[k - 1] == 1.0 and t0[k] == 0.0:
             cur.append(e)
         else:
             if cur:
                 out.append(np.array(cur))
             cur = [s, e]
-        last_k = k
     if cur:
         out.append(np.array(cur))
     return out
@@ -1156,7 +1197,8 @@ def read_bytes(data: bytes, name: str = "<bytes>") -> Drawing:
         raise InputError(name, reason)
     rd = _Reader(data, name)
     try:
-        rd.run()
+        with np.errstate(all="ignore"):  # out-of-range numbers are dropped, not warned twice
+            rd.run()
     except RecursionError as exc:  # pragma: no cover - defensive
         raise InputError(name, "file too deeply nested to read") from exc
     body = len(data) - data.count(b"\x00")
@@ -1178,6 +1220,10 @@ def read_bytes(data: bytes, name: str = "<bytes>") -> Drawing:
         rd.warn(-1, "line types (LT) are not applied: every line is imported solid")
     if rd.text_symbols:
         rd.warn(-1, "symbol mode (SM) characters are not drawn")
+    pen0 = sum(1 for p in rd.paths if p[1] == 0)
+    if pen0:
+        rd.warn(-1, f"{pen0} path(s) drawn with pen 0 (SP0 puts the pen away: a pen plotter "
+                   "would not draw them); imported anyway")
     if not rd.paths:
         rd.warn(-1, "the file has no pen-down geometry")
     for key, count in rd._warn_count.items():
