@@ -118,7 +118,12 @@ def flatten_cubic(ctrl: object, tol: float) -> np.ndarray:
 
 
 def _newton_nearest(
-    c: np.ndarray, p: np.ndarray, u: np.ndarray, lo: object, hi: object, iters: int
+    c: np.ndarray,
+    p: np.ndarray,
+    u: np.ndarray,
+    lo: np.ndarray | float,
+    hi: np.ndarray | float,
+    iters: int,
 ) -> np.ndarray:
     """Newton on f(u) = B'(u)·(B(u) - p), each u kept inside its bracket [lo, hi]."""
     a, b, d, e = _power_coeffs(c)

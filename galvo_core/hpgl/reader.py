@@ -720,7 +720,8 @@ class _Reader:
                 i = m.end()
                 continue
             # not an ordinary command: separators then something else
-            i = _SEP_RE.match(data, i).end()
+            sep = _SEP_RE.match(data, i)  # always matches (possibly empty)
+            i = sep.end() if sep is not None else i
             if i >= n:
                 break
             c = data[i]
