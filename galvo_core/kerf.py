@@ -21,7 +21,8 @@ even-odd region by shapely/GEOS ``buffer`` with round joins. At a convex corner 
 is an arc of radius ``d`` around the corner (the paper replaces the far-away intersection at
 acute corners by that arc); concave corners are exact intersections. The arcs are drawn
 with ``quad_segs`` segments per quarter circle, chosen so the sagitta of every chord,
-``d (1 - cos(θ/2))``, stays within ``arc_tol_bits`` galvo bits. GEOS handles holes,
+``d (1 - cos(θ/2))``, stays within ``arc_tol_bits`` galvo bits, and never fewer than 8 (GEOS
+is less exact below 8; see :func:`quad_segs_for`). GEOS handles holes,
 self-touching rings, rings that vanish and rings that merge. Why GEOS and not Clipper2:
 shapely (GEOS) is already a dependency, is well kept, gives the same result within the arc
 tolerance (bench/RESULTS.md, "Kerf (issue 6)"), and works on floating-point coordinates;
@@ -34,15 +35,20 @@ about 4 Mpixel and the disc radius is at most 64 pixels), compute the Euclidean 
 the nearest kept (``outside``) or removed (``inside``) pixel by two separable passes
 (numpy only), threshold it at ``d`` and trace the level set back to rings by marching
 squares with linear interpolation (vectorised: cycles are linked by pointer jumping), then
-simplify within half a pixel. Accuracy: about one pixel.
+simplify within half a pixel. Accuracy: about two pixels (a pixel centre lies up to a pixel
+inside the true boundary, corrected on average by half a pixel, plus half a pixel of
+simplification). Time grows with the disc radius in pixels, as the paper says.
 
 ``"rectangle"`` (the paper's *solid rectangles*): hatch each region with horizontal scan
-segments ``h <= d / 2`` apart, make each segment a solid rectangle reaching ``d`` beyond it
-on every side, and take the union (GEOS ``union_all``); ``inside`` does the same to the
-complement within a bounding box and subtracts it. A rectangle is the Minkowski sum with a
-square, so edges at 45° move by up to ``d·√2``; each scan segment stands for a strip of
-height ``h``, so horizontal edges are off by up to ``h/2``, and the staircase is simplified
-within ``h/2``: the method's stated tolerance is ``(√2 - 1) d + h`` with ``h = d/4``.
+segments ``h = d/4`` apart, make each segment (standing for a strip of height ``h``) a solid
+rectangle reaching ``d`` beyond it on every side, and take the union (GEOS ``union_all``);
+``inside`` does the same to the complement within a bounding box and subtracts it. A
+rectangle is the Minkowski sum with a square, so edges at 45° move by up to ``d·√2``;
+horizontal edges are off by up to ``h/2``, and the staircase is simplified within ``h/2``:
+the stated tolerance is ``(√2 - 1) d + h`` for ``outside``. Larger where the scan lines
+sample badly or squares compound: for ``inside`` a convex corner of angle θ can be off by
+``(√2 - 1) d / sin(θ/2) + h``, and a sharp tip pointing along the scan lines loses up to
+``(h/2) / tan(θ/2)`` (bench/RESULTS.md has the numbers).
 
 Mapping back to the source paths (``source_index``)
 ---------------------------------------------------
@@ -51,8 +57,8 @@ in the *input* drawing of the path that output path ``k`` came from. The output 
 input's path order: for each input path in turn, an open path is copied unchanged; a closed
 ring is replaced by the compensated rings assigned to it (zero, one or several). A
 compensated ring is assigned to the *lowest index* among the source rings that its vertices
-are nearest to; so a ring that splits into
-two keeps its index for both, and rings that merge take the first (lowest) index. A source
+are nearest to; so a ring that splits into two keeps its index for both, and rings that
+merge take the first (lowest) index. A source
 ring that no output ring touches has vanished (``inside``: narrower than the kerf) or been
 swallowed (``outside``: a hole closed up); each gives a warning naming the path and its
 place in the file. Output rings keep ``pen`` and ``start`` of their source ring, are closed
@@ -81,6 +87,11 @@ RASTER_MAX_RADIUS_PX = 64.0
 RASTER_HARD_LIMIT = 25_000_000
 #: quad_segs bounds for the vector method
 MAX_QUAD_SEGS = 512
+#: GEOS buffers with fewer segments per quarter circle than this are less exact (see
+#: quad_segs_for); trading vertices for accuracy, the vector method never goes below it
+GEOS_MIN_QUAD_SEGS = 8
+#: output vertices sampled when mapping rings back to their sources
+ASSIGN_STRIDE = 4
 #: scan spacing of the rectangle method as a fraction of d
 RECT_SPACING = 0.25
 
@@ -169,11 +180,20 @@ def compensate_indexed(
 
 
 def quad_segs_for(d: float, tol: float) -> int:
-    """Segments per quarter circle so that a chord's sagitta on radius ``d`` is <= ``tol``."""
-    if d <= 0 or tol >= d:
+    """Segments per quarter circle so that a chord's sagitta on radius ``d`` is <= ``tol``.
+
+    Never fewer than :data:`GEOS_MIN_QUAD_SEGS`: below 8 segments per quarter circle GEOS
+    joins short concave runs through a point halfway to the vertex instead of 1/81 of the
+    way, which put outlines up to ~10 % of ``d`` off on dense CAD polylines (measured:
+    bench/RESULTS.md, "Kerf (issue 6)")."""
+    if d <= 0:
         return 1
-    theta = 2.0 * math.acos(1.0 - tol / d)
-    return int(min(MAX_QUAD_SEGS, max(1, math.ceil((math.pi / 2.0) / theta))))
+    if tol >= d:
+        q = 1
+    else:
+        theta = 2.0 * math.acos(1.0 - tol / d)
+        q = int(min(MAX_QUAD_SEGS, max(1, math.ceil((math.pi / 2.0) / theta))))
+    return max(q, GEOS_MIN_QUAD_SEGS)
 
 
 def compensate_geometry(region: BaseGeometry, d: float, *, side: str, method: str,
@@ -222,11 +242,18 @@ def _split(drawing: Drawing) -> tuple[list[int], set[int]]:
     other: set[int] = set()
     for i, p in enumerate(drawing.paths):
         pts = p.points
-        if p.closed and len(pts) >= 4 and abs(_signed_area(pts)) > 0:
+        if p.closed and len(pts) >= 4 and _has_area(pts):
             rings.append(i)
         else:
             other.add(i)
     return rings, other
+
+
+def _has_area(pts: np.ndarray) -> bool:
+    """False when all points lie on one line (a ring that encloses nothing)."""
+    v = pts - pts[0]
+    far = v[int(np.argmax((v * v).sum(axis=1)))]
+    return bool(np.any(np.abs(v[:, 0] * far[1] - v[:, 1] * far[0]) > 0))
 
 
 def _by_pen(drawing: Drawing, rings: list[int]) -> dict[int, list[int]]:
@@ -276,8 +303,13 @@ def even_odd_region(rings: Sequence[np.ndarray]) -> BaseGeometry:
         simple = bool((pairs[0] == pairs[1]).all())
     if simple:
         return _nest(polys)
-    noded = shapely.union_all(shapely.linestrings(np.concatenate(rings), indices=np.repeat(
-        np.arange(len(rings)), [len(r) for r in rings])))
+    lines = shapely.linestrings(np.concatenate(rings), indices=np.repeat(
+        np.arange(len(rings)), [len(r) for r in rings]))
+    try:
+        noded = shapely.union_all(lines)
+    except shapely.errors.GEOSException:  # noding failed to converge: snap to a fine grid
+        x0, y0, x1, y1 = shapely.total_bounds(lines)
+        noded = shapely.union_all(lines, grid_size=1e-9 * max(x1 - x0, y1 - y0, 1.0))
     faces = shapely.get_parts(shapely.polygonize(shapely.get_parts(noded)))
     faces = faces[shapely.area(faces) > 0]
     if len(faces) == 0:
@@ -674,12 +706,25 @@ def _assign(result: BaseGeometry, sources: list[np.ndarray], reach: float
     a, b = _segments(sources)
     owner = np.repeat(np.arange(len(sources)), [len(s) - 1 for s in sources])
     tree = shapely.STRtree(shapely.linestrings(np.stack([a, b], axis=1)))
-    pts = np.concatenate([r[:-1] for r in rings])
-    which = np.repeat(np.arange(len(rings)), [len(r) - 1 for r in rings])
+    # every ASSIGN_STRIDE-th vertex of each output ring (at least one per ring) ...
+    pts = np.concatenate([r[:-1:ASSIGN_STRIDE] for r in rings])
+    which = np.repeat(np.arange(len(rings)), [len(r[:-1:ASSIGN_STRIDE]) for r in rings])
     near = owner[_nearest_segment(tree, pts, a, b, reach)]
     lowest = np.full(len(rings), np.iinfo(np.int64).max)
     np.minimum.at(lowest, which, near)
-    return [(r, int(j)) for r, j in zip(rings, lowest, strict=True)], set(near.tolist())
+    contrib = set(near.tolist())
+    # ... and the source rings no sampled vertex was nearest to are checked whole: one
+    # within reach of an output ring contributes to it (a short stretch of a merged
+    # outline), the others have vanished
+    missing = [j for j in range(len(sources)) if j not in contrib]
+    if missing:
+        out_tree = shapely.STRtree(_linearrings(rings))
+        src_lines = _linearrings([sources[j] for j in missing])
+        mi, ri = out_tree.query(src_lines, predicate="dwithin", distance=reach)
+        for m, r in zip(mi.tolist(), ri.tolist(), strict=True):
+            contrib.add(missing[m])
+            lowest[r] = min(int(lowest[r]), missing[m])
+    return [(r, int(j)) for r, j in zip(rings, lowest, strict=True)], contrib
 
 
 def _start_near(ring: np.ndarray, p: np.ndarray) -> np.ndarray:
