@@ -127,25 +127,9 @@ def _newton_nearest(
 ) -> np.ndarray:
     """Newton on f(u) = B'(u)·(B(u) - p), each u kept inside its bracket [lo, hi]."""
     a, b, d, e = _power_coeffs(c)
-    ax, ay = float(a[0]), float(a[1])
-    bx, by = float(b[0]), float(b[1])
-    dx, dy = float(d[0]), float(d[1])
-    ex = float(e[0])
-    ey = float(e[1])
-    qx = p[:, 0] - ex
-    qy = p[:, 1] - ey
-    a3x, a3y, b2x, b2y = 3.0 * ax, 3.0 * ay, 2.0 * bx, 2.0 * by
-    a6x, a6y = 6.0 * ax, 6.0 * ay
-    for _ in range(iters):
-        rx = ((ax * u + bx) * u + dx) * u - qx
-        ry = ((ay * u + by) * u + dy) * u - qy
-        d1x = (a3x * u + b2x) * u + dx
-        d1y = (a3y * u + b2y) * u + dy
-        f = d1x * rx + d1y * ry
-        fp = (a6x * u + b2x) * rx + (a6y * u + b2y) * ry + d1x * d1x + d1y * d1y
-        step = f / np.where(fp > 0.0, fp, np.inf)
-        u = np.clip(u - step, lo, hi)
-    return u
+    cf = (float(a[0]), float(a[1]), float(b[0]), float(b[1]), float(d[0]), float(d[1]),
+          float(e[0]), float(e[1]))
+    return newton_nearest_many(cf, p[:, 0], p[:, 1], u, iters, lo=lo, hi=hi)[0]
 
 
 _NEAREST_CANDIDATES = 3  # local minima of the sampled distance refined by Newton
@@ -318,10 +302,18 @@ def gather_coeffs(coef: np.ndarray, pid: np.ndarray) -> tuple[np.ndarray, ...]:
 
 
 def newton_nearest_many(
-    cf: tuple[np.ndarray, ...], px: np.ndarray, py: np.ndarray, u: np.ndarray, iters: int
+    cf: tuple[np.ndarray | float, ...],
+    px: np.ndarray,
+    py: np.ndarray,
+    u: np.ndarray,
+    iters: int,
+    *,
+    lo: np.ndarray | float = 0.0,
+    hi: np.ndarray | float = 1.0,
 ) -> tuple[np.ndarray, np.ndarray]:
-    """Newton on f(u) = B'(u)·(B(u) − p) for every point with its own cubic, u kept in
-    [0, 1]; a step where f' <= 0 is not taken. Returns ``(u, squared distance)``.
+    """Newton on f(u) = B'(u)·(B(u) − p) for every point with its own cubic (or one cubic
+    given by scalar coefficients), u kept in [lo, hi] (default [0, 1]); a step where
+    f' <= 0 is not taken. Returns ``(u, squared distance)``.
 
     Any returned u gives an upper bound of the true distance (it is the distance to a point
     of the curve), so a test ``dist <= tol`` made with it is never too lenient.
@@ -341,7 +333,7 @@ def newton_nearest_many(
         fp = (a6x * u + b2x) * rx + (a6y * u + b2y) * ry + d1x * d1x + d1y * d1y
         fp[fp <= 0.0] = np.inf
         u -= f / fp
-        np.clip(u, 0.0, 1.0, out=u)
+        np.clip(u, lo, hi, out=u)
     rx = ((ax * u + bx) * u + dx) * u - qx
     ry = ((ay * u + by) * u + dy) * u - qy
     return u, rx * rx + ry * ry

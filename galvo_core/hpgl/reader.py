@@ -388,13 +388,7 @@ class _Reader:
             else:
                 dx, dy = self.delta_to_plotter(x, y)
                 x, y = self.x + dx, self.y + dy
-            if self.pen_down:
-                if not self.cur:
-                    self.cur = [self.x, self.y]
-                    self.cur_offset = offset
-                self.cur.append(x)
-                self.cur.append(y)
-            self.x, self.y = x, y
+            self.pen_to(x, y, offset)
             return
         pts = self.points_from_params(v, offset, mn)
         if pts is not None:
