@@ -122,6 +122,15 @@ def _brush(colour: str, alpha: int = 255):
     return pg.mkBrush(c)
 
 
+def _rect_data_bounds(self, ax, frac=1.0, orthoRange=None):  # noqa: N803 - pyqtgraph API
+    """pyqtgraph's ``dataBounds`` for items that keep their data rectangle in ``_rect``."""
+    if self._rect.isNull():
+        return None, None
+    if ax == 0:
+        return self._rect.left(), self._rect.right()
+    return self._rect.top(), self._rect.bottom()
+
+
 class DeviationItem(pg.GraphicsObject):
     """Chords coloured by a level in 0..1: ONE item, one QPainterPath per colour bin."""
 
@@ -165,12 +174,7 @@ class DeviationItem(pg.GraphicsObject):
     def boundingRect(self) -> QRectF:  # noqa: N802 - Qt API
         return self._rect
 
-    def dataBounds(self, ax, frac=1.0, orthoRange=None):  # noqa: N802, N803 - pyqtgraph API
-        if self._rect.isNull():
-            return None, None
-        if ax == 0:
-            return self._rect.left(), self._rect.right()
-        return self._rect.top(), self._rect.bottom()
+    dataBounds = _rect_data_bounds  # noqa: N815 - pyqtgraph API
 
     def paint(self, p, *args) -> None:
         small = self.n_chords < MAX_ANTIALIAS_POINTS
@@ -304,12 +308,7 @@ class _FastItem(pg.GraphicsObject):
         pad = 6.0 * px
         return self._rect.adjusted(-pad, -pad, pad, pad)
 
-    def dataBounds(self, ax, frac=1.0, orthoRange=None):  # noqa: N802, N803 - pyqtgraph API
-        if self._rect.isNull():
-            return None, None
-        if ax == 0:
-            return self._rect.left(), self._rect.right()
-        return self._rect.top(), self._rect.bottom()
+    dataBounds = _rect_data_bounds  # noqa: N815 - pyqtgraph API
 
 
 class PointsItem(_FastItem):

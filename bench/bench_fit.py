@@ -35,6 +35,8 @@ import numpy as np
 
 sys.path.insert(0, os.path.join(os.path.dirname(__file__), ".."))
 
+from bench_thin import sines  # noqa: E402  (the same speed curve as the thinning bench)
+
 from galvo_core.fit import (  # noqa: E402
     check_fit,
     control_points,
@@ -207,15 +209,6 @@ def circle(r: float, n: int) -> np.ndarray:
     p = np.c_[r * np.cos(t), r * np.sin(t)]
     p[-1] = p[0]
     return p
-
-
-def sines(n: int = 100_000, seed: int = 1) -> np.ndarray:
-    rng = np.random.default_rng(seed)
-    x = np.sort(rng.uniform(0, 3000, n))
-    y = sum(
-        rng.uniform(5, 60) * np.sin(x / rng.uniform(8, 80) + rng.uniform(0, 6)) for _ in range(3)
-    )
-    return np.c_[x, y]
 
 
 def drawing_paths(path: str) -> list[tuple[np.ndarray, bool]]:
