@@ -26,6 +26,8 @@ import numpy as np
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
+from bench_order import vpype_greedy_linesort  # noqa: E402
+
 from galvo_core.fill import (  # noqa: E402
     coverage,
     find_regions,
@@ -82,14 +84,7 @@ def vpype_fill(lines: list[np.ndarray], mm_per_unit: float) -> list[np.ndarray]:
     scale = mm_per_unit / 25.4 * 96.0  # vpype's unit is the CSS pixel
     lc = vp.LineCollection([(p[:, 0] + 1j * p[:, 1]) * scale for p in lines])
     lc.merge(tolerance=0.05 / 25.4 * 96.0, flip=True)
-    # vpype_cli linesort, greedy part (as in vpype_cli/operations.py)
-    index = vp.LineIndex(lc[1:], reverse=True)
-    new = lc.clone([lc[0]])
-    while len(index) > 0:
-        idx, rev = index.find_nearest(new[-1][-1])
-        line = index.pop(idx)
-        if line is not None:
-            new.append(np.flip(line) if rev else line)
+    new = vpype_greedy_linesort(lc)
     return [np.c_[ln.real, ln.imag] / scale for ln in new]
 
 

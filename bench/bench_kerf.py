@@ -33,6 +33,8 @@ import shapely
 ROOT = FsPath(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
+from results_md import replace_section  # noqa: E402
+
 from galvo_core.drawing import Drawing, Path  # noqa: E402
 from galvo_core.errors import GalvoError  # noqa: E402
 from galvo_core.field import make_field  # noqa: E402
@@ -337,16 +339,7 @@ def main() -> int:
 
 
 def write_section(text: str) -> None:
-    path = ROOT / "bench" / "RESULTS.md"
-    old = path.read_text() if path.exists() else "# Benchmark results\n"
-    head = "## Kerf (issue 6)"
-    if head in old:
-        start = old.index(head)
-        nxt = old.find("\n## ", start + len(head))
-        new = old[:start] + text.rstrip("\n") + "\n" + (old[nxt:] if nxt >= 0 else "")
-    else:
-        new = old.rstrip("\n") + "\n\n" + text
-    path.write_text(new)
+    replace_section("## Kerf (issue 6)", text)
 
 
 if __name__ == "__main__":

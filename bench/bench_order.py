@@ -59,6 +59,15 @@ def vpype_sort(strokes: list[np.ndarray]) -> tuple[float, float]:
 
     lc = vp.LineCollection([s[:, 0] + 1j * s[:, 1] for s in strokes])
     t0 = time.perf_counter()
+    new = vpype_greedy_linesort(lc)
+    dt = time.perf_counter() - t0
+    return float(new.pen_up_length()[0]), dt
+
+
+def vpype_greedy_linesort(lc):  # type: ignore[no-untyped-def] - vpype is a bench-only peer
+    """vpype_cli's ``linesort``, greedy part (as in vpype_cli/operations.py)."""
+    import vpype as vp
+
     index = vp.LineIndex(lc[1:], reverse=True)
     new = lc.clone([lc[0]])
     while len(index) > 0:
@@ -66,8 +75,7 @@ def vpype_sort(strokes: list[np.ndarray]) -> tuple[float, float]:
         line = index.pop(idx)
         if line is not None:
             new.append(np.flip(line) if rev else line)
-    dt = time.perf_counter() - t0
-    return float(new.pen_up_length()[0]), dt
+    return new
 
 
 def instances() -> list[tuple[str, list[np.ndarray]]]:

@@ -39,6 +39,8 @@ REPO = os.path.dirname(HERE)
 if REPO not in sys.path:
     sys.path.insert(0, REPO)
 
+from results_md import replace_section  # noqa: E402
+
 from galvo_core.errors import InputError  # noqa: E402
 from galvo_core.hpgl import read_bytes  # noqa: E402
 
@@ -915,27 +917,7 @@ def _summary(corpus: list[FileResult]) -> str:
 
 
 def write_section(path: str, body: str) -> None:
-    text = ""
-    if os.path.exists(path):
-        with open(path, encoding="utf-8") as f:
-            text = f.read()
-    start = text.find(SECTION + "\n")
-    if start < 0 and text.endswith(SECTION):
-        start = len(text) - len(SECTION)
-    new = SECTION + "\n\n" + body
-    if start < 0:
-        if not text:
-            text = "# Benchmark results\n\n"
-        elif not text.endswith("\n\n"):
-            text = text.rstrip("\n") + "\n\n"
-        text += new
-    else:
-        m = re.compile(r"^## ", re.M).search(text, start + len(SECTION))
-        end = m.start() if m else len(text)
-        tail = text[end:]
-        text = text[:start] + new + ("\n" + tail if tail else "")
-    with open(path, "w", encoding="utf-8") as f:
-        f.write(text)
+    replace_section(SECTION, SECTION + "\n\n" + body, path)
 
 
 def main(argv: list[str] | None = None) -> int:

@@ -32,6 +32,8 @@ import numpy as np
 ROOT = FsPath(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
+from results_md import replace_section  # noqa: E402
+
 from galvo_core.field import FieldMap, make_field  # noqa: E402
 from galvo_core.fit import FittedPath, Segment, fit_path  # noqa: E402
 from galvo_core.hpgl import read_file  # noqa: E402
@@ -377,17 +379,7 @@ def main() -> int:
 
 
 def write_section(text: str) -> None:
-    path = ROOT / "bench" / "RESULTS.md"
-    old = path.read_text() if path.exists() else "# Benchmark results\n"
-    if HEAD in old:
-        start = old.index(HEAD)
-        nxt = old.find("\n## ", start + len(HEAD))
-        new = old[:start] + text.rstrip("\n") + "\n" + (old[nxt:] if nxt >= 0 else "")
-    else:
-        new = old.rstrip("\n") + "\n\n" + text
-    tmp = path.with_name(".RESULTS.md.tmp-sample")
-    tmp.write_text(new)
-    os.replace(tmp, path)
+    replace_section(HEAD, text)
 
 
 if __name__ == "__main__":
