@@ -5,10 +5,14 @@ Three methods (``Params.interpolation``):
 ``adaptive`` (default)
     Every cubic is cut into chords whose *chord height* — the largest distance between the
     chord and the curve stretch it replaces — stays within ``chord_tol_bits``, each chord as
-    long as the bound allows (paper 004's step search, see :func:`sample_curve`). Lines are
-    sent as their end points. The chord height is measured for real, not at the parameter
-    midpoint as paper 000 eq. (5) does: for a 2-D cubic the distance of the curve to the
-    chord's line is a cubic polynomial of the parameter, so its extremes come in closed form
+    long as the bound allows (paper 004's step search, see :func:`sample_curve`). Cubics
+    that meet smoothly (no corner at the joint) are searched as one curve, so a chord may
+    run across their joint — no mark is forced there and no short chord is left at the end
+    of every cubic (runs are cut every :data:`_CHAIN_MARKS` marks or so, see
+    :func:`_smooth_chains`). Lines are sent as their end points. The chord height is
+    measured for real, not at the parameter midpoint as paper 000 eq. (5) does: for a 2-D
+    cubic the distance of the curve to the chord's line is a cubic polynomial of the
+    parameter, so its extremes come in closed form
     (:func:`chord_heights`).
 ``fixed``
     Paper 001's legacy method, kept to show the improvement: walk the curve in fixed steps
@@ -39,9 +43,10 @@ accept it when E_min <= H <= E_max, else double or halve R. Two changes, same gu
   Δt ← Δt·(H_p/H)^(1/p), p = 2 at first and then the local exponent of the last two trials,
   bisecting whenever that leaves the bracket. It needs about 1.5 measurements per mark.
 
-E_max = ``chord_tol_bits``; E_min = :data:`E_MIN_RATIO` · E_max (0.9), so every chord is
-within a few per cent of the longest allowed one (count within about 5 % of the fewest
-possible; see bench/RESULTS.md). A step that reaches the curve's end with H <= E_max ends it.
+E_max = ``chord_tol_bits``; E_min = :data:`E_MIN_RATIO` · E_max (0.97), so every chord is
+within about 1.5 % of the longest allowed one (the count grows like 1/sqrt(H)): within a
+few per cent of the fewest possible and of the integral bound (see bench/RESULTS.md), for
+about 1.3 height measurements per mark. A step that reaches the curve's end with H <= E_max ends it.
 
 Minimum and maximum step
 ------------------------
@@ -49,7 +54,7 @@ No chord is shorter than ``min_step_bits`` except the last one of a stroke and t
 at a corner (a segment joint whose direction turns by more than :data:`CORNER_DEG`): where
 the tolerance would want a shorter step (radius of curvature about a bit) the step is set to
 the minimum instead and counted as a *min-step override* (its chord height is measured and
-reported like any other). A cubic's last chord shorter than the minimum is avoided by moving
+reported like any other). A curve's last chord shorter than the minimum is avoided by moving
 the previous mark to the middle of the last two chords; a mark still closer than the minimum
 to its predecessor (tiny segments, smooth joints) is dropped unless it is a protected mark
 (stroke ends, corners). ``max_step_bits`` (optional) caps every chord and splits lines.
@@ -106,11 +111,13 @@ __all__ = [
 ]
 
 #: E_min / E_max of the step search window
-E_MIN_RATIO = 0.9
+E_MIN_RATIO = 0.97
 #: the most that rounding a mark to whole bits adds to a chord height
 ROUNDING_BOUND_BITS = math.sqrt(2.0) / 2.0
 _MAX_TRIALS = 60
 _OVER_SAMPLES = 64
+#: about how many marks a chain of smoothly joined cubics gathers before it is cut
+_CHAIN_MARKS = 64
 _TINY = 1e-300
 
 
@@ -300,6 +307,109 @@ class _CubicSet:
                         axis=1)
 
 
+class _ChainSet:
+    """Chains of cubics that meet smoothly (no corner at their joints), each searched as one
+    curve, so that a chord may run across a joint: chain k is made of the cubics
+    ``first[k]`` … ``first[k] + n[k] − 1`` of a :class:`_CubicSet`, with the parameter
+    s in [0, n[k]] (cubic ``first[k] + j`` for s in [j, j + 1]). A chord within one cubic
+    is measured by the closed form (:func:`chord_heights`); one across joints piece by piece
+    against the chord (:func:`segment_heights`), as the final measurement does."""
+
+    def __init__(self, cs: _CubicSet, first: np.ndarray, n: np.ndarray) -> None:
+        self.cs, self.first, self.n = cs, first, n
+
+    def locate(self, ids: np.ndarray, s: np.ndarray, *, ending: bool
+               ) -> tuple[np.ndarray, np.ndarray]:
+        """(cubic id, t) of chain parameters ``s``: at a joint the cubic that ends there
+        (``ending``, for a chord's end) or the one that starts there."""
+        last = self.n[ids] - 1
+        j = np.ceil(s) - 1.0 if ending else np.floor(s)
+        j = np.clip(j, 0, last).astype(np.int64)
+        return self.first[ids] + j, s - j
+
+    def guess_terms(self, ids: np.ndarray, s: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        return self.cs.guess_terms(*self.locate(ids, s, ending=False))
+
+    def point(self, ids: np.ndarray, s: np.ndarray) -> np.ndarray:
+        return self.cs.point(*self.locate(ids, s, ending=True))
+
+    def height(self, ids: np.ndarray, sa: np.ndarray, sb: np.ndarray
+               ) -> tuple[np.ndarray, np.ndarray]:
+        ga, ta = self.locate(ids, sa, ending=False)
+        gb, tb = self.locate(ids, sb, ending=True)
+        gb = np.maximum(gb, ga)  # a chord of zero length at a joint
+        tb = np.where(gb == ga, sb - (ga - self.first[ids]), tb)
+        one = gb == ga
+        if one.all():
+            return chord_heights(self.cs.gather(ga), ta, tb)
+        H = np.empty(len(sa))
+        L = np.empty(len(sa))
+        i = np.flatnonzero(one)
+        H[i], L[i] = chord_heights(self.cs.gather(ga[i]), ta[i], tb[i])
+        i = np.flatnonzero(~one)
+        A = self.cs.point(ga[i], ta[i])
+        B = self.cs.point(gb[i], tb[i])
+        H[i] = _span_heights(self.cs, ga[i], ta[i], gb[i], tb[i], A, B)
+        L[i] = np.hypot(B[:, 0] - A[:, 0], B[:, 1] - A[:, 1])
+        return H, L
+
+
+def _span_heights(cs: _CubicSet, ga: np.ndarray, ta: np.ndarray, gb: np.ndarray,
+                  tb: np.ndarray, A: np.ndarray, B: np.ndarray) -> np.ndarray:
+    """Largest distance to the segments A→B (K,) of the curve from (cubic ``ga``, ``ta``)
+    to (cubic ``gb`` > ``ga``, ``tb``): the first cubic from ``ta``, the last up to ``tb``,
+    every cubic between them whole (one vectorised pass per position in the span)."""
+    one, zero = np.ones(len(ga)), np.zeros(len(ga))
+    H = np.maximum(segment_heights(cs.gather(ga), ta, one, A, B),
+                   segment_heights(cs.gather(gb), zero, tb, A, B))
+    off = 1
+    while True:
+        i = np.flatnonzero(ga + off < gb)
+        if not len(i):
+            return H
+        H[i] = np.maximum(H[i], segment_heights(cs.gather(ga[i] + off), zero[i], one[i],
+                                                A[i], B[i]))
+        off += 1
+
+
+def _smooth_chains(cf: CF, is_cubic: np.ndarray, corner: np.ndarray, seg_path: np.ndarray,
+                   tol: float) -> tuple[np.ndarray, np.ndarray]:
+    """``(first, n)`` of the runs of consecutive cubics of one path whose joints are not
+    corners (segment ids in the order of the fit), cut where a run has gathered about
+    :data:`_CHAIN_MARKS` marks: the search advances all curves in lock-step, one mark per
+    curve per round, so a few long chains would cost many rounds over short arrays; a cut
+    costs at most one partial chord in that many. Marks are estimated per cubic by the
+    integral N = ∫ sqrt(κ) ds / sqrt(8 tol) (4-point Gauss–Legendre)."""
+    g = len(is_cubic)
+    joined = np.zeros(g, dtype=bool)  # segment i continues into i + 1
+    if g > 1:
+        joined[:-1] = (is_cubic[:-1] & is_cubic[1:] & ~corner[:-1]
+                       & (seg_path[:-1] == seg_path[1:]))
+    if joined.any():
+        ax, ay, bx, by, dx, dy, _, _ = cf
+        x, w = np.polynomial.legendre.leggauss(4)
+        est = np.zeros(g)
+        for xi, wi in zip(0.5 * (x + 1.0), 0.5 * w, strict=True):
+            d1x = (3.0 * ax * xi + 2.0 * bx) * xi + dx
+            d1y = (3.0 * ay * xi + 2.0 * by) * xi + dy
+            d2x = 6.0 * ax * xi + 2.0 * bx
+            d2y = 6.0 * ay * xi + 2.0 * by
+            sp = np.hypot(d1x, d1y)
+            with np.errstate(divide="ignore", invalid="ignore"):
+                f = np.sqrt(np.abs(d1x * d2y - d1y * d2x) / sp)  # sqrt(κ)·|B'|
+            est += wi * np.nan_to_num(f)
+        est = est / math.sqrt(8.0 * tol) + 1.0
+        # marks gathered before each cubic since the start of its run; cut at multiples
+        start = ~np.r_[False, joined[:-1]]
+        cum = np.cumsum(est) - est
+        run_base = np.maximum.accumulate(np.where(start, cum, 0.0))
+        bucket = np.floor((cum - run_base) / _CHAIN_MARKS)
+        joined[:-1] &= bucket[1:] == bucket[:-1]
+    starts = np.flatnonzero(is_cubic & ~np.r_[False, joined[:-1]])
+    ends = np.flatnonzero(is_cubic & ~joined)
+    return starts, ends - starts + 1
+
+
 Func = Callable[[np.ndarray], np.ndarray]
 
 
@@ -376,8 +486,11 @@ class _FuncCurve:
         return H, L
 
 
+_Curves = _CubicSet | _ChainSet | _FuncCurve
+
+
 # =========================================================================== step search
-def _first_step(curves: _CubicSet | _FuncCurve, ids: np.ndarray, t: np.ndarray,
+def _first_step(curves: _Curves, ids: np.ndarray, t: np.ndarray,
                 hp: float, max_step: float) -> np.ndarray:
     """Paper 004's first trial: R = 2r·sin(θ/2), θ = 2·arccos((r − H_p)/r), r = 1/k, as a
     parameter step R/|P'| (R = the diameter 2r when H_p > r; the whole rest for k = 0)."""
@@ -390,7 +503,7 @@ def _first_step(curves: _CubicSet | _FuncCurve, ids: np.ndarray, t: np.ndarray,
     return np.where(np.isfinite(dt) & (dt > 0.0), dt, np.inf)
 
 
-def _search(curves: _CubicSet | _FuncCurve, ids0: np.ndarray, t0: np.ndarray,
+def _search(curves: _Curves, ids0: np.ndarray, t0: np.ndarray,
             t1: np.ndarray, *, e_min: float, e_max: float, min_step: float, max_step: float,
             cancel: Callable[[], bool] | None = None
             ) -> tuple[np.ndarray, np.ndarray, np.ndarray, int]:
@@ -404,7 +517,7 @@ def _search(curves: _CubicSet | _FuncCurve, ids0: np.ndarray, t0: np.ndarray,
                      max_step=max_step, cancel=cancel)[:4]  # type: ignore[return-value]
 
 
-def _search_h(curves: _CubicSet | _FuncCurve, ids0: np.ndarray, t0: np.ndarray,
+def _search_h(curves: _Curves, ids0: np.ndarray, t0: np.ndarray,
               t1: np.ndarray, *, e_min: float, e_max: float, min_step: float,
               max_step: float, cancel: Callable[[], bool] | None = None
               ) -> tuple[np.ndarray, np.ndarray, np.ndarray, int, np.ndarray, np.ndarray]:
@@ -520,7 +633,7 @@ def _search_h(curves: _CubicSet | _FuncCurve, ids0: np.ndarray, t0: np.ndarray,
     return kk[order], tt[order], oo[order], trials, hh[order], aa[order]
 
 
-def _fix_short_ends(curves: _CubicSet | _FuncCurve, ids0: np.ndarray, t0: np.ndarray,
+def _fix_short_ends(curves: _Curves, ids0: np.ndarray, t0: np.ndarray,
                     k: np.ndarray, t: np.ndarray, *, e_max: float, min_step: float,
                     h: np.ndarray | None = None, a: np.ndarray | None = None) -> None:
     """A curve's last chord shorter than ``min_step``: move the previous mark to the
@@ -910,21 +1023,30 @@ def sample_paths(
     cub = np.flatnonzero(is_cubic)
     if len(cub):
         if interpolation == "adaptive":
-            kk, tt, oo, trials, hh, aa = _search_h(
-                cs, cub, np.zeros(len(cub)), np.ones(len(cub)), e_min=E_MIN_RATIO * tol,
-                e_max=tol, min_step=min_step, max_step=ms_max, cancel=cancel)
-            _fix_short_ends(cs, cub, np.zeros(len(cub)), kk, tt, e_max=tol,
-                            min_step=min_step, h=hh, a=aa)
+            # cubics meeting smoothly are searched as one curve: no mark is forced at
+            # their joint, and no partial chord is left at the end of each cubic
+            first, n = _smooth_chains(cf, is_cubic, corner, geo.seg_path, tol)
+            chains = _ChainSet(cs, first, n)
+            ck = np.arange(len(first))
+            s0 = np.zeros(len(first))
+            kk, ss, oo, trials, hh, aa = _search_h(
+                chains, ck, s0, n.astype(np.float64), e_min=E_MIN_RATIO * tol, e_max=tol,
+                min_step=min_step, max_step=ms_max, cancel=cancel)
+            _fix_short_ends(chains, ck, s0, kk, ss, e_max=tol, min_step=min_step, h=hh, a=aa)
             report.min_step_overrides = int(oo.sum())
             report.trials = trials
-            seg_ids.append(cub[kk])
+            gid, tt = chains.locate(kk, ss, ending=True)
+            # the search's measurement is reused for chords within one cubic only
+            aa = aa - (gid - first[kk])
+            within = aa >= 0.0  # NaN compares False
+            seg_ids.append(gid)
             seg_ts.append(tt)
-            seg_h.append(hh)
-            seg_a.append(aa)
+            seg_h.append(np.where(within, hh, np.nan))
+            seg_a.append(np.where(within, aa, np.nan))
         else:
-            for gid in cub:
-                tf = _fixed_params(cs, int(gid), float(fixed_step_bits), float(fixed_slope_tol))
-                seg_ids.append(np.full(len(tf), gid))
+            for g in cub.tolist():
+                tf = _fixed_params(cs, g, float(fixed_step_bits), float(fixed_slope_tol))
+                seg_ids.append(np.full(len(tf), g))
                 seg_ts.append(tf)
     lines = np.flatnonzero(~is_cubic)
     if len(lines):

@@ -201,7 +201,7 @@ def test_3d_cubic_and_2d_cubic_through_the_generic_search():
     p = ctrl3[:, :2]
     d1 = d1[:, :2]
     d2 = d2[:, :2]
-    s2 = sample_curve(f, df, ddf, 0.0, 1.0, e_min=0.45, e_max=0.5)
+    s2 = sample_curve(f, df, ddf, 0.0, 1.0, e_min=E_MIN_RATIO * 0.5, e_max=0.5)
     res = sample_paths([_path(("cubic", p.tolist()))], FM, chord_tol_bits=0.5,
                        min_step_bits=0.0)
     np.testing.assert_allclose(res.params[0][1], s2.t, atol=1e-6)
@@ -239,6 +239,51 @@ def test_min_step_keeps_corners_and_drops_smooth_joint_marks():
     m = sample_path(fp, FM, min_step_bits=2.5)
     steps = np.hypot(*np.diff(m, axis=0).T)
     assert (steps[:-1] >= 2.5).all() and m[0].tolist() == [0, 0] and m[-1].tolist() == [10, 0]
+
+
+def _circle_quarters(r: float, c: float = 50_000.0) -> list[tuple[str, list[list[float]]]]:
+    k = 4.0 / 3.0 * math.tan(math.pi / 8.0) * r
+    out = []
+    for q in range(4):
+        a0, a1 = q * math.pi / 2, (q + 1) * math.pi / 2
+        p0 = np.array([math.cos(a0), math.sin(a0)]) * r + c
+        p3 = np.array([math.cos(a1), math.sin(a1)]) * r + c
+        t0 = np.array([-math.sin(a0), math.cos(a0)])
+        t3 = np.array([-math.sin(a1), math.cos(a1)])
+        out.append(("cubic", [p0.tolist(), (p0 + k * t0).tolist(), (p3 - k * t3).tolist(),
+                              p3.tolist()]))
+    return out
+
+
+@pytest.mark.parametrize("r", [300.0, 500.0, 20000.0])
+def test_smooth_joints_are_not_forced_marks(r):
+    """A circle drawn as four cubics meeting smoothly is sampled as one curve: chords run
+    across the joints (measured against both cubics), so it takes no more chords than one
+    circle needs. (Very long runs are cut at a joint every few dozen marks; the count bound
+    holds there too.)"""
+    tol = 1.0
+    fp = _path(*_circle_quarters(r), closed=True)
+    res = sample_paths([fp], FM, chord_tol_bits=tol, min_step_bits=2.0)
+    chords = len(res.marks[0]) - 1
+    # every chord but the last is at least E_MIN_RATIO·tol high; the cubic's radius differs
+    # from r by < 0.03 %
+    th_min = 2 * math.acos(1 - E_MIN_RATIO * tol / (r * 1.0003))
+    assert chords <= math.ceil(2 * math.pi / th_min) + 1
+    if r < 1000:  # short: one curve, the three inner joints all spanned by a chord
+        sid, t = res.params[0]
+        spans = np.sum(sid[1:] != sid[:-1] + (t[:-1] >= 1.0))
+        assert spans == 3
+    assert _brute_heights(fp, res).max() <= tol * (1 + 1e-9)
+    assert res.report.max_chord_height_bits <= tol * (1 + 1e-9)
+    assert res.report.chord_violations == 0
+
+
+def test_a_corner_between_cubics_keeps_its_mark():
+    """Cubics meeting at a corner are separate curves: the corner point is a mark."""
+    a = ("cubic", [[0, 0], [300, 400], [700, 400], [1000, 0]])
+    b = ("cubic", [[1000, 0], [1300, 400], [1700, 400], [2000, 0]])  # turns by ~106°
+    m = sample_path(_path(a, b), FM, min_step_bits=2.0)
+    assert [1000, 0] in m.tolist()
 
 
 def test_lines_are_their_end_points_and_max_step_splits():
