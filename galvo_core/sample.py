@@ -56,13 +56,18 @@ the tolerance would want a shorter step (radius of curvature about a bit) the st
 the minimum instead and counted as a *min-step override* (its chord height is measured and
 reported like any other). A curve's last chord shorter than the minimum is avoided by moving
 the previous mark to the middle of the last two chords; a mark still closer than the minimum
-to its predecessor (tiny segments, smooth joints) is dropped unless it is a protected mark
-(stroke ends, corners). ``max_step_bits`` (optional) caps every chord and splits lines.
+to its predecessor (tiny segments, joints with lines) is dropped unless it is a protected
+mark (stroke ends, corners) — or, when the longer chord that dropping it leaves would break
+the tolerance, its unprotected predecessor is dropped instead; when neither can go the
+minimum step wins and the mark is counted as a min-step override. ``max_step_bits``
+(optional) caps every chord and splits lines.
 
 Rounding
 --------
 The chord heights above are for the marks before rounding (``max_chord_height_bits``,
-guaranteed <= ``chord_tol_bits`` except at min-step overrides). Rounding each mark to the
+guaranteed <= ``chord_tol_bits`` except at min-step overrides and where two protected marks
+within a bit of each other round to the same integer mark, so that one of them goes and the
+chord from its neighbour passes it: both are measured and reported). Rounding each mark to the
 nearest integer bit moves it by at most √2/2 bit, so every point of a rounded chord lies
 within √2/2 of the unrounded chord (a convex combination of two such moves): the chord
 height of the integer marks is at most the unrounded one + √2/2 ≈ 0.707 bit. It is measured
@@ -766,8 +771,9 @@ def _dedup(marks: np.ndarray) -> np.ndarray:
 
 
 def _min_step_filter(pts: np.ndarray, prot: np.ndarray, min_step: float,
-                     first: np.ndarray | None = None, d: np.ndarray | None = None
-                     ) -> np.ndarray:
+                     first: np.ndarray | None = None, d: np.ndarray | None = None,
+                     merge_ok: Callable[[int, int], bool] | None = None,
+                     forced: list[int] | None = None) -> np.ndarray:
     """Indices to keep so that consecutive kept marks are >= min_step apart, protected marks
     (stroke ends, corners) always kept.
 
@@ -778,7 +784,14 @@ def _min_step_filter(pts: np.ndarray, prot: np.ndarray, min_step: float,
     is filtered on its own (its ends must be protected). ``d``: the distances between
     consecutive marks, when the caller has them. Only the stretches around chords shorter
     than ``min_step`` are walked one mark at a time; between them every mark is kept (its
-    predecessor is kept and far enough)."""
+    predecessor is kept and far enough).
+
+    ``merge_ok(a, b)`` (optional): whether the chord from mark a to mark b keeps within the
+    chord tolerance. An unprotected mark i too close to the kept mark j before it is then
+    dropped only when the chord j → i + 1 that replaces j → i → i + 1 holds; otherwise j is
+    dropped instead when j is unprotected, the chord from the kept mark before j to i
+    holds and is long enough; when neither holds i is dropped (the minimum step wins) and
+    i is appended to ``forced``."""
     n = len(pts)
     if min_step <= 0.0 or n < 3:
         return np.arange(n)
@@ -821,6 +834,13 @@ def _min_step_filter(pts: np.ndarray, prot: np.ndarray, min_step: float,
                     x[i] - x[keep[-1]], y[i] - y[keep[-1]]) < min_step:
                 keep.pop()
             keep.append(i)
+        elif merge_ok is not None and not merge_ok(j, i + 1):
+            k = keep[-2] if len(keep) > 1 else -1
+            if (k >= 0 and not pr[j] and (fs is None or not fs[j])
+                    and hyp(x[i] - x[k], y[i] - y[k]) >= min_step and merge_ok(k, i)):
+                keep[-1] = i
+            elif forced is not None:
+                forced.append(i)
         i += 1
     return np.asarray(keep, dtype=np.int64)
 
@@ -1093,7 +1113,17 @@ def sample_paths(
         short = (dd < min_step) & ~last_of[:-1]
         if short.any():  # every stroke at once; the loop runs only near short chords
             keep = np.zeros(len(pid), dtype=bool)
-            keep[_min_step_filter(pos, prot, min_step, first=first_of, d=dd)] = True
+            forced: list[int] = []
+
+            def merge_ok(a: int, b: int) -> bool:
+                """The chord from mark a to mark b keeps within the tolerance."""
+                h = _chords_heights(cs, sid[[a]], st[[a]], sid[[b]], st[[b]], pos[[a]],
+                                    pos[[b]])
+                return bool(h[0] <= tol)
+
+            keep[_min_step_filter(pos, prot, min_step, first=first_of, d=dd,
+                                  merge_ok=merge_ok, forced=forced)] = True
+            report.min_step_overrides += len(forced)
             sid, st, pos, pid, hm, am = (x[keep] for x in (sid, st, pos, pid, hm, am))
             first_of, last_of = first_of[keep], last_of[keep]
     # ---- rounding to whole bits; consecutive repeats dropped (the stroke's end kept)
@@ -1200,6 +1230,25 @@ def _measure_marks(cs: _CubicSet, sid: np.ndarray, st: np.ndarray, pos: np.ndarr
     bound[~pair] = -np.inf
     hi_max = _max_int_heights(cs, bound, sa, ta, sb, tb, rf, int(np.count_nonzero(pair)))
     return hf[pair], hi_max
+
+
+def _chords_heights(cs: _CubicSet, sa: np.ndarray, ta: np.ndarray, sb: np.ndarray,
+                    tb: np.ndarray, A: np.ndarray, B: np.ndarray) -> np.ndarray:
+    """Heights of the chords A → B between curve points (segment ``sa``, ``ta``) and
+    (``sb``, ``tb``) with ``sb`` >= ``sa``: the closed form within one segment (exact, A and
+    B on the curve), piece by piece across joints."""
+    mv = (ta >= 1.0) & (sb > sa)  # a chord from a segment's end starts on the next one
+    sa = sa + mv
+    ta = np.where(mv, 0.0, ta)
+    out = np.zeros(len(sa))
+    one = sa == sb
+    if one.any():
+        i = np.flatnonzero(one)
+        out[i], _ = chord_heights(cs.gather(sa[i]), ta[i], tb[i])
+    if not one.all():
+        i = np.flatnonzero(~one)
+        out[i] = _span_heights(cs, sa[i], ta[i], sb[i], tb[i], A[i], B[i])
+    return out
 
 
 def _max_int_heights(cs: _CubicSet, bound: np.ndarray, sa: np.ndarray, ta: np.ndarray,

@@ -286,6 +286,26 @@ def test_a_corner_between_cubics_keeps_its_mark():
     assert [1000, 0] in m.tolist()
 
 
+def test_a_mark_too_close_to_keep_goes_where_the_tolerance_still_holds():
+    """A 1.4-bit line between a cubic and a chain of cubics (from a real nesting file): its
+    end mark is closer than the minimum step to the cubic's end, but dropping it would let
+    the next chord cut the bend by more than the tolerance; the filter drops the mark
+    before it instead, so no chord breaks the tolerance and no mark is closer than the
+    minimum step."""
+    fp = _path(("line", [[51.96, 63.31], [50.96, 70.52]]),
+               ("line", [[50.96, 70.52], [47.68, 85.56]]),
+               ("cubic", [[47.68, 85.56], [46.56, 89.52], [45.54, 92.58], [44.21, 95.96]]),
+               ("line", [[44.21, 95.96], [43.67, 97.24]]),
+               ("cubic", [[43.67, 97.24], [41.95, 101.04], [39.76, 105.26], [37.92, 108.27]]),
+               ("cubic", [[37.92, 108.27], [35.79, 111.76], [33.75, 114.59], [30.9, 118.03]]),
+               ("cubic", [[30.9, 118.03], [23.75, 126.63], [14.94, 134.23], [4.54, 140.74]]))
+    res = sample_paths([fp], FM, chord_tol_bits=1.0, min_step_bits=2.0)
+    assert _brute_heights(fp, res).max() <= 1.0 + 1e-9
+    assert res.report.chord_violations == 0
+    steps = np.hypot(*np.diff(res.float_marks[0], axis=0).T)
+    assert steps[:-1].min() >= 2.0
+
+
 def test_lines_are_their_end_points_and_max_step_splits():
     fp = _path(("line", [[0, 0], [1000, 0]]), ("line", [[1000, 0], [1000, 1000]]))
     assert sample_path(fp, FM).tolist() == [[0, 0], [1000, 0], [1000, 1000]]
