@@ -1,7 +1,9 @@
 """Order benchmark (issue 7): travel of greedy / optimized against LKH (elkai) and vpype.
 
 Instances: random short open strokes (reversible) of n = 200, 1000 (LKH can finish these)
-and 10,000 (timing only), plus the zig-zag hatch strokes of seal.plt and text_outline.plt.
+and 10,000 (timing only), plus the zig-zag hatch strokes of seal.plt and text_outline.plt;
+then optimized / LKH on random 1000-segment instances from seeds 1-8 (the spread). LKH tour
+lengths are cached in bench/out/order_lkh.json (LKH takes ~20-45 s on 1000 strokes).
 LKH gets the exact problem as a symmetric TSP: two nodes per stroke (its ends) joined by a
 forced zero edge, every other edge = distance + BIG, plus one free dummy node (an open
 path). Run in bench/.venv-fill (elkai, vpype). Prints a markdown table.
@@ -9,6 +11,10 @@ path). Run in bench/.venv-fill (elkai, vpype). Prints a markdown table.
 
 from __future__ import annotations
 
+import argparse
+import hashlib
+import json
+import os
 import sys
 import time
 from pathlib import Path
@@ -23,6 +29,27 @@ from galvo_core.hpgl import read_file  # noqa: E402
 from galvo_core.order import Placement, order_strokes, travel_length  # noqa: E402
 from galvo_core.params import Params  # noqa: E402
 from galvo_core.pipeline import Pipeline  # noqa: E402
+
+LKH_CACHE = ROOT / "bench" / "out" / "order_lkh.json"
+
+
+def lkh_cached(strokes: list[np.ndarray]) -> tuple[float, float]:
+    """:func:`lkh`, remembered in bench/out/order_lkh.json by a hash of the points (LKH takes
+    ~45 s on 1000 strokes). Returns (travel, LKH seconds when it was run)."""
+    h = hashlib.sha1()
+    for s in strokes:
+        h.update(np.ascontiguousarray(s, dtype=np.float64).tobytes())
+    key = h.hexdigest()
+    cache = json.loads(LKH_CACHE.read_text()) if LKH_CACHE.exists() else {}
+    if key not in cache:
+        length, dt = lkh(strokes)
+        cache = json.loads(LKH_CACHE.read_text()) if LKH_CACHE.exists() else {}
+        cache[key] = [length, dt]
+        LKH_CACHE.parent.mkdir(parents=True, exist_ok=True)
+        tmp = LKH_CACHE.with_suffix(".tmp")
+        tmp.write_text(json.dumps(cache, indent=1))
+        tmp.replace(LKH_CACHE)
+    return float(cache[key][0]), float(cache[key][1])
 
 
 def lkh(strokes: list[np.ndarray], runs: int = 1) -> tuple[float, float]:
@@ -78,12 +105,17 @@ def vpype_greedy_linesort(lc):  # type: ignore[no-untyped-def] - vpype is a benc
     return new
 
 
+def random_segments(n: int, rng: np.random.Generator) -> list[np.ndarray]:
+    """n segments: a uniform start in a 1000 square, the end ~N(0, 10) away."""
+    a = rng.uniform(0, 1000, (n, 2))
+    return list(np.stack([a, a + rng.normal(0, 10, (n, 2))], 1))
+
+
 def instances() -> list[tuple[str, list[np.ndarray]]]:
     out = []
     rng = np.random.default_rng(7)
     for n in (200, 1000, 10000):
-        a = rng.uniform(0, 1000, (n, 2))
-        out.append((f"random {n} segments", list(np.stack([a, a + rng.normal(0, 10, (n, 2))], 1))))
+        out.append((f"random {n} segments", random_segments(n, rng)))
     for name in ("seal.plt", "text_outline.plt"):
         d = read_file(ROOT / "resources" / "samples" / name)
         sp = Pipeline().field_map(d, Params()).mm_to_units(0.05)
@@ -93,7 +125,46 @@ def instances() -> list[tuple[str, list[np.ndarray]]]:
     return out
 
 
+def seeds_table(seeds: list[int], n: int = 1000, runs: int = 1) -> None:
+    """optimized / LKH on random n-segment instances from other seeds (default budget)."""
+    print("| seed | strokes | greedy | optimized 1 s (s) | LKH | optimized / LKH |")
+    print("| ---: | ---: | ---: | ---: | ---: | ---: |")
+    ratios = []
+    for seed in seeds:
+        st = random_segments(n, np.random.default_rng(seed))
+        g = travel_length(st, order_strokes(st, method="greedy"))
+        best = []
+        for _ in range(runs):
+            t0 = time.perf_counter()
+            best.append(travel_length(st, order_strokes(st, method="optimized")))
+            to = time.perf_counter() - t0
+        o = float(np.median(best))
+        lk, _ = lkh_cached(st)
+        ratios.append(o / lk)
+        print(f"| {seed} | {n} | {g:.0f} | {o:.0f} ({to:.2f}) | {lk:.0f} | {o / lk:.3f} |")
+    r = np.array(ratios)
+    print(f"\noptimized / LKH over {len(r)} seeds: median {np.median(r):.3f}, "
+          f"min {r.min():.3f}, max {r.max():.3f}; load average "
+          + " ".join(f"{x:.2f}" for x in os.getloadavg()))
+
+
 def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__)
+    ap.add_argument("--seeds", type=int, nargs="*",
+                    help="only the random 1000-segment instances from these seeds "
+                         "(default: the main table, then seeds 1-8)")
+    ap.add_argument("--runs", type=int, default=1, help="optimized runs per seed (median)")
+    args = ap.parse_args()
+    if args.seeds:
+        seeds_table(args.seeds, runs=args.runs)
+        return
+    main_table()
+    print()
+    seeds_table(list(range(1, 9)), runs=args.runs)
+
+
+def main_table() -> None:
+    """Travel and time of every method on :func:`instances`."""
     print("| instance | strokes | file | vpype greedy | greedy (s) | optimized 1 s (s) | "
           "LKH (s) | optimized / LKH |")
     print("| --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: |")
@@ -108,7 +179,7 @@ def main() -> None:
         to = time.perf_counter() - t0
         v, _ = vpype_sort(st)
         if n <= 1000:
-            lk, tl = lkh(st)
+            lk, tl = lkh_cached(st)
             lk_s, ratio = f"{lk:.0f} ({tl:.1f})", f"{o / lk:.3f}" if lk > 0 else "-"
         else:
             lk_s, ratio = "too large", "-"

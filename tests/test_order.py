@@ -3,6 +3,7 @@ every stroke once, nesting kept, marks and segments transformed consistently."""
 
 from __future__ import annotations
 
+import itertools
 import time
 
 import numpy as np
@@ -12,11 +13,15 @@ from galvo_core.field import FieldMap
 from galvo_core.job import Stroke
 from galvo_core.order import (
     Placement,
+    _greedy,
+    _improve,
+    _Problem,
     apply_placement,
     apply_to_strokes,
     nesting_constraints,
     order_job_strokes,
     order_strokes,
+    orient_strokes,
     travel_length,
 )
 
@@ -176,3 +181,74 @@ def test_ten_thousand_strokes_optimized_within_budget() -> None:
     assert dt < 4.0  # ~1.1 s on the 2-core development machine; slack for a loaded CI
     g = travel_length(strokes, order_strokes(strokes, method="greedy"))
     assert travel_length(strokes, pl) <= g + 1e-9
+
+
+def test_orient_strokes_is_optimal_for_a_fixed_order() -> None:
+    """The direction of every open stroke and the start of every closed one (among its allowed
+    starts) give the shortest travel for the given order: checked against all combinations."""
+    for seed in range(4):
+        rng = np.random.default_rng(seed)
+        strokes, closed, starts = [], [], []
+        for k in range(9):
+            p = rng.uniform(0, 100, 2)
+            if k % 4 == 1:
+                t = np.linspace(0, 2 * np.pi, 9)
+                strokes.append(np.c_[p[0] + 8 * np.cos(t), p[1] + 8 * np.sin(t)])
+                closed.append(True)
+                starts.append(np.array([0, 3, 5]))
+            else:
+                strokes.append(p + np.cumsum(rng.normal(0, 10, (3, 2)), axis=0))
+                closed.append(False)
+                starts.append(None)
+        order = [int(i) for i in rng.permutation(len(strokes))]
+        got = orient_strokes(strokes, order, closed=closed, starts=starts)
+        assert [p.index for p in got] == order
+        choices = [[Placement(i, False, r) for r in starts[i]] if closed[i]
+                   else [Placement(i), Placement(i, True)] for i in order]
+        best = min(travel_length(strokes, list(c), closed) for c in itertools.product(*choices))
+        assert travel_length(strokes, got, closed) == pytest.approx(best, abs=1e-9)
+        assert all(p.rotate in starts[p.index] for p in got if closed[p.index])
+
+
+def test_optimized_finds_the_optimum_of_small_instances() -> None:
+    """Six reversible strokes: every order and direction tried (720 orders, each with its
+    best directions)."""
+    for seed in range(8):
+        rng = np.random.default_rng(100 + seed)
+        a = rng.uniform(0, 100, (6, 2))
+        strokes = list(np.stack([a, a + rng.normal(0, 15, (6, 2))], axis=1))
+        best = min(travel_length(strokes, orient_strokes(strokes, list(p)))
+                   for p in itertools.permutations(range(6)))
+        got = order_strokes(strokes, method="optimized", time_budget_s=0.1)
+        assert travel_length(strokes, got) == pytest.approx(best, abs=1e-9)
+
+
+def test_optimized_search_is_deterministic_for_a_seed() -> None:
+    """The same kicks, hence the same order, when the time budget does not cut the search."""
+    rng = np.random.default_rng(4)
+    a = rng.uniform(0, 1000, (300, 2))
+    strokes = list(np.stack([a, a + rng.normal(0, 10, (300, 2))], axis=1))
+    closed = [False] * 300
+    prob = _Problem(strokes, closed, None)
+    start = _greedy(prob, [])
+    runs = [_improve(prob, start, [], time.perf_counter() + 60.0, seed=s, max_kicks=300)
+            for s in (0, 0, 1)]
+    assert runs[0] == runs[1]
+    assert sorted(prob.cstroke[runs[2]].tolist()) == list(range(300))
+
+
+def test_precedence_cycle_and_empty_strokes() -> None:
+    """A cycle of precedence pairs cannot be kept: every stroke is still placed once, empty
+    strokes at the end, and optimized is not longer than greedy."""
+    strokes, closed = mixed(9, 60)
+    strokes[5] = np.zeros((0, 2))
+    before = [(1, 2), (2, 3), (3, 1), (10, 5), (5, 11), (20, 40)]
+    g_pl = order_strokes(strokes, method="greedy", closed=closed, before=before)
+    o_pl = order_strokes(strokes, method="optimized", closed=closed, before=before,
+                         time_budget_s=0.2)
+    valid(g_pl, len(strokes))
+    valid(o_pl, len(strokes))
+    assert o_pl[-1].index == 5
+    pos = {p.index: i for i, p in enumerate(o_pl)}
+    assert pos[20] < pos[40]
+    assert travel_length(strokes, o_pl, closed) <= travel_length(strokes, g_pl, closed) + 1e-9
