@@ -18,17 +18,27 @@ coordinates are scaled (x ``SCALE``) and each peer's tolerance is searched (a ge
 then bisection) for the largest value whose result's TRUE max error is <= e_per; its segment
 count there is compared with ours.
 
-Usage: python bench/bench_fit.py [--json out.json]
+Speed on whole drawings (``--speed-only`` runs just that part): ``fit_drawing`` per drawing,
+best of ``--reps``, with the thinning (``thin_many`` on the same points) timed on its own so
+the fitting proper can be read off; with ``--baseline REV`` the fitter of git revision REV
+(its runs.py, fit.py and geometry.py, with today's thinning) is timed interleaved with the
+current one and checked to give the same segments. The load average is printed with every
+row (the box is shared; compare old and new only within one run).
+
+Usage: python bench/bench_fit.py [--json out.json] [--speed-only] [--baseline REV] [--reps N]
 """
 
 from __future__ import annotations
 
 import argparse
+import functools
+import importlib
 import json
 import math
 import os
 import subprocess
 import sys
+import tempfile
 import time
 
 import numpy as np
@@ -37,6 +47,7 @@ sys.path.insert(0, os.path.join(os.path.dirname(__file__), ".."))
 
 from bench_thin import sines  # noqa: E402  (the same speed curve as the thinning bench)
 
+from galvo_core.drawing import Drawing, Path  # noqa: E402
 from galvo_core.fit import (  # noqa: E402
     check_fit,
     control_points,
@@ -46,7 +57,7 @@ from galvo_core.fit import (  # noqa: E402
 )
 from galvo_core.geometry import cubic_eval, flatten_cubic, point_polyline_distance  # noqa: E402
 from galvo_core.hpgl import read_file  # noqa: E402
-from galvo_core.thin import dedup_indices  # noqa: E402
+from galvo_core.thin import dedup_indices, thin_many  # noqa: E402
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.join(HERE, "..")
@@ -245,10 +256,145 @@ def ours(paths, e_per: float = E_PER, reps: int = 3) -> dict:
     )
 
 
+# --- speed on whole drawings -------------------------------------------------------------
+
+#: (name, file, e_per, eps_line): drawings of many small paths and one of a few long ones
+SPEED_SET = [
+    ("seal.plt", "samples/seal.plt", E_PER, E_PER),
+    ("text_outline.plt", "samples/text_outline.plt", 0.75, 0.5),
+    ("noten.hpgl", "corpus/h42i__monoplots__noten.hpgl", E_PER, E_PER),
+    ("noten.hpgl", "corpus/h42i__monoplots__noten.hpgl", 0.75, E_PER),
+    ("curve_1181.plt", "samples/curve_1181.plt", E_PER, E_PER),
+    ("sines 100k", "generated/sines", E_PER, E_PER),
+]
+
+
+def _baseline_fit_drawing(rev: str):
+    """``fit_drawing`` of git revision ``rev``: its runs.py, fit.py and geometry.py copied
+    into a temporary package (imports rewritten), today's galvo_core for everything else."""
+    tmp = tempfile.mkdtemp(prefix="fit_baseline_")
+    pkg = os.path.join(tmp, "fit_baseline")
+    os.makedirs(pkg)
+    open(os.path.join(pkg, "__init__.py"), "w").close()
+    for name in ("runs", "fit", "geometry"):
+        src = subprocess.run(
+            ["git", "show", f"{rev}:galvo_core/{name}.py"],
+            cwd=ROOT,
+            capture_output=True,
+            text=True,
+            check=True,
+        ).stdout
+        for mod in ("runs", "geometry"):
+            src = src.replace(f"from galvo_core.{mod} import", f"from fit_baseline.{mod} import")
+        with open(os.path.join(pkg, f"{name}.py"), "w") as f:
+            f.write(src)
+    sys.path.insert(0, tmp)
+    return importlib.import_module("fit_baseline.fit").fit_drawing
+
+
+def _same_segments(a, b) -> bool:
+    return all(
+        fa.max_error == fb.max_error
+        and fa.n_thinned == fb.n_thinned
+        and len(fa.segments) == len(fb.segments)
+        and all(
+            sa.kind == sb.kind
+            and (sa.first, sa.last) == (sb.first, sb.last)
+            and np.array_equal(sa.points, sb.points)
+            for sa, sb in zip(fa.segments, fb.segments, strict=True)
+        )
+        for fa, fb in zip(a, b, strict=True)
+    )
+
+
+def drawing_speeds(baseline: str | None, reps: int) -> list[dict]:
+    """Input points/s of ``fit_drawing`` on SPEED_SET (best of ``reps``, thinning timed
+    on its own; old and new interleaved when ``baseline`` is given)."""
+    corpus = os.environ.get("GALVO_CORPUS", "/work/shared/corpus/plt")
+    where = dict(samples=os.path.join(ROOT, "resources", "samples"), corpus=corpus)
+    old_fit = _baseline_fit_drawing(baseline) if baseline else None
+    rows = []
+    for name, rel, e_per, eps_line in SPEED_SET:
+        top, fn = rel.split("/")
+        if top == "generated":  # the thinning bench's speed curve, one open path
+            d = Drawing((Path.from_points(sines()),))
+        elif os.path.exists(os.path.join(where[top], fn)):
+            d = read_file(os.path.join(where[top], fn))
+        else:
+            continue
+        works = []
+        for p in d.paths:
+            w = np.asarray(p.points, float).reshape(-1, 2)
+            if p.closed and len(w) >= 2 and not np.array_equal(w[0], w[-1]):
+                w = np.vstack([w, w[:1]])
+            works.append(w)
+        runs = dict(
+            thin=functools.partial(thin_many, works, eps_line),
+            new=functools.partial(fit_drawing, d, e_per=e_per, eps_line=eps_line),
+        )
+        if old_fit is not None:
+            runs["old"] = functools.partial(old_fit, d, e_per=e_per, eps_line=eps_line)
+        load0 = os.getloadavg()[0]
+        best = {k: math.inf for k in runs}
+        out = {}
+        for _ in range(reps):
+            for k, f in runs.items():
+                t0 = time.perf_counter()
+                out[k] = f()
+                best[k] = min(best[k], time.perf_counter() - t0)
+        n = d.n_points
+        fits = out["new"]
+        row = dict(
+            set=name,
+            e_per=e_per,
+            eps_line=eps_line,
+            paths=len(d.paths),
+            points=n,
+            segments=sum(len(f.segments) for f in fits),
+            cubics=sum(f.n_cubics for f in fits),
+            max_error=max((f.max_error for f in fits), default=0.0),
+            load=(load0, os.getloadavg()[0]),
+            thin_s=best["thin"],
+            seconds=best["new"],
+            pts_per_s=n / best["new"],
+            fit_only_pts_per_s=n / max(best["new"] - best["thin"], 1e-9),
+        )
+        if old_fit is not None:
+            row.update(
+                old_seconds=best["old"],
+                old_pts_per_s=n / best["old"],
+                same_as_old=_same_segments(out["old"], fits),
+            )
+        rows.append(row)
+        old = (
+            f"  old {row['old_pts_per_s']:,.0f} pts/s (same: {row['same_as_old']})"
+            if old_fit is not None
+            else ""
+        )
+        print(
+            f"drawing {name:17s} e_per={e_per} eps_line={eps_line}: {row['paths']} paths, "
+            f"{n} pts, {row['segments']} segs ({row['cubics']} cubics), "
+            f"max err {row['max_error']:.4f} | thin {best['thin'] * 1e3:.1f} ms | new "
+            f"{row['pts_per_s']:,.0f} pts/s (without thinning {row['fit_only_pts_per_s']:,.0f})"
+            f"{old} | load {row['load'][0]:.2f}-{row['load'][1]:.2f}",
+            flush=True,
+        )
+    return rows
+
+
 def main() -> dict:
     ap = argparse.ArgumentParser()
     ap.add_argument("--json")
+    ap.add_argument("--speed-only", action="store_true")
+    ap.add_argument("--baseline", help="git revision whose fitter is timed alongside")
+    ap.add_argument("--reps", type=int, default=5)
     args = ap.parse_args()
+    if args.speed_only:
+        res = dict(drawings=drawing_speeds(args.baseline, args.reps))
+        if args.json:
+            with open(args.json, "w") as f:
+                json.dump(res, f, indent=1, default=float)
+        return res
     samples = os.path.join(ROOT, "resources", "samples")
     sets = [
         ("circle r=50, 400 pts", [(circle(50, 400), True)], 50.0),
@@ -286,42 +432,7 @@ def main() -> dict:
             f"{peers}{cm}",
             flush=True,
         )
-    # whole drawings (fit_drawing: all paths of a batch fitted together)
-    corpus = os.environ.get("GALVO_CORPUS", "/work/shared/corpus/plt")
-    drawings = []
-    for name, fp, e_per in [
-        ("seal.plt", os.path.join(samples, "seal.plt"), E_PER),
-        ("text_outline.plt", os.path.join(samples, "text_outline.plt"), 0.75),
-        ("noten.hpgl", os.path.join(corpus, "h42i__monoplots__noten.hpgl"), E_PER),
-        ("noten.hpgl", os.path.join(corpus, "h42i__monoplots__noten.hpgl"), 0.75),
-    ]:
-        if not os.path.exists(fp):
-            continue
-        d = read_file(fp)
-        best = math.inf
-        fits: tuple = ()
-        for _ in range(3):
-            t0 = time.perf_counter()
-            fits = fit_drawing(d, e_per=e_per)
-            best = min(best, time.perf_counter() - t0)
-        row = dict(
-            set=name,
-            e_per=e_per,
-            paths=len(d.paths),
-            points=d.n_points,
-            segments=sum(len(f.segments) for f in fits),
-            cubics=sum(f.n_cubics for f in fits),
-            max_error=max((f.max_error for f in fits), default=0.0),
-            seconds=best,
-            pts_per_s=d.n_points / best,
-        )
-        drawings.append(row)
-        print(
-            f"drawing {name:18s} e_per={e_per}: {row['paths']} paths, {row['points']} pts, "
-            f"{row['segments']} segs ({row['cubics']} cubics), max err {row['max_error']:.4f}, "
-            f"{row['pts_per_s']:,.0f} pts/s",
-            flush=True,
-        )
+    drawings = drawing_speeds(args.baseline, args.reps)
     # paper 000 Table 1
     d = read_file(os.path.join(samples, "curve_1181.plt"))
     fit_report(d)

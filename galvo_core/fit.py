@@ -30,9 +30,10 @@ with the smallest error, away from the ends) and both halves are fitted again; a
 two thinned points is a line (always within ``eps_line``). So the guarantee holds whatever
 the dichotomy does, and lines are the last resort.
 
-All curve pieces of a path are fitted together, round by round (:class:`_BatchFitter`): one
-set of array operations per dichotomy step for every open piece, one vectorised acceptance
-test, the failures split for the next round. The bisection uses up to 128 of the piece's
+All curve pieces of all paths of a batch are fitted together, round by round
+(:class:`_BatchFitter`): one set of array operations per dichotomy step for every open
+piece, one vectorised acceptance test, the failures split for the next round. Each piece's
+result does not depend on the other pieces in the batch. The bisection uses up to 128 of the piece's
 input points (every k-th); the acceptance test uses every input point, with nearest points
 from Newton steps seeded by arc length (a seeded search only for points over the bound).
 Any curve parameter gives an upper bound of the true distance, so the acceptance is never
@@ -62,13 +63,14 @@ from galvo_core.geometry import (
     cubic_length,
     gather_coeffs,
     nearest_on_cubic,
+    nearest_on_cubic_each,
     nearest_on_cubics,
     newton_nearest_many,
     point_polyline_distance,
     point_segment_distance,
     power_coeffs_many,
 )
-from galvo_core.runs import split_pieces
+from galvo_core.runs import segmented_cumsum, split_pieces_many
 from galvo_core.thin import check_positive, thin_many
 
 __all__ = [
@@ -166,6 +168,25 @@ def _check_params(eps_line: object, e_per: object, eps_sum: object) -> tuple[flo
     )
 
 
+_new = object.__new__
+_set_kind, _set_points, _set_first, _set_last = (
+    Segment.__dict__[f].__set__ for f in ("kind", "points", "first", "last")
+)
+
+
+def _make_segment(kind: str, points: np.ndarray, first: int, last: int) -> Segment:
+    """``Segment(kind, points, first, last)`` for arguments already of the right types
+    (``points`` a read-only float64 array), about 1.6x faster than the frozen dataclass's
+    ``__init__`` (it sets the slots directly): fit_paths builds one per segment, tens of
+    thousands per drawing."""
+    s = _new(Segment)
+    _set_kind(s, kind)
+    _set_points(s, points)
+    _set_first(s, first)
+    _set_last(s, last)
+    return s
+
+
 def _seg(kind: str, pts: np.ndarray, first: int, last: int) -> Segment:
     arr = np.array(pts, dtype=np.float64)
     arr.setflags(write=False)
@@ -229,8 +250,15 @@ def _ragged(starts: np.ndarray, counts: np.ndarray) -> tuple[np.ndarray, np.ndar
     return owner, off
 
 
+def _halves(a: np.ndarray, b: np.ndarray, k: np.ndarray) -> np.ndarray:
+    """Pieces (a, k) and (k, b) for every split piece, in order: (2n, 2)."""
+    return np.stack([np.stack([a, k], axis=1), np.stack([k, b], axis=1)], axis=1).reshape(-1, 2)
+
+
 class _BatchFitter:
-    """Fits all curve pieces of one path together, round by round.
+    """Fits curve pieces together (of one path, or of many concatenated paths: ``work`` the
+    input points, ``kept`` the thinned indices into it, ``arc`` the cumulative arc length
+    restarted at every path), round by round.
 
     Each round takes every piece still to do, runs the dichotomy for all of them at once
     (one set of array operations per step, whatever the number of pieces), tests them all
@@ -246,7 +274,7 @@ class _BatchFitter:
         t_out: np.ndarray,
         e_per: float,
         eps_sum: float,
-        arc: np.ndarray | None = None,
+        arc: np.ndarray,
     ) -> None:
         self.work = work
         self.kept = kept
@@ -255,14 +283,9 @@ class _BatchFitter:
         self.t_out = t_out
         self.e_per = e_per
         self.eps_sum = eps_sum
-        if arc is None:
-            seg = np.hypot(*np.diff(work, axis=0).T)
-            arc = np.concatenate(([0.0], np.cumsum(seg)))
-        #: cumulative arc length (per path when several paths are concatenated)
         self.arc = arc
-        #: accepted cubics: (a, b, ctrl, bound of the max input error)
-        self.cubics: list[tuple[int, int, np.ndarray, float]] = []
-        self.lines: list[int] = []  # a of line pieces (a, a + 1)
+        self._cubics: list[tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]] = []
+        self._lines: list[np.ndarray] = []
 
     # -- the one-parameter family ---------------------------------------------------------
     def _triangle(self, A: np.ndarray, B: np.ndarray):
@@ -417,48 +440,73 @@ class _BatchFitter:
             ok &= worst <= e2
         return ok, emax, dist, starts
 
-    def fit(self, curve_pieces: list[tuple[int, int]]) -> None:
-        todo = [(a, b) for a, b in curve_pieces]
-        while todo:
-            ab = np.asarray(todo, dtype=np.intp).reshape(-1, 2)
-            todo = []
+    def fit(self, curve_pieces: np.ndarray) -> None:
+        """Fit the curve pieces (P, 2) (inclusive thinned index ranges a, b); the results
+        are in :meth:`results`."""
+        ab = np.asarray(curve_pieces, dtype=np.intp).reshape(-1, 2)
+        while len(ab):
             line = ab[:, 1] - ab[:, 0] == 1
-            self.lines.extend(int(a) for a in ab[line, 0])
+            self._lines.append(ab[line, 0])
             ab = ab[~line]
             if len(ab) == 0:
                 break
             A, B = ab[:, 0], ab[:, 1]
             ok, p0, qq, p3, sig = self._triangle(A, B)
-            for a, b in ab[~ok]:
-                k = (int(a) + int(b)) // 2
-                todo += [(int(a), k), (k, int(b))]
+            # no triangle (tangents do not meet in front of both ends): split in the middle
+            todo = [_halves(A[~ok], B[~ok], (A[~ok] + B[~ok]) // 2)]
             A, B = A[ok], B[ok]
-            if len(A) == 0:
-                continue
-            i0, i1 = self.kept[A], self.kept[B]
-            ctrl = self._dichotomy(p0[ok], qq[ok], p3[ok], sig[ok], i0, i1)
-            good, emax, dist, starts = self._accept(ctrl, i0, i1)
-            for r in range(len(A)):
-                a, b = int(A[r]), int(B[r])
-                if good[r]:
-                    self.cubics.append((a, b, ctrl[r], float(emax[r])))
-                    continue
-                k = self._split_point(a, b, dist, int(starts[r]))
-                todo += [(a, k), (k, b)]
+            if len(A):
+                i0, i1 = self.kept[A], self.kept[B]
+                ctrl = self._dichotomy(p0[ok], qq[ok], p3[ok], sig[ok], i0, i1)
+                good, emax, dist, starts = self._accept(ctrl, i0, i1)
+                self._cubics.append((A[good], B[good], ctrl[good], emax[good]))
+                bad = ~good
+                k = self._split_points(A[bad], B[bad], dist, starts[bad])
+                todo.append(_halves(A[bad], B[bad], k))
+            ab = np.concatenate(todo)
 
-    def _split_point(self, a: int, b: int, dist: np.ndarray, start: int) -> int:
-        if b - a <= 3:
-            return (a + b) // 2
-        # the interior thinned point with the smallest error, in the middle 60 % of the
-        # piece by input index (the crossing of data and curve), else the middle
-        i0, i1 = int(self.kept[a]), int(self.kept[b])
-        kk = self.kept[a + 1 : b]
-        frac = (kk - i0) / max(1, i1 - i0)
+    def results(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """``(a, b, ctrl, bound, line_a)``: the accepted cubics (thinned index ranges a..b,
+        control points (C, 4, 2), an upper bound of each one's largest input-point error)
+        and the pieces that ended as lines (line_a .. line_a + 1)."""
+        cub = self._cubics
+        line_a = np.concatenate(self._lines) if self._lines else np.zeros(0, dtype=np.intp)
+        if not cub:
+            e = np.zeros(0, dtype=np.intp)
+            return e, e, np.zeros((0, 4, 2)), np.zeros(0), line_a
+        return (
+            np.concatenate([c[0] for c in cub]),
+            np.concatenate([c[1] for c in cub]),
+            np.concatenate([c[2] for c in cub]),
+            np.concatenate([c[3] for c in cub]),
+            line_a,
+        )
+
+    def _split_points(
+        self, A: np.ndarray, B: np.ndarray, dist: np.ndarray, starts: np.ndarray
+    ) -> np.ndarray:
+        """Where to split each failed piece A..B (thinned indices): the interior thinned
+        point with the smallest error (``dist``, the piece's input points from ``starts``)
+        in the middle 60 % of the piece by input index (the crossing of data and curve),
+        the first such point on ties; else, and for pieces of <= 3 segments, the middle."""
+        k = (A + B) // 2
+        big = np.flatnonzero(B - A > 3)
+        if len(big) == 0:
+            return k
+        a, b = A[big], B[big]
+        i0, i1 = self.kept[a], self.kept[b]
+        own, off = _ragged(a, b - a - 1)
+        kk = self.kept[a[own] + 1 + off]
+        frac = (kk - i0[own]) / np.maximum(1, i1 - i0)[own]
         mid = (frac >= 0.2) & (frac <= 0.8)
-        if not mid.any():
-            return (a + b) // 2
-        err = dist[start + kk[mid] - i0]
-        return int(a + 1 + np.flatnonzero(mid)[int(np.argmin(err))])
+        err = dist[starts[big][own] + kk - i0[own]]
+        gmin = np.full(len(big), np.inf)
+        np.minimum.at(gmin, own[mid], err[mid])  # NaN wins, as in argmin
+        g = gmin[own]
+        cand = np.flatnonzero(mid & ((err == g) | (np.isnan(err) & np.isnan(g))))
+        grp, first = np.unique(own[cand], return_index=True)
+        k[big[grp]] = a[grp] + 1 + off[cand[first]]
+        return k
 
 
 def fit_path(
@@ -489,41 +537,6 @@ def fit_path(
     )[0]
 
 
-def _maybe_curvy(
-    qs: list[np.ndarray], cos_join: float = 0.95, length_ratio: float = 3.0
-) -> list[bool]:
-    """Per thinned path: False when it certainly has no curve run (no two consecutive
-    smooth interior vertices, the rule of :func:`galvo_core.runs.smooth_vertices`), so
-    every piece is a line; one vectorised pass over all paths."""
-    lens = np.array([len(q) for q in qs], dtype=np.intp)
-    out = [False] * len(qs)
-    if not len(qs) or lens.max() < 4:
-        return out
-    q = np.concatenate(qs)
-    s = np.diff(q, axis=0)
-    ln = np.hypot(s[:, 0], s[:, 1])
-    with np.errstate(invalid="ignore", divide="ignore"):
-        cos = (s[:-1] * s[1:]).sum(axis=1) / (ln[:-1] * ln[1:])  # at vertex k + 1
-    ends = np.cumsum(lens)
-    firsts = ends - lens
-    bad = np.zeros(len(q), dtype=bool)  # vertex index k not interior
-    bad[firsts] = True
-    bad[ends - 1] = True
-    la, lb = ln[:-1], ln[1:]
-    ratio_ok = (lb <= length_ratio * la) & (la <= length_ratio * lb)
-    # the path's last vertex: a short tail does not count (as in runs.smooth_vertices)
-    tail = np.zeros(len(q), dtype=bool)
-    tail[ends - 2] = True
-    ratio_ok |= tail[1:-1] & (lb < la)
-    sm = np.zeros(len(q), dtype=bool)
-    sm[1:-1] = (cos > cos_join) & ratio_ok
-    sm &= ~bad
-    pair = sm[:-1] & sm[1:]
-    owner = np.repeat(np.arange(len(qs)), lens)[:-1]
-    hit = np.bincount(owner[pair], minlength=len(qs)) > 0
-    return (hit & (lens >= 4)).tolist()
-
-
 def fit_paths(
     paths: Sequence[object],
     closed: Sequence[bool],
@@ -536,10 +549,12 @@ def fit_paths(
 ) -> list[FittedPath]:
     """:func:`fit_path` for many paths at once (the same result as one call per path).
 
-    The thinning runs for all paths in one go (:func:`galvo_core.thin.thin_many`), paths
-    without any curve run skip the tangents, and the curve pieces of ALL paths are fitted
-    together by one :class:`_BatchFitter` (concatenated points; pieces never cross a path),
-    so the fixed cost per path is a few Python operations, not a few hundred array calls.
+    Every stage runs for all paths together on their concatenated points: the thinning
+    (:func:`galvo_core.thin.thin_many`), the curve runs and their pieces
+    (:func:`galvo_core.runs.split_pieces_many`), the fit of every curve piece (one
+    :class:`_BatchFitter`; pieces never cross a path), the errors of all lines and the exact
+    errors of the cubics that decide a path's ``max_error``. The fixed cost per path is a
+    few Python operations (building its segments), not a few hundred array calls.
     """
     eps_line, e_per, eps_sum = _check_params(eps_line, e_per, eps_sum)
     npth = len(paths)
@@ -547,178 +562,178 @@ def fit_paths(
         raise ValueError("fit_paths: one closed flag per path")
     src = list(range(npth)) if source_indices is None else [int(i) for i in source_indices]
     pen = [1] * npth if pens is None else [int(p) for p in pens]
-    works: list[np.ndarray] = []
-    ns: list[int] = []
-    for pts0 in paths:
-        pts = np.asarray(pts0, dtype=np.float64).reshape(-1, 2)
-        if not np.isfinite(pts).all():
-            raise ParamError("points must be finite numbers (found NaN or infinity)")
-        ns.append(len(pts))
-        works.append(pts)
-    for k in range(npth):
-        pts = works[k]
-        if closed[k] and len(pts) >= 2 and not np.array_equal(pts[0], pts[-1]):
-            works[k] = np.vstack([pts, pts[:1]])
+    cl = [bool(c) for c in closed]
+    works, ns = _closed_works(paths, cl)
     kept_all = thin_many(works, eps_line)
+    wlen = np.array([len(w) for w in works], dtype=np.intp)
+    klen = np.array([len(k) for k in kept_all], dtype=np.intp)
     out: list[FittedPath | None] = [None] * npth
-    todo: list[int] = []
-    for k in range(npth):
-        if ns[k] == 0:
-            out[k] = FittedPath(src[k], pen[k], bool(closed[k]), (), 0.0, 0, 0)
-        elif len(kept_all[k]) == 1:
-            w = works[k]
-            seg = _seg("line", w[[0, 0]], 0, len(w) - 1)
-            out[k] = FittedPath(src[k], pen[k], bool(closed[k]), (seg,), 0.0, ns[k], 1)
-        else:
-            todo.append(k)
-    if not todo:
-        return out  # type: ignore[return-value]
-    qs = [works[k][kept_all[k]] for k in todo]
-    curvy = _maybe_curvy(qs)
-    # one concatenated work array; kept indices and thinned indices made global
-    wlen = np.array([len(works[k]) for k in todo], dtype=np.intp)
-    woff = np.concatenate(([0], np.cumsum(wlen)))
-    klen = np.array([len(kept_all[k]) for k in todo], dtype=np.intp)
-    koff = np.concatenate(([0], np.cumsum(klen)))
-    W = np.concatenate([works[k] for k in todo]) if len(todo) > 1 else works[todo[0]]
-    K = np.concatenate([kept_all[k] + woff[t] for t, k in enumerate(todo)])
+    for k in np.flatnonzero(klen == 1).tolist():  # a dot: all points equal
+        seg = _seg("line", works[k][[0, 0]], 0, len(works[k]) - 1)
+        out[k] = FittedPath(src[k], pen[k], cl[k], (seg,), 0.0, ns[k], 1)
+    for k in np.flatnonzero(wlen == 0).tolist():
+        out[k] = FittedPath(src[k], pen[k], cl[k], (), 0.0, 0, 0)
+    todo = np.flatnonzero((wlen > 0) & (klen != 1))
+    if len(todo):
+        fitted = _fit_concatenated(works, kept_all, todo, cl, e_per, eps_sum)
+        for t, k in enumerate(todo.tolist()):
+            segs, worst = fitted[t]
+            out[k] = FittedPath(src[k], pen[k], cl[k], segs, worst, ns[k], int(klen[k]))
+    return out  # type: ignore[return-value]
+
+
+def _closed_works(
+    paths: Sequence[object], closed: list[bool]
+) -> tuple[list[np.ndarray], list[int]]:
+    """The paths as float (N, 2) arrays, a closed path whose last point differs from its
+    first with that point appended, and their input point counts N; non-finite
+    coordinates refused (ParamError)."""
+    works = [np.asarray(p, dtype=np.float64).reshape(-1, 2) for p in paths]
+    n = np.array([len(w) for w in works], dtype=np.intp)
+    if not works:
+        return works, []
+    allp = np.concatenate(works)
+    if not np.isfinite(allp).all():
+        raise ParamError("points must be finite numbers (found NaN or infinity)")
+    last = np.cumsum(n) - 1
+    cand = np.flatnonzero(np.asarray(closed, dtype=bool) & (n >= 2))
+    open_ends = cand[(allp[last[cand] - n[cand] + 1] != allp[last[cand]]).any(axis=1)]
+    for k in open_ends.tolist():
+        works[k] = np.vstack([works[k], works[k][:1]])
+    return works, n.tolist()
+
+
+def _fit_concatenated(
+    works: list[np.ndarray],
+    kept_all: list[np.ndarray],
+    todo: np.ndarray,
+    closed: list[bool],
+    e_per: float,
+    eps_sum: float,
+) -> list[tuple[tuple[Segment, ...], float]]:
+    """Segments and max_error of the paths ``todo`` (>= 2 thinned points each), all at once
+    on the concatenation of every path's points (global indices below)."""
+    wlen = np.array([len(w) for w in works], dtype=np.intp)
+    woff = np.cumsum(wlen) - wlen
+    klen = np.array([len(k) for k in kept_all], dtype=np.intp)
+    W = np.concatenate(works) if len(works) > 1 else works[0]
+    K = np.concatenate(kept_all).astype(np.intp, copy=False) + np.repeat(woff, klen)
+    K = K[np.repeat(np.isin(np.arange(len(works)), todo), klen)]
+    tlen = klen[todo]
+    kend = np.cumsum(tlen) - 1  # each path's last thinned point
     Q = W[K]
-    t_in = np.zeros((len(K), 2))
-    t_out = np.zeros((len(K), 2))
-    # per path: (a, b) pieces in global thinned indices; lines and curves
-    line_pieces: list[list[tuple[int, int]]] = [[] for _ in todo]
-    curve_pieces: list[tuple[int, int]] = []
-    for t, k in enumerate(todo):
-        o = int(koff[t])
-        m = int(klen[t])
-        if not curvy[t]:
-            line_pieces[t] = [(o + i, o + i + 1) for i in range(m - 1)]
-            continue
-        pieces, ti, to = split_pieces(qs[t], closed=bool(closed[k]))
-        t_in[o : o + m] = ti
-        t_out[o : o + m] = to
-        for pc in pieces:
-            if pc.kind == "curve":
-                curve_pieces.append((o + pc.a, o + pc.b))
-            else:
-                line_pieces[t].append((o + pc.a, o + pc.b))
-    # arc length restarted at every path (the same numbers as for one path alone)
-    arc = np.zeros(len(W))
-    for t in range(len(todo)) if curve_pieces else ():
-        if not curvy[t]:
-            continue
-        w = W[woff[t] : woff[t + 1]]
-        np.cumsum(np.hypot(*np.diff(w, axis=0).T), out=arc[woff[t] + 1 : woff[t + 1]])
-    fitter = _BatchFitter(W, K, t_in, t_out, e_per, eps_sum, arc)
-    owner_of = np.repeat(np.arange(len(todo)), klen)
-    if curve_pieces:
-        with np.errstate(invalid="ignore", divide="ignore"):
-            fitter.fit(curve_pieces)
-    # distribute the fitter's results to their paths (global thinned index -> path)
-    cub_by: list[list[tuple[int, int, np.ndarray, float]]] = [[] for _ in todo]
-    for c in fitter.cubics:
-        cub_by[int(owner_of[c[0]])].append(c)
-    for a in fitter.lines:
-        line_pieces[int(owner_of[a])].append((a, a + 1))
-    # all line segments at once: their points (read-only views) and their true max error
-    la = np.array([a for lp in line_pieces for a, _ in lp], dtype=np.intp)
-    lb = np.array([b for lp in line_pieces for _, b in lp], dtype=np.intp)
-    lpts = np.stack([Q[la], Q[lb]], axis=1) if len(la) else np.zeros((0, 2, 2))
+    pa, pb, curve, t_in, t_out = split_pieces_many(Q, tlen, np.asarray(closed)[todo])
+    fitter = _BatchFitter(W, K, t_in, t_out, e_per, eps_sum, _arc_per_path(W, wlen))
+    with np.errstate(invalid="ignore", divide="ignore"):
+        fitter.fit(np.stack([pa[curve], pb[curve]], axis=1))
+    ca, cb, ctrl, bound, fla = fitter.results()
+    la = np.concatenate([pa[~curve], fla])
+    lb = la + 1
+    owner = np.repeat(np.arange(len(todo)), tlen)  # thinned index -> position in todo
+    o_w = woff[todo]
+    end_w = o_w + wlen[todo] - 1  # each path's last input point (trailing repeats included)
+    # line points (read-only views of one array) and their true max error
+    lpts = np.stack([Q[la], Q[lb]], axis=1)
     lpts.setflags(write=False)
     lfirst = K[la]
-    llast = K[lb]
-    # a line ending at the path's last thinned point also takes its trailing repeats
-    is_end = np.isin(lb, koff[1:] - 1)
-    llast[is_end] = woff[owner_of[lb[is_end]] + 1] - 1
+    llast = np.where(np.isin(lb, kend), end_w[owner[lb]], K[lb])
     lerr = _line_errors(W, lpts, lfirst, llast)
-    lfirst_l = lfirst.tolist()
-    llast_l = llast.tolist()
-    la_l = la.tolist()
-    lerr_l = lerr.tolist()
-    pos = 0
-    for t, k in enumerate(todo):
-        o_w = int(woff[t])
-        items: list[tuple[int, Segment]] = []
-        worst = 0.0
-        for _ in range(len(line_pieces[t])):
-            items.append(
-                (la_l[pos], Segment("line", lpts[pos], lfirst_l[pos] - o_w, llast_l[pos] - o_w))
-            )
-            worst = max(worst, lerr_l[pos])
-            pos += 1
-        bounds: dict[int, float] = {}
-        for a, b, ctl, e in cub_by[t]:
-            sg = _seg("cubic", ctl, int(K[a]) - o_w, int(K[b]) - o_w)
-            items.append((a, sg))
-            bounds[sg.first] = e
-        items.sort(key=lambda it: it[0])
-        segs = [it[1] for it in items]
-        work = works[k]
-        last = segs[-1]
-        if last.last != len(work) - 1:  # trailing repeats of the end point
-            segs[-1] = Segment(last.kind, last.points, last.first, len(work) - 1)
-        if bounds:
-            worst = max(worst, _cubic_max_error(work, segs, bounds))
-        out[k] = FittedPath(
-            src[k], pen[k], bool(closed[k]), tuple(segs), worst, ns[k], int(klen[t])
-        )
-    return out  # type: ignore[return-value]
+    worst = np.zeros(len(todo))
+    np.fmax.at(worst, owner[la], lerr)  # NaN (overflow) ignored, as max() did
+    # cubics: a segment ending at the path's last thinned point takes its trailing repeats
+    ctrl = np.ascontiguousarray(ctrl)
+    ctrl.setflags(write=False)
+    cfirst = K[ca]
+    clast = np.where(np.isin(cb, kend), end_w[owner[cb]], K[cb])
+    if len(ca):
+        worst = _cubic_worst(W, ctrl, cfirst, clast, bound, owner[ca], worst)
+    # all segments in path order
+    seg_a = np.concatenate([la, ca])
+    order = np.argsort(seg_a, kind="stable")
+    nl = len(la)
+    kinds = np.array(["line", "cubic"])[(order >= nl).astype(np.intp)].tolist()
+    pts = list(lpts) + list(ctrl)
+    seg_owner = owner[seg_a[order]]
+    first = (np.concatenate([lfirst, cfirst])[order] - o_w[seg_owner]).tolist()
+    last = (np.concatenate([llast, clast])[order] - o_w[seg_owner]).tolist()
+    segs = list(map(_make_segment, kinds, [pts[i] for i in order.tolist()], first, last))
+    bounds = np.searchsorted(seg_owner, np.arange(len(todo) + 1)).tolist()
+    wl = worst.tolist()
+    return [(tuple(segs[bounds[t] : bounds[t + 1]]), wl[t]) for t in range(len(todo))]
+
+
+def _arc_per_path(W: np.ndarray, wlen: np.ndarray) -> np.ndarray:
+    """Cumulative arc length along the concatenated paths, restarted at 0 at every path's
+    first point (the same numbers as ``cumsum`` on each path alone)."""
+    arc = np.zeros(len(W))
+    if len(W) < 2:
+        return arc
+    seg = np.hypot(*np.diff(W, axis=0).T)
+    inside = np.ones(len(seg), dtype=bool)
+    starts = np.cumsum(wlen) - wlen
+    inside[starts[(starts > 0) & (wlen > 0)] - 1] = False  # from one path to the next
+    j = np.flatnonzero(inside)
+    arc[j + 1] = segmented_cumsum(seg[j], np.maximum(wlen - 1, 0))
+    return arc
 
 
 def _line_errors(
     work: np.ndarray, pts: np.ndarray, first: np.ndarray, last: np.ndarray
 ) -> np.ndarray:
     """Per line segment: the largest distance of the input points first..last (indices into
-    ``work``) to the segment ``pts[k]`` (true distances, all segments at once)."""
-    if len(first) == 0:
-        return np.zeros(0)
-    cnt = last - first + 1
-    starts = np.cumsum(cnt) - cnt
-    own = np.repeat(np.arange(len(first)), cnt)
-    idx = first[own] + np.arange(int(cnt.sum())) - starts[own]
-    d = point_segment_distance(work[idx], pts[own, 0], pts[own, 1])
-    return np.maximum.reduceat(d, starts)
+    ``work``) to the segment ``pts[k]`` (true distances, all segments at once). The first
+    and last of those points are the segment's own end points (or repeats of its end), at
+    distance 0, so only the points between them are measured."""
+    err = np.zeros(len(first))
+    cnt = last - first - 1
+    has = np.flatnonzero(cnt > 0)
+    if len(has) == 0:
+        return err
+    c = cnt[has]
+    own, off = _ragged(has, c)
+    idx = first[has][own] + 1 + off
+    seg = pts[has][own]
+    d = point_segment_distance(work[idx], seg[:, 0], seg[:, 1])
+    err[has] = np.maximum.reduceat(d, np.cumsum(c) - c)
+    return err
 
 
-def _cubic_max_error(work: np.ndarray, segs: list[Segment], bound: dict[int, float]) -> float:
-    """Largest true input-point error over the cubics. The fitter's per-cubic values
-    (``bound``, by first index) are upper bounds (distances to some curve point); the cubics
-    are measured exactly (seeded nearest point) in decreasing order of their bound until no
-    bound left can beat the largest exact value."""
-    cubics = [s for s in segs if s.kind == "cubic"]
-    if not cubics:
-        return 0.0
-    bounds = np.array([bound[s.first] for s in cubics])
-    order = np.argsort(-bounds)
-    worst = 0.0
-    for i in order:
-        if bounds[i] <= worst:
-            break
-        s = cubics[int(i)]
-        _, d = nearest_on_cubic(s.points, work[s.first : s.last + 1])
-        worst = max(worst, float(min(d.max(), bounds[i])))
-    return worst
+def _cubic_worst(
+    work: np.ndarray,
+    ctrl: np.ndarray,
+    first: np.ndarray,
+    last: np.ndarray,
+    bound: np.ndarray,
+    path: np.ndarray,
+    worst: np.ndarray,
+) -> np.ndarray:
+    """Per path: ``worst`` raised to the largest true input-point error of its cubics.
 
-
-def _max_error(work: np.ndarray, segs: list[Segment], *, cubics: bool = True) -> float:
-    """Largest distance of an input point to the segment that replaces it (lines only
-    when ``cubics`` is False: the fitter already measured its cubics)."""
-    worst = 0.0
-    lines = [s for s in segs if s.kind == "line"]
-    if lines:
-        firsts = np.array([s.first for s in lines])
-        lasts = np.array([s.last for s in lines])
-        counts = lasts - firsts + 1
-        idx = np.repeat(firsts, counts) + (
-            np.arange(counts.sum()) - np.repeat(np.cumsum(counts) - counts, counts)
-        )
-        a = np.repeat(np.array([s.points[0] for s in lines]), counts, axis=0)
-        b = np.repeat(np.array([s.points[1] for s in lines]), counts, axis=0)
-        worst = float(point_segment_distance(work[idx], a, b).max())
-    for s in segs if cubics else ():
-        if s.kind == "cubic":
-            _, d = nearest_on_cubic(s.points, work[s.first : s.last + 1])
-            worst = max(worst, float(d.max()))
+    The fitter's per-cubic values (``bound``) are upper bounds (distances to some curve
+    point). A cubic is measured exactly (seeded nearest point, input points first..last of
+    ``work``) only while its bound can beat its path's largest value so far: first the
+    cubic with the largest bound of every path, then all cubics still above their path's
+    value; a cubic's error is the smaller of its exact value and its bound. The result is
+    the largest error over all cubics whatever the order of measuring.
+    """
+    worst = worst.copy()
+    order = np.lexsort((-bound, path))  # by path, largest bound first
+    head = order[np.r_[True, path[order][1:] != path[order][:-1]]]
+    done = np.zeros(len(bound), dtype=bool)
+    for pick in (head, None):
+        if pick is None:
+            pick = np.flatnonzero(~done & (bound > worst[path]))
+        pick = pick[bound[pick] > worst[path[pick]]]
+        if len(pick) == 0:
+            continue
+        done[pick] = True
+        cnt = last[pick] - first[pick] + 1
+        starts = np.cumsum(cnt) - cnt
+        own = np.repeat(np.arange(len(pick)), cnt)
+        idx = first[pick][own] + np.arange(int(cnt.sum())) - starts[own]
+        _, d = nearest_on_cubic_each(ctrl[pick], own, work[idx])
+        e = np.minimum(np.maximum.reduceat(d, starts), bound[pick])
+        np.maximum.at(worst, path[pick], e)
     return worst
 
 

@@ -23,6 +23,7 @@ __all__ = [
     "cubic_second_derivative",
     "cubic_length",
     "nearest_on_cubic",
+    "nearest_on_cubic_each",
     "point_segment_distance",
     "point_polyline_distance",
     "flatten_cubic",
@@ -150,47 +151,136 @@ def nearest_on_cubic(
     """
     c = _ctrl(ctrl)
     p = np.asarray(pts, dtype=np.float64).reshape(-1, 2)
+    return nearest_on_cubic_each(
+        c[None], np.zeros(len(p), dtype=np.intp), p, seeds=seeds, iters=iters
+    )
+
+
+def _seed_counts(c: np.ndarray, seeds: int) -> np.ndarray:
+    """Samples - 1 per cubic (M, 4, 2): ``seeds``, more for a control polygon turning more
+    than 90 degrees (loops, cusps)."""
+    legs = np.diff(c, axis=1)
+    ang = np.arctan2(legs[..., 1], legs[..., 0])
+    turn = np.abs(np.angle(np.exp(1j * np.diff(ang, axis=1)))).sum(axis=1)
+    ratio = turn / (np.pi / 2)
+    return (seeds * np.where(ratio > 1.0, ratio, 1.0)).astype(np.intp)
+
+
+def _bernstein_each(c: np.ndarray, t: np.ndarray) -> np.ndarray:
+    """Point k of cubic ``c[k]`` (K, 4, 2) at ``t[k]`` (the arithmetic of
+    :func:`cubic_eval`, so the same bits)."""
+    t = t.reshape(-1, 1)
+    s = 1.0 - t
+    return (
+        (s * s * s) * c[:, 0]
+        + (3.0 * s * s * t) * c[:, 1]
+        + (3.0 * s * t * t) * c[:, 2]
+        + (t * t * t) * c[:, 3]
+    )
+
+
+def nearest_on_cubic_each(
+    ctrl: object, pid: object, pts: object, *, seeds: int = 48, iters: int = 6
+) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`nearest_on_cubic` for many points, each against its own cubic ``ctrl[pid[k]]``.
+
+    ``ctrl`` (M, 4, 2), ``pid`` (K,) ints, ``pts`` (K, 2) -> ``(t, dist)`` (K,) each: bit for
+    bit what :func:`nearest_on_cubic` gives for each cubic and its points (the same samples,
+    candidates and Newton steps; the sampled search runs once per distinct sample count, the
+    Newton refinement once for all points).
+    """
+    c = np.asarray(ctrl, dtype=np.float64).reshape(-1, 4, 2)
+    pid = np.asarray(pid, dtype=np.intp).reshape(-1)
+    p = np.asarray(pts, dtype=np.float64).reshape(-1, 2)
     k = len(p)
     if k == 0:
         return np.zeros(0), np.zeros(0)
-    # more seeds for curves whose control polygon turns a lot (loops, cusps)
-    legs = np.diff(c, axis=0)
-    ang = np.arctan2(legs[:, 1], legs[:, 0])
-    turn = np.abs(np.angle(np.exp(1j * np.diff(ang)))).sum()
-    ns = int(seeds * max(1.0, turn / (np.pi / 2)))
+    nsp = _seed_counts(c, seeds)[pid]
+    # per point: best sample, and the bracketed start of each candidate's Newton run
+    best_u = np.empty(k)
+    best_d2 = np.empty(k)
+    u0 = np.zeros((_NEAREST_CANDIDATES, k))
+    lo = np.zeros((_NEAREST_CANDIDATES, k))
+    hi = np.ones((_NEAREST_CANDIDATES, k))
+    ok = np.zeros((_NEAREST_CANDIDATES, k), dtype=bool)
+    for ns in np.unique(nsp).tolist():
+        sel = np.flatnonzero(nsp == ns)
+        _sampled_candidates(c, pid[sel], p[sel], ns, sel, best_u, best_d2, (u0, lo, hi, ok))
+    # Newton from every candidate (the arithmetic of _power_coeffs and cubic_eval)
+    p0, p1, p2, p3 = c[:, 0], c[:, 1], c[:, 2], c[:, 3]
+    coef = (
+        -p0 + 3.0 * p1 - 3.0 * p2 + p3,
+        3.0 * p0 - 6.0 * p1 + 3.0 * p2,
+        -3.0 * p0 + 3.0 * p1,
+        p0,
+    )
+    if len(c) == 1:  # one cubic (nearest_on_cubic): no per-point copies
+        cf: tuple[np.ndarray | float, ...] = tuple(float(x[0, j]) for x in coef for j in (0, 1))
+        cq = np.broadcast_to(c, (k, 4, 2))
+    else:
+        cf = tuple(x[pid, j] for x in coef for j in (0, 1))
+        cq = c[pid]
+    for m in range(_NEAREST_CANDIDATES):
+        u = newton_nearest_many(cf, p[:, 0], p[:, 1], u0[m], iters, lo=lo[m], hi=hi[m])[0]
+        r = _bernstein_each(cq, u) - p
+        dn = r[:, 0] * r[:, 0] + r[:, 1] * r[:, 1]
+        better = ok[m] & (dn < best_d2)
+        best_u = np.where(better, u, best_u)
+        best_d2 = np.where(better, dn, best_d2)
+    return best_u, np.sqrt(best_d2)
+
+
+def _sampled_candidates(
+    c: np.ndarray,
+    pid: np.ndarray,
+    p: np.ndarray,
+    ns: int,
+    out: np.ndarray,
+    best_u: np.ndarray,
+    best_d2: np.ndarray,
+    cands: tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray],
+) -> None:
+    """The sampled part of :func:`nearest_on_cubic_each` for cubics sampled at ``ns + 1``
+    parameters, written at positions ``out``: the best sample (``best_u``, ``best_d2``) of
+    each point ``p`` and, per candidate (the best few local minima of the sampled distance,
+    not only the smallest: near a cusp or loop the true nearest point can lie in the bracket
+    of a sample slightly farther than the best one), its start, bracket and validity
+    (``cands`` = u0, lo, hi, ok, each (candidates, K))."""
+    u0, lo, hi, ok = cands
+    cubs, ci = np.unique(pid, return_inverse=True)
+    cc = c[cubs]
     su = np.linspace(0.0, 1.0, ns + 1)
-    sp = cubic_eval(c, su)
-    t_out = np.empty(k)
-    d_out = np.empty(k)
-    rows = max(1, _CHUNK_CELLS // (ns + 1))
-    for s0 in range(0, k, rows):
+    t = su.reshape(1, -1, 1)
+    s = 1.0 - t
+    sp = (
+        (s * s * s) * cc[:, None, 0]
+        + (3.0 * s * s * t) * cc[:, None, 1]
+        + (3.0 * s * t * t) * cc[:, None, 2]
+        + (t * t * t) * cc[:, None, 3]
+    )  # (G, ns + 1, 2), the arithmetic of cubic_eval
+    spx = np.ascontiguousarray(sp[:, :, 0])
+    spy = np.ascontiguousarray(sp[:, :, 1])
+    rows = max(1, (_CHUNK_CELLS // 2) // (ns + 1))
+    ncand = min(_NEAREST_CANDIDATES, ns + 1)
+    for s0 in range(0, len(p), rows):
         q = p[s0 : s0 + rows]
-        d2 = (q[:, 0:1] - sp[None, :, 0]) ** 2 + (q[:, 1:2] - sp[None, :, 1]) ** 2
-        # refine the best few local minima of the sampled distance, not only the smallest
-        # sample: near a cusp or loop the true nearest point can lie in the bracket of a
-        # sample that is slightly farther than the best one
+        g = ci[s0 : s0 + rows]
+        o = out[s0 : s0 + rows]
+        d2 = (q[:, 0:1] - spx[g]) ** 2 + (q[:, 1:2] - spy[g]) ** 2
         local = np.ones_like(d2, dtype=bool)
         local[:, 1:] &= d2[:, 1:] <= d2[:, :-1]
         local[:, :-1] &= d2[:, :-1] <= d2[:, 1:]
         masked = np.where(local, d2, np.inf)
-        ncand = min(_NEAREST_CANDIDATES, ns + 1)
         cand = np.argpartition(masked, ncand - 1, axis=1)[:, :ncand]
+        best_u[o] = su[np.argmin(d2, axis=1)]
+        best_d2[o] = d2.min(axis=1)
         rowi = np.arange(len(q))
-        best_u = su[np.argmin(d2, axis=1)]
-        best_d2 = d2.min(axis=1)
         for m in range(ncand):
             j = cand[:, m]
-            ok = np.isfinite(masked[rowi, j])
-            u = _newton_nearest(c, q, su[j], su[np.maximum(j - 1, 0)],
-                                su[np.minimum(j + 1, ns)], iters)
-            r = cubic_eval(c, u) - q
-            dn = r[:, 0] * r[:, 0] + r[:, 1] * r[:, 1]
-            better = ok & (dn < best_d2)
-            best_u = np.where(better, u, best_u)
-            best_d2 = np.where(better, dn, best_d2)
-        t_out[s0 : s0 + rows] = best_u
-        d_out[s0 : s0 + rows] = np.sqrt(best_d2)
-    return t_out, d_out
+            ok[m, o] = np.isfinite(masked[rowi, j])
+            u0[m, o] = su[j]
+            lo[m, o] = su[np.maximum(j - 1, 0)]
+            hi[m, o] = su[np.minimum(j + 1, ns)]
 
 
 def nearest_on_cubic_warm(
@@ -297,8 +387,7 @@ def power_coeffs_many(ctrl: np.ndarray) -> np.ndarray:
 
 def gather_coeffs(coef: np.ndarray, pid: np.ndarray) -> tuple[np.ndarray, ...]:
     """The eight flat per-point coefficient arrays of cubic ``pid[k]`` (see above)."""
-    g = coef[pid]
-    return tuple(np.ascontiguousarray(g[:, i, j]) for i in range(4) for j in range(2))
+    return tuple(coef[:, i, j][pid] for i in range(4) for j in range(2))
 
 
 def newton_nearest_many(

@@ -29,6 +29,14 @@ and ``t_out`` (for a piece starting there). At a smooth vertex both are the Bess
 side of a split share the tangent (G1 joins). At a corner or at an open end they are one-sided
 parabola estimates from the two neighbours on that side, never one segment alone. A closed
 path whose seam vertex is smooth gets the two-sided estimate at the seam.
+
+Many paths at once
+------------------
+:func:`split_pieces_many` does all of the above for many thinned paths concatenated into one
+array (path boundaries respected: no vertex, run or piece crosses one), with a fixed number
+of array operations whatever the number of paths. Its result is exactly (bit for bit) that of
+:func:`split_pieces` per path; the single-path functions are the many-path ones applied to
+one path.
 """
 
 from __future__ import annotations
@@ -38,7 +46,20 @@ from dataclasses import dataclass
 
 import numpy as np
 
-__all__ = ["Piece", "smooth_vertices", "find_runs", "point_tangents", "split_pieces"]
+__all__ = [
+    "Piece",
+    "smooth_vertices",
+    "find_runs",
+    "point_tangents",
+    "split_pieces",
+    "split_pieces_many",
+    "segmented_cumsum",
+]
+
+#: np.unwrap's default period (numpy's pi is math.pi)
+_PERIOD = 2.0 * math.pi
+#: segments up to this length go into one padded table in :func:`segmented_cumsum`
+_SHORT_SEGMENT = 64
 
 
 @dataclass(frozen=True, slots=True)
@@ -51,9 +72,334 @@ class Piece:
     b: int
 
 
+@dataclass(frozen=True, slots=True)
+class _Layout:
+    """Where each point of a concatenation of paths sits: per point its index in its path
+    (``pos``) and its path's length (``m``); per path its first point (``starts``) and
+    length (``lens``)."""
+
+    starts: np.ndarray
+    lens: np.ndarray
+    pos: np.ndarray
+    m: np.ndarray
+
+    @staticmethod
+    def of(lens: object) -> _Layout:
+        ln = np.asarray(lens, dtype=np.intp).reshape(-1)
+        starts = np.cumsum(ln) - ln
+        m = np.repeat(ln, ln)
+        pos = np.arange(len(m)) - np.repeat(starts, ln)
+        return _Layout(starts, ln, pos, m)
+
+    @property
+    def interior(self) -> np.ndarray:
+        """Per point: neither the first nor the last point of its path."""
+        return (self.pos > 0) & (self.pos < self.m - 1)
+
+
+def segmented_cumsum(x: object, lens: object) -> np.ndarray:
+    """``np.cumsum`` restarted at every segment of ``x`` (consecutive segments of lengths
+    ``lens``, summing to ``len(x)``): bit for bit what ``np.cumsum`` gives on each segment
+    alone (the same sequential additions; short segments are summed as rows of one padded
+    table, long ones one at a time)."""
+    v = np.asarray(x, dtype=np.float64).reshape(-1)
+    ln = np.asarray(lens, dtype=np.intp).reshape(-1)
+    out = np.empty_like(v)
+    starts = np.cumsum(ln) - ln
+    short = (ln > 0) & (ln <= _SHORT_SEGMENT)
+    if short.any():
+        sl = ln[short]
+        rows = np.repeat(np.arange(len(sl)), sl)
+        cols = np.arange(len(rows)) - np.repeat(np.cumsum(sl) - sl, sl)
+        src = starts[short][rows] + cols
+        tab = np.zeros((len(sl), int(sl.max())))
+        tab[rows, cols] = v[src]
+        np.cumsum(tab, axis=1, out=tab)
+        out[src] = tab[rows, cols]
+    long_ = ln > _SHORT_SEGMENT
+    for s0, n in zip(starts[long_].tolist(), ln[long_].tolist(), strict=True):
+        np.cumsum(v[s0 : s0 + n], out=out[s0 : s0 + n])
+    return out
+
+
 def _segments(q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     s = np.diff(q, axis=0)
     return s, np.hypot(s[:, 0], s[:, 1])
+
+
+def _vertex_rules(
+    q: np.ndarray,
+    lay: _Layout,
+    cos_join: float,
+    length_ratio: float,
+    *,
+    want_turn: bool = False,
+    seg: tuple[np.ndarray, np.ndarray] | None = None,
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Per point of the concatenation: (smooth, turn angle or zeros, cross sign); only a
+    path's interior points can be smooth or have a turn (the rules of the module doc).
+    ``seg``: the segment vectors and lengths of ``q`` when already known."""
+    n = len(q)
+    smooth = np.zeros(n, dtype=bool)
+    turn = np.zeros(n)
+    sign = np.zeros(n)
+    if n < 3:
+        return smooth, turn, sign
+    s, ln = _segments(q) if seg is None else seg
+    a, b = s[:-1], s[1:]
+    la, lb = ln[:-1], ln[1:]
+    dot = (a * b).sum(axis=1)
+    cr = a[:, 0] * b[:, 1] - a[:, 1] * b[:, 0]
+    pos, m = lay.pos[1:-1], lay.m[1:-1]
+    inner = (pos > 0) & (pos < m - 1)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        cos = dot / (la * lb)
+        ratio_ok = (lb <= length_ratio * la) & (la <= length_ratio * lb)
+        # the greedy thinning leaves a short last segment (the tail of the path): it is not
+        # a long thinned line, so the length rule does not cut it off
+        ratio_ok |= (pos == m - 2) & (lb < la)
+        smooth[1:-1] = inner & (cos > cos_join) & ratio_ok
+        if want_turn:
+            turn[1:-1] = np.where(inner, np.arctan2(cr, dot), 0.0)
+        # a turn below ~1e-12 rad is numerically straight: no sign
+        sign[1:-1] = np.where(inner & (np.abs(cr) > 1e-12 * la * lb), np.sign(cr), 0.0)
+    return smooth, turn, sign
+
+
+def _runs(smooth: np.ndarray, sign: np.ndarray, lay: _Layout) -> tuple[np.ndarray, np.ndarray]:
+    """Curve runs of all paths: inclusive point ranges (ra, rb), rb - ra >= 3, in order.
+
+    A run ends at every interior vertex that is not smooth (a corner) and at every smooth
+    vertex whose turn has the opposite sign of the previous signed smooth vertex with no
+    corner in between (an inflection); path ends end runs too.
+    """
+    if len(smooth) == 0:
+        empty = np.zeros(0, dtype=np.intp)
+        return empty, empty
+    wall = ~smooth  # corners and path ends
+    stretch = np.cumsum(wall)
+    ends = wall.copy()
+    signed = np.flatnonzero(smooth & (sign != 0.0))
+    if len(signed) > 1:
+        p, c = signed[:-1], signed[1:]
+        flip = (stretch[p] == stretch[c]) & (sign[p] == -sign[c])
+        ends[c[flip]] = True
+    e = np.flatnonzero(ends)
+    s0, s1 = e[:-1], e[1:]
+    keep = (lay.pos[s0] != lay.m[s0] - 1) & (s1 - s0 >= 3)
+    return s0[keep], s1[keep]
+
+
+def _bessel(q0: np.ndarray, q1: np.ndarray, q2: np.ndarray) -> np.ndarray:
+    """Unit tangent at q1 of the parabola through three points (chord-length weights)."""
+    d0 = q1 - q0
+    d1 = q2 - q1
+    return _bessel_of(d0, np.hypot(d0[..., 0], d0[..., 1]), d1, np.hypot(d1[..., 0], d1[..., 1]))
+
+
+def _bessel_of(d0: np.ndarray, h0: np.ndarray, d1: np.ndarray, h1: np.ndarray) -> np.ndarray:
+    """:func:`_bessel` from the two segment vectors around the point and their lengths."""
+    h0 = h0[..., None]
+    h1 = h1[..., None]
+    t = (h1 / (h0 + h1)) * d0 / h0 + (h0 / (h0 + h1)) * d1 / h1
+    return t / np.hypot(t[..., 0], t[..., 1])[..., None]
+
+
+def _tangents(
+    q: np.ndarray,
+    lay: _Layout,
+    smooth: np.ndarray,
+    closed: np.ndarray,
+    cos_join: float,
+    length_ratio: float,
+    seg: tuple[np.ndarray, np.ndarray] | None = None,
+) -> tuple[np.ndarray, np.ndarray]:
+    """(t_in, t_out) of every point of the concatenation (see :func:`point_tangents`).
+
+    ``seg``: the segment vectors and lengths of ``q`` when already known.
+    """
+    n = len(q)
+    t_in = np.zeros((n, 2))
+    t_out = np.zeros((n, 2))
+    if n < 2:
+        return t_in, t_out
+    s, ln = _segments(q) if seg is None else seg
+    nonempty = lay.lens > 0
+    with np.errstate(invalid="ignore", divide="ignore"):
+        u = s / ln[:, None]
+        # one segment's direction, none across two paths
+        t_out[:-1] = u
+        t_out[(lay.starts + lay.lens - 1)[nonempty]] = 0.0
+        t_in[1:] = u
+        t_in[lay.starts[nonempty]] = 0.0
+        mid = np.flatnonzero(lay.interior)
+        if len(mid) == 0:
+            return t_in, t_out
+        central = np.zeros((n, 2))
+        central[mid] = _bessel_of(s[mid - 1], ln[mid - 1], s[mid], ln[mid])
+        # one-sided parabola estimates where no two-sided one replaces them: direction at
+        # angle 2·angle(segment) − angle(central tangent of the neighbour)
+        au = np.arctan2(u[:, 1], u[:, 0])
+        ac = np.zeros(n)
+        ac[mid] = np.arctan2(central[mid, 1], central[mid, 0])
+        f = np.flatnonzero((lay.pos <= lay.m - 3) & ~smooth)  # start at k: q[k], q[k+1], q[k+2]
+        ang = 2.0 * au[f] - ac[f + 1]
+        t_out[f, 0] = np.cos(ang)
+        t_out[f, 1] = np.sin(ang)
+        g = np.flatnonzero((lay.pos >= 2) & ~smooth)  # end at k: q[k-2], q[k-1], q[k]
+        ang = 2.0 * au[g - 1] - ac[g - 1]
+        t_in[g, 0] = np.cos(ang)
+        t_in[g, 1] = np.sin(ang)
+        sm = np.flatnonzero(smooth)
+        t_out[sm] = central[sm]
+        t_in[sm] = central[sm]
+        _seam_tangents(q, s, ln, lay, closed, cos_join, length_ratio, t_in, t_out)
+    return t_in, t_out
+
+
+def _seam_tangents(q, s, ln, lay, closed, cos_join, length_ratio, t_in, t_out) -> None:
+    """A closed path (first point == last point, >= 4 points) whose seam vertex is smooth
+    gets the two-sided estimate at both ends (in place)."""
+    cand = np.flatnonzero(np.asarray(closed, dtype=bool) & (lay.lens >= 4))
+    if len(cand) == 0:
+        return
+    s0 = lay.starts[cand]
+    e0 = s0 + lay.lens[cand] - 1
+    same = (q[s0] == q[e0]).all(axis=1)
+    s0, e0 = s0[same], e0[same]
+    a, b = s[e0 - 1], s[s0]
+    la, lb = ln[e0 - 1], ln[s0]
+    cos = (a * b).sum(axis=1) / (la * lb)
+    # the single-path rule computed a @ b (BLAS dot, may round differently in the last
+    # bit): decide values within rounding of the threshold exactly as it did
+    for i in np.flatnonzero(~(np.abs(cos - cos_join) > 1e-9)).tolist():
+        cos[i] = float(a[i] @ b[i]) / (la[i] * lb[i])
+    ok = (cos > cos_join) & (lb <= length_ratio * la) & (la <= length_ratio * lb)
+    s0, e0 = s0[ok], e0[ok]
+    if len(s0):
+        c = _bessel(q[e0 - 1], q[s0], q[s0 + 1])
+        t_out[s0] = c
+        t_in[e0] = c
+
+
+def _unwrap_each(p: np.ndarray, first: np.ndarray, cnt: np.ndarray) -> np.ndarray:
+    """``np.unwrap`` (period 2π) of every run ``p[first[r] : first[r] + cnt[r]]`` (runs
+    consecutive, each >= 2 long), bit for bit as on each run alone."""
+    up = p.copy()
+    if len(p) < 2:
+        return up
+    dd = np.diff(p)
+    inner = np.ones(len(dd), dtype=bool)
+    inner[first[1:] - 1] = False  # differences across two runs
+    j = np.flatnonzero(inner)
+    d = dd[j]
+    high = _PERIOD / 2
+    low = -high
+    ddmod = np.mod(d - low, _PERIOD) + low
+    np.copyto(ddmod, high, where=(ddmod == low) & (d > 0))
+    ph = ddmod - d
+    np.copyto(ph, 0, where=abs(d) < high)
+    up[j + 1] = p[j + 1] + segmented_cumsum(ph, cnt - 1)
+    return up
+
+
+def _split_runs(
+    ra: np.ndarray, rb: np.ndarray, t_in: np.ndarray, t_out: np.ndarray, limit: float
+) -> tuple[np.ndarray, np.ndarray]:
+    """Every run cut into pieces of total turning < ``limit`` (radians): (pa, pb) in order.
+
+    Turning is measured on the unwrapped tangent angle (out-tangent at the run's start, the
+    in-tangents after it); a run turning more is cut into n balanced pieces.
+    """
+    if len(ra) == 0:
+        return ra, rb
+    cnt = rb - ra + 1
+    first = np.cumsum(cnt) - cnt
+    own = np.repeat(np.arange(len(ra)), cnt)
+    off = np.arange(int(cnt.sum())) - first[own]
+    gi = ra[own] + off
+    tang = np.where((off == 0)[:, None], t_out[gi], t_in[gi])
+    ang = _unwrap_each(np.arctan2(tang[:, 1], tang[:, 0]), first, cnt)
+    total = np.abs(ang[first + cnt - 1] - ang[first])
+    with np.errstate(invalid="ignore"):
+        many = np.flatnonzero(np.ceil(total / limit * (1.0 + 1e-9)) > 1.0)
+    if len(many) == 0:
+        return ra, rb
+    pa: list[np.ndarray] = [ra]
+    pb: list[np.ndarray] = [rb]
+    drop = np.zeros(len(ra), dtype=bool)
+    drop[many] = True
+    for r in many.tolist():
+        a, b = int(ra[r]), int(rb[r])
+        cuts = _balanced_cuts(a, b, ang[first[r] : first[r] + cnt[r]], total[r], limit)
+        pa.append(np.asarray(cuts[:-1], dtype=np.intp))
+        pb.append(np.asarray(cuts[1:], dtype=np.intp))
+    pa[0], pb[0] = ra[~drop], rb[~drop]
+    a_all = np.concatenate(pa)
+    order = np.argsort(a_all, kind="stable")
+    return a_all[order], np.concatenate(pb)[order]
+
+
+def _balanced_cuts(a: int, b: int, ang: np.ndarray, total: float, limit: float) -> list[int]:
+    """Cut points a < c1 < ... < b of one run: n = ceil(total / limit) pieces of about equal
+    turning, each stepped back until it turns less than ``limit`` (when it can)."""
+    n = max(1, math.ceil(total / limit * (1.0 + 1e-9)))
+    cuts = [a]
+    rel = np.abs(ang - ang[0])
+    for i in range(1, n):
+        k = a + int(np.searchsorted(rel, total * i / n))
+        k = min(max(k, cuts[-1] + 1), b - 1)
+        # keep the piece under the limit: step back while it turns too much
+        while k - 1 > cuts[-1] and abs(ang[k - a] - ang[cuts[-1] - a]) >= limit:
+            k -= 1
+        if cuts[-1] < k < b:
+            cuts.append(k)
+    cuts.append(b)
+    return cuts
+
+
+def split_pieces_many(
+    q: object,
+    lens: object,
+    closed: object,
+    *,
+    max_turn_deg: float = 80.0,
+    cos_join: float = 0.95,
+    length_ratio: float = 3.0,
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """:func:`split_pieces` of many thinned paths at once.
+
+    ``q`` (N, 2) is the concatenation of the paths, ``lens`` their point counts (sum N),
+    ``closed`` one flag per path. Returns ``(a, b, curve, t_in, t_out)``: the pieces of
+    every path in path order, as inclusive ranges ``a[i]..b[i]`` of indices into ``q``
+    (never crossing a path), ``curve[i]`` True for a "curve" piece, False for a line, and
+    the (N, 2) tangents. Exactly (bit for bit) the pieces and tangents of
+    :func:`split_pieces` on each path, offset by the path's first index.
+    """
+    qq = np.asarray(q, dtype=np.float64).reshape(-1, 2)
+    lay = _Layout.of(lens)
+    if lay.m.size != len(qq):
+        raise ValueError("split_pieces_many: lens must sum to len(q)")
+    cl = np.asarray(closed, dtype=bool).reshape(-1)
+    if len(cl) != len(lay.lens):
+        raise ValueError("split_pieces_many: one closed flag per path")
+    seg = _segments(qq) if len(qq) >= 2 else None
+    smooth, _, sign = _vertex_rules(qq, lay, cos_join, length_ratio, seg=seg)
+    t_in, t_out = _tangents(qq, lay, smooth, cl, cos_join, length_ratio, seg=seg)
+    ra, rb = _runs(smooth, sign, lay)
+    ca, cb = _split_runs(ra, rb, t_in, t_out, math.radians(max_turn_deg))
+    # every segment outside the runs is a line; so is a run's piece of one segment
+    cover = np.zeros(len(qq) + 1, dtype=np.intp)
+    np.add.at(cover, ra, 1)
+    np.add.at(cover, rb, -1)
+    covered = np.cumsum(cover[:-1])[:-1] > 0 if len(qq) else np.zeros(0, dtype=bool)
+    inside = lay.pos[:-1] < lay.m[:-1] - 1
+    la = np.flatnonzero(inside & ~covered)
+    a = np.concatenate([la, ca])
+    b = np.concatenate([la + 1, cb])
+    order = np.argsort(a, kind="stable")
+    a, b = a[order], b[order]
+    return a, b, b - a >= 2, t_in, t_out
 
 
 def smooth_vertices(
@@ -63,110 +409,29 @@ def smooth_vertices(
 
     End points (k = 0, M-1) are not smooth here (see :func:`point_tangents` for the seam).
     """
-    m = len(q)
-    smooth = np.zeros(m, dtype=bool)
-    turn = np.zeros(m)
-    sign = np.zeros(m)
-    if m < 3:
-        return smooth, turn, sign
-    s, ln = _segments(q)
-    a, b = s[:-1], s[1:]
-    la, lb = ln[:-1], ln[1:]
-    dot = (a * b).sum(axis=1)
-    cr = a[:, 0] * b[:, 1] - a[:, 1] * b[:, 0]
-    with np.errstate(invalid="ignore", divide="ignore"):
-        cos = dot / (la * lb)
-    ratio_ok = (lb <= length_ratio * la) & (la <= length_ratio * lb)
-    # the greedy thinning leaves a short last segment (the tail of the path): it is not a
-    # long thinned line, so the length rule does not cut it off
-    ratio_ok[-1] |= lb[-1] < la[-1]
-    ok = (cos > cos_join) & ratio_ok
-    smooth[1:-1] = ok
-    turn[1:-1] = np.arctan2(cr, dot)
-    # a turn below ~1e-12 rad is numerically straight: no sign
-    sign[1:-1] = np.where(np.abs(cr) > 1e-12 * la * lb, np.sign(cr), 0.0)
-    return smooth, turn, sign
+    qq = np.asarray(q, dtype=np.float64).reshape(-1, 2)
+    return _vertex_rules(qq, _Layout.of([len(qq)]), cos_join, length_ratio, want_turn=True)
 
 
 def find_runs(
     q: np.ndarray, *, cos_join: float = 0.95, length_ratio: float = 3.0
 ) -> list[tuple[int, int]]:
     """Curve runs as inclusive point ranges (a, b) with b - a >= 3 (at least 4 points)."""
-    m = len(q)
-    if m < 4:
-        return []
-    smooth, _, sign = smooth_vertices(q, cos_join=cos_join, length_ratio=length_ratio)
-    runs: list[tuple[int, int]] = []
-    start = 0
-    run_sign = 0.0
-    sm = smooth.tolist()
-    sg = sign.tolist()
-    for k in range(1, m - 1):
-        joins = sm[k] and not (run_sign * sg[k] < 0.0)
-        if joins:
-            if run_sign == 0.0:
-                run_sign = sg[k]
-            continue
-        if k - start >= 3:
-            runs.append((start, k))
-        start = k
-        # an inflection starts the new run with the new turn's sign already known
-        run_sign = sg[k] if sm[k] else 0.0
-    if m - 1 - start >= 3:
-        runs.append((start, m - 1))
-    return runs
-
-
-def _bessel(q0: np.ndarray, q1: np.ndarray, q2: np.ndarray) -> np.ndarray:
-    """Unit tangent at q1 of the parabola through three points (chord-length weights)."""
-    d0 = q1 - q0
-    d1 = q2 - q1
-    h0 = np.hypot(d0[..., 0], d0[..., 1])[..., None]
-    h1 = np.hypot(d1[..., 0], d1[..., 1])[..., None]
-    t = (h1 / (h0 + h1)) * d0 / h0 + (h0 / (h0 + h1)) * d1 / h1
-    return t / np.hypot(t[..., 0], t[..., 1])[..., None]
-
-
-def _rot_reflect(u: np.ndarray, c: np.ndarray) -> np.ndarray:
-    """Direction at angle 2·angle(u) − angle(c): the parabola's end tangent."""
-    au = np.arctan2(u[..., 1], u[..., 0])
-    ac = np.arctan2(c[..., 1], c[..., 0])
-    ang = 2.0 * au - ac
-    return np.stack([np.cos(ang), np.sin(ang)], axis=-1)
+    qq = np.asarray(q, dtype=np.float64).reshape(-1, 2)
+    lay = _Layout.of([len(qq)])
+    smooth, _, sign = _vertex_rules(qq, lay, cos_join, length_ratio)
+    ra, rb = _runs(smooth, sign, lay)
+    return list(zip(ra.tolist(), rb.tolist(), strict=True))
 
 
 def point_tangents(
     q: np.ndarray, *, closed: bool = False, cos_join: float = 0.95, length_ratio: float = 3.0
 ) -> tuple[np.ndarray, np.ndarray]:
     """Unit tangents ``(t_in, t_out)``, each (M, 2), following the path direction."""
-    m = len(q)
-    s, ln = _segments(q)
-    u = s / ln[:, None]
-    t_in = np.zeros((m, 2))
-    t_out = np.zeros((m, 2))
-    t_out[:-1] = u
-    t_in[1:] = u
-    if m < 3:
-        return t_in, t_out
-    smooth, _, _ = smooth_vertices(q, cos_join=cos_join, length_ratio=length_ratio)
-    central = np.zeros((m, 2))
-    central[1:-1] = _bessel(q[:-2], q[1:-1], q[2:])
-    # one-sided parabola estimates (need a second point on that side)
-    fwd = _rot_reflect(u[:-1], central[1:-1])  # start at k uses q[k], q[k+1], q[k+2]
-    bwd = _rot_reflect(u[1:], central[1:-1])  # end at k uses q[k-2], q[k-1], q[k]
-    t_out[:-2] = fwd
-    t_in[2:] = bwd
-    t_out[smooth] = central[smooth]
-    t_in[smooth] = central[smooth]
-    if closed and m >= 4 and np.array_equal(q[0], q[-1]):
-        a, b = s[-1], s[0]
-        la, lb = ln[-1], ln[0]
-        cos = float(a @ b) / (la * lb)
-        if cos > cos_join and lb <= length_ratio * la and la <= length_ratio * lb:
-            c = _bessel(q[-2], q[0], q[1])
-            t_out[0] = c
-            t_in[-1] = c
-    return t_in, t_out
+    qq = np.asarray(q, dtype=np.float64).reshape(-1, 2)
+    lay = _Layout.of([len(qq)])
+    smooth, _, _ = _vertex_rules(qq, lay, cos_join, length_ratio)
+    return _tangents(qq, lay, smooth, np.array([closed]), cos_join, length_ratio)
 
 
 def split_pieces(
@@ -185,43 +450,17 @@ def split_pieces(
     thinned path already turns more (then it is still marked "curve" and the fitter falls
     back to lines).
     """
-    m = len(q)
-    if m < 2:
-        return [], np.zeros((m, 2)), np.zeros((m, 2))
-    t_in, t_out = point_tangents(q, closed=closed, cos_join=cos_join, length_ratio=length_ratio)
-    runs = find_runs(q, cos_join=cos_join, length_ratio=length_ratio)
-    limit = math.radians(max_turn_deg)
-    pieces: list[Piece] = []
-    pos = 0
-
-    def lines(a: int, b: int) -> None:
-        pieces.extend(Piece("line", k, k + 1) for k in range(a, b))
-
-    for a, b in runs:
-        lines(pos, a)
-        # cumulative tangent angle along the run: out-tangent at a, central inside, in at b
-        tang = np.concatenate([t_out[a : a + 1], t_in[a + 1 : b + 1]])
-        ang = np.unwrap(np.arctan2(tang[:, 1], tang[:, 0]))
-        # interior points have t_in == t_out except at the ends, which is what we want
-        total = abs(ang[-1] - ang[0])
-        n = max(1, math.ceil(total / limit * (1.0 + 1e-9)))
-        cuts = [a]
-        if n > 1:
-            rel = np.abs(ang - ang[0])
-            for i in range(1, n):
-                k = a + int(np.searchsorted(rel, total * i / n))
-                k = min(max(k, cuts[-1] + 1), b - 1)
-                # keep the piece under the limit: step back while it turns too much
-                while k - 1 > cuts[-1] and abs(ang[k - a] - ang[cuts[-1] - a]) >= limit:
-                    k -= 1
-                if cuts[-1] < k < b:
-                    cuts.append(k)
-        cuts.append(b)
-        for c0, c1 in zip(cuts[:-1], cuts[1:], strict=True):
-            if c1 - c0 >= 2:
-                pieces.append(Piece("curve", c0, c1))
-            else:
-                lines(c0, c1)
-        pos = b
-    lines(pos, m - 1)
+    qq = np.asarray(q, dtype=np.float64).reshape(-1, 2)
+    a, b, curve, t_in, t_out = split_pieces_many(
+        qq,
+        [len(qq)],
+        [closed],
+        max_turn_deg=max_turn_deg,
+        cos_join=cos_join,
+        length_ratio=length_ratio,
+    )
+    pieces = [
+        Piece("curve" if c else "line", i, j)
+        for i, j, c in zip(a.tolist(), b.tolist(), curve.tolist(), strict=True)
+    ]
     return pieces, t_in, t_out

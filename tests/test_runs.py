@@ -5,8 +5,17 @@ from __future__ import annotations
 import math
 
 import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
-from galvo_core.runs import find_runs, point_tangents, split_pieces
+from galvo_core.runs import (
+    find_runs,
+    point_tangents,
+    segmented_cumsum,
+    split_pieces,
+    split_pieces_many,
+)
 from galvo_core.thin import thin
 
 
@@ -106,3 +115,74 @@ def test_thinned_ellipse_pieces_respect_turn_limit():
     for pc in pieces:
         if pc.kind == "curve":
             assert float(t_out[pc.a] @ t_in[pc.b]) > math.cos(math.radians(80)) - 1e-9
+
+
+# --- many paths at once ------------------------------------------------------------------
+
+
+def _mixed_thinned_paths(seed):
+    """Thinned-path-like polylines of every kind the rules distinguish, with their flags."""
+    rng = np.random.default_rng(seed)
+    out = []
+    for i in range(40):
+        kind = i % 8
+        if kind == 0:  # closed circle, smooth seam, 5 pieces of 72 degrees
+            q = arc(rng.uniform(5, 500), 0, 2 * math.pi, int(rng.integers(20, 140)))
+            q[-1] = q[0]
+            out.append((q, True))
+        elif kind == 1:  # a spiral turning several times (many balanced cuts)
+            t = np.linspace(0, rng.uniform(7, 20), int(rng.integers(60, 200)))
+            out.append((np.c_[t * np.cos(t), t * np.sin(t)] * 10, False))
+        elif kind == 2:  # S-curve: an inflection
+            a = arc(50, math.pi, 0, 30, c=(50, 0))
+            b = arc(50, math.pi, 2 * math.pi, 30, c=(150, 0))[1:]
+            out.append((np.vstack([a, b]), False))
+        elif kind == 3:  # polygon: corners only
+            out.append(
+                (np.array([[0, 0], [10, 0], [10, 10], [5, 14], [0, 10], [0, 0]], float), True)
+            )
+        elif kind == 4:  # tiny paths: one, two, three points
+            out.append((rng.normal(size=(int(rng.integers(1, 4)), 2)) * 10, bool(i % 3)))
+        elif kind == 5:  # long line running into a curve, short tail at the end
+            q = np.vstack([[[-200.0, 0.0]], arc(10, -math.pi / 2, 0, 20, c=(0, 10))])
+            out.append((np.vstack([q, q[-1:] + [0.0, 0.3]]), False))
+        elif kind == 6:  # noisy arc on integer coordinates
+            t = np.sort(rng.uniform(0, 3, 50))
+            out.append(
+                (np.round(np.c_[np.cos(t), np.sin(t)] * 80 + rng.normal(0, 0.5, (50, 2))), False)
+            )
+        else:  # closed path whose seam is a corner
+            q = arc(100, 0, 1.5 * math.pi, 40)
+            out.append((np.vstack([q, [[0.0, 0.0]], q[:1]]), True))
+    return out
+
+
+@pytest.mark.parametrize("seed", [0, 1, 2])
+def test_many_paths_at_once_give_exactly_the_pieces_of_each_path(seed):
+    """split_pieces_many on the concatenation = split_pieces per path, offset by the path's
+    first index, bit for bit (tangents too); no piece crosses a path boundary."""
+    items = _mixed_thinned_paths(seed)
+    qs = [q for q, _ in items]
+    lens = [len(q) for q in qs]
+    a, b, curve, t_in, t_out = split_pieces_many(np.concatenate(qs), lens, [c for _, c in items])
+    off = np.concatenate(([0], np.cumsum(lens)))
+    expected = []
+    for k, (q, c) in enumerate(items):
+        pieces, ti, to = split_pieces(q, closed=c)
+        expected += [(p.a + off[k], p.b + off[k], p.kind == "curve") for p in pieces]
+        np.testing.assert_array_equal(t_in[off[k] : off[k + 1]], ti)
+        np.testing.assert_array_equal(t_out[off[k] : off[k + 1]], to)
+    assert list(zip(a.tolist(), b.tolist(), curve.tolist(), strict=True)) == expected
+    owner = np.searchsorted(off, a, side="right")
+    assert (np.searchsorted(off, b, side="left") == owner).all()  # b <= the path's last
+
+
+@settings(max_examples=60, deadline=None)
+@given(st.lists(st.integers(0, 150), max_size=30), st.integers(0, 2**31))
+def test_segmented_cumsum_is_cumsum_of_each_segment_bit_for_bit(lens, seed):
+    x = np.random.default_rng(seed).normal(size=sum(lens)) * 1e3
+    got = segmented_cumsum(x, lens)
+    s = 0
+    for n in lens:
+        np.testing.assert_array_equal(got[s : s + n], np.cumsum(x[s : s + n]))
+        s += n
