@@ -30,6 +30,7 @@ segment that replaces it, and the first and last points are always kept.
 
 from __future__ import annotations
 
+import itertools
 import math
 from collections.abc import Sequence
 
@@ -57,22 +58,6 @@ def dedup_indices(points: np.ndarray) -> np.ndarray:
         return np.zeros(0, dtype=np.intp)
     diff = np.any(points[1:] != points[:-1], axis=1)
     return np.concatenate(([0], np.flatnonzero(diff) + 1)).astype(np.intp)
-
-
-def _segment_ok(q: np.ndarray, i: int, j: int, eps: float) -> bool:
-    """Exact test: every point strictly between i and j within eps of segment [q_i, q_j]."""
-    if j - i < 2:
-        return True
-    a = q[i]
-    ab = q[j] - a
-    ap = q[i + 1 : j] - a
-    den = float(ab @ ab)
-    if den > 0.0:
-        s = np.clip((ap @ ab) / den, 0.0, 1.0)
-        e = ap - s[:, None] * ab
-    else:
-        e = ap
-    return bool(np.max(e[:, 0] * e[:, 0] + e[:, 1] * e[:, 1]) <= eps * eps)
 
 
 #: reach of the all-starts sweep before a start counts as "long" (numpy greedy from there)
@@ -195,87 +180,304 @@ def _farthest(ok: np.ndarray) -> np.ndarray:
     return (w - 1 - np.argmax(ok[:, ::-1], axis=1)) * ok.any(axis=1)
 
 
-def _reach(x: np.ndarray, y: np.ndarray, i: int, eps: float, chunk: int) -> int:
-    """The farthest j > i such that [q_i, q_j] serves every point between (see module doc);
-    ``x``, ``y`` the coordinates of one path (consecutive points distinct)."""
-    n = len(x)
-    x0 = float(x[i])
-    y0 = float(y[i])
-    while True:
-        e = min(n - 1, i + chunk)
-        vx = x[i + 1 : e + 1] - x0
-        vy = y[i + 1 : e + 1] - y0
-        r = np.hypot(vx, vy)
-        far = r > eps
-        f0 = int(far.argmax())
-        if not far[f0]:
-            if e == n - 1:
-                return e
-            chunk *= 2
-            continue
-        cx = float(vx[f0] / r[f0])
-        cy = float(vy[f0] / r[f0])
-        theta = np.arctan2(cx * vy - cy * vx, cx * vx + cy * vy)
-        with np.errstate(divide="ignore", invalid="ignore"):
-            w = np.arcsin(eps / np.where(far, r, 0.0))  # NaN for near points: no bound
-        lo = np.fmax.accumulate(theta - w)  # NaN until the first far point
-        hi = np.fmin.accumulate(theta + w)
-        empty = lo > hi
-        m_stop = int(empty.argmax())
-        if not empty[m_stop]:
-            if e < n - 1:
-                chunk *= 2
-                continue
-            m_stop = len(r)
-        mm = min(m_stop + 1, len(r))
-        # candidate m (end point i+1+m) needs the wedge of points 0..m-1 non-empty and
-        # containing its direction, and no earlier point farther than r_m + eps from P_i;
-        # the farthest candidate that passes wins (plain Python on the few candidates)
-        rmax = np.maximum.accumulate(r[:mm])
-        tiny = 1e-12
-        top = mm
-        while top > 1:  # blocks of 32 candidates from the far end, as Python floats
-            b0 = max(1, top - 32)
-            th_l = theta[b0:top].tolist()
-            r_l = r[b0:top].tolist()
-            lo_l = lo[b0 - 1 : top - 1].tolist()
-            hi_l = hi[b0 - 1 : top - 1].tolist()
-            rb_l = rmax[b0 - 1 : top - 1].tolist()
-            for k in range(top - b0 - 1, -1, -1):
-                t = th_l[k]
-                lw = lo_l[k]
-                hw = hi_l[k]
-                if lw != lw:  # no far point before this one: any direction
-                    lw, hw = -math.inf, math.inf
-                rm = r_l[k]
-                rb = rb_l[k]
-                if not ((lw <= t <= hw) or rm <= eps) or rb > rm + eps:
-                    continue
-                # no earlier point farther from P_i than P_j: ray distance == segment
-                # distance, so the wedge test alone is exact (kept a hair inside eps)
-                j = i + 1 + b0 + k
-                if (rb <= rm and lw + tiny <= t <= hw - tiny) or _segment_ok_xy(x, y, i, j, eps):
-                    return j
-            top = b0
-        return i + 1
-
-
-def _segment_ok_xy(x: np.ndarray, y: np.ndarray, i: int, j: int, eps: float) -> bool:
-    """:func:`_segment_ok` on coordinate arrays."""
-    if j - i < 2:
-        return True
-    ax = float(x[i])
-    ay = float(y[i])
-    bx = float(x[j]) - ax
-    by = float(y[j]) - ay
-    px = x[i + 1 : j] - ax
-    py = y[i + 1 : j] - ay
+def _exact_ok(
+    x: np.ndarray, y: np.ndarray, ia: np.ndarray, ib: np.ndarray, eps: float
+) -> np.ndarray:
+    """Per pair (ia[k], ib[k]), ib > ia + 1: True when every point strictly between lies
+    within eps of the segment [P_ia, P_ib] (true point-to-segment distance)."""
+    cnt = ib - ia - 1
+    first = np.cumsum(cnt) - cnt
+    own = np.repeat(np.arange(len(ia)), cnt)
+    off = np.arange(int(cnt.sum())) - first[own] + 1
+    a = ia[own]
+    ax = x[a]
+    ay = y[a]
+    bx = x[ib[own]] - ax
+    by = y[ib[own]] - ay
+    px = x[a + off] - ax
+    py = y[a + off] - ay
     den = bx * bx + by * by
-    if den > 0.0:
-        s = np.clip((px * bx + py * by) / den, 0.0, 1.0)
-        px = px - s * bx
-        py = py - s * by
-    return bool((px * px + py * py).max() <= eps * eps)
+    t = np.clip((px * bx + py * by) / np.where(den > 0.0, den, 1.0), 0.0, 1.0)
+    t = np.where(den > 0.0, t, 0.0)
+    ex = px - t * bx
+    ey = py - t * by
+    return np.maximum.reduceat(ex * ex + ey * ey, first) <= eps * eps
+
+
+def _reach_rows(
+    x: np.ndarray, y: np.ndarray, pend: np.ndarray, eps: float, s: np.ndarray, k_win: int
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The sleeve search of many starts at once, each over the next ``k_win`` points.
+
+    For start i the reach is the farthest j > i such that every point strictly between lies
+    within eps of [P_i, P_j] (see module doc): the wedge of ray directions serving the
+    points before a candidate is the running intersection of [theta - asin(eps/r),
+    theta + asin(eps/r)] (angles relative to the first point farther than eps); the search
+    stops where that wedge is empty (no farther end can serve them). The farthest candidate
+    whose direction lies in the wedge is accepted when no earlier point is farther from P_i
+    (ray distance equals segment distance, kept 1e-12 rad inside), else it is checked
+    exactly; a failing candidate gives way to the next one down.
+
+    Arrays are (start, window position); ``x``, ``y`` the concatenated points of all paths,
+    ``pend[i]`` the last index of i's path (every start below its path end). Returns
+    ``(j, mstop, retry)``: the reach (meaningless where ``retry``), the window position where
+    the wedge emptied (to size the next window), and the starts whose wedge is still open
+    at the end of the window while their path goes on (search again with a larger window).
+    """
+    m = len(s)
+    rows = np.arange(m)
+    pe = pend[s]
+    lim = pe - s
+    d = np.arange(1, k_win + 1)
+    idx = s[:, None] + d
+    short = bool((lim < k_win).any())  # some window runs past its path end
+    if short:
+        np.minimum(idx, pe[:, None], out=idx)
+    vx = x[idx]
+    vx -= x[s][:, None]
+    vy = y[idx]
+    vy -= y[s][:, None]
+    r = np.hypot(vx, vy)
+    far = r > eps
+    if short:
+        valid = d <= lim[:, None]
+        far &= valid
+    f0 = far.argmax(axis=1)
+    hasfar = far[rows, f0]
+    rf = r[rows, f0]
+    cx = (vx[rows, f0] / rf)[:, None]
+    cy = (vy[rows, f0] / rf)[:, None]
+    theta = np.arctan2(cx * vy - cy * vx, cx * vx + cy * vy)
+    w = np.arcsin(eps / np.where(far, r, 0.0))  # NaN for near points: no bound
+    lo = np.fmax.accumulate(theta - w, axis=1)  # NaN until the first far point
+    hi = np.fmin.accumulate(theta + w, axis=1)
+    empty = lo > hi
+    if short:
+        empty &= valid
+    e0 = empty.argmax(axis=1)
+    has_e = empty[rows, e0]
+    n_win = np.minimum(lim, k_win)
+    mstop = np.where(has_e, e0, n_win)
+    retry = ~has_e & (lim > k_win)
+    mm = np.minimum(mstop + 1, n_win)
+    # candidates lie below mm: drop the columns no row needs
+    k_use = max(2, int(mm.max()))
+    lo = lo[:, : k_use - 1]
+    hi = hi[:, : k_use - 1]
+    np.fmax(lo, -np.inf, out=lo)  # no far point yet: any direction
+    np.fmin(hi, np.inf, out=hi)
+    rmax = np.maximum.accumulate(r[:, : k_use - 1], axis=1)
+    # candidate end m (window position m, point s + 1 + m), m = 1 .. k_use - 1, is column
+    # m - 1: direction inside the wedge of the points before it (or m itself within eps of
+    # P_s), no point before it farther than r_m + eps from P_s
+    th1 = theta[:, 1:k_use]
+    r1 = r[:, 1:k_use]
+    c = lo <= th1
+    c &= th1 <= hi
+    c |= ~far[:, 1:k_use]
+    c &= rmax <= r1 + eps
+    c &= d[: k_use - 1] < mm[:, None]
+    j = s + 1
+    nofar = ~hasfar & ~retry  # every point of the rest of the path within eps of P_s
+    if not hasfar.all():
+        j[nofar] = pe[nofar]
+    todo = np.flatnonzero(~nofar & ~retry)
+    while len(todo):
+        cc = c[todo]
+        top = (k_use - 2) - cc[:, ::-1].argmax(axis=1)
+        has = cc[np.arange(len(todo)), top]
+        if not has.all():
+            todo = todo[has]
+            top = top[has]
+            if not len(todo):
+                break
+        t = th1[todo, top]
+        # no earlier point farther from P_s than the end: the wedge alone is exact
+        sure = rmax[todo, top] <= r1[todo, top]
+        sure &= lo[todo, top] + _TINY <= t
+        sure &= t <= hi[todo, top] - _TINY
+        jj = s[todo] + 2 + top
+        if sure.all():
+            j[todo] = jj
+            break
+        j[todo[sure]] = jj[sure]
+        rest = ~sure
+        todo = todo[rest]
+        top = top[rest]
+        jj = jj[rest]
+        good = _exact_ok(x, y, s[todo], jj, eps)
+        j[todo[good]] = jj[good]
+        bad = ~good
+        c[todo[bad], top[bad]] = False
+        todo = todo[bad]
+    return j, mstop, retry
+
+
+#: first window of a start without history; later windows are sized from the last one
+_WIN0 = 48
+#: seeds inside a long dense stretch are this many kept lines apart (see :func:`_walk`)
+_SEED_LINES = 32
+#: ... and at least this many points apart
+_SEED_GAP = 256
+#: a seed that has not met another walker this many steps past the next seed gives up
+_SEED_SLACK = 48
+#: no seeds inside a stretch where one kept line covers more points than this
+_SEED_MAX_REACH = 400
+#: stretches of unknown reaches shorter than this get no seed of their own
+_RUN_MIN = 48
+
+
+class _Walker:
+    """One greedy walk: ``cur`` its point, ``end`` its path's last point; a seed (not
+    ``true``) also has its stretch end ``stop``, the next seed ``cap`` and a count ``past``
+    of steps beyond it; ``win`` the next window size."""
+
+    __slots__ = ("cur", "end", "true", "stop", "cap", "past", "win")
+
+    def __init__(self, cur: int, end: int, true: bool, stop: int, cap: int, win: int) -> None:
+        self.cur = cur
+        self.end = end
+        self.true = true
+        self.stop = stop
+        self.cap = cap
+        self.past = 0
+        self.win = win
+
+
+def _walk(
+    x: np.ndarray,
+    y: np.ndarray,
+    pend: np.ndarray,
+    eps: float,
+    starts: list[int],
+    nxt: list[int],
+    opened: np.ndarray,
+) -> None:
+    """Fill ``nxt[i]`` (the greedy reach of i; -1 = not known yet, only where ``opened``)
+    for every point the greedy chains from ``starts`` (the path starts) stand on.
+
+    Walkers advance in lockstep: each round every walker follows known reaches in plain
+    Python up to a point whose reach is unknown, and the reaches of all those points are
+    found in one :func:`_reach_rows` call (a few per round, grouped by window size). A plain
+    walk through dense stretches (unknown reaches) would take one round per kept line, so
+    seed walkers start at every stretch of at least ``_RUN_MIN`` points and, once the reach
+    there is known, every ``_SEED_LINES`` kept lines along a long one: greedy chains from
+    different points meet after a few lines on most curves (from then on they are the same
+    chain), so a true walk finds the seeds' reaches already known. Walkers standing on the
+    same point are merged; a seed that leaves its stretch, or goes ``_SEED_SLACK`` steps
+    past the next seed without meeting anyone, stops. A seed is only ever a head start: the
+    chains are those of plain walks, found in fewer rounds.
+    """
+    n = len(opened)
+    # stretches of unknown reaches, split at path ends
+    first = opened.copy()
+    first[1:] &= ~opened[:-1] | (pend[:-1] != pend[1:])
+    rs = np.flatnonzero(first)
+    last = opened.copy()
+    last[:-1] &= ~opened[1:] | (pend[:-1] != pend[1:])
+    ren = np.flatnonzero(last) + 1
+    run_id = np.cumsum(first) - 1
+    long_runs = np.flatnonzero(ren - rs >= _RUN_MIN)
+    sd = rs[long_runs]
+    sd = sd[np.isin(sd, starts, invert=True)]
+    # a seed's cap is the next seed of its path (or the path end)
+    cap = np.append(sd[1:], n)
+    cap = np.where(pend[cap.clip(max=n - 1)] == pend[sd], cap, pend[sd] + 1)
+    walkers = [_Walker(a, int(pend[a]), True, n, n, _WIN0) for a in starts]
+    walkers += [
+        _Walker(a, e, False, e + 1, b, _WIN0)
+        for a, e, b in zip(sd.tolist(), pend[sd].tolist(), cap.tolist(), strict=True)
+    ]
+    rid_l = run_id.tolist()
+    ren_l = ren.tolist()
+    split: set[int] = set()
+    while walkers:
+        at: dict[int, _Walker] = {}
+        for w in walkers:
+            c = w.cur
+            e = w.end
+            while c < e:
+                j = nxt[c]
+                if j < 0:
+                    break
+                c = j
+            if c >= e:
+                continue
+            if not w.true:
+                if c >= w.stop:
+                    continue
+                if c > w.cap:
+                    w.past += 1
+                    if w.past > _SEED_SLACK:
+                        continue
+            w.cur = c
+            o = at.get(c)
+            if o is None:
+                at[c] = w
+            else:  # two walks met: from here on they are one
+                o.true = o.true or w.true
+                o.cap = max(o.cap, w.cap)
+                o.stop = max(o.stop, w.stop)
+        if not at:
+            break
+        walkers = list(at.values())
+        _reach_batch(x, y, pend, eps, walkers, nxt)
+        for w in walkers[:]:
+            c = w.cur
+            rid = rid_l[c]
+            reach = nxt[c] - c
+            if rid in split or reach < 0:  # (reach < 0: still searching, larger window)
+                continue
+            split.add(rid)
+            stop = ren_l[rid]
+            gap = max(_SEED_GAP, _SEED_LINES * reach)
+            if reach > _SEED_MAX_REACH or stop - c < 2 * gap:
+                continue
+            pos = list(range(c + gap, stop - gap // 2, gap))
+            caps = pos[1:] + [stop if w.true else w.cap]
+            walkers += [
+                _Walker(p, w.end, False, w.end + 1, q, w.win)
+                for p, q in zip(pos, caps, strict=True)
+            ]
+            if not w.true:
+                w.cap = min(w.cap, pos[0])
+
+
+#: cost of one :func:`_reach_rows` call in window cells (decides when to split a round)
+_CALL_CELLS = 1200
+
+
+def _reach_batch(
+    x: np.ndarray, y: np.ndarray, pend: np.ndarray, eps: float, walkers: list, nxt: list[int]
+) -> None:
+    """Set ``nxt[w.cur]`` for the walkers of one round and size each one's next window from
+    where its wedge emptied (a quarter more, + 8). One :func:`_reach_rows` call, or two
+    when the short windows would waste more than a call costs; a walker whose wedge is still
+    open at the end of its window keeps its point and gets twice the window next round."""
+    m = len(walkers)
+    wins = [w.win for w in walkers]
+    order = sorted(range(m), key=wins.__getitem__)
+    ws = [wins[k] for k in order]
+    top = ws[-1]
+    best, cut = m * top, m
+    for k in range(1, m):
+        cost = _CALL_CELLS + k * ws[k - 1] + (m - k) * top
+        if cost < best:
+            best, cut = cost, k
+    groups = [(order[:cut], ws[cut - 1]), (order[cut:], top)] if cut < m else [(order, top)]
+    for rows, k_win in groups:
+        grp = [walkers[k] for k in rows]
+        s = np.array([w.cur for w in grp], dtype=np.intp)
+        j, ms, retry = _reach_rows(x, y, pend, eps, s, k_win)
+        jl = j.tolist()
+        ml = ms.tolist()
+        rl = retry.tolist()
+        for k, w in enumerate(grp):
+            if rl[k]:
+                w.win = 2 * k_win
+            else:
+                nxt[w.cur] = jl[k]
+                w.win = max(16, ml[k] + ml[k] // 4 + 8)
 
 
 def thin(points: object, eps_line: float, *, closed: bool = False) -> np.ndarray:
@@ -307,69 +509,81 @@ def thin_many(paths: Sequence[object], eps_line: float) -> list[np.ndarray]:
     """:func:`thin` for many paths in one go (same result as one call per path).
 
     All paths are deduplicated and concatenated; the short reaches of every start are found
-    by one vectorised sweep over all paths together (:func:`_sweep`), the greedy chain walks
-    them in plain Python, and only starts whose sleeve reaches farther than ``_SWEEP``
-    points run the chunked numpy search (:func:`_reach`). Paths with fewer than
-    ``_DP_RATIO`` points per kept line then get the shortest path over the exactly verified
-    shortcuts of at most ``_DP_WINDOW`` steps plus the greedy ones (all such paths again in
-    one sweep).
+    by one vectorised sweep over all paths together (:func:`_sweep`); where the sleeve
+    reaches farther than ``_SWEEP`` points the reach is found only for the points the greedy
+    chains stand on, many at once (:func:`_walk`). Paths with fewer than ``_DP_RATIO``
+    points per kept line then get the shortest path over the exactly verified shortcuts of
+    at most ``_DP_WINDOW`` steps plus the greedy ones (all such paths again in one sweep).
     """
     eps = check_positive("eps_line", eps_line)
     arrs = [np.asarray(p, dtype=np.float64).reshape(-1, 2) for p in paths]
-    us = [dedup_indices(p) for p in arrs]
-    out: list[np.ndarray] = [u for u in us]
-    big = [k for k, u in enumerate(us) if len(u) > 2]
-    if not big:
-        return out
-    qs = [arrs[k][us[k]] for k in big]
-    lens = np.array([len(q) for q in qs], dtype=np.intp)
+    if not arrs:
+        return []
+    lens0 = np.array([len(p) for p in arrs], dtype=np.intp)
+    o0 = np.concatenate(([0], np.cumsum(lens0)))
+    pts = np.concatenate(arrs) if len(arrs) > 1 else arrs[0]
+    # duplicates: a point equal to its predecessor in the same path is dropped
+    keep = np.ones(len(pts), dtype=bool)
+    if len(pts) > 1:
+        keep[1:] = np.any(pts[1:] != pts[:-1], axis=1)
+    keep[o0[:-1][lens0 > 0]] = True
+    kidx = np.flatnonzero(keep)  # original (concatenated) index of every distinct point
+    ck = np.concatenate(([0], np.cumsum(keep)))
+    dl = ck[o0[1:]] - ck[o0[:-1]]  # distinct points per path
+    big = dl > 2
+    sel = np.ones(len(kidx), dtype=bool)  # distinct points kept by the thinning
+    if big.any():
+        on = np.repeat(big, dl)
+        qpos = np.flatnonzero(on)  # the thinned paths' points, concatenated
+        sel[qpos] = False
+        flat = _thin_concat(pts[kidx[qpos]], dl[big], eps)
+        sel[qpos[flat]] = True
+    got = kidx[sel] - np.repeat(o0[:-1], dl)[sel]
+    cut = np.cumsum(np.concatenate(([0], sel)))[ck[o0]].tolist()
+    return [got[c0:c1] for c0, c1 in zip(cut[:-1], cut[1:], strict=True)]
+
+
+def _thin_concat(q: np.ndarray, lens: np.ndarray, eps: float) -> np.ndarray:
+    """Kept points of every path of ``q`` (the distinct points of all paths with more than
+    two, concatenated; ``lens`` points each) as increasing indices into ``q``."""
     offs = np.concatenate(([0], np.cumsum(lens)))
-    q = np.concatenate(qs) if len(qs) > 1 else qs[0]
     x = np.ascontiguousarray(q[:, 0])
     y = np.ascontiguousarray(q[:, 1])
     pend = np.repeat(offs[1:] - 1, lens)
     n = len(q)
-    # a sample of every _SAMPLE-th start tells where sleeves are long (dense curves): those
-    # stretches skip the sweep and use the numpy search from each kept point
-    samp = np.arange(0, n, _SAMPLE)
-    _, sopen = _sweep(x, y, pend, eps, samp, _SWEEP)
-    dense = np.repeat(sopen & np.append(sopen[1:], True), _SAMPLE)[:n]
-    opened = dense.copy()
-    starts = np.flatnonzero(~dense)
-    reach_d = np.zeros(n, dtype=np.intp)
-    if len(starts):
-        ok, op = _sweep(x, y, pend, eps, starts, _SWEEP)
-        reach_d[starts] = _farthest(ok)
-        opened[starts] = op
-    reach = (np.arange(n) + reach_d).tolist()
-    opn = opened.tolist()
-    chains: list[list[int]] = []
-    dp_paths: list[int] = []
-    for t in range(len(qs)):
-        a, e = int(offs[t]), int(offs[t + 1]) - 1
-        ch = [a]
-        i = a
-        chunk = 32
-        qq: tuple[np.ndarray, np.ndarray] | None = None
-        while i < e:
-            if opn[i]:
-                if qq is None:
-                    qq = (x[a : e + 1], y[a : e + 1])
-                j = a + _reach(qq[0], qq[1], i - a, eps, chunk)
-                chunk = max(32, 2 * (j - i))
-            else:
-                j = reach[i]
-            ch.append(j)
-            i = j
-        chains.append(ch)
-        if e + 1 - a < _DP_RATIO * len(ch):
-            dp_paths.append(t)
-    if dp_paths:
-        _shortest_many(x, y, pend, eps, offs, dp_paths, chains)
-    for t, k in enumerate(big):
-        a = int(offs[t])
-        out[k] = us[k][np.asarray(chains[t], dtype=np.intp) - a]
-    return out
+    with np.errstate(divide="ignore", invalid="ignore"):
+        # a sample of every _SAMPLE-th start tells where sleeves are long (dense curves):
+        # those stretches skip the sweep; their reaches are found only where a chain stands
+        samp = np.arange(0, n, _SAMPLE)
+        _, sopen = _sweep(x, y, pend, eps, samp, _SWEEP)
+        dense = np.repeat(sopen & np.append(sopen[1:], True), _SAMPLE)[:n]
+        opened = dense.copy()
+        starts = np.flatnonzero(~dense)
+        nxt_a = np.full(n, -1, dtype=np.intp)
+        if len(starts):
+            ok, op = _sweep(x, y, pend, eps, starts, _SWEEP)
+            nxt_a[starts] = starts + _farthest(ok)
+            opened[starts] = op
+        nxt_a[opened] = -1
+        nxt = nxt_a.tolist()
+        offl = offs.tolist()
+        if opened.any():
+            _walk(x, y, pend, eps, offl[:-1], nxt, opened)
+        chains: list[list[int]] = []
+        dp_paths: list[int] = []
+        for t in range(len(lens)):
+            a, e = offl[t], offl[t + 1] - 1
+            ch = [a]
+            i = a
+            while i < e:
+                i = nxt[i]
+                ch.append(i)
+            chains.append(ch)
+            if e + 1 - a < _DP_RATIO * len(ch):
+                dp_paths.append(t)
+        if dp_paths:
+            _shortest_many(x, y, pend, eps, offs, dp_paths, chains)
+    return np.fromiter(itertools.chain.from_iterable(chains), dtype=np.intp)
 
 
 def _shortest_many(
@@ -383,43 +597,193 @@ def _shortest_many(
 ) -> None:
     """Replace ``chains[t]`` of every path t in ``paths`` by the fewest kept points over the
     valid shortcuts of at most ``_DP_WINDOW`` steps plus the greedy ones (so never more
-    than the greedy result): a shortest path (Imai–Iri) in that graph, ties broken towards
-    the farthest predecessor. Every shortcut used is verified exactly."""
+    than the greedy result): a shortest path (Imai–Iri) in that graph; of several
+    predecessors at the same distance the one farthest back wins, a greedy shortcut longer
+    than the window only when strictly better. Every shortcut used is verified exactly.
+
+    A point no shortcut passes over (a corner) is on every path, so the paths split there
+    into independent pieces. Two equivalent solvers share the pieces: a breadth-first search
+    over all of them at once (:func:`_dp_levels`, one round of numpy calls per kept point of
+    the longest piece) and a plain Python relaxation over the edges (:func:`_dp_edges`, for
+    pieces with many kept points and few edges each).
+    """
+    n = len(x)
     starts = np.concatenate([np.arange(offs[t], offs[t + 1]) for t in paths])
     ok, _ = _sweep(x, y, pend, eps, starts, _DP_WINDOW)
     ri, dd = np.nonzero(ok)
     ii = starts[ri]
     jj = ii + dd
+    ext = [pb for t in paths for pb in _extras(chains[t])]
+    ep = np.array([p for p, _ in ext], dtype=np.intp)
+    eb = np.array([b for _, b in ext], dtype=np.intp)
+    # points passed over by some shortcut; the others cut the paths into pieces
+    span = np.bincount(ii + 1, minlength=n + 1)[: n + 1] - np.bincount(jj, minlength=n + 1)
+    span[ep + 1] += 1
+    span[eb] -= 1
+    inside = np.zeros(n, dtype=bool)
+    inside[starts] = True
+    cuts = np.flatnonzero((np.cumsum(span[:n]) == 0) & inside)
+    last = np.zeros(n, dtype=bool)
+    last[offs[1:] - 1] = True
+    seg_a = cuts[~last[cuts]]  # piece [seg_a[k], seg_e[k]]
+    seg_e = cuts[1:][~last[cuts[:-1]]] if len(cuts) > 1 else cuts[:0]
+    # cost of each piece by edge relaxation (its edges) and its greedy kept points
+    deg = np.count_nonzero(ok, axis=1)
+    cdeg = np.concatenate(([0], np.cumsum(np.bincount(starts, weights=deg, minlength=n))))
+    edges = (cdeg[seg_e] - cdeg[seg_a]).astype(np.intp)
+    chain_nodes = np.fromiter(
+        itertools.chain.from_iterable(chains[t] for t in paths), dtype=np.intp
+    )
+    ck = np.searchsorted(chain_nodes, seg_e, side="right") - np.searchsorted(
+        chain_nodes, seg_a, side="right"
+    )
+    # breadth-first for the pieces with at most l_cut greedy lines, where one round of the
+    # search costs about as much as _LEVEL_EDGES edges in Python
+    order = np.argsort(ck, kind="stable")
+    rest = int(edges.sum()) - np.cumsum(edges[order])
+    cost = ck[order] * _LEVEL_EDGES + rest
+    k_best = int(np.argmin(cost))
+    l_cut = int(ck[order[k_best]]) if cost[k_best] < edges.sum() else -1
+    pred = np.full(n, -1, dtype=np.intp)
+    lv = ck <= l_cut
+    if lv.any():
+        _dp_levels(n, seg_a[lv], cuts, ii, jj, starts, deg, ep, eb, pred)
+    if not lv.all():
+        a_l = seg_a[~lv]
+        e_l = seg_e[~lv]
+        on = np.zeros(n + 1, dtype=np.int8)
+        np.add.at(on, a_l, 1)
+        np.add.at(on, e_l, -1)
+        sel = np.cumsum(on[:n]).astype(bool)[ii]
+        _dp_edges(
+            a_l.tolist(),
+            e_l.tolist(),
+            ii[sel],
+            jj[sel],
+            dict(zip(eb.tolist(), ep.tolist(), strict=True)),
+            pred,
+        )
+    pl = pred.tolist()
+    for t in paths:
+        a, e = int(offs[t]), int(offs[t + 1]) - 1
+        path = [e]
+        while path[-1] != a:
+            path.append(pl[path[-1]])
+        if len(path) <= len(chains[t]):
+            path.reverse()
+            chains[t] = path
+
+
+#: one breadth-first round over all pieces costs about as much as this many Python edges
+_LEVEL_EDGES = 60
+
+
+def _extras(chain: list[int]) -> list[tuple[int, int]]:
+    """Greedy shortcuts (p, b) longer than the DP window (not in the sweep's table)."""
+    return [(p, b) for p, b in zip(chain[:-1], chain[1:], strict=True) if b - p > _DP_WINDOW]
+
+
+def _dp_levels(
+    n: int,
+    seeds: np.ndarray,
+    cuts: np.ndarray,
+    ii: np.ndarray,
+    jj: np.ndarray,
+    starts: np.ndarray,
+    deg: np.ndarray,
+    ep: np.ndarray,
+    eb: np.ndarray,
+    pred: np.ndarray,
+) -> None:
+    """:func:`_shortest_many`'s predecessors by breadth-first search from the piece starts
+    ``seeds``, all pieces at once.
+
+    ``ii``, ``jj``: every valid shortcut (sorted by start; the sweep rows ``starts`` with
+    ``deg`` shortcuts each), nodes are global point indices; ``ep -> eb`` the greedy long
+    shortcuts. Level k holds the points first reached with k lines from their piece start:
+    a point's predecessor is the smallest start among the level's shortcuts into it, or the
+    greedy long shortcut when no table shortcut reaches it at that level (the order of the
+    edge-by-edge relaxation). A piece end (a cut point) gets its predecessor the same way
+    but is not expanded again (it starts the next piece)."""
+    big = np.iinfo(np.intp).max
+    cnt_of = np.zeros(n, dtype=np.intp)
+    cnt_of[starts] = deg
+    est_of = np.zeros(n, dtype=np.intp)
+    est_of[starts] = np.cumsum(deg) - deg
+    best = np.full(n, big, dtype=np.intp)
+    best[cuts] = 0  # reached: as piece starts (expanded once, below) or never used
+    need = np.zeros(n, dtype=bool)  # cut points still waiting for their predecessor
+    need[cuts] = True
+    need[pred >= 0] = False
+    ext = np.full(n, -1, dtype=np.intp)
+    ext[ep] = eb
+    front = seeds
+    level = 0
+    while len(front):
+        level += 1
+        cnt = cnt_of[front]
+        tot = int(cnt.sum())
+        src = np.repeat(front, cnt)
+        eid = np.arange(tot) + np.repeat(est_of[front] - (np.cumsum(cnt) - cnt), cnt)
+        tgt, first = np.unique(jj[eid], return_index=True)  # first: smallest start
+        srcu = src[first]
+        w = need[tgt]
+        if w.any():
+            pred[tgt[w]] = srcu[w]
+            need[tgt[w]] = False
+        new = best[tgt] == big
+        tgt = tgt[new]
+        best[tgt] = level
+        pred[tgt] = srcu[new]
+        et = ext[front]
+        hit = et >= 0
+        if hit.any():
+            p = front[hit]
+            et = et[hit]
+            w = need[et]
+            if w.any():
+                pred[et[w]] = p[w]
+                need[et[w]] = False
+            free = best[et] == big
+            best[et[free]] = level
+            pred[et[free]] = p[free]
+            tgt = np.sort(np.concatenate((tgt, et[free])))
+        front = tgt
+
+
+def _dp_edges(
+    seg_a: list[int],
+    seg_e: list[int],
+    ii: np.ndarray,
+    jj: np.ndarray,
+    extra: dict[int, int],
+    pred: np.ndarray,
+) -> None:
+    """:func:`_shortest_many`'s predecessors in the pieces [seg_a[k], seg_e[k]] by relaxing
+    their shortcuts (ii -> jj) in plain Python, grouped by end point, within a group by
+    start; ``extra[b] = p`` the greedy long shortcuts."""
     order = np.lexsort((ii, jj))
     ii_l = ii[order].tolist()
     jj_l = jj[order].tolist()
-    # edges grouped by end point (ascending), within a group by start ascending
     pos = 0
     ne = len(jj_l)
-    for t in paths:
-        a, e = int(offs[t]), int(offs[t + 1])
-        g = chains[t]
-        extra = {b: p for p, b in zip(g[:-1], g[1:], strict=True) if b - p > _DP_WINDOW}
-        n = e - a
-        inf = n + 1
-        best = [inf] * n
-        pred = [0] * n
+    for a, e in zip(seg_a, seg_e, strict=True):
+        m = e + 1 - a
+        inf = m + 1
+        best = [inf] * m
+        prd = [0] * m
         best[0] = 0
-        while pos < ne and jj_l[pos] < e:
+        while pos < ne and jj_l[pos] <= e:
             i = ii_l[pos] - a
             j = jj_l[pos] - a
             v = best[i] + 1
             if v < best[j]:
                 best[j] = v
-                pred[j] = i
+                prd[j] = i
             pos += 1
             if extra and (pos == ne or jj_l[pos] != jj_l[pos - 1]):
                 p = extra.get(j + a)
                 if p is not None and best[p - a] + 1 < best[j]:
                     best[j] = best[p - a] + 1
-                    pred[j] = p - a
-        path = [n - 1]
-        while path[-1] != 0:
-            path.append(pred[path[-1]])
-        if len(path) <= len(g):
-            chains[t] = [a + k for k in reversed(path)]
+                    prd[j] = p - a
+        pred[a + 1 : e + 1] = np.asarray(prd[1:], dtype=np.intp) + a
