@@ -9,11 +9,18 @@ for the segment, since the segment lies on the ray) prunes, and the exact point-
 distance decides every candidate whose in-between points are not all closer to P_i than P_j.
 
 Usage: python bench/bench_thin.py [--json out.json]
+       python bench/bench_thin.py --old OLD_THIN.py [--reps N] [--json out.json]
+
+With ``--old`` only the speed curves are run, the given frozen copy of galvo_core/thin.py
+and the current one interleaved (best of N each, same process), with the load average
+before and after; every path's kept indices are compared too (the speed rows of
+bench/RESULTS.md come from this).
 """
 
 from __future__ import annotations
 
 import argparse
+import importlib.util
 import json
 import math
 import os
@@ -177,10 +184,84 @@ def timed(paths: list[np.ndarray], eps: float, reps: int = 5, many: bool = False
     return best, kept
 
 
+def speed_inputs() -> list[tuple[str, list[np.ndarray], float]]:
+    """The speed curves: (name, paths, eps) as the fitter thins them (one thin_many call)."""
+    t = np.linspace(0, 2 * np.pi, 200_000)
+    out = [
+        ("sines 100k", [sines()], 0.02),
+        ("ellipse 200k", [np.c_[400 * np.cos(t), 300 * np.sin(t)]], 0.02),
+        ("sparse walk 20k", [sparse_walk()], 0.02),
+        ("sparse walk 20k", [sparse_walk()], 1.0),
+    ]
+    corp: list[np.ndarray] = []
+    for f in CORPUS_FILES:
+        fp = os.path.join(CORPUS, f)
+        if os.path.exists(fp):
+            corp += paths_of(fp)
+    if corp:
+        out += [(f"corpus {len(CORPUS_FILES)} files", corp, e) for e in (0.02, 1.0)]
+    samples = os.path.join(ROOT, "resources", "samples")
+    out.append(("seal.plt", paths_of(os.path.join(samples, "seal.plt")), 0.02))
+    glyphs = paths_of(os.path.join(samples, "text_outline.plt"))
+    out += [("text_outline.plt", glyphs, e) for e in (0.02, 0.5)]
+    noten = os.path.join(CORPUS, "h42i__monoplots__noten.hpgl")
+    if os.path.exists(noten):
+        out += [("noten.hpgl", paths_of(noten), e) for e in (0.02, 0.5)]
+    return out
+
+
+def compare_old(old_path: str, reps: int) -> list[dict]:
+    """Old (frozen copy at ``old_path``) against current ``thin_many``, interleaved."""
+    spec = importlib.util.spec_from_file_location("thin_old", old_path)
+    assert spec is not None and spec.loader is not None
+    old = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(old)
+    rows = []
+    print(f"load average before: {os.getloadavg()}", flush=True)
+    for name, paths, eps in speed_inputs():
+        n = sum(len(p) for p in paths)
+        best = {"old": math.inf, "new": math.inf}
+        res = {}
+        for _ in range(reps):
+            for lab, fn in (("old", old.thin_many), ("new", thin_many)):
+                t0 = time.perf_counter()
+                res[lab] = fn(paths, eps)
+                best[lab] = min(best[lab], time.perf_counter() - t0)
+        same = all(np.array_equal(a, b) for a, b in zip(res["old"], res["new"], strict=True))
+        row = dict(
+            set=name,
+            eps=eps,
+            paths=len(paths),
+            points=n,
+            kept=sum(len(k) for k in res["new"]),
+            old_pts_per_s=n / best["old"],
+            new_pts_per_s=n / best["new"],
+            identical=same,
+            load=os.getloadavg()[0],
+        )
+        rows.append(row)
+        print(
+            f"{name:18s} eps={eps:<5} paths={len(paths):5d} n={n:7d} kept={row['kept']:6d} "
+            f"old {n / best['old'] / 1e6:6.3f}M  new {n / best['new'] / 1e6:6.3f}M pts/s  "
+            f"x{best['old'] / best['new']:.2f}  identical={same}  load {row['load']:.2f}",
+            flush=True,
+        )
+    print(f"load average after: {os.getloadavg()}", flush=True)
+    return rows
+
+
 def main() -> dict:
     ap = argparse.ArgumentParser()
     ap.add_argument("--json")
+    ap.add_argument("--old", help="frozen copy of galvo_core/thin.py to time against")
+    ap.add_argument("--reps", type=int, default=5)
     args = ap.parse_args()
+    if args.old:
+        cmp = compare_old(args.old, args.reps)
+        if args.json:
+            with open(args.json, "w") as f:
+                json.dump(dict(compare=cmp), f, indent=1)
+        return dict(compare=cmp)
     rows = []
     for name, paths, epss in datasets():
         n_in = sum(len(p) for p in paths)

@@ -30,7 +30,6 @@ segment that replaces it, and the first and last points are always kept.
 
 from __future__ import annotations
 
-import itertools
 import math
 from collections.abc import Sequence
 
@@ -73,53 +72,93 @@ _LOOSE = 1e-9
 _TINY = 1e-12
 
 
+class _Sleeve:
+    """Sweep state of the starts whose wedge is still open after ``d`` steps: rows ``row``
+    of the table, starts ``s``, their path ends ``lim``, wedge ``lo``..``hi`` (radians,
+    relative to the first point farther than eps, direction ``rx``, ``ry``, once ``has``),
+    farthest distance ``rmax`` so far."""
+
+    __slots__ = ("d", "row", "s", "lim", "xs", "ys", "lo", "hi", "rmax", "rx", "ry", "has")
+
+    def take(self, keep: np.ndarray) -> None:
+        """Keep only the starts ``keep`` (mask)."""
+        for f in ("row", "s", "lim", "xs", "ys", "lo", "hi", "rmax", "rx", "ry", "has"):
+            setattr(self, f, getattr(self, f)[keep])
+
+
 def _sweep(
-    x: np.ndarray, y: np.ndarray, pend: np.ndarray, eps: float, s0: np.ndarray, d_max: int
-) -> tuple[np.ndarray, np.ndarray]:
+    x: np.ndarray,
+    y: np.ndarray,
+    pend: np.ndarray,
+    eps: float,
+    s0: np.ndarray,
+    d_max: int,
+    width: int = 0,
+) -> tuple[np.ndarray, np.ndarray, _Sleeve]:
     """The sleeve for many starts at once (vectorised over the starts, one step per
     distance d = 1 .. ``d_max``).
 
     ``x``, ``y``: concatenated points (consecutive points of a path distinct); ``pend[i]``:
-    index of the last point of i's path; ``s0``: the starts. Returns ``(ok, opened)``:
-    ``ok[k, d]`` is True when the shortcut s0[k] -> s0[k] + d is valid (every point strictly
-    between within eps of the segment, decided exactly), ``opened[k]`` when the wedge is
-    still non-empty after ``d_max`` steps and the path goes on (a valid end may lie
-    farther). A start stops as soon as its wedge is empty (no farther end can be valid:
-    the wedge is necessary for the segment too) or its path ends.
+    index of the last point of i's path; ``s0``: the starts. Returns ``(ok, opened,
+    state)``: ``ok[k, d]`` is True when the shortcut s0[k] -> s0[k] + d is valid (every
+    point strictly between within eps of the segment, decided exactly; the table has
+    ``max(d_max, width) + 1`` columns), ``opened[k]`` when the wedge is still non-empty
+    after ``d_max`` steps and the path goes on (a valid end may lie farther); ``state``
+    lets :func:`_sweep_steps` go on farther. A start stops as soon as its wedge is empty (no
+    farther end can be valid: the wedge is necessary for the segment too) or its path ends.
     """
     m = len(s0)
-    ok = np.zeros((m, d_max + 1), dtype=bool)
-    opened = np.zeros(m, dtype=bool)
+    ok = np.zeros((m, max(d_max, width) + 1), dtype=bool)
     lim = pend[s0]
     live = s0 < lim
     ok[live, 1] = True
-    row = np.flatnonzero(live)
-    s = s0[live]
-    lim = lim[live]
-    k = len(s)
-    lo = np.full(k, -np.inf)
-    hi = np.full(k, np.inf)
-    rmax = np.zeros(k)
-    rx = np.zeros(k)
-    ry = np.zeros(k)
-    has = np.zeros(k, dtype=bool)
+    st = _Sleeve()
+    st.d = 0
+    st.row = np.flatnonzero(live)
+    st.s = s0[live]
+    st.lim = lim[live]
+    k = len(st.s)
+    st.lo = np.full(k, -np.inf)
+    st.hi = np.full(k, np.inf)
+    st.rmax = np.zeros(k)
+    st.rx = np.zeros(k)
+    st.ry = np.zeros(k)
+    st.has = np.zeros(k, dtype=bool)
+    st.xs, st.ys = x[st.s], y[st.s]
+    _sweep_steps(x, y, eps, st, ok, s0, d_max)
+    opened = np.zeros(m, dtype=bool)
+    opened[st.row] = True
+    return ok, opened, st
+
+
+def _sweep_steps(
+    x: np.ndarray,
+    y: np.ndarray,
+    eps: float,
+    st: _Sleeve,
+    ok: np.ndarray,
+    s0: np.ndarray,
+    d_max: int,
+) -> None:
+    """Steps ``st.d + 1`` .. ``d_max`` of :func:`_sweep` (table ``ok``, rows of starts
+    ``s0``); afterwards ``st`` holds the starts whose wedge is still open."""
     chk_rows: list[np.ndarray] = []
-    chk_d: list[np.ndarray] = []
-    xs, ys = x[s], y[s]
+    chk_d: list[int] = []
     with np.errstate(divide="ignore", invalid="ignore"):
-        for d in range(1, d_max + 1):
-            if len(s) == 0:
+        for d in range(st.d + 1, d_max + 1):
+            if len(st.s) == 0:
                 break
-            j = s + d
-            vx = x[j] - xs
-            vy = y[j] - ys
+            j = st.s + d
+            vx = x[j] - st.xs
+            vy = y[j] - st.ys
             r = np.hypot(vx, vy)
             far = r > eps
-            new = far & ~has
+            new = far & ~st.has
             if new.any():
-                rx = np.where(new, vx / r, rx)
-                ry = np.where(new, vy / r, ry)
-                has |= new
+                st.rx = np.where(new, vx / r, st.rx)
+                st.ry = np.where(new, vy / r, st.ry)
+                st.has |= new
+            rx, ry, lo, hi, rmax = st.rx, st.ry, st.lo, st.hi, st.rmax
             th = np.arctan2(rx * vy - ry * vx, rx * vx + ry * vy)
             if d >= 2:
                 # candidate end j: direction inside the wedge of the points before it (or j
@@ -128,50 +167,44 @@ def _sweep(
                 maybe &= rmax <= r + eps
                 # no point before farther from s than j: ray distance == segment distance,
                 # so the wedge alone decides (kept a hair inside against rounding)
-                sure = maybe & (rmax <= r) & ((th >= lo + _TINY) & (th <= hi - _TINY) | ~has)
-                ok[row[sure], d] = True
+                sure = maybe & (rmax <= r) & ((th >= lo + _TINY) & (th <= hi - _TINY) | ~st.has)
+                ok[st.row[sure], d] = True
                 rest = maybe & ~sure
                 if rest.any():
-                    chk_rows.append(row[rest])
-                    chk_d.append(np.full(int(np.count_nonzero(rest)), d))
+                    chk_rows.append(st.row[rest])
+                    chk_d.append(d)
             w = np.arcsin(eps / np.where(far, r, 0.0))  # NaN for near points: no bound
             np.fmax(lo, th - w, out=lo)
             np.fmin(hi, th + w, out=hi)
             np.maximum(rmax, r, out=rmax)
-            alive = (lo <= hi + _LOOSE) & (j < lim)  # a wedge closed by rounding only
-            if d == d_max:
-                opened[row[alive]] = True
-                break
+            alive = (lo <= hi + _LOOSE) & (j < st.lim)  # a wedge closed by rounding only
             if not alive.all():
-                row, s, lim, xs, ys = row[alive], s[alive], lim[alive], xs[alive], ys[alive]
-                lo, hi, rmax = lo[alive], hi[alive], rmax[alive]
-                rx, ry, has = rx[alive], ry[alive], has[alive]
-    if chk_rows:
+                st.take(alive)
+    st.d = d_max
+    for rows, d in zip(chk_rows, chk_d, strict=True):
         # exact point-to-segment distances for the candidates the wedge left open
-        rows = np.concatenate(chk_rows)
-        dd = np.concatenate(chk_d)
-        ia0 = s0[rows]
-        cnt = dd - 1
-        first = np.cumsum(cnt) - cnt
-        own = np.repeat(np.arange(len(rows)), cnt)
-        off = np.arange(int(cnt.sum())) - first[own] + 1
-        ia = ia0[own]
-        ib = ia + dd[own]
-        ax, ay = x[ia], y[ia]
-        bx = x[ib] - ax
-        by = y[ib] - ay
-        px = x[ia + off] - ax
-        py = y[ia + off] - ay
-        den = bx * bx + by * by
-        with np.errstate(divide="ignore", invalid="ignore"):
-            t = np.clip((px * bx + py * by) / np.where(den > 0.0, den, 1.0), 0.0, 1.0)
-        t = np.where(den > 0.0, t, 0.0)
-        ex = px - t * bx
-        ey = py - t * by
-        worst = np.maximum.reduceat(ex * ex + ey * ey, first)
-        good = worst <= eps * eps
-        ok[rows[good], dd[good]] = True
-    return ok, opened
+        ok[rows, d] = _check_rows(x, y, s0[rows], d, eps)
+
+
+def _check_rows(x: np.ndarray, y: np.ndarray, s: np.ndarray, d: int, eps: float) -> np.ndarray:
+    """Exact test of the shortcuts s -> s + d (one per start in ``s``): every point between
+    within eps of the segment (true point-to-segment distance)."""
+    xs = x[s][:, None]
+    ys = y[s][:, None]
+    bx = x[s + d][:, None] - xs
+    by = y[s + d][:, None] - ys
+    k = s[:, None] + np.arange(1, d)
+    px = x[k] - xs
+    py = y[k] - ys
+    den = bx * bx + by * by
+    pos = den > 0.0
+    with np.errstate(divide="ignore", invalid="ignore"):
+        t = np.clip((px * bx + py * by) / np.where(pos, den, 1.0), 0.0, 1.0)
+    if not pos.all():
+        t = np.where(pos, t, 0.0)
+    ex = px - t * bx
+    ey = py - t * by
+    return np.max(ex * ex + ey * ey, axis=1) <= eps * eps
 
 
 def _farthest(ok: np.ndarray) -> np.ndarray:
@@ -311,6 +344,65 @@ def _reach_rows(
         c[todo[bad], top[bad]] = False
         todo = todo[bad]
     return j, mstop, retry
+
+
+def _reach_one(
+    x: np.ndarray, y: np.ndarray, i: int, pe: int, eps: float, k_win: int
+) -> tuple[int, int, bool]:
+    """:func:`_reach_rows` for one start i (path end ``pe``) on plain slices, with the
+    candidates tried from the far end in plain Python (the same decisions, fewer calls).
+    Returns ``(j, mstop, retry)``."""
+    e = min(pe, i + k_win)
+    x0 = x[i]
+    y0 = y[i]
+    vx = x[i + 1 : e + 1] - x0
+    vy = y[i + 1 : e + 1] - y0
+    r = np.hypot(vx, vy)
+    n_win = len(r)
+    retry = pe > i + k_win
+    far = r > eps
+    f0 = int(far.argmax())
+    if not far[f0]:
+        return pe, n_win, retry
+    cx = vx[f0] / r[f0]
+    cy = vy[f0] / r[f0]
+    theta = np.arctan2(cx * vy - cy * vx, cx * vx + cy * vy)
+    w = np.arcsin(eps / np.where(far, r, 0.0))  # NaN for near points: no bound
+    lo = np.fmax.accumulate(theta - w)  # NaN until the first far point
+    hi = np.fmin.accumulate(theta + w)
+    empty = lo > hi
+    m_stop = int(empty.argmax())
+    if not empty[m_stop]:
+        if retry:
+            return i + 1, n_win, True
+        m_stop = n_win
+    mm = min(m_stop + 1, n_win)
+    rmax = np.maximum.accumulate(r[:mm])
+    top = mm
+    while top > 1:  # blocks of 32 candidates from the far end, as Python floats
+        b0 = max(1, top - 32)
+        th_l = theta[b0:top].tolist()
+        r_l = r[b0:top].tolist()
+        lo_l = lo[b0 - 1 : top - 1].tolist()
+        hi_l = hi[b0 - 1 : top - 1].tolist()
+        rb_l = rmax[b0 - 1 : top - 1].tolist()
+        for k in range(top - b0 - 1, -1, -1):
+            t = th_l[k]
+            lw = lo_l[k]
+            hw = hi_l[k]
+            if lw != lw:  # no far point before this one: any direction
+                lw, hw = -math.inf, math.inf
+            rm = r_l[k]
+            rb = rb_l[k]
+            if not ((lw <= t <= hw) or rm <= eps) or rb > rm + eps:
+                continue
+            j = i + 1 + b0 + k
+            if (rb <= rm and lw + _TINY <= t <= hw - _TINY) or bool(
+                _exact_ok(x, y, np.array([i]), np.array([j]), eps)[0]
+            ):
+                return j, m_stop, False
+        top = b0
+    return i + 1, m_stop, False
 
 
 #: first window of a start without history; later windows are sized from the last one
@@ -467,11 +559,16 @@ def _reach_batch(
     groups = [(order[:cut], ws[cut - 1]), (order[cut:], top)] if cut < m else [(order, top)]
     for rows, k_win in groups:
         grp = [walkers[k] for k in rows]
-        s = np.array([w.cur for w in grp], dtype=np.intp)
-        j, ms, retry = _reach_rows(x, y, pend, eps, s, k_win)
-        jl = j.tolist()
-        ml = ms.tolist()
-        rl = retry.tolist()
+        if len(grp) == 1:
+            c = grp[0].cur
+            j1, m1, r1 = _reach_one(x, y, c, int(pend[c]), eps, k_win)
+            jl, ml, rl = [j1], [m1], [r1]
+        else:
+            s = np.array([w.cur for w in grp], dtype=np.intp)
+            j, ms, retry = _reach_rows(x, y, pend, eps, s, k_win)
+            jl = j.tolist()
+            ml = ms.tolist()
+            rl = retry.tolist()
         for k, w in enumerate(grp):
             if rl[k]:
                 w.win = 2 * k_win
@@ -545,7 +642,8 @@ def thin_many(paths: Sequence[object], eps_line: float) -> list[np.ndarray]:
 
 def _thin_concat(q: np.ndarray, lens: np.ndarray, eps: float) -> np.ndarray:
     """Kept points of every path of ``q`` (the distinct points of all paths with more than
-    two, concatenated; ``lens`` points each) as increasing indices into ``q``."""
+    two, concatenated; ``lens`` points each) as increasing indices into ``q``: the greedy
+    chain, or the DP's where a path has few points per kept line."""
     offs = np.concatenate(([0], np.cumsum(lens)))
     x = np.ascontiguousarray(q[:, 0])
     y = np.ascontiguousarray(q[:, 1])
@@ -555,35 +653,71 @@ def _thin_concat(q: np.ndarray, lens: np.ndarray, eps: float) -> np.ndarray:
         # a sample of every _SAMPLE-th start tells where sleeves are long (dense curves):
         # those stretches skip the sweep; their reaches are found only where a chain stands
         samp = np.arange(0, n, _SAMPLE)
-        _, sopen = _sweep(x, y, pend, eps, samp, _SWEEP)
+        _, sopen, _ = _sweep(x, y, pend, eps, samp, _SWEEP)
         dense = np.repeat(sopen & np.append(sopen[1:], True), _SAMPLE)[:n]
         opened = dense.copy()
         starts = np.flatnonzero(~dense)
         nxt_a = np.full(n, -1, dtype=np.intp)
+        table = None
         if len(starts):
-            ok, op = _sweep(x, y, pend, eps, starts, _SWEEP)
-            nxt_a[starts] = starts + _farthest(ok)
+            # (the table is as wide as the DP window: the DP goes on from here)
+            ok, op, st = _sweep(x, y, pend, eps, starts, _SWEEP, width=_DP_WINDOW)
+            nxt_a[starts] = starts + _farthest(ok[:, : _SWEEP + 1])
             opened[starts] = op
+            table = (starts, ok, st)
         nxt_a[opened] = -1
         nxt = nxt_a.tolist()
-        offl = offs.tolist()
         if opened.any():
-            _walk(x, y, pend, eps, offl[:-1], nxt, opened)
-        chains: list[list[int]] = []
-        dp_paths: list[int] = []
-        for t in range(len(lens)):
-            a, e = offl[t], offl[t + 1] - 1
-            ch = [a]
+            _walk(x, y, pend, eps, offs[:-1].tolist(), nxt, opened)
+        keep = _chain_marks(nxt, offs)
+        cnt = np.add.reduceat(keep, offs[:-1])
+        dp = lens < _DP_RATIO * cnt
+        if dp.any():
+            _shortest_many(x, y, pend, eps, offs, dp, keep, cnt, table)
+    return np.flatnonzero(keep)
+
+
+#: from this many paths on, chains are marked by pointer doubling instead of walked
+_MANY_PATHS = 32
+
+
+def _chain_marks(nxt: list[int], offs: np.ndarray) -> np.ndarray:
+    """The points the greedy chains stand on (``nxt``: reach of each point, known on every
+    chain), from every path start (``offs[:-1]``) to its end, as a mask."""
+    n = len(nxt)
+    keep = np.zeros(n, dtype=bool)
+    if len(offs) - 1 < _MANY_PATHS:
+        nodes: list[int] = []
+        for a, e in zip(offs[:-1].tolist(), (offs[1:] - 1).tolist(), strict=True):
             i = a
+            nodes.append(i)
             while i < e:
                 i = nxt[i]
-                ch.append(i)
-            chains.append(ch)
-            if e + 1 - a < _DP_RATIO * len(ch):
-                dp_paths.append(t)
-        if dp_paths:
-            _shortest_many(x, y, pend, eps, offs, dp_paths, chains)
-    return np.fromiter(itertools.chain.from_iterable(chains), dtype=np.intp)
+                nodes.append(i)
+        keep[nodes] = True
+        return keep
+    jump = np.array(nxt, dtype=np.intp)
+    free = jump < 0
+    jump[free] = np.flatnonzero(free)
+    ends = offs[1:] - 1
+    jump[ends] = ends
+    return _reachable(jump, offs[:-1])
+
+
+def _reachable(jump: np.ndarray, roots: np.ndarray) -> np.ndarray:
+    """Mask of every point reached from ``roots`` by repeating ``jump`` (fixed points end a
+    chain): pointer doubling, log2(longest chain) whole-array steps."""
+    mark = np.zeros(len(jump), dtype=bool)
+    mark[roots] = True
+    s = np.asarray(roots, dtype=np.intp)
+    while True:
+        t = jump[s]
+        t = t[~mark[t]]  # (repeats only of a chain end: harmless)
+        if not len(t):
+            return mark
+        mark[t] = True
+        s = np.concatenate((s, t))
+        jump = jump[jump]
 
 
 def _shortest_many(
@@ -592,14 +726,17 @@ def _shortest_many(
     pend: np.ndarray,
     eps: float,
     offs: np.ndarray,
-    paths: list[int],
-    chains: list[list[int]],
+    dp: np.ndarray,
+    keep: np.ndarray,
+    cnt: np.ndarray,
+    table: tuple[np.ndarray, np.ndarray, _Sleeve] | None,
 ) -> None:
-    """Replace ``chains[t]`` of every path t in ``paths`` by the fewest kept points over the
-    valid shortcuts of at most ``_DP_WINDOW`` steps plus the greedy ones (so never more
-    than the greedy result): a shortest path (Imai–Iri) in that graph; of several
-    predecessors at the same distance the one farthest back wins, a greedy shortcut longer
-    than the window only when strictly better. Every shortcut used is verified exactly.
+    """In ``keep`` (the greedy chains, ``cnt`` points per path), replace the chain of every
+    path with ``dp`` by the fewest kept points over the valid shortcuts of at most
+    ``_DP_WINDOW`` steps plus the greedy ones (so never more than the greedy result): a
+    shortest path (Imai–Iri) in that graph; of several predecessors at the same distance the
+    one farthest back wins, a greedy shortcut longer than the window only when strictly
+    better. Every shortcut used is verified exactly.
 
     A point no shortcut passes over (a corner) is on every path, so the paths split there
     into independent pieces. Two equivalent solvers share the pieces: a breadth-first search
@@ -608,14 +745,20 @@ def _shortest_many(
     pieces with many kept points and few edges each).
     """
     n = len(x)
-    starts = np.concatenate([np.arange(offs[t], offs[t + 1]) for t in paths])
-    ok, _ = _sweep(x, y, pend, eps, starts, _DP_WINDOW)
+    lens = np.diff(offs)
+    in_dp = np.repeat(dp, lens)
+    starts = np.flatnonzero(in_dp)
+    ok = _dp_table(x, y, pend, eps, starts, table)
     ri, dd = np.nonzero(ok)
     ii = starts[ri]
     jj = ii + dd
-    ext = [pb for t in paths for pb in _extras(chains[t])]
-    ep = np.array([p for p, _ in ext], dtype=np.intp)
-    eb = np.array([b for _, b in ext], dtype=np.intp)
+    chain_nodes = np.flatnonzero(keep & in_dp)
+    # greedy shortcuts longer than the window (not in the table)
+    ep = chain_nodes[:-1]
+    eb = chain_nodes[1:]
+    long = (eb - ep > _DP_WINDOW) & (pend[ep] == pend[eb])
+    ep = ep[long]
+    eb = eb[long]
     # points passed over by some shortcut; the others cut the paths into pieces
     span = np.bincount(ii + 1, minlength=n + 1)[: n + 1] - np.bincount(jj, minlength=n + 1)
     span[ep + 1] += 1
@@ -631,9 +774,6 @@ def _shortest_many(
     deg = np.count_nonzero(ok, axis=1)
     cdeg = np.concatenate(([0], np.cumsum(np.bincount(starts, weights=deg, minlength=n))))
     edges = (cdeg[seg_e] - cdeg[seg_a]).astype(np.intp)
-    chain_nodes = np.fromiter(
-        itertools.chain.from_iterable(chains[t] for t in paths), dtype=np.intp
-    )
     ck = np.searchsorted(chain_nodes, seg_e, side="right") - np.searchsorted(
         chain_nodes, seg_a, side="right"
     )
@@ -663,24 +803,47 @@ def _shortest_many(
             dict(zip(eb.tolist(), ep.tolist(), strict=True)),
             pred,
         )
-    pl = pred.tolist()
-    for t in paths:
-        a, e = int(offs[t]), int(offs[t + 1]) - 1
-        path = [e]
-        while path[-1] != a:
-            path.append(pl[path[-1]])
-        if len(path) <= len(chains[t]):
-            path.reverse()
-            chains[t] = path
+    # the shortest paths: back from every path end along the predecessors
+    jump = np.where(pred >= 0, pred, np.arange(n))
+    mark = _reachable(jump, offs[1:][dp] - 1)
+    use = np.zeros(len(dp), dtype=bool)
+    use[dp] = np.add.reduceat(mark, offs[:-1])[dp] <= cnt[dp]
+    sel = np.repeat(use, lens)
+    keep[sel] = mark[sel]
+
+
+def _dp_table(
+    x: np.ndarray,
+    y: np.ndarray,
+    pend: np.ndarray,
+    eps: float,
+    starts: np.ndarray,
+    table: tuple[np.ndarray, np.ndarray, _Sleeve] | None,
+) -> np.ndarray:
+    """Valid shortcuts of at most ``_DP_WINDOW`` steps from every point of ``starts``
+    (sorted): the greedy's sweep ``table`` (its starts, table, open wedges) goes on to the
+    window for the starts it has, a new sweep does the others (same decisions either way:
+    every start is swept on its own)."""
+    n = len(x)
+    ok = np.zeros((len(starts), _DP_WINDOW + 1), dtype=bool)
+    done = np.zeros(n, dtype=bool)
+    if table is not None:
+        s8, ok8, st = table
+        in_dp = np.zeros(n, dtype=bool)
+        in_dp[starts] = True
+        st.take(in_dp[st.s])
+        _sweep_steps(x, y, eps, st, ok8, s8, _DP_WINDOW)
+        mine = in_dp[s8]
+        ok[np.searchsorted(starts, s8[mine])] = ok8[mine]
+        done[s8] = True
+    rest = starts[~done[starts]]
+    if len(rest):
+        ok[np.searchsorted(starts, rest)] = _sweep(x, y, pend, eps, rest, _DP_WINDOW)[0]
+    return ok
 
 
 #: one breadth-first round over all pieces costs about as much as this many Python edges
 _LEVEL_EDGES = 60
-
-
-def _extras(chain: list[int]) -> list[tuple[int, int]]:
-    """Greedy shortcuts (p, b) longer than the DP window (not in the sweep's table)."""
-    return [(p, b) for p, b in zip(chain[:-1], chain[1:], strict=True) if b - p > _DP_WINDOW]
 
 
 def _dp_levels(
