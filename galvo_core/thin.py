@@ -30,6 +30,7 @@ segment that replaces it, and the first and last points are always kept.
 
 from __future__ import annotations
 
+import bisect
 import math
 from collections.abc import Sequence
 
@@ -444,7 +445,7 @@ def _walk(
     starts: list[int],
     nxt: list[int],
     opened: np.ndarray,
-) -> None:
+) -> list[int]:
     """Fill ``nxt[i]`` (the greedy reach of i; -1 = not known yet, only where ``opened``)
     for every point the greedy chains from ``starts`` (the path starts) stand on.
 
@@ -458,7 +459,8 @@ def _walk(
     chain), so a true walk finds the seeds' reaches already known. Walkers standing on the
     same point are merged; a seed that leaves its stretch, or goes ``_SEED_SLACK`` steps
     past the next seed without meeting anyone, stops. A seed is only ever a head start: the
-    chains are those of plain walks, found in fewer rounds.
+    chains are those of plain walks, found in fewer rounds. Returns the points whose reach
+    it found.
     """
     n = len(opened)
     # stretches of unknown reaches, split at path ends
@@ -468,7 +470,6 @@ def _walk(
     last = opened.copy()
     last[:-1] &= ~opened[1:] | (pend[:-1] != pend[1:])
     ren = np.flatnonzero(last) + 1
-    run_id = np.cumsum(first) - 1
     long_runs = np.flatnonzero(ren - rs >= _RUN_MIN)
     sd = rs[long_runs]
     sd = sd[np.isin(sd, starts, invert=True)]
@@ -480,8 +481,9 @@ def _walk(
         _Walker(a, e, False, e + 1, b, _WIN0)
         for a, e, b in zip(sd.tolist(), pend[sd].tolist(), cap.tolist(), strict=True)
     ]
-    rid_l = run_id.tolist()
+    rs_l = rs.tolist()
     ren_l = ren.tolist()
+    found: list[int] = []
     split: set[int] = set()
     while walkers:
         at: dict[int, _Walker] = {}
@@ -513,10 +515,10 @@ def _walk(
         if not at:
             break
         walkers = list(at.values())
-        _reach_batch(x, y, pend, eps, walkers, nxt)
+        _reach_batch(x, y, pend, eps, walkers, nxt, found)
         for w in walkers[:]:
             c = w.cur
-            rid = rid_l[c]
+            rid = bisect.bisect_right(rs_l, c) - 1  # c's stretch
             reach = nxt[c] - c
             if rid in split or reach < 0:  # (reach < 0: still searching, larger window)
                 continue
@@ -533,14 +535,25 @@ def _walk(
             ]
             if not w.true:
                 w.cap = min(w.cap, pos[0])
+    return found
 
 
 #: cost of one :func:`_reach_rows` call in window cells (decides when to split a round)
 _CALL_CELLS = 1200
+#: most window cells (starts x window points) in one :func:`_reach_rows` call
+_MAX_CELLS = 1 << 19
+#: windows this long are searched one start at a time (calls cost little against them)
+_ONE_BY_ONE = 2048
 
 
 def _reach_batch(
-    x: np.ndarray, y: np.ndarray, pend: np.ndarray, eps: float, walkers: list, nxt: list[int]
+    x: np.ndarray,
+    y: np.ndarray,
+    pend: np.ndarray,
+    eps: float,
+    walkers: list,
+    nxt: list[int],
+    found: list[int],
 ) -> None:
     """Set ``nxt[w.cur]`` for the walkers of one round and size each one's next window from
     where its wedge emptied (a quarter more, + 8). One :func:`_reach_rows` call, or two
@@ -557,12 +570,19 @@ def _reach_batch(
         if cost < best:
             best, cut = cost, k
     groups = [(order[:cut], ws[cut - 1]), (order[cut:], top)] if cut < m else [(order, top)]
+    # bounded memory: at most _MAX_CELLS window cells per call
+    groups = [
+        (rows[c : c + max(1, _MAX_CELLS // k_win)], k_win)
+        for rows, k_win in groups
+        for c in range(0, len(rows), max(1, _MAX_CELLS // k_win))
+    ]
     for rows, k_win in groups:
         grp = [walkers[k] for k in rows]
-        if len(grp) == 1:
-            c = grp[0].cur
-            j1, m1, r1 = _reach_one(x, y, c, int(pend[c]), eps, k_win)
-            jl, ml, rl = [j1], [m1], [r1]
+        if len(grp) == 1 or k_win >= _ONE_BY_ONE:
+            one = [_reach_one(x, y, w.cur, int(pend[w.cur]), eps, k_win) for w in grp]
+            jl = [o[0] for o in one]
+            ml = [o[1] for o in one]
+            rl = [o[2] for o in one]
         else:
             s = np.array([w.cur for w in grp], dtype=np.intp)
             j, ms, retry = _reach_rows(x, y, pend, eps, s, k_win)
@@ -574,6 +594,7 @@ def _reach_batch(
                 w.win = 2 * k_win
             else:
                 nxt[w.cur] = jl[k]
+                found.append(w.cur)
                 w.win = max(16, ml[k] + ml[k] // 4 + 8)
 
 
@@ -625,19 +646,22 @@ def thin_many(paths: Sequence[object], eps_line: float) -> list[np.ndarray]:
         keep[1:] = np.any(pts[1:] != pts[:-1], axis=1)
     keep[o0[:-1][lens0 > 0]] = True
     kidx = np.flatnonzero(keep)  # original (concatenated) index of every distinct point
-    ck = np.concatenate(([0], np.cumsum(keep)))
-    dl = ck[o0[1:]] - ck[o0[:-1]]  # distinct points per path
+    ck = np.searchsorted(kidx, o0)  # first distinct point of each path
+    dl = np.diff(ck)  # distinct points per path
     big = dl > 2
-    sel = np.ones(len(kidx), dtype=bool)  # distinct points kept by the thinning
     if big.any():
-        on = np.repeat(big, dl)
-        qpos = np.flatnonzero(on)  # the thinned paths' points, concatenated
+        sel = np.ones(len(kidx), dtype=bool)  # distinct points kept by the thinning
+        qpos = np.flatnonzero(np.repeat(big, dl))  # the thinned paths' points, concatenated
         sel[qpos] = False
         flat = _thin_concat(pts[kidx[qpos]], dl[big], eps)
         sel[qpos[flat]] = True
-    got = kidx[sel] - np.repeat(o0[:-1], dl)[sel]
-    cut = np.cumsum(np.concatenate(([0], sel)))[ck[o0]].tolist()
-    return [got[c0:c1] for c0, c1 in zip(cut[:-1], cut[1:], strict=True)]
+        kept = kidx[sel]
+    else:
+        kept = kidx
+    cut = np.searchsorted(kept, o0)
+    got = kept - np.repeat(o0[:-1], np.diff(cut))
+    cl = cut.tolist()
+    return [got[c0:c1] for c0, c1 in zip(cl[:-1], cl[1:], strict=True)]
 
 
 def _thin_concat(q: np.ndarray, lens: np.ndarray, eps: float) -> np.ndarray:
@@ -668,8 +692,9 @@ def _thin_concat(q: np.ndarray, lens: np.ndarray, eps: float) -> np.ndarray:
         nxt_a[opened] = -1
         nxt = nxt_a.tolist()
         if opened.any():
-            _walk(x, y, pend, eps, offs[:-1].tolist(), nxt, opened)
-        keep = _chain_marks(nxt, offs)
+            found = _walk(x, y, pend, eps, offs[:-1].tolist(), nxt, opened)
+            nxt_a[found] = [nxt[i] for i in found]
+        keep = _chain_marks(nxt, nxt_a, offs)
         cnt = np.add.reduceat(keep, offs[:-1])
         dp = lens < _DP_RATIO * cnt
         if dp.any():
@@ -681,9 +706,10 @@ def _thin_concat(q: np.ndarray, lens: np.ndarray, eps: float) -> np.ndarray:
 _MANY_PATHS = 32
 
 
-def _chain_marks(nxt: list[int], offs: np.ndarray) -> np.ndarray:
-    """The points the greedy chains stand on (``nxt``: reach of each point, known on every
-    chain), from every path start (``offs[:-1]``) to its end, as a mask."""
+def _chain_marks(nxt: list[int], nxt_a: np.ndarray, offs: np.ndarray) -> np.ndarray:
+    """The points the greedy chains stand on (``nxt``, the same as array ``nxt_a``: reach of
+    each point, known on every chain), from every path start (``offs[:-1]``) to its end, as
+    a mask."""
     n = len(nxt)
     keep = np.zeros(n, dtype=bool)
     if len(offs) - 1 < _MANY_PATHS:
@@ -696,7 +722,7 @@ def _chain_marks(nxt: list[int], offs: np.ndarray) -> np.ndarray:
                 nodes.append(i)
         keep[nodes] = True
         return keep
-    jump = np.array(nxt, dtype=np.intp)
+    jump = nxt_a.copy()
     free = jump < 0
     jump[free] = np.flatnonzero(free)
     ends = offs[1:] - 1
