@@ -301,9 +301,9 @@ def main() -> dict:
             t = np.linspace(0, 2 * np.pi, 200_000)
             p = np.c_[400 * np.cos(t), 300 * np.sin(t)]
         dt, kept = timed([p], 0.02)
-        opt = imai_iri(p[dedup_indices(p)], 0.02) if len(p) <= 100_000 else None
-        speed.append(dict(set=name, points=len(p), kept=kept, opt=opt, pts_per_s=len(p) / dt))
-        print(f"speed {name:18s} kept={kept:6d} opt={opt} {len(p) / dt:,.0f} pts/s", flush=True)
+        best_n = imai_iri(p[dedup_indices(p)], 0.02) if len(p) <= 100_000 else None
+        speed.append(dict(set=name, points=len(p), kept=kept, opt=best_n, pts_per_s=len(p) / dt))
+        print(f"speed {name:18s} kept={kept:6d} opt={best_n} {len(p) / dt:,.0f} pts/s", flush=True)
     # whole drawings through thin_many (how the fitter thins): many small paths
     for name, fp, eps in [
         ("seal.plt", os.path.join(ROOT, "resources", "samples", "seal.plt"), 0.02),

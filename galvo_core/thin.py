@@ -15,14 +15,22 @@ The paper walks the points, growing a line P1→P2 while every point between sta
   when its direction lies in [θ − asin(ε/r), θ + asin(ε/r)]; the running intersection of
   these wedges (cumulative max / min) tells for every candidate end at once whether the ray
   towards it serves all points before it. Candidates are then confirmed with the exact
-  point-to-segment distance. Cost is linear in the number of points looked at; a kept point
-  costs a fixed number of numpy calls, so sparse input (few points per kept line) is slower
-  per point than dense input.
+  point-to-segment distance.
+
+Speed (numpy only; the cost of a numpy call, not of the arithmetic, is what counts): short
+reaches (sparse points) come from one sweep over every start of every path at once; long
+reaches (dense curves) are searched only from the points the greedy chain stands on, but for
+many chains in lockstep (one batched search per round), with seed walkers along long dense
+stretches: greedy chains from different points meet after a few lines on most curves, so the
+true chain finds most reaches already known. Seeds and batching change only how fast the
+chain is found, never which points it keeps.
 
 Near-optimal count: where the greedy leaves fewer than 16 points per kept line (integer
 coordinates, sparse points), the greedy is not within 2 % of the optimum (up to 20 % over on
 glyph outlines); there the kept points are a shortest path (Imai–Iri) over every exactly
 verified shortcut of at most 24 steps plus the greedy shortcuts, so never worse than greedy.
+It is solved piecewise (a point no shortcut passes over splits a path) by a breadth-first
+search over all pieces at once, or edge by edge in Python for pieces with many kept points.
 
 Guarantee (tested): every dropped point lies within ``eps_line`` (input units) of the kept
 segment that replaces it, and the first and last points are always kept.
@@ -71,6 +79,8 @@ _DP_WINDOW = 24
 _LOOSE = 1e-9
 #: margin inside the wedge for the "sure" shortcut (no exact check)
 _TINY = 1e-12
+#: candidates checked at once per start when the farthest one is not accepted outright
+_TOP = 4
 
 
 class _Sleeve:
@@ -80,6 +90,18 @@ class _Sleeve:
     farthest distance ``rmax`` so far."""
 
     __slots__ = ("d", "row", "s", "lim", "xs", "ys", "lo", "hi", "rmax", "rx", "ry", "has")
+    d: int
+    row: np.ndarray
+    s: np.ndarray
+    lim: np.ndarray
+    xs: np.ndarray
+    ys: np.ndarray
+    lo: np.ndarray
+    hi: np.ndarray
+    rmax: np.ndarray
+    rx: np.ndarray
+    ry: np.ndarray
+    has: np.ndarray
 
     def take(self, keep: np.ndarray) -> None:
         """Keep only the starts ``keep`` (mask)."""
@@ -316,34 +338,40 @@ def _reach_rows(
     if not hasfar.all():
         j[nofar] = pe[nofar]
     todo = np.flatnonzero(~nofar & ~retry)
+    if not len(todo):
+        return j, mstop, retry
+    # the farthest candidate of each start, usually accepted by the wedge alone
+    cc = c[todo]
+    top = (k_use - 2) - cc[:, ::-1].argmax(axis=1)
+    has = cc[np.arange(len(todo)), top]
+    t = th1[todo, top]
+    # no earlier point farther from P_s than the end: the wedge alone is exact
+    sure = has & (rmax[todo, top] <= r1[todo, top])
+    sure &= lo[todo, top] + _TINY <= t
+    sure &= t <= hi[todo, top] - _TINY
+    j[todo[sure]] = s[todo[sure]] + 2 + top[sure]
+    todo = todo[has & ~sure]
+    # the others: the _TOP farthest candidates at a time, checked exactly where needed
     while len(todo):
         cc = c[todo]
-        top = (k_use - 2) - cc[:, ::-1].argmax(axis=1)
-        has = cc[np.arange(len(todo)), top]
-        if not has.all():
-            todo = todo[has]
-            top = top[has]
-            if not len(todo):
-                break
-        t = th1[todo, top]
-        # no earlier point farther from P_s than the end: the wedge alone is exact
-        sure = rmax[todo, top] <= r1[todo, top]
-        sure &= lo[todo, top] + _TINY <= t
-        sure &= t <= hi[todo, top] - _TINY
-        jj = s[todo] + 2 + top
-        if sure.all():
-            j[todo] = jj
-            break
-        j[todo[sure]] = jj[sure]
-        rest = ~sure
-        todo = todo[rest]
-        top = top[rest]
-        jj = jj[rest]
-        good = _exact_ok(x, y, s[todo], jj, eps)
-        j[todo[good]] = jj[good]
-        bad = ~good
-        c[todo[bad], top[bad]] = False
-        todo = todo[bad]
+        pick = cc & (np.cumsum(cc[:, ::-1], axis=1)[:, ::-1] <= _TOP)
+        ri, col = np.nonzero(pick)
+        rows = todo[ri]
+        t = th1[rows, col]
+        good = rmax[rows, col] <= r1[rows, col]
+        good &= lo[rows, col] + _TINY <= t
+        good &= t <= hi[rows, col] - _TINY
+        jj = s[rows] + 2 + col
+        if not good.all():
+            ns = np.flatnonzero(~good)
+            good[ns] = _exact_ok(x, y, s[rows[ns]], jj[ns], eps)
+        best = np.full(len(todo), -1)
+        np.maximum.at(best, ri[good], col[good])
+        found = best >= 0
+        j[todo[found]] = s[todo[found]] + 2 + best[found]
+        drop = ~found[ri]
+        c[rows[drop], col[drop]] = False
+        todo = todo[~found & pick.any(axis=1)]
     return j, mstop, retry
 
 
