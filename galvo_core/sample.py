@@ -280,6 +280,20 @@ def segment_heights(coef: np.ndarray | CF, ta: np.ndarray, tb: np.ndarray, A: np
 
 
 # =========================================================================== curves
+def _speed_curvature(cf: CF, t: np.ndarray | float) -> tuple[np.ndarray, np.ndarray]:
+    """(|B'(t)|, curvature at t) of cubics in power form (curvature NaN or inf where the
+    speed is 0)."""
+    ax, ay, bx, by, dx, dy, _, _ = cf
+    d1x = (3.0 * ax * t + 2.0 * bx) * t + dx
+    d1y = (3.0 * ay * t + 2.0 * by) * t + dy
+    d2x = 6.0 * ax * t + 2.0 * bx
+    d2y = 6.0 * ay * t + 2.0 * by
+    sp = np.hypot(d1x, d1y)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        k = np.abs(d1x * d2y - d1y * d2x) / (sp * sp * sp)
+    return sp, k
+
+
 class _CubicSet:
     """Many 2-D cubics in power form (lines are cubics with a = b = 0), stored as eight
     contiguous coefficient arrays."""
@@ -292,15 +306,7 @@ class _CubicSet:
 
     def guess_terms(self, ids: np.ndarray, t: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """(|B'|, curvature) at t."""
-        ax, ay, bx, by, dx, dy, _, _ = self.gather(ids)
-        d1x = (3.0 * ax * t + 2.0 * bx) * t + dx
-        d1y = (3.0 * ay * t + 2.0 * by) * t + dy
-        d2x = 6.0 * ax * t + 2.0 * bx
-        d2y = 6.0 * ay * t + 2.0 * by
-        sp = np.hypot(d1x, d1y)
-        with np.errstate(divide="ignore", invalid="ignore"):
-            k = np.abs(d1x * d2y - d1y * d2x) / (sp * sp * sp)
-        return sp, k
+        return _speed_curvature(self.gather(ids), t)
 
     def height(self, ids: np.ndarray, ta: np.ndarray, tb: np.ndarray
                ) -> tuple[np.ndarray, np.ndarray]:
@@ -391,18 +397,12 @@ def _smooth_chains(cf: CF, is_cubic: np.ndarray, corner: np.ndarray, seg_path: n
         joined[:-1] = (is_cubic[:-1] & is_cubic[1:] & ~corner[:-1]
                        & (seg_path[:-1] == seg_path[1:]))
     if joined.any():
-        ax, ay, bx, by, dx, dy, _, _ = cf
         x, w = np.polynomial.legendre.leggauss(4)
         est = np.zeros(g)
         for xi, wi in zip(0.5 * (x + 1.0), 0.5 * w, strict=True):
-            d1x = (3.0 * ax * xi + 2.0 * bx) * xi + dx
-            d1y = (3.0 * ay * xi + 2.0 * by) * xi + dy
-            d2x = 6.0 * ax * xi + 2.0 * bx
-            d2y = 6.0 * ay * xi + 2.0 * by
-            sp = np.hypot(d1x, d1y)
-            with np.errstate(divide="ignore", invalid="ignore"):
-                f = np.sqrt(np.abs(d1x * d2y - d1y * d2x) / sp)  # sqrt(κ)·|B'|
-            est += wi * np.nan_to_num(f)
+            sp, k = _speed_curvature(cf, float(xi))
+            with np.errstate(invalid="ignore"):
+                est += wi * np.nan_to_num(np.sqrt(k) * sp, posinf=0.0)  # sqrt(κ)·|B'|
         est = est / math.sqrt(8.0 * tol) + 1.0
         # marks gathered before each cubic since the start of its run; cut at multiples
         start = ~np.r_[False, joined[:-1]]
