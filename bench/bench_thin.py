@@ -201,7 +201,9 @@ def speed_inputs() -> list[tuple[str, list[np.ndarray], float]]:
     if corp:
         out += [(f"corpus {len(CORPUS_FILES)} files", corp, e) for e in (0.02, 1.0)]
     samples = os.path.join(ROOT, "resources", "samples")
-    out.append(("seal.plt", paths_of(os.path.join(samples, "seal.plt")), 0.02))
+    seal = paths_of(os.path.join(samples, "seal.plt"))
+    out += [("seal.plt", seal, e) for e in (0.02, 0.5)]
+    out.append(("curve_1181.plt", paths_of(os.path.join(samples, "curve_1181.plt")), 0.02))
     glyphs = paths_of(os.path.join(samples, "text_outline.plt"))
     out += [("text_outline.plt", glyphs, e) for e in (0.02, 0.5)]
     noten = os.path.join(CORPUS, "h42i__monoplots__noten.hpgl")

@@ -23,14 +23,20 @@ reaches (dense curves) are searched only from the points the greedy chain stands
 many chains in lockstep (one batched search per round), with seed walkers along long dense
 stretches: greedy chains from different points meet after a few lines on most curves, so the
 true chain finds most reaches already known. Seeds and batching change only how fast the
-chain is found, never which points it keeps.
+chain is found, never which points it keeps. Paths likely to need the DP below (short, or
+few sampled starts with long reaches) are instead swept whole to the DP window: the DP needs
+that table anyway, and it holds every reach of at most 24 points. (The walk's wedge test is
+strict, the sweep's has a 1e-9 rad slack before the exact check; where that slack mattered
+for a start, its reach is still found by the walk, so the result is the same either way.)
 
 Near-optimal count: where the greedy leaves fewer than 16 points per kept line (integer
 coordinates, sparse points), the greedy is not within 2 % of the optimum (up to 20 % over on
 glyph outlines); there the kept points are a shortest path (Imai–Iri) over every exactly
 verified shortcut of at most 24 steps plus the greedy shortcuts, so never worse than greedy.
 It is solved piecewise (a point no shortcut passes over splits a path) by a breadth-first
-search over all pieces at once, or edge by edge in Python for pieces with many kept points.
+search over all pieces at once (levels as Python integer bit sets: one shift/and/or per
+shortcut length a level), or edge by edge in Python for pieces with many kept points; a
+piece the greedy crosses with one line keeps that line.
 
 Guarantee (tested): every dropped point lies within ``eps_line`` (input units) of the kept
 segment that replaces it, and the first and last points are always kept.
@@ -72,6 +78,10 @@ def dedup_indices(points: np.ndarray) -> np.ndarray:
 _SWEEP = 8
 #: stride of the sampled starts that find the dense stretches (see :func:`thin_many`)
 _SAMPLE = 16
+#: a path with at most this fraction of its sampled starts open after _SWEEP points, or
+#: at most _WHOLE_LEN points, is swept whole to _DP_WINDOW points (see :func:`_thin_concat`)
+_WHOLE_OPEN = 0.9
+_WHOLE_LEN = 1024
 #: below this many points per kept line the greedy result is improved by the window DP
 _DP_RATIO = 16
 _DP_WINDOW = 24
@@ -108,6 +118,16 @@ class _Sleeve:
         for f in ("row", "s", "lim", "xs", "ys", "lo", "hi", "rmax", "rx", "ry", "has"):
             setattr(self, f, getattr(self, f)[keep])
 
+    def split(self, mask: np.ndarray) -> _Sleeve:
+        """The starts ``mask`` as a new state (same step); this one keeps the others."""
+        other = _Sleeve()
+        other.d = self.d
+        for f in ("row", "s", "lim", "xs", "ys", "lo", "hi", "rmax", "rx", "ry", "has"):
+            v = getattr(self, f)
+            setattr(other, f, v[mask])
+            setattr(self, f, v[~mask])
+        return other
+
 
 def _sweep(
     x: np.ndarray,
@@ -117,6 +137,7 @@ def _sweep(
     s0: np.ndarray,
     d_max: int,
     width: int = 0,
+    fuzzy: np.ndarray | None = None,
 ) -> tuple[np.ndarray, np.ndarray, _Sleeve]:
     """The sleeve for many starts at once (vectorised over the starts, one step per
     distance d = 1 .. ``d_max``).
@@ -127,8 +148,9 @@ def _sweep(
     point strictly between within eps of the segment, decided exactly; the table has
     ``max(d_max, width) + 1`` columns), ``opened[k]`` when the wedge is still non-empty
     after ``d_max`` steps and the path goes on (a valid end may lie farther); ``state``
-    lets :func:`_sweep_steps` go on farther. A start stops as soon as its wedge is empty (no
-    farther end can be valid: the wedge is necessary for the segment too) or its path ends.
+    lets :func:`_sweep_steps` go on farther (``fuzzy``: see there). A start stops as soon
+    as its wedge is empty (no farther end can be valid: the wedge is necessary for the
+    segment too) or its path ends.
     """
     m = len(s0)
     ok = np.zeros((m, max(d_max, width) + 1), dtype=bool)
@@ -148,7 +170,7 @@ def _sweep(
     st.ry = np.zeros(k)
     st.has = np.zeros(k, dtype=bool)
     st.xs, st.ys = x[st.s], y[st.s]
-    _sweep_steps(x, y, eps, st, ok, s0, d_max)
+    _sweep_steps(x, y, eps, st, ok, s0, d_max, fuzzy)
     opened = np.zeros(m, dtype=bool)
     opened[st.row] = True
     return ok, opened, st
@@ -162,9 +184,15 @@ def _sweep_steps(
     ok: np.ndarray,
     s0: np.ndarray,
     d_max: int,
+    fuzzy: np.ndarray | None = None,
 ) -> None:
     """Steps ``st.d + 1`` .. ``d_max`` of :func:`_sweep` (table ``ok``, rows of starts
-    ``s0``); afterwards ``st`` holds the starts whose wedge is still open."""
+    ``s0``); afterwards ``st`` holds the starts whose wedge is still open.
+
+    ``fuzzy`` (per table row, if given) is set where the sweep's slack mattered: a
+    candidate within ``_LOOSE`` outside the wedge went to the exact check, or the wedge was
+    empty but within the slack. Elsewhere the table's farthest valid end is exactly what
+    :func:`_reach_rows` (strict wedge, same arithmetic) finds."""
     chk_rows: list[np.ndarray] = []
     chk_d: list[int] = []
     with np.errstate(divide="ignore", invalid="ignore"):
@@ -188,6 +216,10 @@ def _sweep_steps(
                 # itself near s), no point before it farther than r_j + eps from s
                 maybe = ((th >= lo - _LOOSE) & (th <= hi + _LOOSE)) | ~far
                 maybe &= rmax <= r + eps
+                if fuzzy is not None:
+                    fz = maybe & ~(((th >= lo) & (th <= hi)) | ~far)
+                    if fz.any():
+                        fuzzy[st.row[fz]] = True
                 # no point before farther from s than j: ray distance == segment distance,
                 # so the wedge alone decides (kept a hair inside against rounding)
                 sure = maybe & (rmax <= r) & ((th >= lo + _TINY) & (th <= hi - _TINY) | ~st.has)
@@ -201,6 +233,10 @@ def _sweep_steps(
             np.fmin(hi, th + w, out=hi)
             np.maximum(rmax, r, out=rmax)
             alive = (lo <= hi + _LOOSE) & (j < st.lim)  # a wedge closed by rounding only
+            if fuzzy is not None:
+                fz = alive & (lo > hi)
+                if fz.any():
+                    fuzzy[st.row[fz]] = True
             if not alive.all():
                 st.take(alive)
     st.d = d_max
@@ -707,14 +743,34 @@ def _thin_concat(q: np.ndarray, lens: np.ndarray, eps: float) -> np.ndarray:
         samp = np.arange(0, n, _SAMPLE)
         _, sopen, _ = _sweep(x, y, pend, eps, samp, _SWEEP)
         dense = np.repeat(sopen & np.append(sopen[1:], True), _SAMPLE)[:n]
+        # paths likely to get the DP (few samples still open, or short) are swept whole to
+        # the DP window: the DP needs that table anyway, and it holds most greedy reaches
+        pid = np.searchsorted(offs, samp, side="right") - 1
+        n_open = np.bincount(pid, weights=sopen, minlength=len(lens))
+        n_samp = np.bincount(pid, minlength=len(lens))
+        whole = np.repeat((n_open <= _WHOLE_OPEN * n_samp) | (lens <= _WHOLE_LEN), lens)
+        dense0 = dense.copy()
+        dense &= ~whole
         opened = dense.copy()
         starts = np.flatnonzero(~dense)
         nxt_a = np.full(n, -1, dtype=np.intp)
         table = None
         if len(starts):
             # (the table is as wide as the DP window: the DP goes on from here)
-            ok, op, st = _sweep(x, y, pend, eps, starts, _SWEEP, width=_DP_WINDOW)
-            nxt_a[starts] = starts + _farthest(ok[:, : _SWEEP + 1])
+            w_row = whole[starts]
+            fuzzy = np.zeros(len(starts), dtype=bool) if w_row.any() else None
+            ok, op, st = _sweep(x, y, pend, eps, starts, _SWEEP, _DP_WINDOW, fuzzy)
+            if fuzzy is not None:
+                # reaches a plain greedy walk finds where the sweep stopped at _SWEEP (or
+                # skipped the point): from the whole table unless its slack mattered
+                walked = w_row & (op | dense0[starts])
+                st_w = st.split(whole[st.s])
+                _sweep_steps(x, y, eps, st_w, ok, starts, _DP_WINDOW, fuzzy)
+                op[w_row] = False
+                op[st_w.row] = True
+                op |= walked & fuzzy
+            # (the farthest valid end: beyond it no wedge stayed open)
+            nxt_a[starts] = starts + _farthest(ok)
             opened[starts] = op
             table = (starts, ok, st)
         nxt_a[opened] = -1
@@ -831,20 +887,25 @@ def _shortest_many(
     ck = np.searchsorted(chain_nodes, seg_e, side="right") - np.searchsorted(
         chain_nodes, seg_a, side="right"
     )
-    # breadth-first for the pieces with at most l_cut greedy lines, where one round of the
-    # search costs about as much as _LEVEL_EDGES edges in Python
+    # breadth-first for the pieces with at most l_cut greedy lines: a round costs about
+    # _LEVEL_EDGES Python edges plus _WORD_EDGES per 64 points of the pieces still going
     order = np.argsort(ck, kind="stable")
     rest = int(edges.sum()) - np.cumsum(edges[order])
-    cost = ck[order] * _LEVEL_EDGES + rest
+    size = seg_e - seg_a + 1
+    bits = np.cumsum(size[order] * ck[order]) / 64.0
+    cost = ck[order] * _LEVEL_EDGES + bits * _WORD_EDGES + rest
     k_best = int(np.argmin(cost))
     l_cut = int(ck[order[k_best]]) if cost[k_best] < edges.sum() else -1
     pred = np.full(n, -1, dtype=np.intp)
-    lv = ck <= l_cut
+    one = ck == 1  # one greedy line: the DP cannot do better, and takes that line
+    pred[seg_e[one]] = seg_a[one]
+    lv = (ck <= l_cut) & ~one
     if lv.any():
-        _dp_levels(n, seg_a[lv], cuts, ii, jj, starts, deg, ep, eb, pred)
-    if not lv.all():
-        a_l = seg_a[~lv]
-        e_l = seg_e[~lv]
+        _dp_levels(seg_a[lv], seg_e[lv], ck[lv], ok, starts, ii, jj, ep, eb, pred)
+    ed = (ck > l_cut) & ~one
+    if ed.any():
+        a_l = seg_a[ed]
+        e_l = seg_e[ed]
         on = np.zeros(n + 1, dtype=np.int8)
         np.add.at(on, a_l, 1)
         np.add.at(on, e_l, -1)
@@ -896,76 +957,140 @@ def _dp_table(
     return ok
 
 
-#: one breadth-first round over all pieces costs about as much as this many Python edges
-_LEVEL_EDGES = 60
+#: one breadth-first round costs about as much as this many Python edges (one per
+#: shortcut in :func:`_dp_edges`), plus _WORD_EDGES per 64 points of the pieces it works on
+_LEVEL_EDGES = 6
+_WORD_EDGES = 0.33
+#: most (round x point) cells unpacked at once when the rounds' bit sets become distances
+_UNPACK_CELLS = 1 << 22
 
 
 def _dp_levels(
-    n: int,
-    seeds: np.ndarray,
-    cuts: np.ndarray,
+    seg_a: np.ndarray,
+    seg_e: np.ndarray,
+    rounds_est: np.ndarray,
+    ok: np.ndarray,
+    starts: np.ndarray,
     ii: np.ndarray,
     jj: np.ndarray,
-    starts: np.ndarray,
-    deg: np.ndarray,
     ep: np.ndarray,
     eb: np.ndarray,
     pred: np.ndarray,
 ) -> None:
-    """:func:`_shortest_many`'s predecessors by breadth-first search from the piece starts
-    ``seeds``, all pieces at once.
+    """:func:`_shortest_many`'s predecessors in the pieces [seg_a[k], seg_e[k]] (sorted,
+    inside the sweep rows ``starts``) by a breadth-first search from their starts, all
+    pieces at once.
 
-    ``ii``, ``jj``: every valid shortcut (sorted by start; the sweep rows ``starts`` with
-    ``deg`` shortcuts each), nodes are global point indices; ``ep -> eb`` the greedy long
-    shortcuts. Level k holds the points first reached with k lines from their piece start:
-    a point's predecessor is the smallest start among the level's shortcuts into it, or the
-    greedy long shortcut when no table shortcut reaches it at that level (the order of the
-    edge-by-edge relaxation). A piece end (a cut point) gets its predecessor the same way
-    but is not expanded again (it starts the next piece)."""
+    ``ok``: the shortcut table of the rows ``starts`` (``ok[r, d]``: starts[r] -> starts[r]
+    + d valid), also listed as ``ii -> jj`` (point indices); ``ep -> eb`` the greedy long
+    shortcuts. The search finds each point's distance (lines from its piece start), one
+    round per level, on Python integers as bit sets: a round is a shift, an and and an or
+    per shortcut length, whatever the number of pieces. Each piece gets its own bit range
+    (its end a copy that is never expanded), the pieces with most greedy lines
+    (``rounds_est``) in the lowest bits, so the sets shrink as the short pieces finish.
+    Then, vectorised over the shortcuts, a point's predecessor is the smallest start among
+    the table shortcuts into it from one level below, else the greedy long shortcut (when
+    only that one reaches it from there): the order of the edge-by-edge relaxation
+    (:func:`_dp_edges`)."""
+    size = seg_e - seg_a + 1
+    order = np.argsort(-rounds_est, kind="stable")
+    base = np.zeros(len(seg_a), dtype=np.intp)
+    base[order] = np.cumsum(size[order]) - size[order]  # first bit of each piece
+    total = int(size.sum())
+    shift = np.repeat(seg_a - base, size)[np.argsort(np.repeat(base, size), kind="stable")]
+    gpos = np.arange(total) + shift  # point index of every bit
+    is_end = np.zeros(total, dtype=bool)
+    is_end[base + size - 1] = True
+    width = ok.shape[1]
+    tab = ok[np.searchsorted(starts, gpos)]
+    tab[is_end] = False
+    packed = np.packbits(tab.T, axis=1, bitorder="little")
+    shifts = [
+        (d, int.from_bytes(packed[d].tobytes(), "little"))
+        for d in range(1, width)
+        if packed[d].any()
+    ]
+    # greedy long shortcuts inside the pieces, as bits
+    pk = np.searchsorted(seg_a, ep, side="right") - 1
+    inside = (pk >= 0) & (ep < seg_e[pk.clip(min=0)])
+    lp = ep[inside]
+    lb = eb[inside]
+    lbit = lp - seg_a[pk[inside]] + base[pk[inside]]
+    lpairs = list(zip(lbit.tolist(), (lbit + (lb - lp)).tolist(), strict=True))
+    long_bits = _to_int(_mask(total, lbit))
+    seen = _to_int(_mask(total, np.concatenate((base, base + size - 1))))
+    front = _to_int(_mask(total, base))
+    rounds: list[int] = []
+    while front:
+        nxt = 0
+        for d, b in shifts:
+            t = front & b
+            if t:
+                nxt |= t << d
+        if long_bits and front & long_bits:
+            for p, e in lpairs:
+                if front >> p & 1:
+                    nxt |= 1 << e
+        nxt &= ~seen
+        seen |= nxt
+        rounds.append(nxt)
+        front = nxt
+    n = len(pred)
+    dist = np.zeros(n, dtype=np.intp)
+    dist[gpos] = _levels_of(rounds, total)  # (piece ends and starts: 0 either way)
+    # predecessors: from one level below, smallest table start first, else the long one
+    src = np.zeros(n, dtype=bool)
+    src[gpos[~is_end]] = True
+    sel = src[ii]
+    ia = ii[sel]
+    ja = jj[sel]
+    da = dist[ia]
     big = np.iinfo(np.intp).max
-    cnt_of = np.zeros(n, dtype=np.intp)
-    cnt_of[starts] = deg
-    est_of = np.zeros(n, dtype=np.intp)
-    est_of[starts] = np.cumsum(deg) - deg
-    best = np.full(n, big, dtype=np.intp)
-    best[cuts] = 0  # reached: as piece starts (expanded once, below) or never used
-    need = np.zeros(n, dtype=bool)  # cut points still waiting for their predecessor
-    need[cuts] = True
-    need[pred >= 0] = False
-    ext = np.full(n, -1, dtype=np.intp)
-    ext[ep] = eb
-    front = seeds
-    level = 0
-    while len(front):
-        level += 1
-        cnt = cnt_of[front]
-        tot = int(cnt.sum())
-        src = np.repeat(front, cnt)
-        eid = np.arange(tot) + np.repeat(est_of[front] - (np.cumsum(cnt) - cnt), cnt)
-        tgt, first = np.unique(jj[eid], return_index=True)  # first: smallest start
-        srcu = src[first]
-        w = need[tgt]
-        if w.any():
-            pred[tgt[w]] = srcu[w]
-            need[tgt[w]] = False
-        new = best[tgt] == big
-        tgt = tgt[new]
-        best[tgt] = level
-        pred[tgt] = srcu[new]
-        et = ext[front]
-        hit = et >= 0
-        if hit.any():
-            p = front[hit]
-            et = et[hit]
-            w = need[et]
-            if w.any():
-                pred[et[w]] = p[w]
-                need[et[w]] = False
-            free = best[et] == big
-            best[et[free]] = level
-            pred[et[free]] = p[free]
-            tgt = np.sort(np.concatenate((tgt, et[free])))
-        front = tgt
+    low = np.full(n, big, dtype=np.intp)
+    np.minimum.at(low, ja, da)
+    if len(lp):
+        np.minimum.at(low, lb, dist[lp])
+    good = da == low[ja]
+    pm = np.full(n, big, dtype=np.intp)
+    np.minimum.at(pm, ja[good], ia[good])
+    tgt = np.flatnonzero(low < big)
+    p = pm[tgt]
+    if len(lp):
+        lsrc = np.full(n, -1, dtype=np.intp)
+        lsrc[lb] = lp
+        p = np.where(p < big, p, lsrc[tgt])
+    pred[tgt] = p
+
+
+def _mask(n: int, idx: np.ndarray) -> np.ndarray:
+    """Boolean mask of length n, True at ``idx``."""
+    m = np.zeros(n, dtype=bool)
+    m[idx] = True
+    return m
+
+
+def _to_int(mask: np.ndarray) -> int:
+    """A boolean mask as a Python integer bit set (bit i = mask[i])."""
+    return int.from_bytes(np.packbits(mask, bitorder="little").tobytes(), "little")
+
+
+def _levels_of(rounds: list[int], n: int) -> np.ndarray:
+    """Per point (bit) 0 .. n - 1, the (1-based) round whose bit set holds it, 0 for none
+    (the sets are disjoint). Only the nonzero 64-bit words are unpacked."""
+    dist = np.zeros(n, dtype=np.intp)
+    if not rounds:
+        return dist
+    nw = (n + 63) // 64
+    words = np.frombuffer(
+        b"".join(r.to_bytes(8 * nw, "little") for r in rounds), dtype="<u8"
+    ).reshape(len(rounds), nw)
+    lv, wd = np.nonzero(words)
+    bits = np.unpackbits(
+        words[lv, wd].astype("<u8").view(np.uint8).reshape(-1, 8), axis=1, bitorder="little"
+    )
+    k, b = np.nonzero(bits)
+    dist[wd[k] * 64 + b] = lv[k] + 1
+    return dist
 
 
 def _dp_edges(

@@ -221,6 +221,7 @@ def test_dp_solvers_agree(monkeypatch, eps):
     (same tie rules), on paths with few points per kept line where the DP decides."""
     paths = _few_points_per_line_paths()
     monkeypatch.setattr(thin_mod, "_LEVEL_EDGES", 0)  # everything breadth-first
+    monkeypatch.setattr(thin_mod, "_WORD_EDGES", 0)
     bfs = thin_many(paths, eps)
     monkeypatch.setattr(thin_mod, "_LEVEL_EDGES", 10**9)  # everything by relaxation
     edges = thin_many(paths, eps)
@@ -321,3 +322,40 @@ def test_many_small_paths_in_one_call_equal_one_call_each():
         for p, k in zip(paths[::50] + [walk], many[::50] + [many[-1]], strict=True):
             np.testing.assert_array_equal(k, thin(p, eps))
             assert_thin_guarantee(p, k, eps)
+
+
+def _integer_outlines():
+    """Integer-coordinate outlines with long collinear runs (where the sweep's rounding
+    slack and the greedy's strict wedge can disagree) and rounded curves."""
+    rng = np.random.default_rng(5)
+    out = []
+    for r in (30, 60, 120, 400):
+        t = np.linspace(0, 2 * np.pi, int(5 * r))
+        out.append(np.round(np.c_[r * np.cos(t), 0.7 * r * np.sin(t)]))
+    for _ in range(6):  # polylines through integer points, one point per unit step
+        corners = np.cumsum(rng.integers(-40, 41, (8, 2)), axis=0)
+        runs = [
+            np.round(a + np.linspace(0, 1, int(np.abs(b - a).max()) + 1)[:-1, None] * (b - a))
+            for a, b in zip(corners[:-1], corners[1:], strict=True)
+        ]
+        out.append(np.concatenate(runs + [corners[-1:]]))
+    return out
+
+
+@pytest.mark.parametrize("eps", [0.5, 1.0, 2.0])
+def test_whole_path_sweep_changes_nothing(monkeypatch, eps):
+    """Sweeping a path whole to the DP window (instead of walking its dense stretches)
+    gives the plain flow's result, also where the sweep's slack and the walk's strict
+    wedge disagree on integer collinear runs."""
+    paths = _integer_outlines()
+    ref = thin_many(paths, eps)
+    with monkeypatch.context() as m:  # no path swept whole
+        m.setattr(thin_mod, "_WHOLE_OPEN", -1.0)
+        m.setattr(thin_mod, "_WHOLE_LEN", 0)
+        plain = thin_many(paths, eps)
+    monkeypatch.setattr(thin_mod, "_WHOLE_OPEN", 2.0)  # every path swept whole
+    whole = thin_many(paths, eps)
+    for p, a, b, c in zip(paths, ref, plain, whole, strict=True):
+        np.testing.assert_array_equal(a, b)
+        np.testing.assert_array_equal(a, c)
+        assert_thin_guarantee(p, a, eps)
