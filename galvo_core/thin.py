@@ -85,6 +85,8 @@ _WHOLE_LEN = 1024
 #: below this many points per kept line the greedy result is improved by the window DP
 _DP_RATIO = 16
 _DP_WINDOW = 24
+#: at most this many starts left: the sweep's remaining steps are done as one 2-D block
+_FEW = 256
 #: slack of the wedge prefilter (radians): a candidate this close outside is checked exactly
 _LOOSE = 1e-9
 #: margin inside the wedge for the "sure" shortcut (no exact check)
@@ -195,9 +197,14 @@ def _sweep_steps(
     :func:`_reach_rows` (strict wedge, same arithmetic) finds."""
     chk_rows: list[np.ndarray] = []
     chk_d: list[int] = []
+    blk: tuple[np.ndarray, np.ndarray] | None = None
     with np.errstate(divide="ignore", invalid="ignore"):
         for d in range(st.d + 1, d_max + 1):
             if len(st.s) == 0:
+                break
+            if len(st.s) <= _FEW and d < d_max:
+                # few starts left: the remaining steps at once (2-D, same decisions)
+                blk = _sweep_block(x, y, eps, st, ok, d - 1, d_max, fuzzy)
                 break
             j = st.s + d
             vx = x[j] - st.xs
@@ -243,6 +250,111 @@ def _sweep_steps(
     for rows, d in zip(chk_rows, chk_d, strict=True):
         # exact point-to-segment distances for the candidates the wedge left open
         ok[rows, d] = _check_rows(x, y, s0[rows], d, eps)
+    if blk is not None and len(blk[0]):
+        rows, dd = blk
+        ok[rows, dd] = _exact_ok(x, y, s0[rows], s0[rows] + dd, eps)
+
+
+def _sweep_block(
+    x: np.ndarray,
+    y: np.ndarray,
+    eps: float,
+    st: _Sleeve,
+    ok: np.ndarray,
+    d0: int,
+    d1: int,
+    fuzzy: np.ndarray | None,
+) -> tuple[np.ndarray, np.ndarray]:
+    """Steps d0 + 1 .. d1 of :func:`_sweep_steps` for every live start of ``st`` at once,
+    as 2-D arrays (start x distance): marks the sure shortcuts in ``ok`` (and ``fuzzy``),
+    returns the (table row, distance) of the candidates that need the exact check, and
+    keeps in ``st`` the starts still open after d1. Each cell is decided by the same
+    arithmetic as one step at a time (wedge bounds and farthest distance by cumulative
+    max / min along the row); cells past the step where a start stopped are ignored."""
+    dist = np.arange(d0 + 1, d1 + 1)
+    j = st.s[:, None] + dist
+    np.minimum(j, st.lim[:, None], out=j)  # (cells past the path end are never used)
+    vx = x[j]
+    vx -= st.xs[:, None]
+    vy = y[j]
+    vy -= st.ys[:, None]
+    r = np.hypot(vx, vy)
+    far = r > eps
+    # direction of reference: the first point farther than eps (maybe in this block)
+    has0 = st.has
+    rx, ry = st.rx, st.ry
+    f0 = far.argmax(axis=1)
+    rows = np.arange(len(f0))
+    new = ~has0 & far[rows, f0]
+    if new.any():
+        nr = np.flatnonzero(new)
+        nf = f0[nr]
+        rx = rx.copy()
+        ry = ry.copy()
+        rx[nr] = vx[nr, nf] / r[nr, nf]
+        ry[nr] = vy[nr, nf] / r[nr, nf]
+    cols = np.arange(d1 - d0)
+    has = has0[:, None] | (new[:, None] & (cols >= f0[:, None]))
+    rxc = rx[:, None]
+    ryc = ry[:, None]
+    th = np.arctan2(rxc * vy - ryc * vx, rxc * vx + ryc * vy)
+    w = np.arcsin(eps / np.where(far, r, 0.0))  # NaN for near points: no bound
+    k = d1 - d0 + 1
+    lo = np.empty((len(f0), k))
+    lo[:, 0] = st.lo
+    np.subtract(th, w, out=lo[:, 1:])
+    np.fmax.accumulate(lo, axis=1, out=lo)
+    hi = np.empty((len(f0), k))
+    hi[:, 0] = st.hi
+    np.add(th, w, out=hi[:, 1:])
+    np.fmin.accumulate(hi, axis=1, out=hi)
+    rmax = np.empty((len(f0), k))
+    rmax[:, 0] = st.rmax
+    rmax[:, 1:] = r
+    np.maximum.accumulate(rmax, axis=1, out=rmax)
+    # a start is evaluated at step d while its wedge was open and its path went on before
+    alive = lo[:, 1:] <= hi[:, 1:] + _LOOSE
+    alive &= j < st.lim[:, None]
+    run = np.empty((len(f0), k), dtype=bool)
+    run[:, 0] = True
+    run[:, 1:] = alive
+    np.logical_and.accumulate(run, axis=1, out=run)
+    lb = lo[:, :-1]
+    hb = hi[:, :-1]
+    rb = rmax[:, :-1]
+    # candidate end j: direction inside the wedge of the points before it (or j itself near
+    # s), no point before it farther than r_j + eps from s
+    maybe = (th >= lb - _LOOSE) & (th <= hb + _LOOSE)
+    maybe |= ~far
+    maybe &= rb <= r + eps
+    maybe &= run[:, :-1]
+    if d0 == 0:
+        maybe[:, 0] = False  # (d = 1: always valid, set by the caller)
+    if fuzzy is not None:
+        fz = maybe & far & ~((th >= lb) & (th <= hb))
+        fz |= run[:, :-1] & alive & (lo[:, 1:] > hi[:, 1:])
+        fuzzy[st.row[fz.any(axis=1)]] = True
+    # no point before farther from s than j: the wedge alone decides (a hair inside)
+    sure = (th >= lb + _TINY) & (th <= hb - _TINY)
+    sure |= ~has
+    sure &= rb <= r
+    sure &= maybe
+    ri, ci = np.nonzero(sure)
+    ok[st.row[ri], ci + (d0 + 1)] = True
+    maybe &= ~sure
+    ri, ci = np.nonzero(maybe)
+    out_rows = st.row[ri]
+    out_d = ci + (d0 + 1)
+    last = run[:, -1]
+    st.lo = lo[:, -1]
+    st.hi = hi[:, -1]
+    st.rmax = rmax[:, -1]
+    st.rx = rx
+    st.ry = ry
+    st.has = has[:, -1]
+    if not last.all():
+        st.take(last)
+    return out_rows, out_d
 
 
 def _check_rows(x: np.ndarray, y: np.ndarray, s: np.ndarray, d: int, eps: float) -> np.ndarray:
@@ -741,15 +853,21 @@ def _thin_concat(q: np.ndarray, lens: np.ndarray, eps: float) -> np.ndarray:
         # a sample of every _SAMPLE-th start tells where sleeves are long (dense curves):
         # those stretches skip the sweep; their reaches are found only where a chain stands
         samp = np.arange(0, n, _SAMPLE)
-        _, sopen, _ = _sweep(x, y, pend, eps, samp, _SWEEP)
-        dense = np.repeat(sopen & np.append(sopen[1:], True), _SAMPLE)[:n]
         # paths likely to get the DP (few samples still open, or short) are swept whole to
-        # the DP window: the DP needs that table anyway, and it holds most greedy reaches
+        # the DP window: the DP needs that table anyway, and it holds most greedy reaches.
+        # Samples are swept here only where a long path needs them (the others' come from
+        # the sweep of every start below, the same decisions)
+        short = lens <= _WHOLE_LEN
+        need = np.logical_or.reduceat(np.repeat(~short, lens), samp) if n else samp > 0
+        need[1:] |= need[:-1]  # (a stretch is dense when its sample and the next are open)
+        sopen = np.zeros(len(samp), dtype=bool)
+        if need.any():
+            sopen[need] = _sweep(x, y, pend, eps, samp[need], _SWEEP)[1]
+        dense = np.repeat(sopen & np.append(sopen[1:], True), _SAMPLE)[:n]
         pid = np.searchsorted(offs, samp, side="right") - 1
         n_open = np.bincount(pid, weights=sopen, minlength=len(lens))
         n_samp = np.bincount(pid, minlength=len(lens))
-        whole = np.repeat((n_open <= _WHOLE_OPEN * n_samp) | (lens <= _WHOLE_LEN), lens)
-        dense0 = dense.copy()
+        whole = np.repeat((n_open <= _WHOLE_OPEN * n_samp) | short, lens)
         dense &= ~whole
         opened = dense.copy()
         starts = np.flatnonzero(~dense)
@@ -762,7 +880,10 @@ def _thin_concat(q: np.ndarray, lens: np.ndarray, eps: float) -> np.ndarray:
             ok, op, st = _sweep(x, y, pend, eps, starts, _SWEEP, _DP_WINDOW, fuzzy)
             if fuzzy is not None:
                 # reaches a plain greedy walk finds where the sweep stopped at _SWEEP (or
-                # skipped the point): from the whole table unless its slack mattered
+                # skipped the point as dense): from the whole table unless its slack mattered
+                rest = np.flatnonzero(~need)  # samples of short paths, all in starts
+                sopen[rest] = op[np.searchsorted(starts, samp[rest])]
+                dense0 = np.repeat(sopen & np.append(sopen[1:], True), _SAMPLE)[:n]
                 walked = w_row & (op | dense0[starts])
                 st_w = st.split(whole[st.s])
                 _sweep_steps(x, y, eps, st_w, ok, starts, _DP_WINDOW, fuzzy)
@@ -1002,9 +1123,9 @@ def _dp_levels(
     is_end = np.zeros(total, dtype=bool)
     is_end[base + size - 1] = True
     width = ok.shape[1]
-    tab = ok[np.searchsorted(starts, gpos)]
-    tab[is_end] = False
-    packed = np.packbits(tab.T, axis=1, bitorder="little")
+    tab = np.take(np.ascontiguousarray(ok.T), np.searchsorted(starts, gpos), axis=1)
+    tab[:, is_end] = False
+    packed = np.packbits(tab, axis=1, bitorder="little")
     shifts = [
         (d, int.from_bytes(packed[d].tobytes(), "little"))
         for d in range(1, width)
@@ -1076,20 +1197,17 @@ def _to_int(mask: np.ndarray) -> int:
 
 def _levels_of(rounds: list[int], n: int) -> np.ndarray:
     """Per point (bit) 0 .. n - 1, the (1-based) round whose bit set holds it, 0 for none
-    (the sets are disjoint). Only the nonzero 64-bit words are unpacked."""
+    (the sets are disjoint). Only the nonzero bytes are unpacked."""
     dist = np.zeros(n, dtype=np.intp)
     if not rounds:
         return dist
-    nw = (n + 63) // 64
-    words = np.frombuffer(
-        b"".join(r.to_bytes(8 * nw, "little") for r in rounds), dtype="<u8"
-    ).reshape(len(rounds), nw)
-    lv, wd = np.nonzero(words)
-    bits = np.unpackbits(
-        words[lv, wd].astype("<u8").view(np.uint8).reshape(-1, 8), axis=1, bitorder="little"
-    )
-    k, b = np.nonzero(bits)
-    dist[wd[k] * 64 + b] = lv[k] + 1
+    nb = (n + 7) // 8
+    packed = np.frombuffer(b"".join(r.to_bytes(nb, "little") for r in rounds), dtype=np.uint8)
+    nz = np.flatnonzero(packed)  # (round, byte) of every nonzero byte
+    q = np.flatnonzero(np.unpackbits(packed[nz], bitorder="little"))
+    at = nz[q >> 3]
+    lv, by = np.divmod(at, nb)
+    dist[by * 8 + (q & 7)] = lv + 1
     return dist
 
 

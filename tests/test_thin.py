@@ -359,3 +359,30 @@ def test_whole_path_sweep_changes_nothing(monkeypatch, eps):
         np.testing.assert_array_equal(a, b)
         np.testing.assert_array_equal(a, c)
         assert_thin_guarantee(p, a, eps)
+
+
+@pytest.mark.parametrize("eps", [0.02, 0.5, 1.0])
+def test_block_sweep_decides_as_step_by_step(monkeypatch, eps):
+    """The sweep's remaining steps done as one 2-D block give the same shortcut table,
+    open wedges and slack flags as one step at a time (every start, 24 steps)."""
+    rng = np.random.default_rng(8)
+    paths = _integer_outlines() + [
+        np.cumsum(rng.normal(0, 0.4, (700, 2)), axis=0),
+        _dense_wavy(2, 900),
+    ]
+    paths = [p[thin_mod.dedup_indices(p)] for p in paths]  # (the sweep's input)
+    pts = np.concatenate(paths)
+    lens = np.array([len(p) for p in paths])
+    pend = np.repeat(np.cumsum(lens) - 1, lens)
+    x = np.ascontiguousarray(pts[:, 0])
+    y = np.ascontiguousarray(pts[:, 1])
+    starts = np.arange(0, len(pts), 3)
+    out = []
+    for few in (0, 10**9):
+        monkeypatch.setattr(thin_mod, "_FEW", few)
+        fz = np.zeros(len(starts), dtype=bool)
+        ok, op, _ = thin_mod._sweep(x, y, pend, eps, starts, 24, fuzzy=fz)
+        out.append((ok, op, fz))
+    for a, b in zip(out[0], out[1], strict=True):
+        np.testing.assert_array_equal(a, b)
+    assert out[0][0][:, 2:].any()
