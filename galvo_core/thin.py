@@ -380,8 +380,14 @@ def _check_rows(x: np.ndarray, y: np.ndarray, s: np.ndarray, d: int, eps: float)
 
 def _farthest(ok: np.ndarray) -> np.ndarray:
     """Per row: the largest d with ok[row, d] (0 when none)."""
-    w = ok.shape[1]
-    return (w - 1 - np.argmax(ok[:, ::-1], axis=1)) * ok.any(axis=1)
+    m, w = ok.shape
+    if w > 32:
+        return (w - 1 - np.argmax(ok[:, ::-1], axis=1)) * ok.any(axis=1)
+    # each row as a 32-bit integer: its highest set bit is the frexp exponent - 1 (exact)
+    pad = np.zeros((m, 32), dtype=bool)
+    pad[:, :w] = ok
+    v = np.packbits(pad, axis=1, bitorder="little").view("<u4")[:, 0]
+    return np.frexp(v.astype(np.float64))[1] - (v > 0)
 
 
 def _exact_ok(
@@ -980,7 +986,8 @@ def _shortest_many(
     in_dp = np.repeat(dp, lens)
     starts = np.flatnonzero(in_dp)
     ok = _dp_table(x, y, pend, eps, starts, table)
-    ri, dd = np.nonzero(ok)
+    w = ok.shape[1]
+    ri, dd = np.divmod(np.flatnonzero(ok), w)  # (faster than a 2-D nonzero)
     ii = starts[ri]
     jj = ii + dd
     chain_nodes = np.flatnonzero(keep & in_dp)
@@ -1002,7 +1009,7 @@ def _shortest_many(
     seg_a = cuts[~last[cuts]]  # piece [seg_a[k], seg_e[k]]
     seg_e = cuts[1:][~last[cuts[:-1]]] if len(cuts) > 1 else cuts[:0]
     # cost of each piece by edge relaxation (its edges) and its greedy kept points
-    deg = np.count_nonzero(ok, axis=1)
+    deg = np.bincount(ri, minlength=len(starts))
     cdeg = np.concatenate(([0], np.cumsum(np.bincount(starts, weights=deg, minlength=n))))
     edges = (cdeg[seg_e] - cdeg[seg_a]).astype(np.intp)
     ck = np.searchsorted(chain_nodes, seg_e, side="right") - np.searchsorted(
@@ -1022,7 +1029,7 @@ def _shortest_many(
     pred[seg_e[one]] = seg_a[one]
     lv = (ck <= l_cut) & ~one
     if lv.any():
-        _dp_levels(seg_a[lv], seg_e[lv], ck[lv], ok, starts, ii, jj, ep, eb, pred)
+        _dp_levels(seg_a[lv], seg_e[lv], ck[lv], w, ii, jj, ep, eb, pred)
     ed = (ck > l_cut) & ~one
     if ed.any():
         a_l = seg_a[ed]
@@ -1070,6 +1077,8 @@ def _dp_table(
         st.take(in_dp[st.s])
         _sweep_steps(x, y, eps, st, ok8, s8, _DP_WINDOW)
         mine = in_dp[s8]
+        if np.count_nonzero(mine) == len(starts):  # (every start in the table)
+            return ok8[mine]
         ok[np.searchsorted(starts, s8[mine])] = ok8[mine]
         done[s8] = True
     rest = starts[~done[starts]]
@@ -1090,23 +1099,21 @@ def _dp_levels(
     seg_a: np.ndarray,
     seg_e: np.ndarray,
     rounds_est: np.ndarray,
-    ok: np.ndarray,
-    starts: np.ndarray,
+    width: int,
     ii: np.ndarray,
     jj: np.ndarray,
     ep: np.ndarray,
     eb: np.ndarray,
     pred: np.ndarray,
 ) -> None:
-    """:func:`_shortest_many`'s predecessors in the pieces [seg_a[k], seg_e[k]] (sorted,
-    inside the sweep rows ``starts``) by a breadth-first search from their starts, all
-    pieces at once.
+    """:func:`_shortest_many`'s predecessors in the pieces [seg_a[k], seg_e[k]] (sorted)
+    by a breadth-first search from their starts, all pieces at once.
 
-    ``ok``: the shortcut table of the rows ``starts`` (``ok[r, d]``: starts[r] -> starts[r]
-    + d valid), also listed as ``ii -> jj`` (point indices); ``ep -> eb`` the greedy long
-    shortcuts. The search finds each point's distance (lines from its piece start), one
-    round per level, on Python integers as bit sets: a round is a shift, an and and an or
-    per shortcut length, whatever the number of pieces. Each piece gets its own bit range
+    ``ii -> jj``: every valid table shortcut (point indices, sorted by start, at most
+    ``width - 1`` points long); ``ep -> eb`` the greedy long shortcuts. The search finds
+    each point's distance (lines from its piece start), one round per level, on Python
+    integers as bit sets: a round is a shift, an and and an or per shortcut length,
+    whatever the number of pieces. Each piece gets its own bit range
     (its end a copy that is never expanded), the pieces with most greedy lines
     (``rounds_est``) in the lowest bits, so the sets shrink as the short pieces finish.
     Then, vectorised over the shortcuts, a point's predecessor is the smallest start among
@@ -1118,13 +1125,20 @@ def _dp_levels(
     base = np.zeros(len(seg_a), dtype=np.intp)
     base[order] = np.cumsum(size[order]) - size[order]  # first bit of each piece
     total = int(size.sum())
-    shift = np.repeat(seg_a - base, size)[np.argsort(np.repeat(base, size), kind="stable")]
-    gpos = np.arange(total) + shift  # point index of every bit
+    gpos = np.arange(total) + np.repeat((seg_a - base)[order], size[order])  # point of a bit
     is_end = np.zeros(total, dtype=bool)
     is_end[base + size - 1] = True
-    width = ok.shape[1]
-    tab = np.take(np.ascontiguousarray(ok.T), np.searchsorted(starts, gpos), axis=1)
-    tab[:, is_end] = False
+    n = len(pred)
+    # the table shortcuts from inside the pieces, one bit set per length
+    src = np.zeros(n, dtype=bool)
+    src[gpos[~is_end]] = True
+    bit_of = np.zeros(n, dtype=np.intp)
+    bit_of[gpos[~is_end]] = np.flatnonzero(~is_end)
+    sel = src[ii]
+    ia = ii[sel]
+    ja = jj[sel]
+    tab = np.zeros((width, total), dtype=bool)
+    tab[ja - ia, bit_of[ia]] = True
     packed = np.packbits(tab, axis=1, bitorder="little")
     shifts = [
         (d, int.from_bytes(packed[d].tobytes(), "little"))
@@ -1156,15 +1170,9 @@ def _dp_levels(
         seen |= nxt
         rounds.append(nxt)
         front = nxt
-    n = len(pred)
     dist = np.zeros(n, dtype=np.intp)
     dist[gpos] = _levels_of(rounds, total)  # (piece ends and starts: 0 either way)
     # predecessors: from one level below, smallest table start first, else the long one
-    src = np.zeros(n, dtype=bool)
-    src[gpos[~is_end]] = True
-    sel = src[ii]
-    ia = ii[sel]
-    ja = jj[sel]
     da = dist[ia]
     big = np.iinfo(np.intp).max
     low = np.full(n, big, dtype=np.intp)
