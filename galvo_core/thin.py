@@ -825,7 +825,8 @@ def thin_many(paths: Sequence[object], eps_line: float) -> list[np.ndarray]:
     # duplicates: a point equal to its predecessor in the same path is dropped
     keep = np.ones(len(pts), dtype=bool)
     if len(pts) > 1:
-        keep[1:] = np.any(pts[1:] != pts[:-1], axis=1)
+        # (two column compares: np.any along a length-2 axis is far slower)
+        keep[1:] = (pts[1:, 0] != pts[:-1, 0]) | (pts[1:, 1] != pts[:-1, 1])
     keep[o0[:-1][lens0 > 0]] = True
     kidx = np.flatnonzero(keep)  # original (concatenated) index of every distinct point
     ck = np.searchsorted(kidx, o0)  # first distinct point of each path
