@@ -198,6 +198,7 @@ def _sweep_steps(
     chk_rows: list[np.ndarray] = []
     chk_d: list[int] = []
     blk: tuple[np.ndarray, np.ndarray] | None = None
+    all_has = bool(st.has.all())  # (then no direction of reference is set any more)
     with np.errstate(divide="ignore", invalid="ignore"):
         for d in range(st.d + 1, d_max + 1):
             if len(st.s) == 0:
@@ -211,25 +212,35 @@ def _sweep_steps(
             vy = y[j] - st.ys
             r = np.hypot(vx, vy)
             far = r > eps
-            new = far & ~st.has
-            if new.any():
-                st.rx = np.where(new, vx / r, st.rx)
-                st.ry = np.where(new, vy / r, st.ry)
-                st.has |= new
+            near = ~far
+            if not all_has:
+                new = far & ~st.has
+                if new.any():
+                    st.rx = np.where(new, vx / r, st.rx)
+                    st.ry = np.where(new, vy / r, st.ry)
+                    st.has |= new
+                    all_has = bool(st.has.all())
             rx, ry, lo, hi, rmax = st.rx, st.ry, st.lo, st.hi, st.rmax
             th = np.arctan2(rx * vy - ry * vx, rx * vx + ry * vy)
             if d >= 2:
                 # candidate end j: direction inside the wedge of the points before it (or j
                 # itself near s), no point before it farther than r_j + eps from s
-                maybe = ((th >= lo - _LOOSE) & (th <= hi + _LOOSE)) | ~far
+                maybe = (th >= lo - _LOOSE) & (th <= hi + _LOOSE)
+                maybe |= near
                 maybe &= rmax <= r + eps
-                if fuzzy is not None:
-                    fz = maybe & ~(((th >= lo) & (th <= hi)) | ~far)
+                if fuzzy is not None:  # (th, lo, hi are never NaN)
+                    fz = (th < lo) | (th > hi)
+                    fz &= far
+                    fz &= maybe
                     if fz.any():
                         fuzzy[st.row[fz]] = True
                 # no point before farther from s than j: ray distance == segment distance,
                 # so the wedge alone decides (kept a hair inside against rounding)
-                sure = maybe & (rmax <= r) & ((th >= lo + _TINY) & (th <= hi - _TINY) | ~st.has)
+                sure = (th >= lo + _TINY) & (th <= hi - _TINY)
+                if not all_has:
+                    sure |= ~st.has
+                sure &= rmax <= r
+                sure &= maybe
                 ok[st.row[sure], d] = True
                 rest = maybe & ~sure
                 if rest.any():
