@@ -82,6 +82,9 @@ _SAMPLE = 16
 #: at most _WHOLE_LEN points, is swept whole to _DP_WINDOW points (see :func:`_thin_concat`)
 _WHOLE_OPEN = 0.9
 _WHOLE_LEN = 1024
+#: ... or (paths of at most _MID_LEN points) at most this fraction open after _DP_WINDOW
+_WHOLE_OPEN24 = 0.5
+_MID_LEN = 16384
 #: below this many points per kept line the greedy result is improved by the window DP
 _DP_RATIO = 16
 _DP_WINDOW = 24
@@ -879,13 +882,24 @@ def _thin_concat(q: np.ndarray, lens: np.ndarray, eps: float) -> np.ndarray:
         need = np.logical_or.reduceat(np.repeat(~short, lens), samp) if n else samp > 0
         need[1:] |= need[:-1]  # (a stretch is dense when its sample and the next are open)
         sopen = np.zeros(len(samp), dtype=bool)
-        if need.any():
-            sopen[need] = _sweep(x, y, pend, eps, samp[need], _SWEEP)[1]
-        dense = np.repeat(sopen & np.append(sopen[1:], True), _SAMPLE)[:n]
         pid = np.searchsorted(offs, samp, side="right") - 1
-        n_open = np.bincount(pid, weights=sopen, minlength=len(lens))
         n_samp = np.bincount(pid, minlength=len(lens))
-        whole = np.repeat((n_open <= _WHOLE_OPEN * n_samp) | short, lens)
+        far24 = np.zeros(len(lens), dtype=bool)
+        if need.any():
+            ok_s, sopen[need], st_s = _sweep(x, y, pend, eps, samp[need], _SWEEP, _DP_WINDOW)
+            # mid-sized paths whose samples are open after _SWEEP: is a sleeve of _DP_WINDOW
+            # points still open at most of them? (else the DP is likely: sweep them whole)
+            n_open = np.bincount(pid, weights=sopen, minlength=len(lens))
+            mid = (lens > _WHOLE_LEN) & (lens <= _MID_LEN) & (n_open > _WHOLE_OPEN * n_samp)
+            pick = mid[pid[need][st_s.row]]
+            if pick.any():
+                st_s.take(pick)
+                _sweep_steps(x, y, eps, st_s, ok_s, samp[need], _DP_WINDOW)
+                n24 = np.bincount(pid[need][st_s.row], minlength=len(lens))
+                far24 = mid & (n24 <= _WHOLE_OPEN24 * n_samp)
+        dense = np.repeat(sopen & np.append(sopen[1:], True), _SAMPLE)[:n]
+        n_open = np.bincount(pid, weights=sopen, minlength=len(lens))
+        whole = np.repeat((n_open <= _WHOLE_OPEN * n_samp) | short | far24, lens)
         dense &= ~whole
         opened = dense.copy()
         starts = np.flatnonzero(~dense)

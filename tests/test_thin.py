@@ -352,12 +352,19 @@ def test_whole_path_sweep_changes_nothing(monkeypatch, eps):
     with monkeypatch.context() as m:  # no path swept whole
         m.setattr(thin_mod, "_WHOLE_OPEN", -1.0)
         m.setattr(thin_mod, "_WHOLE_LEN", 0)
+        m.setattr(thin_mod, "_MID_LEN", 0)
         plain = thin_many(paths, eps)
+    with monkeypatch.context() as m:  # whole where few samples stay open after 24
+        m.setattr(thin_mod, "_WHOLE_LEN", 8)
+        m.setattr(thin_mod, "_WHOLE_OPEN", -1.0)
+        m.setattr(thin_mod, "_WHOLE_OPEN24", 1.0)
+        by24 = thin_many(paths, eps)
     monkeypatch.setattr(thin_mod, "_WHOLE_OPEN", 2.0)  # every path swept whole
     whole = thin_many(paths, eps)
-    for p, a, b, c in zip(paths, ref, plain, whole, strict=True):
+    for p, a, b, c, e in zip(paths, ref, plain, whole, by24, strict=True):
         np.testing.assert_array_equal(a, b)
         np.testing.assert_array_equal(a, c)
+        np.testing.assert_array_equal(a, e)
         assert_thin_guarantee(p, a, eps)
 
 
