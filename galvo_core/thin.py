@@ -23,9 +23,11 @@ reaches (dense curves) are searched only from the points the greedy chain stands
 many chains in lockstep (one batched search per round), with seed walkers along long dense
 stretches: greedy chains from different points meet after a few lines on most curves, so the
 true chain finds most reaches already known. Seeds and batching change only how fast the
-chain is found, never which points it keeps. Paths likely to need the DP below (short, or
-few sampled starts with long reaches) are instead swept whole to the DP window: the DP needs
-that table anyway, and it holds every reach of at most 24 points. (The walk's wedge test is
+chain is found, never which points it keeps. Paths likely to need the DP below (short, few
+sampled starts with reaches over 8 points, or mid-sized with most samples closing within
+24) are instead swept whole to the DP window: the DP needs that table anyway, and it holds
+every reach of at most 24 points. The sweep's last steps, once few starts are left, run as
+one 2-D block (same arithmetic per cell). (The walk's wedge test is
 strict, the sweep's has a 1e-9 rad slack before the exact check; where that slack mattered
 for a start, its reach is still found by the walk, so the result is the same either way.)
 
