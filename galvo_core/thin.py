@@ -87,6 +87,7 @@ _WHOLE_LEN = 1024
 #: ... or (paths of at most _MID_LEN points) at most this fraction open after _DP_WINDOW
 _WHOLE_OPEN24 = 0.5
 _MID_LEN = 16384
+_SUB24 = 4
 #: below this many points per kept line the greedy result is improved by the window DP
 _DP_RATIO = 16
 _DP_WINDOW = 24
@@ -891,14 +892,18 @@ def _thin_concat(q: np.ndarray, lens: np.ndarray, eps: float) -> np.ndarray:
             ok_s, sopen[need], st_s = _sweep(x, y, pend, eps, samp[need], _SWEEP, _DP_WINDOW)
             # mid-sized paths whose samples are open after _SWEEP: is a sleeve of _DP_WINDOW
             # points still open at most of them? (else the DP is likely: sweep them whole)
+            # (every _SUB24-th sample is enough for that estimate)
             n_open = np.bincount(pid, weights=sopen, minlength=len(lens))
             mid = (lens > _WHOLE_LEN) & (lens <= _MID_LEN) & (n_open > _WHOLE_OPEN * n_samp)
-            pick = mid[pid[need][st_s.row]]
+            p_need = pid[need]
+            sub = np.arange(len(p_need)) % _SUB24 == 0
+            pick = mid[p_need[st_s.row]] & sub[st_s.row]
             if pick.any():
                 st_s.take(pick)
                 _sweep_steps(x, y, eps, st_s, ok_s, samp[need], _DP_WINDOW)
-                n24 = np.bincount(pid[need][st_s.row], minlength=len(lens))
-                far24 = mid & (n24 <= _WHOLE_OPEN24 * n_samp)
+                n24 = np.bincount(p_need[st_s.row], minlength=len(lens))
+                n_sub = np.bincount(p_need[sub], minlength=len(lens))
+                far24 = mid & (n24 <= _WHOLE_OPEN24 * n_sub)
         dense = np.repeat(sopen & np.append(sopen[1:], True), _SAMPLE)[:n]
         n_open = np.bincount(pid, weights=sopen, minlength=len(lens))
         whole = np.repeat((n_open <= _WHOLE_OPEN * n_samp) | short | far24, lens)
