@@ -140,15 +140,21 @@ def paths_of(path: str) -> list[np.ndarray]:
     return [np.asarray(p.points, float) for p in read_file(path).paths if len(p.points) >= 2]
 
 
-def datasets() -> list[tuple[str, list[np.ndarray], list[float]]]:
-    sets = [("circles", circles(), [0.02, 0.1])]
-    glyph = os.path.join(ROOT, "resources", "samples", "text_outline.plt")
-    sets.append(("glyph outlines (text_outline.plt)", paths_of(glyph), [0.02, 0.5]))
+def corpus_paths() -> list[np.ndarray]:
+    """The paths of every CORPUS_FILES file present (none when the corpus is not beside)."""
     corp: list[np.ndarray] = []
     for f in CORPUS_FILES:
         fp = os.path.join(CORPUS, f)
         if os.path.exists(fp):
             corp += paths_of(fp)
+    return corp
+
+
+def datasets() -> list[tuple[str, list[np.ndarray], list[float]]]:
+    sets = [("circles", circles(), [0.02, 0.1])]
+    glyph = os.path.join(ROOT, "resources", "samples", "text_outline.plt")
+    sets.append(("glyph outlines (text_outline.plt)", paths_of(glyph), [0.02, 0.5]))
+    corp = corpus_paths()
     if corp:
         sets.append((f"corpus ({len(CORPUS_FILES)} files)", corp, [0.02, 1.0]))
     return sets
@@ -193,11 +199,7 @@ def speed_inputs() -> list[tuple[str, list[np.ndarray], float]]:
         ("sparse walk 20k", [sparse_walk()], 0.02),
         ("sparse walk 20k", [sparse_walk()], 1.0),
     ]
-    corp: list[np.ndarray] = []
-    for f in CORPUS_FILES:
-        fp = os.path.join(CORPUS, f)
-        if os.path.exists(fp):
-            corp += paths_of(fp)
+    corp = corpus_paths()
     if corp:
         out += [(f"corpus {len(CORPUS_FILES)} files", corp, e) for e in (0.02, 1.0)]
     samples = os.path.join(ROOT, "resources", "samples")
