@@ -44,6 +44,7 @@ from galvo_core.kerf import (  # noqa: E402
     compensate_indexed,
     even_odd_region,
     quad_segs_for,
+    reduce_tol_for,
 )
 
 try:
@@ -74,14 +75,23 @@ def exact(region, d, side):
     return shapely.buffer(region, d if side == "outside" else -d, quad_segs=1024)
 
 
+CHUNK = 500_000  # points per nearest-segment query (bounds memory on huge outlines)
+
+
+def _nearest_dist(tree, pts):
+    """Distance from each point (an (N, 2) array) to the nearest geometry in ``tree``,
+    queried in chunks."""
+    out = np.empty(len(pts))
+    for i in range(0, len(pts), CHUNK):
+        _, out[i:i + CHUNK] = tree.query_nearest(shapely.points(pts[i:i + CHUNK]),
+                                                 return_distance=True, all_matches=False)
+    return out
+
+
 def _one_way(geom, ref, step):
     """Largest distance from the outline of geom (densified to ``step``) to ref's outline."""
     pts = shapely.get_coordinates(shapely.segmentize(geom.boundary, step))
-    rings = [shapely.get_coordinates(r) for r in
-             shapely.get_rings(shapely.get_parts(ref))]
-    segs = np.concatenate([np.stack([r[:-1], r[1:]], axis=1) for r in rings])
-    tree = shapely.STRtree(shapely.linestrings(segs))
-    _, dist = tree.query_nearest(shapely.points(pts), return_distance=True, all_matches=False)
+    dist = _nearest_dist(_segment_tree(ref), pts)
     return float(dist.max()) if len(dist) else 0.0
 
 
@@ -96,6 +106,23 @@ def deviation(geom, ref, step=0.25):
     return hd, float(shapely.symmetric_difference(geom, ref).area)
 
 
+def _segment_tree(geom):
+    rings = [shapely.get_coordinates(r) for r in shapely.get_rings(shapely.get_parts(geom))]
+    segs = np.concatenate([np.stack([r[:-1], r[1:]], axis=1) for r in rings])
+    return shapely.STRtree(shapely.linestrings(segs))
+
+
+def offset_error(geom, region, d, step=0.25):
+    """Reference-free check of an offset outline: the largest | distance from a point of
+    geom's outline (densified to ``step``) to the input region's outline - d |. Every
+    point of the exact offset is exactly d from the input's outline; chords of arcs lie
+    a sagitta closer."""
+    if geom.is_empty or region.is_empty:
+        return math.inf if geom.is_empty != region.is_empty else 0.0
+    pts = shapely.get_coordinates(shapely.segmentize(geom.boundary, step))
+    return float(np.abs(_nearest_dist(_segment_tree(region), pts) - d).max())
+
+
 def rings_of(drawing: Drawing):
     return [p.points for p in drawing.paths if p.closed and len(p.points) >= 4]
 
@@ -104,6 +131,8 @@ def clipper_offset(rings, d, side, tol):
     """Clipper2: even-odd union (orients rings) then InflatePaths, round joins; numpy in
     and out."""
     u = clipper2.union([r[:-1] for r in rings], clipper2.FillRule.EVEN_ODD, precision=4)
+    if len(u) == 0:
+        return []
     o = clipper2.inflate_paths(u, d if side == "outside" else -d, clipper2.JoinType.ROUND,
                                clipper2.EndType.POLYGON, precision=4, arc_tolerance=tol)
     return [np.asarray(p) for p in o]
@@ -130,11 +159,13 @@ def sample_table(lines, name, kerf_mm, mag=TRUE_MAG, arc_bits=1.0):
     lines.append(f"\n**{name}** ({len(dr.paths)} paths, {dr.n_points} points), kerf {kerf_mm} "
                  f"mm -> d = {d:.3f} units ({kerf_mm / 2 * 1000:.0f} µm), magnification "
                  f"{mag:.3f}, arc tolerance {arc_bits:g} bit = {tol:.4f} units "
-                 f"(quad_segs {quad_segs_for(d, tol)}); target deviation <= arc tol + e_per "
+                 f"(vector: GEOS quad_segs {quad_segs_for(d, tol)}, then thinned within "
+                 f"{reduce_tol_for(d, tol):.4f} units); target deviation <= arc tol + e_per "
                  f"= {tol + E_PER:.4f} units\n")
-    lines.append("| method | side | max dev (units) | max dev (µm) | sym. diff area (units²) "
-                 "| vertices | time (ms) | valid |")
-    lines.append("|---|---|---|---|---|---|---|---|")
+    lines.append("| method | side | max dev (units) | max dev (µm) | offset error (units) "
+                 "| sym. diff area (units²) | vertices | time (ms) | valid |")
+    lines.append("|---|---|---|---|---|---|---|---|---|")
+    cross = []
     res = {}
     for side in ("outside", "inside"):
         ref = exact(region, d, side)
@@ -147,19 +178,27 @@ def sample_table(lines, name, kerf_mm, mag=TRUE_MAG, arc_bits=1.0):
                                            res=fm.bits_to_units(1.0))
             valid = bool(internal.is_valid) and bool(geom.is_valid)
             dev, sd = deviation(geom, ref)
+            err = offset_error(geom, region, d)
             nv = sum(len(p.points) - 1 for p in out.paths if p.closed)
             res[(m, side)] = (dev, t, nv)
             lines.append(f"| {m} | {side} | {dev:.4f} | {dev * fm.mm_per_unit * 1000:.2f} | "
-                         f"{sd:.2f} | {nv} | {t * 1000:.1f} | {valid} |")
+                         f"{err:.4f} | {sd:.2f} | {nv} | {t * 1000:.1f} | {valid} |")
         if clipper2 is not None:
             paths, t = timed(lambda side=side: clipper_offset(rings_of(dr), d, side, tol), 7)
             geom = clipper_geom(paths)
             dev, sd = deviation(geom, ref)
+            err = offset_error(geom, region, d)
             nv = sum(len(p) for p in paths)
             res[("clipper2", side)] = (dev, t, nv)
             lines.append(f"| Clipper2 {clipper2.CLIPPER2_VERSION} | {side} | {dev:.4f} | "
-                         f"{dev * fm.mm_per_unit * 1000:.2f} | {sd:.2f} | {nv} | "
+                         f"{dev * fm.mm_per_unit * 1000:.2f} | {err:.4f} | {sd:.2f} | {nv} | "
                          f"{t * 1000:.1f} | {bool(geom.is_valid)} |")
+            fine = clipper_geom(clipper_offset(rings_of(dr), d, side, tol / 100))
+            cross.append(f"{side} {deviation(fine, ref)[0]:.4f}")
+    if cross:
+        lines.append("\nReference cross-check: Clipper2 at arc tolerance tol/100 (no input "
+                     "simplification) vs the GEOS reference, max distance (units): "
+                     + ", ".join(cross))
     if clipper2 is not None:
         for side in ("outside", "inside"):
             v, c = res[("vector", side)], res[("clipper2", side)]
@@ -194,35 +233,71 @@ def acute_table(lines):
         lines.append(f"| {m} | {far:.3f} | {far / d:.2f} |")
 
 
-def corpus_table(lines, kerf_mm=0.1):
-    files = sorted(p for p in CORPUS.glob("*") if p.is_file())
-    lines.append(f"\n**Corpus** ({CORPUS.name}/, fit to the field, kerf {kerf_mm} mm, both "
-                 "sides): files with closed paths; validity = GEOS is_valid of the compensated "
-                 "region and of the region rebuilt from the output paths\n")
-    lines.append("| method | files | rings in | invalid | worst time (s) | total time (s) | "
-                 "max dev vs exact (units) |")
-    lines.append("|---|---|---|---|---|---|---|")
-    drawings = []
-    for f in files:
+def corpus_drawings():
+    """(name, drawing) of every corpus file that reads and has closed paths."""
+    out = []
+    for f in sorted(p for p in CORPUS.glob("*") if p.is_file()):
         try:
             dr = read_file(f)
         except GalvoError:
             continue
-        if dr.n_closed == 0:
+        if dr.n_closed:
+            out.append((f.name, dr))
+    return out
+
+
+def pen_rings(dr, pen):
+    return [p.points for p in dr.paths if p.closed and p.pen == pen and len(p.points) >= 4]
+
+
+def vector_checks(name, dr, out, fm, kerf_mm, side, t_ours):
+    """One corpus row of the vector method against the exact offset and Clipper2: the
+    deviation from the GEOS reference and the reference-free offset error (both in bits),
+    vertices and time of ours and of Clipper2 (per pen, summed)."""
+    bit = fm.bits_to_units(1.0)
+    d = fm.mm_to_units(kerf_mm / 2)
+    step = max(0.25, bit / 4)
+    row = {"name": name, "side": side, "dev": 0.0, "err": 0.0, "cdev": 0.0, "cerr": 0.0,
+           "nv": 0, "nc": 0,
+           "t": t_ours, "tc": 0.0}
+    row["nv"] = sum(len(p.points) - 1 for p in out.paths if p.closed)
+    for pen in sorted({p.pen for p in dr.paths}):
+        rings = pen_rings(dr, pen)
+        if not rings:
             continue
-        drawings.append((f.name, dr))
-    for m in METHODS:
+        reg = even_odd_region(rings)
+        g = output_region(out, pen)
+        ref = exact(reg, d, side)
+        row["dev"] = max(row["dev"], deviation(g, ref, step)[0] / bit)
+        row["err"] = max(row["err"], offset_error(g, reg, d, step) / bit)
+        if clipper2 is not None:
+            paths, tc = timed(lambda rings=rings: clipper_offset(rings, d, side, bit), 1)
+            row["nc"] += sum(len(p) for p in paths)
+            row["tc"] += tc
+            cg = clipper_geom(paths)
+            row["cdev"] = max(row["cdev"], deviation(cg, ref, step)[0] / bit)
+            row["cerr"] = max(row["cerr"], offset_error(cg, reg, d, step) / bit)
+    return row
+
+
+def corpus_table(lines, kerf_mm=0.1, methods=METHODS):
+    lines.append(f"\n**Corpus** ({CORPUS.name}/, fit to the field, kerf {kerf_mm} mm, both "
+                 "sides): files with closed paths; validity = GEOS is_valid of the compensated "
+                 "region and of the region rebuilt from the output paths\n")
+    lines.append("| method | files | rings in | invalid | worst time (s) | total time (s) |")
+    lines.append("|---|---|---|---|---|---|")
+    drawings = corpus_drawings()
+    vec_rows = []
+    for m in methods:
         invalid = 0
         worst = 0.0
         total = 0.0
         nr = 0
-        maxdev = 0.0
         bad = []
         for name, dr in drawings:
             fm = make_field(dr.bbox(), magnification=None, fit_field=True)
-            size = max(dr.size_mm()) * 0 + max(
-                (dr.bbox()[2] - dr.bbox()[0]), (dr.bbox()[3] - dr.bbox()[1])) * fm.mm_per_unit
-            if kerf_mm > size:
+            x0, y0, x1, y1 = dr.bbox()
+            if kerf_mm > max(x1 - x0, y1 - y0) * fm.mm_per_unit:
                 continue
             for side in ("outside", "inside"):
                 t = time.perf_counter()
@@ -234,28 +309,50 @@ def corpus_table(lines, kerf_mm=0.1):
                 dt = time.perf_counter() - t
                 worst = max(worst, dt)
                 total += dt
-                ok = True
-                for pen in sorted({p.pen for p in dr.paths}):
-                    g = output_region(out, pen)
-                    if not g.is_valid:
-                        ok = False
-                    if m == "vector" and side == "outside":
-                        rings = [p.points for p in dr.paths if p.closed and p.pen == pen
-                                 and len(p.points) >= 4]
-                        if rings:
-                            reg = even_odd_region(rings)
-                            ref = exact(reg, fm.mm_to_units(kerf_mm / 2), side)
-                            dev = deviation(g, ref)[0]
-                            maxdev = max(maxdev, dev / fm.bits_to_units(1.0))
+                ok = all(output_region(out, pen).is_valid for pen in {p.pen for p in dr.paths})
                 if not ok:
                     invalid += 1
                     bad.append(f"{name} ({side})")
+                if m == "vector":
+                    vec_rows.append(vector_checks(name, dr, out, fm, kerf_mm, side, dt))
             nr += sum(1 for p in dr.paths if p.closed)
-        dev_s = f"{maxdev:.2f} bits" if m == "vector" else "-"
-        lines.append(f"| {m} | {len(drawings)} | {nr} | {invalid} | {worst:.2f} | {total:.2f} "
-                     f"| {dev_s} |")
+        lines.append(f"| {m} | {len(drawings)} | {nr} | {invalid} | {worst:.2f} | {total:.2f} |")
         for b in bad[:5]:
-            lines.append(f"|  | problem: {b} | | | | | |")
+            lines.append(f"|  | problem: {b} | | | | |")
+    if vec_rows:
+        vector_corpus_summary(lines, vec_rows)
+
+
+def vector_corpus_summary(lines, rows):
+    """The vector method over the corpus: deviation, vertices and time against Clipper2."""
+    worst_dev = max(rows, key=lambda r: r["dev"])
+    worst_err = max(rows, key=lambda r: r["err"])
+    lines.append(f"\n**Vector method over the corpus** ({len(rows)} file x side runs, 1 bit "
+                 "arc tolerance at each file's fit-field magnification):\n")
+    lines.append(f"- deviation from the GEOS reference: max {worst_dev['dev']:.3f} bits "
+                 f"({worst_dev['name']}, {worst_dev['side']}); reference-free offset error "
+                 f"(| distance to the input outline - d |): max {worst_err['err']:.3f} bits "
+                 f"({worst_err['name']}, {worst_err['side']})")
+    with_c = [r for r in rows if r["nc"] > 0]
+    if with_c:
+        cd = max(with_c, key=lambda r: r["cdev"])
+        ce = max(with_c, key=lambda r: r["cerr"])
+        lines.append(f"- Clipper2 at the same arc tolerance, same measures: deviation from the "
+                     f"GEOS reference max {cd['cdev']:.3f} bits ({cd['name']}, {cd['side']}); "
+                     f"offset error max {ce['cerr']:.3f} bits ({ce['name']}, {ce['side']})")
+        ratio = np.array([r["nv"] / r["nc"] for r in with_c])
+        k = int(np.argmax(ratio))
+        over = [f"{r['name']} ({r['side']}, x{r['nv'] / r['nc']:.2f})" for r in with_c
+                if r["nv"] > 1.2 * r["nc"]]
+        lines.append(f"- vertices / Clipper2's at the same arc tolerance: median "
+                     f"x{np.median(ratio):.2f}, worst x{ratio[k]:.2f} ({with_c[k]['name']}, "
+                     f"{with_c[k]['side']}); runs above x1.2: {len(over)}"
+                     + (f" ({'; '.join(over[:6])})" if over else ""))
+        slow = max(with_c, key=lambda r: r["t"])
+        tr = np.array([r["t"] / r["tc"] for r in with_c if r["tc"] > 0])
+        lines.append(f"- time / Clipper2's (even-odd union + offset, one run each): median "
+                     f"x{np.median(tr):.2f}; slowest file {slow['name']} ({slow['side']}): "
+                     f"{slow['t']:.2f} s, Clipper2 {slow['tc']:.2f} s")
 
 
 def hypothesis_validity(lines, n=300):
@@ -312,7 +409,9 @@ def hypothesis_validity(lines, n=300):
 def main() -> int:
     ap = argparse.ArgumentParser()
     ap.add_argument("--write", action="store_true", help="update bench/RESULTS.md")
-    ap.add_argument("--quick", action="store_true")
+    ap.add_argument("--quick", action="store_true", help="samples only (no corpus sweep)")
+    ap.add_argument("--corpus-methods", default=",".join(METHODS),
+                    help="methods for the corpus sweep (comma-separated; default all)")
     args = ap.parse_args()
     lines = ["## Kerf (issue 6)", ""]
     lines.append(f"Date 2026-11-23. Machine: {platform.machine()} {platform.processor() or ''} "
@@ -329,7 +428,7 @@ def main() -> int:
     sample_table(lines, "text_outline.plt", 0.4)
     acute_table(lines)
     if not args.quick:
-        corpus_table(lines)
+        corpus_table(lines, methods=tuple(args.corpus_methods.split(",")))
         hypothesis_validity(lines)
     text = "\n".join(lines) + "\n"
     print(text)

@@ -19,11 +19,22 @@ Methods
 ``"vector"`` (default, the paper's *parallel movement*): the exact parallel offset of the
 even-odd region by shapely/GEOS ``buffer`` with round joins. At a convex corner the offset
 is an arc of radius ``d`` around the corner (the paper replaces the far-away intersection at
-acute corners by that arc); concave corners are exact intersections. The arcs are drawn
-with ``quad_segs`` segments per quarter circle, chosen so the sagitta of every chord,
-``d (1 - cos(θ/2))``, stays within ``arc_tol_bits`` galvo bits, and never fewer than 8 (GEOS
-is less exact below 8; see :func:`quad_segs_for`). GEOS handles holes,
-self-touching rings, rings that vanish and rings that merge. Why GEOS and not Clipper2:
+acute corners by that arc); concave corners are exact intersections. GEOS draws the arcs
+finely, with ``quad_segs`` segments per quarter circle chosen so the sagitta of every chord,
+``d (1 - cos(θ/2))``, is within 1/16 of the arc tolerance ``tol`` (``arc_tol_bits`` galvo
+bits), and never fewer than 8 (GEOS is less exact below 8; see :func:`quad_segs_for`).
+The outline is then thinned by Douglas-Peucker within the rest of the budget,
+``tol - sagitta`` (:func:`reduce_vertices`: valid, same rings, else unthinned), so every
+point stays within ``tol`` of GEOS's exact offset while arcs end up with about as many
+chords as Clipper2 draws at the same tolerance, and densely sampled input curves lose the
+vertices the tolerance does not need. (GEOS also drops concave input vertices less than
+``d/100`` deep before buffering, as its exact reference does; bench/RESULTS.md compares
+both with Clipper2 at a fine tolerance.) GEOS handles holes,
+self-touching rings, rings that vanish and rings that merge. Each polygon of the region is
+buffered on its own and the grown ones that meet are unioned group by group (one buffer of
+a MultiPolygon of thousands of parts nodes them all together: 5x slower on a corpus file);
+sliver holes that only the chords of meeting arcs leave (no point in them is farther than
+``d`` from the region) are removed, as the laser would mark them as tiny loops. Why GEOS and not Clipper2:
 shapely (GEOS) is already a dependency, is well kept, gives the same result within the arc
 tolerance (bench/RESULTS.md, "Kerf (issue 6)"), and works on floating-point coordinates;
 Clipper2's Python bindings ``pyclipr`` ship no wheel for this platform (its source build
@@ -88,8 +99,11 @@ RASTER_HARD_LIMIT = 25_000_000
 #: quad_segs bounds for the vector method
 MAX_QUAD_SEGS = 512
 #: GEOS buffers with fewer segments per quarter circle than this are less exact (see
-#: quad_segs_for); trading vertices for accuracy, the vector method never goes below it
+#: quad_segs_for); the vector method never goes below it
 GEOS_MIN_QUAD_SEGS = 8
+#: the vector method's GEOS arcs are drawn with chords whose sagitta is at most this share
+#: of the arc tolerance; the rest of the tolerance is the budget of the vertex reduction
+ARC_SHARE = 1.0 / 16.0
 #: output vertices sampled when mapping rings back to their sources
 ASSIGN_STRIDE = 4
 #: scan spacing of the rectangle method as a fraction of d
@@ -179,21 +193,170 @@ def compensate_indexed(
     return drawing.with_paths(paths, warnings=warnings), tuple(origin)
 
 
+def arc_sagitta(d: float, quad_segs: int) -> float:
+    """Largest distance between an arc of radius ``d`` and its chords when a quarter
+    circle is drawn with ``quad_segs`` chords (GEOS puts the chord ends on the circle)."""
+    return d * (1.0 - math.cos(math.pi / (4.0 * quad_segs)))
+
+
 def quad_segs_for(d: float, tol: float) -> int:
-    """Segments per quarter circle so that a chord's sagitta on radius ``d`` is <= ``tol``.
+    """Segments per quarter circle of the vector method's GEOS buffer: the fewest whose
+    chord sagitta on radius ``d`` is <= ``ARC_SHARE * tol`` (the rest of ``tol`` is left to
+    :func:`reduce_vertices`, which thins the result to about Clipper2's vertex count).
 
     Never fewer than :data:`GEOS_MIN_QUAD_SEGS`: below 8 segments per quarter circle GEOS
     joins short concave runs through a point halfway to the vertex instead of 1/81 of the
     way, which put outlines up to ~10 % of ``d`` off on dense CAD polylines (measured:
-    bench/RESULTS.md, "Kerf (issue 6)")."""
+    bench/RESULTS.md, "Kerf (issue 6)"). Never more than :data:`MAX_QUAD_SEGS`."""
     if d <= 0:
-        return 1
-    if tol >= d:
+        return GEOS_MIN_QUAD_SEGS
+    s = ARC_SHARE * tol
+    if s >= d:
         q = 1
     else:
-        theta = 2.0 * math.acos(1.0 - tol / d)
+        theta = 2.0 * math.acos(1.0 - s / d)
         q = int(min(MAX_QUAD_SEGS, max(1, math.ceil((math.pi / 2.0) / theta))))
     return max(q, GEOS_MIN_QUAD_SEGS)
+
+
+def reduce_tol_for(d: float, tol: float) -> float:
+    """How far :func:`reduce_vertices` may move the vector method's outline: the arc
+    tolerance less the sagitta of the GEOS arcs (so arcs stay within ``tol`` of the true
+    circle), never negative."""
+    return max(0.0, tol - arc_sagitta(d, quad_segs_for(d, tol)))
+
+
+def reduce_vertices(geom: BaseGeometry, eps: float) -> BaseGeometry:
+    """``geom`` (a valid (Multi)Polygon) with fewer vertices, each ring moved by at most
+    ``eps`` (symmetric Hausdorff distance between the old and the new ring).
+
+    Guaranteed, and checked on the result: it is valid, keeps every polygon and every hole
+    (same counts, same order, same first vertex per ring), each ring's vertices are a
+    subsequence of its old vertices, and every dropped vertex lies within ``eps`` of the
+    chord that replaces it (so each chord is within ``eps`` of the stretch it replaces and
+    the other way round). What fails a check is put back as it was: a ring, a polygon, or
+    (when thinned polygons come to overlap) the polygons concerned; ``geom`` itself when
+    nothing else gives a valid result.
+
+    Which vertices to keep comes from GEOS's Douglas-Peucker on each ring on its own (fast:
+    no repair of the whole geometry), for a polygon that comes out invalid from GEOS's
+    topology-preserving variant on that polygon (its rings cannot cross or collapse). Each
+    ring's first vertex is kept: GEOS drops a ring's end point by looking at that vertex
+    alone, which can leave vertices dropped before it beyond ``eps``."""
+    if eps <= 0 or geom.is_empty:
+        return geom
+    parts = shapely.get_parts(geom)
+    n_holes = shapely.get_num_interior_rings(parts)
+    owner = np.repeat(np.arange(len(parts)), n_holes + 1)  # part of each ring
+    xy, ring = shapely.get_coordinates(shapely.get_rings(parts), return_index=True)
+    rings = shapely.get_rings(parts)
+    kept = _kept_of(xy, ring, shapely.simplify(rings, eps, preserve_topology=False), eps)
+    polys = _polys_of(xy, ring, kept, owner)
+    bad = np.flatnonzero(~shapely.is_valid(polys))
+    if len(bad):
+        on = np.isin(owner, bad)[ring]
+        try:
+            tps = shapely.simplify(parts[bad], eps, preserve_topology=True)
+            tps_rings = shapely.get_rings(tps)
+        except shapely.errors.GEOSException:
+            tps_rings = None
+        if tps_rings is not None and np.all(shapely.get_type_id(tps) == 3) and np.array_equal(
+                shapely.get_num_interior_rings(tps), n_holes[bad]):
+            sub = _kept_of(xy[on], np.unique(ring[on], return_inverse=True)[1], tps_rings, eps)
+            kept[on] = sub
+        else:
+            kept[on] = True
+        polys = _polys_of(xy, ring, kept, owner)
+        still = np.flatnonzero(~shapely.is_valid(polys))
+        if len(still):
+            kept[np.isin(owner, still)[ring]] = True
+            polys = _polys_of(xy, ring, kept, owner)
+    if len(polys) == 1:
+        return polys[0]
+    out = shapely.MultiPolygon(list(polys))
+    if not out.is_valid:
+        # thinned polygons that now meet: those go back as they were
+        i, j = shapely.STRtree(polys).query(polys, predicate="intersects")
+        meet = np.unique(np.concatenate([i[i != j], j[i != j]]))
+        kept[np.isin(owner, meet)[ring]] = True
+        out = shapely.MultiPolygon(list(_polys_of(xy, ring, kept, owner)))
+        if not out.is_valid:
+            return geom
+    return out
+
+
+def _kept_of(xy: np.ndarray, ring: np.ndarray, simplified: np.ndarray, eps: float
+             ) -> np.ndarray:
+    """Mask of the vertices ``xy`` (ring numbers ``ring``, 0..R-1, rows in ring order, each
+    ring closed) that the simplified rings (an array of R geometries) kept, plus each
+    ring's first and closing vertex. A ring is kept whole when fewer than 4 of its
+    vertices remain or a dropped vertex lies farther than ``eps`` from its chord. (The
+    result is built from the rings' own vertices and checked, whatever GEOS did.)"""
+    oxy, oring = shapely.get_coordinates(simplified, return_index=True)
+    okeys = _xy_hash(oxy, oring)
+    order = np.argsort(okeys)
+    keys = _xy_hash(xy, ring)
+    pos = np.minimum(np.searchsorted(okeys[order], keys), max(len(order) - 1, 0))
+    if len(order):
+        cand = order[pos]
+        # exact (ring, x, y) matches (a hash collision only drops a vertex, which the
+        # chord check below then judges)
+        kept = (okeys[cand] == keys) & (oring[cand] == ring) & np.all(oxy[cand] == xy, axis=1)
+    else:
+        kept = np.zeros(len(xy), dtype=bool)
+    starts = np.flatnonzero(np.diff(ring, prepend=-1))
+    kept[starts] = True  # each ring's first vertex ...
+    kept[np.append(starts[1:] - 1, len(xy) - 1)] = True  # ... and its closing copy
+    n_rings = int(ring[-1]) + 1 if len(ring) else 0
+    whole = np.bincount(ring[kept], minlength=n_rings) < 4
+    whole[_far_rings(xy, ring, kept, eps, n_rings)] = True
+    kept[whole[ring]] = True
+    return kept
+
+
+def _polys_of(xy: np.ndarray, ring: np.ndarray, kept: np.ndarray, owner: np.ndarray
+              ) -> np.ndarray:
+    """Polygons from the kept vertices: ring r belongs to polygon ``owner[r]`` (its
+    exterior first, then its holes)."""
+    rings = shapely.linearrings(xy[kept], indices=ring[kept])
+    return shapely.polygons(rings, indices=owner)
+
+
+def _xy_hash(xy: np.ndarray, ring: np.ndarray) -> np.ndarray:
+    """A 64-bit hash of each (ring, x, y), for matching exact coordinates by sorting
+    (callers compare the matched coordinates themselves; -0.0 hashes as 0.0). Each word
+    is folded in and then mixed (multiply, xor-shift), so coordinates that differ only in
+    sign or order do not collide."""
+    bits = np.ascontiguousarray(xy + 0.0).view(np.uint64)
+    h = ring.astype(np.uint64)
+    with np.errstate(over="ignore"):
+        for word in (bits[:, 0], bits[:, 1]):
+            h = (h ^ word) * np.uint64(0x9E3779B97F4A7C15)
+            h ^= h >> np.uint64(29)
+            h *= np.uint64(0xBF58476D1CE4E5B9)
+            h ^= h >> np.uint64(32)
+    return h
+
+
+def _far_rings(xy: np.ndarray, ring: np.ndarray, kept: np.ndarray, eps: float,
+               n_rings: int) -> np.ndarray:
+    """Mask of the rings with a vertex not ``kept`` that lies farther than ``eps`` from
+    the segment between the kept vertices before and after it (each ring's first and last
+    rows are kept)."""
+    far = np.zeros(n_rings, dtype=bool)
+    drop = ~kept
+    if not drop.any():
+        return far
+    idx = np.arange(len(xy))
+    prev = np.maximum.accumulate(np.where(kept, idx, 0))
+    nxt = np.minimum.accumulate(np.where(kept, idx, len(xy) - 1)[::-1])[::-1]
+    p, a, b = xy[drop], xy[prev[drop]], xy[nxt[drop]]
+    ab = b - a
+    ll = np.einsum("ij,ij->i", ab, ab)
+    t = np.clip(np.einsum("ij,ij->i", p - a, ab) / np.where(ll > 0, ll, 1.0), 0.0, 1.0)
+    dist = np.hypot(*(a + t[:, None] * ab - p).T)
+    far[ring[drop][dist > eps]] = True
+    return far
 
 
 def compensate_geometry(region: BaseGeometry, d: float, *, side: str, method: str,
@@ -286,9 +449,11 @@ def even_odd_region(rings: Sequence[np.ndarray]) -> BaseGeometry:
     """The valid (Multi)Polygon that the closed rings enclose by the even-odd rule.
 
     Rings may touch, cross themselves and each other. Fast path: simple rings that do not
-    touch one another are nested by containment. General path: node all rings (GEOS
-    union of the linework), polygonize the faces and keep the faces whose interior point
-    has an odd ray-crossing count against the original edges.
+    touch one another are nested by containment. General path: first cancel the edges that
+    occur an even number of times over all rings (either direction; see
+    :func:`_odd_edges`: a ray crosses two equal edges both or neither, so no point's parity
+    changes), node the remaining linework (GEOS union), polygonize the faces and keep the
+    faces whose interior point has an odd ray-crossing count against the remaining edges.
     """
     rings = [_closed(r) for r in rings]
     rings = [r for r in rings if len(r) >= 4]
@@ -303,8 +468,10 @@ def even_odd_region(rings: Sequence[np.ndarray]) -> BaseGeometry:
         simple = bool((pairs[0] == pairs[1]).all())
     if simple:
         return _nest(polys)
-    lines = shapely.linestrings(np.concatenate(rings), indices=np.repeat(
-        np.arange(len(rings)), [len(r) for r in rings]))
+    a, b, keep, rep = _odd_edges(rings)
+    if not keep.any():
+        return shapely.Polygon()
+    lines = _edge_runs(a, b, keep, [len(r) - 1 for r in rings])
     try:
         noded = shapely.union_all(lines)
     except shapely.errors.GEOSException:  # noding failed to converge: snap to a fine grid
@@ -315,15 +482,57 @@ def even_odd_region(rings: Sequence[np.ndarray]) -> BaseGeometry:
     if len(faces) == 0:
         return shapely.Polygon()
     pts = shapely.get_coordinates(shapely.point_on_surface(faces))
-    a, b = _segments(rings)
-    odd = _crossings(pts, a, b) % 2 == 1
-    keep = faces[odd]
-    if len(keep) == 0:
+    odd = _crossings(pts, a[rep], b[rep]) % 2 == 1
+    inside = faces[odd]
+    if len(inside) == 0:
         return shapely.Polygon()
-    out = shapely.coverage_union_all(keep)
+    out = shapely.coverage_union_all(inside)
     if not shapely.is_valid(out):
-        out = shapely.make_valid(shapely.union_all(keep))
+        out = shapely.make_valid(shapely.union_all(inside))
     return _polygonal(out)
+
+
+def _odd_edges(rings: Sequence[np.ndarray]
+               ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """All edges of the closed rings, (a, b); a mask of those that take part in the
+    even-odd rule; and the indices of one kept edge per class of equal kept edges.
+
+    Kept: not zero-length, and in a class of equal edges (the same two end points, either
+    direction) of odd size. The ray-crossing parity of every point is the same over the
+    kept edges as over all edges, and the same over one edge per class: two equal edges
+    are crossed by a ray both or neither (the half-open rule does not depend on
+    direction), and a zero-length edge never. Stacked hatch strips and shared outline
+    pieces cancel this way."""
+    a, b = _segments(rings)
+    swap = (a[:, 0] > b[:, 0]) | ((a[:, 0] == b[:, 0]) & (a[:, 1] > b[:, 1]))
+    key = np.ascontiguousarray(np.concatenate(
+        [np.where(swap[:, None], b, a), np.where(swap[:, None], a, b)], axis=1) + 0.0)
+    _, first, inv, cnt = np.unique(key.view(np.dtype((np.void, key.itemsize * 4))).ravel(),
+                                   return_index=True, return_inverse=True,
+                                   return_counts=True)
+    nonzero = ~np.all(a == b, axis=1)
+    odd = cnt % 2 == 1
+    keep = nonzero & odd[inv.ravel()]
+    rep = first[odd]
+    return a, b, keep, rep[nonzero[rep]]
+
+
+def _edge_runs(a: np.ndarray, b: np.ndarray, keep: np.ndarray, sizes: list[int]
+               ) -> np.ndarray:
+    """LineStrings of the kept edges: each maximal run of consecutive kept edges of one
+    ring becomes one line (fewer, longer lines node faster than single edges)."""
+    ring_of = np.repeat(np.arange(len(sizes)), sizes)
+    idx = np.nonzero(keep)[0]
+    new_run = np.ones(len(idx), dtype=bool)
+    new_run[1:] = (np.diff(idx) != 1) | (ring_of[idx[1:]] != ring_of[idx[:-1]])
+    run = np.cumsum(new_run) - 1
+    # a run's points: the start of each edge, then the end of the run's last edge
+    last = np.ones(len(idx), dtype=bool)
+    last[:-1] = new_run[1:]
+    pts = np.concatenate([a[idx], b[idx[last]]])
+    pid = np.concatenate([run, run[last]])
+    order = np.argsort(pid, kind="stable")
+    return shapely.linestrings(pts[order], indices=pid[order])
 
 
 def _linearrings(rings: Sequence[np.ndarray]) -> np.ndarray:
@@ -425,9 +634,85 @@ def _apply(region: BaseGeometry, d: float, side: str, method: str, tol: float,
 
 
 def _vector(region: BaseGeometry, d: float, side: str, tol: float) -> BaseGeometry:
+    """GEOS buffer of each polygon of the region on its own (the offset of a union is the
+    union of the offsets), then the grown polygons that meet are unioned, group by group;
+    shrunk polygons cannot meet. Much faster than one buffer of a MultiPolygon of
+    thousands of parts, which nodes them all together."""
     q = quad_segs_for(d, tol)
-    dist = d if side == "outside" else -d
-    return shapely.buffer(region, dist, quad_segs=q, join_style="round")
+    parts = shapely.get_parts(region)
+    grown = shapely.buffer(parts, d if side == "outside" else -d, quad_segs=q,
+                           join_style="round")
+    grown = grown[~shapely.is_empty(grown)]
+    if side == "outside" and len(grown) > 1:
+        i, j = shapely.STRtree(grown).query(grown, predicate="intersects")
+        label = _components(len(grown), i, j)
+        size = np.bincount(label, minlength=len(grown))
+        together = size[label] > 1
+        order = np.flatnonzero(together)[np.argsort(label[together], kind="stable")]
+        cuts = np.cumsum(size[np.unique(label[together])])[:-1]
+        groups = [shapely.union_all(grown[g]) for g in np.split(order, cuts)]
+        grown = np.array(list(grown[~together]) + groups, dtype=object)
+    polys = [p for g in grown for p in shapely.get_parts(_polygonal(g))]
+    if side == "outside":
+        polys = _without_false_holes(polys, region, d, tol)
+    if not polys:
+        return shapely.Polygon()
+    out = polys[0] if len(polys) == 1 else shapely.MultiPolygon(polys)
+    return reduce_vertices(out, reduce_tol_for(d, tol))
+
+
+#: a small hole is probed on a grid of this many points per side (plus two inner points)
+PROBE_GRID = 7
+
+
+def _without_false_holes(polys: list[BaseGeometry], region: BaseGeometry, d: float,
+                         size: float) -> list[BaseGeometry]:
+    """The grown polygons without the false holes: where the chords of two arcs meet, the
+    buffer can leave a sliver hole a fraction of the arc tolerance wide where the exact
+    offset has none (the laser would mark it as a tiny loop). A hole smaller than ``size``
+    across (bounding-box diagonal) is false when no probe point inside it lies farther
+    than ``d`` from the region (every point of a true hole does); probes: a
+    ``PROBE_GRID`` grid over its box, its centroid and a point on its surface."""
+    out = []
+    for p in polys:
+        holes = list(p.interiors)
+        small = [k for k, h in enumerate(holes) if _across(h) < size]
+        if not small:
+            out.append(p)
+            continue
+        false = {k for k in small if not _farther_inside(shapely.Polygon(holes[k]), region, d)}
+        out.append(shapely.Polygon(p.exterior, [h for k, h in enumerate(holes)
+                                                if k not in false]))
+    return out
+
+
+def _across(ring: BaseGeometry) -> float:
+    x0, y0, x1, y1 = ring.bounds
+    return math.hypot(x1 - x0, y1 - y0)
+
+
+def _farther_inside(hole: BaseGeometry, region: BaseGeometry, d: float) -> bool:
+    """Whether a probe point inside ``hole`` lies farther than ``d`` from ``region``."""
+    x0, y0, x1, y1 = hole.bounds
+    gx, gy = np.meshgrid(np.linspace(x0, x1, PROBE_GRID), np.linspace(y0, y1, PROBE_GRID))
+    probes = np.concatenate([shapely.points(gx.ravel(), gy.ravel()),
+                             [hole.centroid, hole.point_on_surface()]])
+    probes = probes[shapely.contains_properly(hole, probes)]
+    return bool(len(probes)) and bool((shapely.distance(region, probes) > d).any())
+
+
+def _components(n: int, i: np.ndarray, j: np.ndarray) -> np.ndarray:
+    """Connected components of the graph on 0..n-1 with edges (i[k], j[k]): each node's
+    label is the smallest node of its component (label propagation with pointer
+    jumping)."""
+    label = np.arange(n)
+    while True:
+        old = label.copy()
+        np.minimum.at(label, i, label[j])
+        np.minimum.at(label, j, label[i])
+        label = label[label]
+        if np.array_equal(label, old):
+            return label
 
 
 def _scan(rings: Sequence[np.ndarray], y0: float, h: float, n: int
@@ -690,6 +975,35 @@ def _nearest_segment(tree: shapely.STRtree, pts: np.ndarray, a: np.ndarray, b: n
     return best
 
 
+def _nearest_source(pts: np.ndarray, sources: list[np.ndarray], reach: float) -> np.ndarray:
+    """Index of the source ring nearest to each point (every point lies within ``reach`` of
+    some source, else the nearest-neighbour fallback finds it). A point within ``reach`` of
+    only one source's bounding box has that source as its nearest; the others are settled
+    segment by segment, with a tree of the segments of the sources that can be nearest to
+    them (short pieces: a whole ring would make every distance O(ring size))."""
+    n, m = len(pts), len(sources)
+    near = np.full(n, -1, dtype=np.int64)
+    lo = np.array([s.min(axis=0) for s in sources]) - reach
+    hi = np.array([s.max(axis=0) for s in sources]) + reach
+    boxes = shapely.STRtree(shapely.box(lo[:, 0], lo[:, 1], hi[:, 0], hi[:, 1]))
+    pi, si = boxes.query(shapely.points(pts))  # (point, box) pairs: the point is in the box
+    count = np.bincount(pi, minlength=n)
+    one = count[pi] == 1
+    near[pi[one]] = si[one]
+    rest = np.flatnonzero(count != 1)
+    if (count == 0).any():
+        cand = np.arange(m)  # a point beyond every box: any source may be nearest
+    else:
+        cand = np.unique(si[count[pi] > 1])
+    if len(rest):
+        subset = [sources[j] for j in cand.tolist()]
+        a, b = _segments(subset)
+        owner = np.repeat(cand, [len(s) - 1 for s in subset])
+        tree = shapely.STRtree(shapely.linestrings(np.stack([a, b], axis=1)))
+        near[rest] = owner[_nearest_segment(tree, pts[rest], a, b, reach)]
+    return near
+
+
 def _assign(result: BaseGeometry, sources: list[np.ndarray], reach: float
             ) -> tuple[list[tuple[np.ndarray, int]], set[int]]:
     """Each output ring with the (local) index of its source ring: the lowest index among
@@ -702,14 +1016,10 @@ def _assign(result: BaseGeometry, sources: list[np.ndarray], reach: float
         return [], set()
     if len(sources) == 1:
         return [(r, 0) for r in rings], {0}
-    # a tree of short pieces (a whole ring would make every distance O(ring size))
-    a, b = _segments(sources)
-    owner = np.repeat(np.arange(len(sources)), [len(s) - 1 for s in sources])
-    tree = shapely.STRtree(shapely.linestrings(np.stack([a, b], axis=1)))
     # every ASSIGN_STRIDE-th vertex of each output ring (at least one per ring) ...
     pts = np.concatenate([r[:-1:ASSIGN_STRIDE] for r in rings])
     which = np.repeat(np.arange(len(rings)), [len(r[:-1:ASSIGN_STRIDE]) for r in rings])
-    near = owner[_nearest_segment(tree, pts, a, b, reach)]
+    near = _nearest_source(pts, sources, reach)
     lowest = np.full(len(rings), np.iinfo(np.int64).max)
     np.minimum.at(lowest, which, near)
     contrib = set(near.tolist())

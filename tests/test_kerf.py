@@ -14,12 +14,16 @@ from galvo_core.drawing import Drawing, Path, SourcePos
 from galvo_core.errors import ParamError
 from galvo_core.field import make_field
 from galvo_core.kerf import (
+    ARC_SHARE,
     RECT_SPACING,
+    arc_sagitta,
     compensate,
     compensate_geometry,
     compensate_indexed,
     even_odd_region,
     quad_segs_for,
+    reduce_tol_for,
+    reduce_vertices,
 )
 
 MAG = 10.0  # bits per unit: 1 bit = 0.1 unit
@@ -81,15 +85,17 @@ def test_square_grows_to_rounded_square() -> None:
     assert np.allclose(shapely.Polygon(p.points).bounds, (-d, -d, s + d, s + d), atol=1e-6)
 
 
-def test_quad_segs_meet_the_arc_tolerance() -> None:
-    for d, tol in ((5.0, 0.1), (100.0, 0.067), (1.0, 0.5), (0.3, 1.0)):
+def test_quad_segs_and_thinning_budget_share_the_arc_tolerance() -> None:
+    for d, tol in ((5.0, 0.1), (100.0, 0.067), (1.0, 0.5), (0.3, 1.0), (2.0, 0.0671)):
         q = quad_segs_for(d, tol)
-        theta = (math.pi / 2) / q
-        assert d * (1 - math.cos(theta / 2)) <= tol + 1e-12
+        assert math.isclose(arc_sagitta(d, q), d * (1 - math.cos(math.pi / (4 * q))))
+        assert arc_sagitta(d, q) <= ARC_SHARE * tol + 1e-12
         assert q >= 8  # GEOS is less exact below 8 (see galvo_core.kerf.quad_segs_for)
         if q > 8:  # and not finer than needed
-            theta2 = (math.pi / 2) / (q - 1)
-            assert d * (1 - math.cos(theta2 / 2)) > tol
+            assert arc_sagitta(d, q - 1) > ARC_SHARE * tol
+        # GEOS arcs plus the thinning stay within the arc tolerance
+        eps = reduce_tol_for(d, tol)
+        assert eps > 0 and math.isclose(eps + arc_sagitta(d, q), tol)
 
 
 def test_ring_with_hole_grows_outwards_and_hole_shrinks() -> None:
@@ -208,6 +214,99 @@ def test_self_intersecting_ring_is_even_odd() -> None:
         assert region_of(out).area > 5000.0
 
 
+def test_rings_drawn_twice_cancel() -> None:
+    # even-odd: a ring drawn twice encloses nothing; a square drawn twice inside a ring
+    # drawn once leaves the ring's region whole
+    sq = square(0, 0, 100)
+    assert even_odd_region([sq, sq[::-1]]).is_empty
+    inner = square(30, 30, 40)
+    region = even_odd_region([sq, inner, inner])
+    assert math.isclose(region.area, 10000.0) and region.is_valid
+
+
+@st.composite
+def grid_rectangles(draw):
+    """Axis-parallel rectangles on a coarse integer grid: many share whole edges (as
+    stacked hatch strips do) or cross."""
+    n = draw(st.integers(2, 12))
+    rings = []
+    for _ in range(n):
+        x0, y0 = draw(st.integers(0, 8)), draw(st.integers(0, 8))
+        w, h = draw(st.integers(1, 6)), draw(st.integers(1, 6))
+        r = rect(x0, y0, x0 + w, y0 + h)
+        rings.append(r if draw(st.booleans()) else r[::-1])
+    if draw(st.booleans()):  # and a slanted ring crossing them
+        rings.append(np.array([(0.5, 0.25), (13.5, 3.5), (7.25, 13.5), (0.5, 0.25)]))
+    return rings
+
+
+@settings(max_examples=60, deadline=None, database=None)
+@given(grid_rectangles())
+def test_even_odd_region_is_the_parity_of_the_rings(rings) -> None:
+    region = even_odd_region(rings)
+    assert region.is_valid
+    # probe points off every edge: the region holds those inside an odd number of rings
+    xs, ys = np.meshgrid(np.arange(0.3, 14.5, 0.6), np.arange(0.2, 14.5, 0.6))
+    pts = shapely.points(xs.ravel(), ys.ravel())
+    rings_poly = [shapely.Polygon(r) for r in rings]
+    count = sum(shapely.contains(shapely.make_valid(p), pts).astype(int) if p.is_valid
+                else _parity_by_crossing(r, xs.ravel(), ys.ravel())
+                for p, r in zip(rings_poly, rings, strict=True))
+    on_edge = shapely.dwithin(shapely.MultiLineString([r for r in rings]), pts, 1e-6)
+    inside = shapely.contains(region, pts)
+    assert np.array_equal(inside[~on_edge], (count % 2 == 1)[~on_edge])
+
+
+def _parity_by_crossing(ring: np.ndarray, x: np.ndarray, y: np.ndarray) -> np.ndarray:
+    """1 where a horizontal ray from (x, y) crosses the ring an odd number of times."""
+    a, b = ring[:-1], ring[1:]
+    ylo, yhi = np.minimum(a[:, 1], b[:, 1]), np.maximum(a[:, 1], b[:, 1])
+    span = (ylo[None, :] <= y[:, None]) & (y[:, None] < yhi[None, :])
+    with np.errstate(divide="ignore", invalid="ignore"):
+        xc = a[:, 0] + (y[:, None] - a[:, 1]) * (b[:, 0] - a[:, 0]) / (b[:, 1] - a[:, 1])
+    return ((span & (xc > x[:, None])).sum(axis=1) % 2).astype(int)
+
+
+def test_vector_thinning_stays_within_the_arc_tolerance() -> None:
+    # a densely sampled circle with a square hole: the thinned offset has far fewer
+    # vertices than GEOS's, and stays within the arc tolerance of the exact offset
+    t = np.linspace(0, 2 * np.pi, 2001)
+    circle = np.column_stack([100 * np.cos(t), 100 * np.sin(t)])
+    circle[-1] = circle[0]
+    dr = drawing(circle, square(-20, -20, 40, ccw=False))
+    fm = field_for(dr)
+    d, tol = 5.0, fm.bits_to_units(1.0)
+    region = region_of(dr)
+    for side in ("outside", "inside"):
+        out = compensate(dr, kerf_mm=kerf_for(fm, d), side=side, method="vector", fm=fm)
+        got = region_of(out)
+        exact = shapely.buffer(region, d if side == "outside" else -d, quad_segs=1024)
+        dev = shapely.hausdorff_distance(got.boundary, exact.boundary, densify=0.05)
+        assert dev <= tol * 1.001, (side, dev, tol)
+        raw = shapely.buffer(region, d if side == "outside" else -d,
+                             quad_segs=quad_segs_for(d, tol))
+        n_out = sum(len(p.points) - 1 for p in out.paths)
+        assert n_out < shapely.get_num_coordinates(raw) / 4
+        assert len(out.paths) == 2
+
+
+def test_reduce_vertices_falls_back_to_keeping_topology() -> None:
+    # plain Douglas-Peucker would drop the shell's dip at (50, 0) and leave the hole
+    # outside the shell; the result must keep the hole inside, valid, with the same rings
+    shell = [(0, 1), (50, 0), (100, 1), (100, 50), (0, 50), (0, 1)]
+    hole = [(49, 0.2), (50, 0.3), (51, 0.2), (49, 0.2)]
+    poly = shapely.Polygon(shell, [hole])
+    assert poly.is_valid
+    plain = shapely.simplify(poly, 1.5, preserve_topology=False)
+    assert not (plain.is_valid and shapely.get_num_interior_rings(plain) == 1
+                and plain.geom_type == "Polygon")
+    out = reduce_vertices(poly, 1.5)
+    assert out.is_valid and out.geom_type == "Polygon"
+    assert shapely.get_num_interior_rings(out) == 1
+    assert shapely.contains(out.exterior.convex_hull, shapely.Polygon(hole))
+    assert shapely.hausdorff_distance(out.boundary, poly.boundary, densify=0.01) <= 1.5
+
+
 # ------------------------------------------------------------------------------ robustness
 @st.composite
 def random_rings(draw):
@@ -247,6 +346,34 @@ def test_random_polygons_never_give_invalid_output(rings, d, side) -> None:
         g = compensate_geometry(region, d, side=side, method=method, tol=0.1,
                                 res=max(0.1, d / 10), res_auto=False)
         assert g.is_valid, method
+
+
+@st.composite
+def offset_polygons(draw):
+    """A GEOS offset of random star-shaped rings (valid, with arcs, maybe holes)."""
+    rings = draw(random_rings())
+    region = even_odd_region(rings)
+    d = draw(st.floats(0.3, 8))
+    out = shapely.buffer(region, draw(st.sampled_from([d, -d])), quad_segs=16)
+    return out, draw(st.floats(0.01, 2.0))
+
+
+@settings(max_examples=60, deadline=None, database=None,
+          suppress_health_check=[HealthCheck.too_slow, HealthCheck.filter_too_much])
+@given(offset_polygons())
+def test_reduce_vertices_never_moves_the_outline_beyond_its_budget(case) -> None:
+    geom, eps = case
+    if geom.is_empty or not geom.is_valid:
+        return
+    out = reduce_vertices(geom, eps)
+    assert out.is_valid
+    parts_in, parts_out = shapely.get_parts(geom), shapely.get_parts(out)
+    assert len(parts_in) == len(parts_out)
+    assert np.array_equal(shapely.get_num_interior_rings(parts_in),
+                          shapely.get_num_interior_rings(parts_out))
+    assert shapely.get_num_coordinates(out) <= shapely.get_num_coordinates(geom)
+    for a, b in zip(shapely.get_rings(parts_in), shapely.get_rings(parts_out), strict=True):
+        assert shapely.hausdorff_distance(a, b, densify=0.02) <= eps * (1 + 1e-9) + 1e-9
 
 
 # ------------------------------------------------------------------------------ interface
@@ -301,3 +428,72 @@ def test_samples_all_methods_valid() -> None:
                                          fm=fm)
         assert region_of(out).is_valid
         assert set(origin) <= set(range(len(dr.paths)))
+
+
+def test_output_vertices_map_to_their_nearest_source_ring() -> None:
+    """The mapping back to source paths: each point gets the source ring whose outline is
+    nearest, whether its bounding box tells the sources apart (a ring and its hole, rings
+    side by side) or not (a point between two rings, near both boxes)."""
+    from galvo_core.kerf import _nearest_source
+
+    rng = np.random.default_rng(7)
+
+    def circle(cx: float, cy: float, r: float, n: int = 90) -> np.ndarray:
+        a = np.linspace(0.0, 2 * math.pi, n)
+        return np.stack([cx + r * np.cos(a), cy + r * np.sin(a)], axis=1)
+
+    sources = [circle(0, 0, 50), circle(0, 0, 20), circle(120, 0, 30), circle(75, 45, 8)]
+    reach = 6.0
+    # points within reach of some ring: ring points pushed sideways by up to reach
+    ring = rng.integers(0, len(sources), 400)
+    pts = np.array([sources[k][rng.integers(0, 89)] for k in ring])
+    pts += rng.uniform(-reach / 1.5, reach / 1.5, pts.shape)
+    a = np.concatenate([s[:-1] for s in sources])
+    b = np.concatenate([s[1:] for s in sources])
+    owner = np.repeat(np.arange(len(sources)), [len(s) - 1 for s in sources])
+    ab = b - a
+    t = np.clip(((pts[:, None] - a[None]) * ab[None]).sum(-1) / (ab * ab).sum(-1), 0, 1)
+    dist = np.hypot(*(a[None] + t[..., None] * ab[None] - pts[:, None]).transpose(2, 0, 1))
+    expected = owner[np.argmin(dist, axis=1)]
+    assert np.array_equal(_nearest_source(pts, sources, reach), expected)
+
+
+def test_false_sliver_holes_go_true_small_holes_stay() -> None:
+    """Where arc chords meet, a buffer can leave a sliver hole that the exact offset does not
+    have; the laser would mark it as a tiny loop. A small hole that is really there (the
+    region is farther than d around it) stays."""
+    from galvo_core.kerf import _across, _without_false_holes
+
+    d, tol = 4.0, 0.5
+    square = shapely.box(0, 0, 100, 100)
+    # a fake sliver deep inside the grown square (every point of it is within d of it)
+    sliver = shapely.Polygon([(50, 50), (50.2, 50.05), (50.1, 50.2)])
+    grown = shapely.Polygon(square.buffer(d).exterior, [sliver.exterior])
+    assert grown.is_valid and len(grown.interiors) == 1
+    assert len(_without_false_holes([grown], square, d, tol)[0].interiors) == 0
+    # a frame whose square window is just wider than 2d: a true hole 0.2 units wide
+    frame = shapely.Polygon(shapely.box(-50, -50, 50, 50).exterior,
+                            [shapely.box(-4.1, -4.1, 4.1, 4.1).exterior])
+    true_grown = shapely.buffer(frame, d, quad_segs=64)
+    assert len(true_grown.interiors) == 1 and _across(true_grown.interiors[0]) < tol
+    kept = _without_false_holes([true_grown], frame, d, tol)[0]
+    assert len(kept.interiors) == 1
+
+
+def test_parts_grown_one_by_one_match_one_buffer_of_all() -> None:
+    """The vector method buffers each polygon on its own and unions those that meet: the
+    result is the same region as one GEOS buffer of the whole MultiPolygon."""
+    rng = np.random.default_rng(3)
+    parts = [shapely.box(x, y, x + w, y + h) for x, y, w, h in
+             zip(rng.uniform(0, 200, 60), rng.uniform(0, 200, 60), rng.uniform(2, 15, 60),
+                 rng.uniform(2, 15, 60), strict=True)]
+    region = shapely.union_all(parts)
+    assert region.geom_type == "MultiPolygon"
+    for side, dist in (("outside", 3.0), ("inside", -1.5)):
+        ours = compensate_geometry(region, 3.0 if side == "outside" else 1.5, side=side,
+                                   method="vector", tol=0.05, res=0.05)
+        whole = shapely.buffer(region, dist, quad_segs=64)
+        assert ours.is_valid
+        assert len(shapely.get_parts(ours)) == len(shapely.get_parts(whole))
+        # within the arc tolerance of each other (ours: chords within 0.05 of the arcs)
+        assert shapely.hausdorff_distance(ours.boundary, whole.boundary, densify=0.1) <= 0.051
