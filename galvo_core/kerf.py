@@ -34,9 +34,10 @@ self-touching rings, rings that vanish and rings that merge. Each polygon of the
 buffered on its own and the grown ones that meet are unioned group by group (one buffer of
 a MultiPolygon of thousands of parts nodes them all together: 5x slower on a corpus file);
 sliver holes that only the chords of meeting arcs leave (no point in them is farther than
-``d`` from the region) are removed, as the laser would mark them as tiny loops. Why GEOS and not Clipper2:
-shapely (GEOS) is already a dependency, is well kept, gives the same result within the arc
-tolerance (bench/RESULTS.md, "Kerf (issue 6)"), and works on floating-point coordinates;
+``d`` from the region) are removed, as the laser would mark them as tiny loops.
+Why GEOS and not Clipper2: shapely (GEOS) is already a dependency, is well kept, gives the
+same result within the arc tolerance (bench/RESULTS.md, "Kerf (issue 6)"), and works on
+floating-point coordinates;
 Clipper2's Python bindings ``pyclipr`` ship no wheel for this platform (its source build
 fails), so a Clipper2 dependency would be a build risk for every user.
 
@@ -89,6 +90,7 @@ from shapely.geometry.base import BaseGeometry
 from galvo_core.drawing import Drawing, Path, Warning
 from galvo_core.errors import ParamError
 from galvo_core.field import FieldMap
+from galvo_core.geometry import point_segment_distance
 from galvo_core.params import KERF_METHODS, KERF_SIDES
 
 #: default raster size limit (pixels) and largest disc radius (pixels) for ``raster``
@@ -248,8 +250,8 @@ def reduce_vertices(geom: BaseGeometry, eps: float) -> BaseGeometry:
     parts = shapely.get_parts(geom)
     n_holes = shapely.get_num_interior_rings(parts)
     owner = np.repeat(np.arange(len(parts)), n_holes + 1)  # part of each ring
-    xy, ring = shapely.get_coordinates(shapely.get_rings(parts), return_index=True)
     rings = shapely.get_rings(parts)
+    xy, ring = shapely.get_coordinates(rings, return_index=True)
     kept = _kept_of(xy, ring, shapely.simplify(rings, eps, preserve_topology=False), eps)
     polys = _polys_of(xy, ring, kept, owner)
     bad = np.flatnonzero(~shapely.is_valid(polys))
@@ -350,11 +352,7 @@ def _far_rings(xy: np.ndarray, ring: np.ndarray, kept: np.ndarray, eps: float,
     idx = np.arange(len(xy))
     prev = np.maximum.accumulate(np.where(kept, idx, 0))
     nxt = np.minimum.accumulate(np.where(kept, idx, len(xy) - 1)[::-1])[::-1]
-    p, a, b = xy[drop], xy[prev[drop]], xy[nxt[drop]]
-    ab = b - a
-    ll = np.einsum("ij,ij->i", ab, ab)
-    t = np.clip(np.einsum("ij,ij->i", p - a, ab) / np.where(ll > 0, ll, 1.0), 0.0, 1.0)
-    dist = np.hypot(*(a + t[:, None] * ab - p).T)
+    dist = point_segment_distance(xy[drop], xy[prev[drop]], xy[nxt[drop]])
     far[ring[drop][dist > eps]] = True
     return far
 
@@ -959,11 +957,7 @@ def _nearest_segment(tree: shapely.STRtree, pts: np.ndarray, a: np.ndarray, b: n
     pi, si = tree.query(shapely.points(pts), predicate="dwithin", distance=reach)
     best = np.full(n, -1, dtype=np.int64)
     if len(pi):
-        p = pts[pi]
-        ab = b[si] - a[si]
-        ll = np.einsum("ij,ij->i", ab, ab)
-        t = np.clip(np.einsum("ij,ij->i", p - a[si], ab) / np.where(ll > 0, ll, 1.0), 0, 1)
-        dd = ((a[si] + t[:, None] * ab - p) ** 2).sum(axis=1)
+        dd = point_segment_distance(pts[pi], a[si], b[si])
         order = np.lexsort((si, dd, pi))  # per point: smallest distance first
         first = np.ones(len(order), dtype=bool)
         first[1:] = pi[order][1:] != pi[order][:-1]
