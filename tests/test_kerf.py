@@ -480,6 +480,31 @@ def test_false_sliver_holes_go_true_small_holes_stay() -> None:
     assert len(kept.interiors) == 1
 
 
+@pytest.mark.parametrize("radius", [10.11, 10.115, 10.12, 10.13, 10.15])
+def test_inward_offset_has_no_false_sliver_and_keeps_true_ones(radius: float) -> None:
+    """Three tiny holes about d from a common centre: the exact inward offset leaves
+    nothing there (radius <= 10.12) or a speck that is really deeper than d (10.13 on);
+    the coarse buffer's chords leave a sliver in both cases. The laser must mark a loop
+    there exactly when the exact offset has one."""
+    d, tol = 10.0, 0.5
+
+    def square(cx: float, cy: float, h: float) -> np.ndarray:
+        return np.array([[cx - h, cy - h], [cx + h, cy - h], [cx + h, cy + h],
+                         [cx - h, cy + h], [cx - h, cy - h]])
+
+    holes = [square(radius * math.cos(a), radius * math.sin(a), 0.1)
+             for a in (0.0, 2 * math.pi / 3, 4 * math.pi / 3)]
+    region = even_odd_region([square(0, 0, 100), *holes])
+    coarse = shapely.buffer(region, -d, quad_segs=quad_segs_for(d, tol))
+    assert len(shapely.get_parts(coarse)) == 2  # the chords leave a speck in the middle
+    exact = shapely.buffer(region, -d, quad_segs=1024)
+    ours = compensate_geometry(region, d, side="inside", method="vector", tol=tol, res=tol)
+    assert ours.is_valid
+    assert len(shapely.get_parts(ours)) == len(shapely.get_parts(exact))
+    centre = shapely.Point(0, 0).buffer(1.0)
+    assert ours.intersects(centre) == exact.intersects(centre)
+
+
 def test_parts_grown_one_by_one_match_one_buffer_of_all() -> None:
     """The vector method buffers each polygon on its own and unions those that meet: the
     result is the same region as one GEOS buffer of the whole MultiPolygon."""
