@@ -4,7 +4,9 @@ Per corpus file with closed paths and side: ``compensate_indexed`` (vector, kerf
 the fit-field magnification, 1 bit arc tolerance) against Clipper2's even-odd union +
 InflatePaths per pen (numpy in and out), best of 3 each. Prints the totals, the ratios over
 the runs where Clipper2 takes at least 5 ms (below that both are a few milliseconds and the
-ratio is fixed per-call cost), and the runs above 1.2x Clipper2's vertex count.
+ratio is fixed per-call cost), and the runs above 1.2x Clipper2's vertex count, each with
+both outlines' reference-free offset error (largest | distance to the input outline - d |,
+densified to 0.1 bit) in bits.
 
 Run with the benchmark's own environment (made by run_kerf.sh):
 ``PYTHONPATH=. bench/.venv-kerf/bin/python bench/kerf_corpus_time.py``
@@ -21,16 +23,36 @@ sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import bench_kerf as bk  # noqa: E402
 
 from galvo_core import kerf  # noqa: E402
+from galvo_core.drawing import Drawing  # noqa: E402
 from galvo_core.field import make_field  # noqa: E402
 
 KERF_MM = 0.1
 MEANINGFUL_S = 0.005
 
 
-def runs() -> list[tuple[str, str, float, float, int, int]]:
+def offset_errors(dr: Drawing, side: str) -> tuple[float, float]:
+    """Largest offset error of ours and of Clipper2's outline, in bits, over the pens."""
+    fm = make_field(dr.bbox(), magnification=None, fit_field=True)
+    d = fm.mm_to_units(KERF_MM / 2)
+    bit = fm.bits_to_units(1.0)
+    ours = theirs = 0.0
+    for pen in sorted({p.pen for p in dr.paths}):
+        rings = bk.pen_rings(dr, pen)
+        if not rings:
+            continue
+        region = kerf.even_odd_region(rings)
+        mine = kerf.compensate_geometry(region, d, side=side, method="vector", tol=bit,
+                                        res=bit)
+        clip = bk.clipper_geom(bk.clipper_offset(rings, d, side, bit))
+        ours = max(ours, bk.offset_error(mine, region, d, step=bit / 10) / bit)
+        theirs = max(theirs, bk.offset_error(clip, region, d, step=bit / 10) / bit)
+    return ours, theirs
+
+
+def runs(drawings: dict[str, Drawing]) -> list[tuple[str, str, float, float, int, int]]:
     """(file, side, our time, Clipper2 time, our vertices, Clipper2 vertices) per run."""
     rows = []
-    for name, dr in bk.corpus_drawings():
+    for name, dr in drawings.items():
         fm = make_field(dr.bbox(), magnification=None, fit_field=True)
         x0, y0, x1, y1 = dr.bbox()
         if KERF_MM > max(x1 - x0, y1 - y0) * fm.mm_per_unit:
@@ -54,7 +76,8 @@ def runs() -> list[tuple[str, str, float, float, int, int]]:
 
 
 def main() -> None:
-    rows = runs()
+    drawings = dict(bk.corpus_drawings())
+    rows = runs(drawings)
     t = np.array([r[2] for r in rows])
     c = np.array([r[3] for r in rows])
     nv = np.array([r[4] for r in rows])
@@ -70,7 +93,12 @@ def main() -> None:
         print(f"  {r[0]} {r[1]}: {r[2] * 1000:.1f} ms vs {r[3] * 1000:.1f} ms")
     print(f"other runs: ours median {np.median(t[~big]) * 1000:.1f} ms, "
           f"max {t[~big].max() * 1000:.1f} ms")
-    over = [f"{r[0]} {r[1]} ({r[4]} vs {r[5]})" for r in rows if r[4] > 1.2 * r[5]]
+    over = []
+    for r in rows:
+        if r[4] > 1.2 * r[5]:
+            e_ours, e_clip = offset_errors(drawings[r[0]], r[1])
+            over.append(f"{r[0]} {r[1]} ({r[4]} at {e_ours:.4f} bits vs {r[5]} at "
+                        f"{e_clip:.4f} bits)")
     vr = nv / np.maximum(nc, 1)
     print(f"vertices: total x{nv.sum() / nc.sum():.2f}, median x{np.median(vr):.2f}; "
           f"runs above x1.2: {len(over)}: " + "; ".join(over))
