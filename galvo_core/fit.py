@@ -393,36 +393,37 @@ class _BatchFitter:
         sl = ssum(tl)
         sh = ssum(th)
         t = np.full(m, 0.5)
-        done = np.zeros(m, dtype=bool)
-        t[sl <= 0.0] = 0.0
-        done |= sl <= 0.0
+        done = sl <= 0.0
+        t[done] = 0.0
         hi_case = ~done & (sh >= 0.0)
         t[hi_case] = 1.0
         done |= hi_case
         ustate[:] = u
         side = np.zeros(m)
-        for _ in range(_MAX_BISECT):
-            if done.all():
-                break
-            with np.errstate(divide="ignore", invalid="ignore"):
+        with np.errstate(divide="ignore", invalid="ignore"):
+            for _ in range(_MAX_BISECT):
+                if done.all():
+                    break
                 tn = (tl * sh - th * sl) / (sh - sl)
-            bad = ~((tl < tn) & (tn < th))
-            tn = np.where(bad, 0.5 * (tl + th), tn)
-            tn = np.where(done, t, tn)
-            s = ssum(tn, np.flatnonzero(~done[pid]))
-            t = tn
-            stop = ~done & ((np.abs(s) < self.eps_sum) | (th - tl < 1e-9))
-            upd = ~done & ~stop
-            pos = upd & (s > 0.0)
-            neg = upd & ~(s > 0.0)
-            sh = np.where(pos & (side == 1), 0.5 * sh, sh)
-            tl = np.where(pos, t, tl)
-            sl = np.where(pos, s, sl)
-            sl = np.where(neg & (side == -1), 0.5 * sl, sl)
-            th = np.where(neg, t, th)
-            sh = np.where(neg, s, sh)
-            side = np.where(pos, 1.0, np.where(neg, -1.0, side))
-            done |= stop
+                inner = (tl < tn) & (tn < th)
+                tn = np.where(inner, tn, 0.5 * (tl + th))
+                tn = np.where(done, t, tn)
+                s = ssum(tn, np.flatnonzero(~done[pid]) if done.any() else None)
+                t = tn
+                going = ~done
+                stop = going & ((np.abs(s) < self.eps_sum) | (th - tl < 1e-9))
+                upd = going ^ stop  # (stop lies within going)
+                pos = upd & (s > 0.0)
+                neg = upd ^ pos
+                sh = np.where(pos & (side == 1), 0.5 * sh, sh)
+                tl = np.where(pos, t, tl)
+                sl = np.where(pos, s, sl)
+                sl = np.where(neg & (side == -1), 0.5 * sl, sl)
+                th = np.where(neg, t, th)
+                sh = np.where(neg, s, sh)
+                side[pos] = 1.0
+                side[neg] = -1.0
+                done |= stop
         return self._ctrl(p0, qq, p3, t)
 
     def _accept(self, ctrl: np.ndarray, i0: np.ndarray, i1: np.ndarray):
@@ -647,10 +648,14 @@ def _fit_concatenated(
     klen = np.array([len(k) for k in kept_all], dtype=np.intp)
     W = np.concatenate(works) if len(works) > 1 else works[0]
     K = np.concatenate(kept_all).astype(np.intp, copy=False) + np.repeat(woff, klen)
-    K = K[np.repeat(np.isin(np.arange(len(works)), todo), klen)]
+    in_todo = np.zeros(len(works), dtype=bool)
+    in_todo[todo] = True
+    K = K[np.repeat(in_todo, klen)]
     tlen = klen[todo]
     kend = np.cumsum(tlen) - 1  # each path's last thinned point
     Q = W[K]
+    is_kend = np.zeros(len(Q), dtype=bool)
+    is_kend[kend] = True
     pa, pb, curve, t_in, t_out = split_pieces_many(Q, tlen, np.asarray(closed)[todo])
     fitter = _BatchFitter(W, K, t_in, t_out, e_per, eps_sum, _arc_per_path(W, wlen))
     with np.errstate(invalid="ignore", divide="ignore"):
@@ -665,7 +670,7 @@ def _fit_concatenated(
     lpts = np.stack([Q[la], Q[lb]], axis=1)
     lpts.setflags(write=False)
     lfirst = K[la]
-    llast = np.where(np.isin(lb, kend), end_w[owner[lb]], K[lb])
+    llast = np.where(is_kend[lb], end_w[owner[lb]], K[lb])
     lerr = _line_errors(W, lpts, lfirst, llast)
     worst = np.zeros(len(todo))
     np.fmax.at(worst, owner[la], lerr)  # NaN (overflow) ignored, as max() did
@@ -673,7 +678,7 @@ def _fit_concatenated(
     ctrl = np.ascontiguousarray(ctrl)
     ctrl.setflags(write=False)
     cfirst = K[ca]
-    clast = np.where(np.isin(cb, kend), end_w[owner[cb]], K[cb])
+    clast = np.where(is_kend[cb], end_w[owner[cb]], K[cb])
     if len(ca):
         worst = _cubic_worst(W, ctrl, cfirst, clast, bound, owner[ca], worst)
     # all segments in path order
