@@ -255,9 +255,9 @@ def _curve_to_polyline_bound_many(
     s = px * tx + py * ty
     p = np.abs(px * nx + py * ny)
     o = np.maximum(np.maximum(-s, s - ln), 0.0)
-    # a zero-length segment is its point
-    p = np.where(good, p, np.hypot(px, py))
-    o = np.where(good, o, 0.0)
+    if not good.all():  # a zero-length segment is its point
+        p = np.where(good, p, np.hypot(px, py))
+        o = np.where(good, o, 0.0)
     perp = p.max(axis=0)
     over = o.max(axis=0)
     return np.sqrt(perp * perp + over * over)
@@ -374,17 +374,17 @@ class _BatchFitter:
                 ustate[:] = uu
             else:
                 ustate[pm] = uu
-            (ax, ay), (bx, by), (dx, dy), (ex, ey) = cf
-            tx = (3.0 * ax * uu + 2.0 * bx) * uu + dx
-            ty = (3.0 * ay * uu + 2.0 * by) * uu + dy
-            bad = tx * tx + ty * ty <= (tiny if pm is None else tiny[pm])
+            # (x and y as the rows of (2, K) arrays, u in both rows)
+            a, b, d, e = cf
+            u2 = np.empty(q.shape)
+            u2[:] = uu
+            tg = (3.0 * a * u2 + 2.0 * b) * u2 + d
+            t2 = tg * tg
+            bad = t2[0] + t2[1] <= (tiny if pm is None else tiny[pm])
             if bad.any():
-                ch = chxy if pm is None else chxy[:, pm]
-                tx = np.where(bad, ch[0], tx)
-                ty = np.where(bad, ch[1], ty)
-            rx = q[0] - (((ax * uu + bx) * uu + dx) * uu + ex)
-            ry = q[1] - (((ay * uu + by) * uu + dy) * uu + ey)
-            side = np.sign(tx * ry - ty * rx)
+                tg = np.where(bad, chxy if pm is None else chxy[:, pm], tg)
+            r = q - (((a * u2 + b) * u2 + d) * u2 + e)
+            side = np.sign(tg[0] * r[1] - tg[1] * r[0])
             w = (sg if pm is None else sg[pm]) * side * np.sqrt(d2)
             return -np.bincount(pp, weights=w, minlength=m)
 

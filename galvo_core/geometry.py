@@ -402,6 +402,10 @@ def gather_coeffs(coef: np.ndarray, pid: np.ndarray) -> np.ndarray:
     return np.take(coef.transpose(1, 2, 0), pid, axis=2)
 
 
+#: points per block of :func:`newton_nearest_many` (its (2, K) work arrays stay in cache)
+_NEWTON_BLOCK = 1 << 14
+
+
 def newton_nearest_many(
     cf: np.ndarray,
     p: np.ndarray,
@@ -419,60 +423,80 @@ def newton_nearest_many(
     Any returned u gives an upper bound of the true distance (it is the distance to a point
     of the curve), so a test ``dist <= tol`` made with it is never too lenient.
     """
-    (ax, ay), (bx, by), (dx, dy), (ex, ey) = cf
-    qx = p[0] - ex
-    qy = p[1] - ey
-    a3x, a3y, b2x, b2y = 3.0 * ax, 3.0 * ay, 2.0 * bx, 2.0 * by
-    a6x, a6y = 6.0 * ax, 6.0 * ay
-    u = u.copy()
-    for _ in range(iters):  # (in place, the arithmetic of the formulas in the comments)
-        rx = _horner3(ax, bx, dx, u)  # ((a u + b) u + d) u - q
-        rx -= qx
-        ry = _horner3(ay, by, dy, u)
-        ry -= qy
-        d1x = a3x * u  # B'(u) = (3a u + 2b) u + d
-        d1x += b2x
-        d1x *= u
-        d1x += dx
-        d1y = a3y * u
-        d1y += b2y
-        d1y *= u
-        d1y += dy
-        f = d1x * rx  # B'·(B - p)
-        f += d1y * ry
-        fp = a6x * u  # (6a u + 2b)·(B - p) + |B'|^2
-        fp += b2x
-        fp *= rx
-        t = a6y * u
-        t += b2y
-        t *= ry
-        fp += t
-        d1x *= d1x
-        fp += d1x
-        d1y *= d1y
-        fp += d1y
+    k = len(u)
+    if k <= _NEWTON_BLOCK:
+        return _newton_block(cf, p, u, iters, lo, hi)
+    u_out = np.empty(k)
+    d2_out = np.empty(k)
+    for c in range(0, k, _NEWTON_BLOCK):
+        s = slice(c, c + _NEWTON_BLOCK)
+        u_out[s], d2_out[s] = _newton_block(
+            cf[:, :, s] if cf.shape[2] > 1 else cf,
+            p[:, s],
+            u[s],
+            iters,
+            lo[s] if isinstance(lo, np.ndarray) else lo,
+            hi[s] if isinstance(hi, np.ndarray) else hi,
+        )
+    return u_out, d2_out
+
+
+def _newton_block(
+    cf: np.ndarray,
+    p: np.ndarray,
+    u: np.ndarray,
+    iters: int,
+    lo: np.ndarray | float,
+    hi: np.ndarray | float,
+) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`newton_nearest_many` on one block: x and y as the rows of (2, K) arrays, u
+    in both rows (so no operation broadcasts), in place."""
+    a, b, d, e = cf
+    q = p - e
+    a3 = 3.0 * a
+    b2 = 2.0 * b
+    a6 = 6.0 * a
+    uu = np.empty(q.shape)
+    uu[:] = u
+    u = uu[0]
+    r = np.empty(q.shape)
+    d1 = np.empty(q.shape)
+    g = np.empty(q.shape)
+    for _ in range(iters):
+        _residual(a, b, d, q, uu, r)  # B(u) - p
+        np.multiply(a3, uu, out=d1)  # B'(u) = (3a u + 2b) u + d
+        d1 += b2
+        d1 *= uu
+        d1 += d
+        np.multiply(d1, r, out=g)  # f = B'·(B - p)
+        f = g[0] + g[1]
+        np.multiply(a6, uu, out=g)  # f' = (6a u + 2b)·(B - p) + |B'|^2
+        g += b2
+        g *= r
+        fp = g[0] + g[1]
+        d1 *= d1
+        fp += d1[0]
+        fp += d1[1]
         fp[fp <= 0.0] = np.inf
         f /= fp
         u -= f
         u.clip(lo, hi, out=u)
-    rx = _horner3(ax, bx, dx, u)
-    rx -= qx
-    ry = _horner3(ay, by, dy, u)
-    ry -= qy
-    rx *= rx
-    ry *= ry
-    rx += ry
-    return u, rx
+        uu[1] = u
+    _residual(a, b, d, q, uu, r)
+    r *= r
+    return u.copy(), r[0] + r[1]
 
 
-def _horner3(a: np.ndarray, b: np.ndarray, d: np.ndarray, u: np.ndarray) -> np.ndarray:
-    """((a u + b) u + d) u, element-wise into a new array."""
-    r = a * u
-    r += b
-    r *= u
-    r += d
-    r *= u
-    return r
+def _residual(
+    a: np.ndarray, b: np.ndarray, d: np.ndarray, q: np.ndarray, u: np.ndarray, out: np.ndarray
+) -> None:
+    """``out`` = ((a u + b) u + d) u − q, element-wise in place."""
+    np.multiply(a, u, out=out)
+    out += b
+    out *= u
+    out += d
+    out *= u
+    out -= q
 
 
 def nearest_on_cubics(

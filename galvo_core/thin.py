@@ -364,10 +364,6 @@ def _sweep_block(
     maybe &= run[:, :-1]
     if d0 == 0:
         maybe[:, 0] = False  # (d = 1: always valid, set by the caller)
-    if fuzzy is not None:
-        fz = maybe & far & ~((th >= lb) & (th <= hb))
-        fz |= run[:, :-1] & alive & (lo[:, 1:] > hi[:, 1:])
-        fuzzy[st.row[fz.any(axis=1)]] = True
     # no point before farther from s than j: the wedge alone decides (a hair inside)
     sure = (th >= lb + _TINY) & (th <= hb - _TINY)
     sure |= ~has
@@ -377,6 +373,14 @@ def _sweep_block(
     ok[st.row[ri], ci + (d0 + 1)] = True
     maybe &= ~sure
     ri, ci = np.nonzero(maybe)
+    if fuzzy is not None:
+        fz = run[:, :-1] & alive & (lo[:, 1:] > hi[:, 1:])
+        fuzzy[st.row[fz.any(axis=1)]] = True
+        # a far candidate outside the strict wedge (never sure: it has a direction) is
+        # among those to check
+        t = th[ri, ci]
+        out = far[ri, ci] & ~((t >= lb[ri, ci]) & (t <= hb[ri, ci]))
+        fuzzy[st.row[ri[out]]] = True
     out_rows = st.row[ri]
     out_d = ci + (d0 + 1)
     last = run[:, -1]
