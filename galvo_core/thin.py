@@ -26,8 +26,9 @@ true chain finds most reaches already known. Seeds and batching change only how 
 chain is found, never which points it keeps. Paths likely to need the DP below (short, few
 sampled starts with reaches over 8 points, or mid-sized with most samples closing within
 24) are instead swept whole to the DP window: the DP needs that table anyway, and it holds
-every reach of at most 24 points. The sweep's last steps, once few starts are left, run as
-one 2-D block (same arithmetic per cell). (The walk's wedge test is
+every reach of at most 24 points. The sweep's last steps, once few starts are left (or few
+cells, past the first 8 steps, on a dense stretch where starts no longer stop), run as one
+2-D block (same arithmetic per cell). (The walk's wedge test is
 strict, the sweep's has a 1e-9 rad slack before the exact check; where that slack mattered
 for a start, its reach is still found by the walk, so the result is the same either way.)
 
@@ -1193,14 +1194,14 @@ def _dp_levels(
     n = len(pred)
     # the table shortcuts from inside the pieces, one bit set per length
     src = np.zeros(n, dtype=bool)
-    src[gpos[~is_end]] = True
+    inner = np.flatnonzero(~is_end)
+    src[gpos[inner]] = True
     bit_of = np.zeros(n, dtype=np.intp)
-    bit_of[gpos[~is_end]] = np.flatnonzero(~is_end)
+    bit_of[gpos[inner]] = inner
     sel = src[ii]
-    ia = ii[sel]
-    ja = jj[sel]
+    ia, ja = (ii, jj) if sel.all() else (ii[sel], jj[sel])
     tab = np.zeros((width, total), dtype=bool)
-    tab[ja - ia, bit_of[ia]] = True
+    tab.reshape(-1)[(ja - ia) * total + bit_of[ia]] = True
     packed = np.packbits(tab, axis=1, bitorder="little")
     nb = packed.shape[1]
     raw = packed.tobytes()
