@@ -26,8 +26,8 @@ true chain finds most reaches already known. Seeds and batching change only how 
 chain is found, never which points it keeps. Paths likely to need the DP below (short, few
 sampled starts with reaches over 8 points, or mid-sized with most samples closing within
 24) are instead swept whole to the DP window: the DP needs that table anyway, and it holds
-every reach of at most 24 points. The sweep's last steps, once few starts are left (or few
-cells, past the first 8 steps, on a dense stretch where starts no longer stop), run as one
+every reach of at most 24 points. The sweep's last steps, once few starts are left (or not
+many, past the first 8 steps, on a dense stretch where starts no longer stop), run as one
 2-D block (same arithmetic per cell). (The walk's wedge test is
 strict, the sweep's has a 1e-9 rad slack before the exact check; where that slack mattered
 for a start, its reach is still found by the walk, so the result is the same either way.)
@@ -92,11 +92,11 @@ _SUB24 = 4
 #: below this many points per kept line the greedy result is improved by the window DP
 _DP_RATIO = 16
 _DP_WINDOW = 24
-#: at most this many starts left, or (past _SWEEP) at most _BLOCK_CELLS (start x step) to go
-#: while at least the fraction _SURVIVE of the starts survived the last step: the sweep's
-#: remaining steps are done as one 2-D block
+#: at most this many starts left, or (past _SWEEP) at most _FEW_DENSE while at least the
+#: fraction _SURVIVE of them survived the last step: the sweep's remaining steps are done as
+#: one 2-D block
 _FEW = 256
-_BLOCK_CELLS = 1 << 14
+_FEW_DENSE = 512
 _SURVIVE = 0.9
 #: slack of the wedge prefilter (radians): a candidate this close outside is checked exactly
 _LOOSE = 1e-9
@@ -217,16 +217,11 @@ def _sweep_steps(
             if k == 0:
                 break
             if d < d_max and (
-                k <= _FEW
-                or (
-                    d > _SWEEP
-                    and 0 < _SURVIVE * k_last <= k
-                    and k * (d_max + 1 - d) <= _BLOCK_CELLS
-                )
+                k <= _FEW or (d > _SWEEP and k <= _FEW_DENSE and 0 < _SURVIVE * k_last <= k)
             ):
-                # few starts left, or few cells to go on a dense stretch (the starts open
-                # after _SWEEP steps, and still not stopping: the block pays for every cell
-                # up to d_max): the remaining steps at once (2-D, same decisions)
+                # few starts left, or not many on a dense stretch (open after _SWEEP steps
+                # and still not stopping: the block pays for every cell up to d_max): the
+                # remaining steps at once (2-D, same decisions)
                 blk = _sweep_block(x, y, eps, st, ok, d - 1, d_max, fuzzy)
                 break
             k_last = k

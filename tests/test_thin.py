@@ -386,9 +386,9 @@ def test_block_sweep_decides_as_step_by_step(monkeypatch, eps):
     starts = np.arange(0, len(pts), 3)
     out = []
     # one step at a time; the block from the start; steps, then a block once past _SWEEP
-    for few, cells in ((0, 0), (10**9, 0), (0, 10**9)):
+    for few, few_dense in ((0, 0), (10**9, 0), (0, 10**9)):
         monkeypatch.setattr(thin_mod, "_FEW", few)
-        monkeypatch.setattr(thin_mod, "_BLOCK_CELLS", cells)
+        monkeypatch.setattr(thin_mod, "_FEW_DENSE", few_dense)
         fz = np.zeros(len(starts), dtype=bool)
         ok, op, _ = thin_mod._sweep(x, y, pend, eps, starts, 24, fuzzy=fz)
         out.append((ok, op, fz))
