@@ -68,6 +68,7 @@ from galvo_core.geometry import (
     newton_nearest_many,
     point_polyline_distance,
     point_segment_distance,
+    power_coeffs_into,
     power_coeffs_many,
 )
 from galvo_core.runs import segmented_cumsum, split_pieces_many
@@ -193,16 +194,37 @@ def _seg(kind: str, pts: np.ndarray, first: int, last: int) -> Segment:
     return Segment(kind, arr, int(first), int(last))
 
 
+#: pairs measured at once by :func:`_curve_to_polyline_bound_many` (its candidates x pairs
+#: tables stay small)
+_BOUND_CHUNK = 1 << 14
+
+
 def _curve_to_polyline_bound_many(
-    cf: tuple[np.ndarray, ...], a: np.ndarray, b: np.ndarray, u0: np.ndarray, u1: np.ndarray
+    cf: np.ndarray, a: np.ndarray, b: np.ndarray, u0: np.ndarray, u1: np.ndarray
 ) -> np.ndarray:
     """Per pair k: an upper bound of the distance from the curve stretch u0[k]..u1[k] of
-    cubic ``cf`` (per-pair power coefficients) to the segment [a[k], b[k]] (see module doc).
+    cubic ``cf`` (per-pair power coefficients, a (4, 2, K) block as in
+    :func:`galvo_core.geometry.newton_nearest_many`) to the segment [a[k], b[k]] (see
+    module doc).
 
     |perpendicular| and overshoot beyond the segment's ends are maximised exactly over the
-    stretch (end values and roots of their derivatives, quadratics in u).
+    stretch (end values and roots of their derivatives, quadratics in u): all seven
+    candidate parameters of a pair are evaluated at once, ``_BOUND_CHUNK`` pairs at a time.
     """
-    ax, ay, bx, by, dx, dy, ex, ey = cf
+    if len(a) > _BOUND_CHUNK:
+        return np.concatenate(
+            [
+                _curve_to_polyline_bound_many(
+                    cf[:, :, c : c + _BOUND_CHUNK],
+                    a[c : c + _BOUND_CHUNK],
+                    b[c : c + _BOUND_CHUNK],
+                    u0[c : c + _BOUND_CHUNK],
+                    u1[c : c + _BOUND_CHUNK],
+                )
+                for c in range(0, len(a), _BOUND_CHUNK)
+            ]
+        )
+    (ax, ay), (bx, by), (dx, dy), (ex, ey) = cf
     lo = np.minimum(u0, u1)
     hi = np.maximum(u0, u1)
     abx = b[:, 0] - a[:, 0]
@@ -212,33 +234,32 @@ def _curve_to_polyline_bound_many(
     inv = 1.0 / np.where(good, ln, 1.0)
     tx, ty = abx * inv, aby * inv  # direction
     nx, ny = -ty, tx  # normal
-    # B'(u) = 3a u^2 + 2b u + d
-    cands = [lo, hi, 0.5 * (lo + hi)]
+    # B'(u) = 3a u^2 + 2b u + d along the normal (row 0) and the direction (row 1)
+    vx = np.stack([nx, tx])
+    vy = np.stack([ny, ty])
     with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
-        for vx, vy in ((nx, ny), (tx, ty)):
-            qa = 3.0 * (ax * vx + ay * vy)
-            qb = 2.0 * (bx * vx + by * vy)
-            qc = dx * vx + dy * vy
-            disc = qb * qb - 4.0 * qa * qc
-            sq = np.sqrt(np.maximum(disc, 0.0))
-            lin = np.abs(qa) <= 1e-14 * (np.abs(qb) + np.abs(qc) + 1e-300)
-            for sgn in (1.0, -1.0):
-                r = np.where(lin, -qc / qb, (-qb + sgn * sq) / (2.0 * qa))
-                r = np.where((np.isfinite(r) & (disc >= 0.0)) | lin, r, lo)
-                cands.append(np.clip(np.nan_to_num(r, nan=0.0), lo, hi))
-    perp = np.zeros(len(a))
-    over = np.zeros(len(a))
-    for uu in cands:
-        px = ((ax * uu + bx) * uu + dx) * uu + ex - a[:, 0]
-        py = ((ay * uu + by) * uu + dy) * uu + ey - a[:, 1]
-        s = px * tx + py * ty
-        p = np.abs(px * nx + py * ny)
-        o = np.maximum(np.maximum(-s, s - ln), 0.0)
-        # a zero-length segment is its point
+        qa = 3.0 * (ax * vx + ay * vy)
+        qb = 2.0 * (bx * vx + by * vy)
+        qc = dx * vx + dy * vy
+        disc = qb * qb - 4.0 * qa * qc
+        sq = np.sqrt(np.maximum(disc, 0.0))
+        lin = np.abs(qa) <= 1e-14 * (np.abs(qb) + np.abs(qc) + 1e-300)
+        sgn = np.array([1.0, -1.0]).reshape(2, 1, 1)
+        r = np.where(lin, -qc / qb, (-qb + sgn * sq) / (2.0 * qa))  # (sign, row, pair)
+        r = np.where((np.isfinite(r) & (disc >= 0.0)) | lin, r, lo)
+    r[np.isnan(r)] = 0.0
+    r.clip(lo, hi, out=r)
+    uu = np.concatenate([lo, hi, 0.5 * (lo + hi), r.reshape(-1)]).reshape(7, -1)
+    px = ((ax * uu + bx) * uu + dx) * uu + ex - a[:, 0]
+    py = ((ay * uu + by) * uu + dy) * uu + ey - a[:, 1]
+    s = px * tx + py * ty
+    p = np.abs(px * nx + py * ny)
+    o = np.maximum(np.maximum(-s, s - ln), 0.0)
+    if not good.all():  # a zero-length segment is its point
         p = np.where(good, p, np.hypot(px, py))
         o = np.where(good, o, 0.0)
-        np.maximum(perp, p, out=perp)
-        np.maximum(over, o, out=over)
+    perp = p.max(axis=0)
+    over = o.max(axis=0)
     return np.sqrt(perp * perp + over * over)
 
 
@@ -322,38 +343,48 @@ class _BatchFitter:
         cnt = -(-L // stride)
         pid, off = _ragged(np.zeros(m, dtype=np.intp), cnt)
         idx = i0[pid] + 1 + stride[pid] * off
-        pts = self.work[idx]
-        px, py = pts[:, 0].copy(), pts[:, 1].copy()
+        pxy = self.work[idx].T.copy()  # (2, K)
         span = self.arc[i1] - self.arc[i0]
         u = (self.arc[idx] - self.arc[i0][pid]) / np.where(span > 0, span, 1.0)[pid]
-        chord = (p3 - p0)[pid]
-        chord2 = (chord * chord).sum(axis=1)
+        chord = p3 - p0
+        chxy = chord.T[:, pid]
+        tiny = 1e-18 * (chord * chord).sum(axis=1)[pid]
         sg = sig[pid]
         ustate = u.copy()
+        # per piece: P1 = P0 + t (Q - P0), P2 = P3 + t (Q - P3); their power coefficients
+        # in a (4, 2, m) block, gathered per point
+        cfm = np.empty((4, 2, m))
+        p0t = p0.T
+        p3t = p3.T
+        q0 = (qq - p0).T
+        q3 = (qq - p3).T
 
         def ssum(t: np.ndarray, pm: np.ndarray | None = None) -> np.ndarray:
             """Signed error sums of all pieces at ``t`` (only pieces with points ``pm``
             are evaluated, the others come back 0)."""
+            if pm is not None and len(pm) == len(pid):
+                pm = None  # (every point: no copies)
             pp = pid if pm is None else pid[pm]
-            qx = px if pm is None else px[pm]
-            qy = py if pm is None else py[pm]
-            cf = gather_coeffs(power_coeffs_many(self._ctrl(p0, qq, p3, t)), pp)
+            power_coeffs_into(cfm, p0t, p0t + t * q0, p3t + t * q3, p3t)
+            cf = np.take(cfm, pp, axis=2)
+            q = pxy if pm is None else pxy[:, pm]
             u0 = ustate if pm is None else ustate[pm]
-            uu, d2 = newton_nearest_many(cf, qx, qy, u0, 3)
+            uu, d2 = newton_nearest_many(cf, q, u0, 3)
             if pm is None:
                 ustate[:] = uu
             else:
                 ustate[pm] = uu
-            ch = chord if pm is None else chord[pm]
-            ax, ay, bx, by, dx, dy, ex, ey = cf
-            tx = (3.0 * ax * uu + 2.0 * bx) * uu + dx
-            ty = (3.0 * ay * uu + 2.0 * by) * uu + dy
-            bad = tx * tx + ty * ty <= 1e-18 * (chord2 if pm is None else chord2[pm])
-            tx = np.where(bad, ch[:, 0], tx)
-            ty = np.where(bad, ch[:, 1], ty)
-            rx = qx - (((ax * uu + bx) * uu + dx) * uu + ex)
-            ry = qy - (((ay * uu + by) * uu + dy) * uu + ey)
-            side = np.sign(tx * ry - ty * rx)
+            # (x and y as the rows of (2, K) arrays, u in both rows)
+            a, b, d, e = cf
+            u2 = np.empty(q.shape)
+            u2[:] = uu
+            tg = (3.0 * a * u2 + 2.0 * b) * u2 + d
+            t2 = tg * tg
+            bad = t2[0] + t2[1] <= (tiny if pm is None else tiny[pm])
+            if bad.any():
+                tg = np.where(bad, chxy if pm is None else chxy[:, pm], tg)
+            r = q - (((a * u2 + b) * u2 + d) * u2 + e)
+            side = np.sign(tg[0] * r[1] - tg[1] * r[0])
             w = (sg if pm is None else sg[pm]) * side * np.sqrt(d2)
             return -np.bincount(pp, weights=w, minlength=m)
 
@@ -362,36 +393,37 @@ class _BatchFitter:
         sl = ssum(tl)
         sh = ssum(th)
         t = np.full(m, 0.5)
-        done = np.zeros(m, dtype=bool)
-        t[sl <= 0.0] = 0.0
-        done |= sl <= 0.0
+        done = sl <= 0.0
+        t[done] = 0.0
         hi_case = ~done & (sh >= 0.0)
         t[hi_case] = 1.0
         done |= hi_case
         ustate[:] = u
         side = np.zeros(m)
-        for _ in range(_MAX_BISECT):
-            if done.all():
-                break
-            with np.errstate(divide="ignore", invalid="ignore"):
+        with np.errstate(divide="ignore", invalid="ignore"):
+            for _ in range(_MAX_BISECT):
+                if done.all():
+                    break
                 tn = (tl * sh - th * sl) / (sh - sl)
-            bad = ~((tl < tn) & (tn < th))
-            tn = np.where(bad, 0.5 * (tl + th), tn)
-            tn = np.where(done, t, tn)
-            s = ssum(tn, np.flatnonzero(~done[pid]))
-            t = tn
-            stop = ~done & ((np.abs(s) < self.eps_sum) | (th - tl < 1e-9))
-            upd = ~done & ~stop
-            pos = upd & (s > 0.0)
-            neg = upd & ~(s > 0.0)
-            sh = np.where(pos & (side == 1), 0.5 * sh, sh)
-            tl = np.where(pos, t, tl)
-            sl = np.where(pos, s, sl)
-            sl = np.where(neg & (side == -1), 0.5 * sl, sl)
-            th = np.where(neg, t, th)
-            sh = np.where(neg, s, sh)
-            side = np.where(pos, 1.0, np.where(neg, -1.0, side))
-            done |= stop
+                inner = (tl < tn) & (tn < th)
+                tn = np.where(inner, tn, 0.5 * (tl + th))
+                tn = np.where(done, t, tn)
+                s = ssum(tn, np.flatnonzero(~done[pid]) if done.any() else None)
+                t = tn
+                going = ~done
+                stop = going & ((np.abs(s) < self.eps_sum) | (th - tl < 1e-9))
+                upd = going ^ stop  # (stop lies within going)
+                pos = upd & (s > 0.0)
+                neg = upd ^ pos
+                sh = np.where(pos & (side == 1), 0.5 * sh, sh)
+                tl = np.where(pos, t, tl)
+                sl = np.where(pos, s, sl)
+                sl = np.where(neg & (side == -1), 0.5 * sl, sl)
+                th = np.where(neg, t, th)
+                sh = np.where(neg, s, sh)
+                side[pos] = 1.0
+                side[neg] = -1.0
+                done |= stop
         return self._ctrl(p0, qq, p3, t)
 
     def _accept(self, ctrl: np.ndarray, i0: np.ndarray, i1: np.ndarray):
@@ -403,11 +435,10 @@ class _BatchFitter:
         starts = np.cumsum(cnt) - cnt
         idx = i0[pid] + off
         pts = self.work[idx]
-        px, py = pts[:, 0].copy(), pts[:, 1].copy()
         span = self.arc[i1] - self.arc[i0]
         u = (self.arc[idx] - self.arc[i0][pid]) / np.where(span > 0, span, 1.0)[pid]
         cf = gather_coeffs(power_coeffs_many(ctrl), pid)
-        u, d2 = newton_nearest_many(cf, px, py, u, 6)
+        u, d2 = newton_nearest_many(cf, pts.T, u, 6)
         # ends of each piece are the curve's ends
         ends = np.concatenate([starts, starts + cnt - 1])
         u[starts] = 0.0
@@ -433,8 +464,7 @@ class _BatchFitter:
         pair &= ok[pid]
         j = np.flatnonzero(pair)
         if len(j):
-            pcf = tuple(c[j] for c in cf)
-            bnd = _curve_to_polyline_bound_many(pcf, pts[j], pts[j + 1], u[j], u[j + 1])
+            bnd = _curve_to_polyline_bound_many(cf[:, :, j], pts[j], pts[j + 1], u[j], u[j + 1])
             worst = np.zeros(m)
             np.maximum.at(worst, pid[j], bnd)
             ok &= worst <= e2
@@ -618,10 +648,14 @@ def _fit_concatenated(
     klen = np.array([len(k) for k in kept_all], dtype=np.intp)
     W = np.concatenate(works) if len(works) > 1 else works[0]
     K = np.concatenate(kept_all).astype(np.intp, copy=False) + np.repeat(woff, klen)
-    K = K[np.repeat(np.isin(np.arange(len(works)), todo), klen)]
+    in_todo = np.zeros(len(works), dtype=bool)
+    in_todo[todo] = True
+    K = K[np.repeat(in_todo, klen)]
     tlen = klen[todo]
     kend = np.cumsum(tlen) - 1  # each path's last thinned point
     Q = W[K]
+    is_kend = np.zeros(len(Q), dtype=bool)
+    is_kend[kend] = True
     pa, pb, curve, t_in, t_out = split_pieces_many(Q, tlen, np.asarray(closed)[todo])
     fitter = _BatchFitter(W, K, t_in, t_out, e_per, eps_sum, _arc_per_path(W, wlen))
     with np.errstate(invalid="ignore", divide="ignore"):
@@ -636,7 +670,7 @@ def _fit_concatenated(
     lpts = np.stack([Q[la], Q[lb]], axis=1)
     lpts.setflags(write=False)
     lfirst = K[la]
-    llast = np.where(np.isin(lb, kend), end_w[owner[lb]], K[lb])
+    llast = np.where(is_kend[lb], end_w[owner[lb]], K[lb])
     lerr = _line_errors(W, lpts, lfirst, llast)
     worst = np.zeros(len(todo))
     np.fmax.at(worst, owner[la], lerr)  # NaN (overflow) ignored, as max() did
@@ -644,7 +678,7 @@ def _fit_concatenated(
     ctrl = np.ascontiguousarray(ctrl)
     ctrl.setflags(write=False)
     cfirst = K[ca]
-    clast = np.where(np.isin(cb, kend), end_w[owner[cb]], K[cb])
+    clast = np.where(is_kend[cb], end_w[owner[cb]], K[cb])
     if len(ca):
         worst = _cubic_worst(W, ctrl, cfirst, clast, bound, owner[ca], worst)
     # all segments in path order

@@ -127,10 +127,8 @@ def _newton_nearest(
     iters: int,
 ) -> np.ndarray:
     """Newton on f(u) = B'(u)·(B(u) - p), each u kept inside its bracket [lo, hi]."""
-    a, b, d, e = _power_coeffs(c)
-    cf = (float(a[0]), float(a[1]), float(b[0]), float(b[1]), float(d[0]), float(d[1]),
-          float(e[0]), float(e[1]))
-    return newton_nearest_many(cf, p[:, 0], p[:, 1], u, iters, lo=lo, hi=hi)[0]
+    cf = np.array(_power_coeffs(c))[:, :, None]
+    return newton_nearest_many(cf, p.T, u, iters, lo=lo, hi=hi)[0]
 
 
 _NEAREST_CANDIDATES = 3  # local minima of the sampled distance refined by Newton
@@ -215,13 +213,14 @@ def nearest_on_cubic_each(
         p0,
     )
     if len(c) == 1:  # one cubic (nearest_on_cubic): no per-point copies
-        cf: tuple[np.ndarray | float, ...] = tuple(float(x[0, j]) for x in coef for j in (0, 1))
+        cf = np.array(coef)[:, 0, :, None]
         cq = np.broadcast_to(c, (k, 4, 2))
     else:
-        cf = tuple(x[pid, j] for x in coef for j in (0, 1))
+        cf = gather_coeffs(np.stack(coef, axis=1), pid)
         cq = c[pid]
+    pt = p.T
     for m in range(_NEAREST_CANDIDATES):
-        u = newton_nearest_many(cf, p[:, 0], p[:, 1], u0[m], iters, lo=lo[m], hi=hi[m])[0]
+        u = newton_nearest_many(cf, pt, u0[m], iters, lo=lo[m], hi=hi[m])[0]
         r = _bernstein_each(cq, u) - p
         dn = r[:, 0] * r[:, 0] + r[:, 1] * r[:, 1]
         better = ok[m] & (dn < best_d2)
@@ -371,61 +370,133 @@ def _polyline_distance_rtree(p: np.ndarray, q: np.ndarray) -> np.ndarray:
 # --- many cubics at once --------------------------------------------------------------
 #
 # The fitter works on many pieces at a time: every point k belongs to a cubic ``pid[k]``.
-# A cubic is held in power form per point, eight flat arrays (ax, ay, bx, by, dx, dy, ex,
-# ey) with B(u) = ((a·u + b)·u + d)·u + e, so that each Newton step is a handful of
-# element-wise operations over all points of all pieces together.
+# The cubics are held in power form per point, one (4, 2, K) block ``cf`` (rows a, b, d, e;
+# x and y) with B(u) = ((a·u + b)·u + d)·u + e, so that each Newton step is a handful of
+# element-wise operations over both coordinates of all points of all pieces together.
 
 
 def power_coeffs_many(ctrl: np.ndarray) -> np.ndarray:
     """Power-basis coefficients of M cubics: ``ctrl`` (M, 4, 2) -> (M, 4, 2) = [a, b, d, e]."""
     c = np.asarray(ctrl, dtype=np.float64)
-    p0, p1, p2, p3 = c[:, 0], c[:, 1], c[:, 2], c[:, 3]
-    return np.stack(
-        [-p0 + 3.0 * (p1 - p2) + p3, 3.0 * (p0 + p2) - 6.0 * p1, 3.0 * (p1 - p0), p0], axis=1
-    )
+    out = np.empty(c.shape)
+    power_coeffs_into(out.swapaxes(0, 1), c[:, 0], c[:, 1], c[:, 2], c[:, 3])
+    return out
 
 
-def gather_coeffs(coef: np.ndarray, pid: np.ndarray) -> tuple[np.ndarray, ...]:
-    """The eight flat per-point coefficient arrays of cubic ``pid[k]`` (see above)."""
-    return tuple(coef[:, i, j][pid] for i in range(4) for j in range(2))
+def power_coeffs_into(
+    out: np.ndarray, p0: np.ndarray, p1: np.ndarray, p2: np.ndarray, p3: np.ndarray
+) -> np.ndarray:
+    """``out[0 .. 3]`` = a, b, d, e of B(u) = ((a u + b) u + d) u + e for the control points
+    p0 .. p3 (arrays of one shape, e.g. (M, 2) or (2, M)); returns ``out``."""
+    np.add(-p0, 3.0 * (p1 - p2), out=out[0])
+    out[0] += p3
+    np.subtract(3.0 * (p0 + p2), 6.0 * p1, out=out[1])
+    np.multiply(3.0, p1 - p0, out=out[2])
+    out[3] = p0
+    return out
+
+
+def gather_coeffs(coef: np.ndarray, pid: np.ndarray) -> np.ndarray:
+    """The (4, 2, K) coefficient block (see above) of cubic ``pid[k]`` per point, from the
+    (M, 4, 2) coefficients ``coef`` of :func:`power_coeffs_many`."""
+    return np.take(coef.transpose(1, 2, 0), pid, axis=2)
+
+
+#: points per block of :func:`newton_nearest_many` (its (2, K) work arrays stay in cache)
+_NEWTON_BLOCK = 1 << 14
 
 
 def newton_nearest_many(
-    cf: tuple[np.ndarray | float, ...],
-    px: np.ndarray,
-    py: np.ndarray,
+    cf: np.ndarray,
+    p: np.ndarray,
     u: np.ndarray,
     iters: int,
     *,
     lo: np.ndarray | float = 0.0,
     hi: np.ndarray | float = 1.0,
 ) -> tuple[np.ndarray, np.ndarray]:
-    """Newton on f(u) = B'(u)·(B(u) − p) for every point with its own cubic (or one cubic
-    given by scalar coefficients), u kept in [lo, hi] (default [0, 1]); a step where
-    f' <= 0 is not taken. Returns ``(u, squared distance)``.
+    """Newton on f(u) = B'(u)·(B(u) − p) for every point with its own cubic (``cf`` the
+    (4, 2, K) block, see above, or (4, 2, 1) for one cubic), points ``p`` (2, K), u kept in
+    [lo, hi] (default [0, 1]); a step where f' <= 0 is not taken. Returns ``(u, squared
+    distance)``.
 
     Any returned u gives an upper bound of the true distance (it is the distance to a point
     of the curve), so a test ``dist <= tol`` made with it is never too lenient.
     """
-    ax, ay, bx, by, dx, dy, ex, ey = cf
-    qx = px - ex
-    qy = py - ey
-    a3x, a3y, b2x, b2y = 3.0 * ax, 3.0 * ay, 2.0 * bx, 2.0 * by
-    a6x, a6y = 6.0 * ax, 6.0 * ay
-    u = u.copy()
+    k = len(u)
+    if k <= _NEWTON_BLOCK:
+        return _newton_block(cf, p, u, iters, lo, hi)
+    u_out = np.empty(k)
+    d2_out = np.empty(k)
+    for c in range(0, k, _NEWTON_BLOCK):
+        s = slice(c, c + _NEWTON_BLOCK)
+        u_out[s], d2_out[s] = _newton_block(
+            cf[:, :, s] if cf.shape[2] > 1 else cf,
+            p[:, s],
+            u[s],
+            iters,
+            lo[s] if isinstance(lo, np.ndarray) else lo,
+            hi[s] if isinstance(hi, np.ndarray) else hi,
+        )
+    return u_out, d2_out
+
+
+def _newton_block(
+    cf: np.ndarray,
+    p: np.ndarray,
+    u: np.ndarray,
+    iters: int,
+    lo: np.ndarray | float,
+    hi: np.ndarray | float,
+) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`newton_nearest_many` on one block: x and y as the rows of (2, K) arrays, u
+    in both rows (so no operation broadcasts), in place."""
+    a, b, d, e = cf
+    q = p - e
+    a3 = 3.0 * a
+    b2 = 2.0 * b
+    a6 = 6.0 * a
+    uu = np.empty(q.shape)
+    uu[:] = u
+    u = uu[0]
+    r = np.empty(q.shape)
+    d1 = np.empty(q.shape)
+    g = np.empty(q.shape)
     for _ in range(iters):
-        rx = ((ax * u + bx) * u + dx) * u - qx
-        ry = ((ay * u + by) * u + dy) * u - qy
-        d1x = (a3x * u + b2x) * u + dx
-        d1y = (a3y * u + b2y) * u + dy
-        f = d1x * rx + d1y * ry
-        fp = (a6x * u + b2x) * rx + (a6y * u + b2y) * ry + d1x * d1x + d1y * d1y
+        _residual(a, b, d, q, uu, r)  # B(u) - p
+        np.multiply(a3, uu, out=d1)  # B'(u) = (3a u + 2b) u + d
+        d1 += b2
+        d1 *= uu
+        d1 += d
+        np.multiply(d1, r, out=g)  # f = B'·(B - p)
+        f = g[0] + g[1]
+        np.multiply(a6, uu, out=g)  # f' = (6a u + 2b)·(B - p) + |B'|^2
+        g += b2
+        g *= r
+        fp = g[0] + g[1]
+        d1 *= d1
+        fp += d1[0]
+        fp += d1[1]
         fp[fp <= 0.0] = np.inf
-        u -= f / fp
-        np.clip(u, lo, hi, out=u)
-    rx = ((ax * u + bx) * u + dx) * u - qx
-    ry = ((ay * u + by) * u + dy) * u - qy
-    return u, rx * rx + ry * ry
+        f /= fp
+        u -= f
+        u.clip(lo, hi, out=u)
+        uu[1] = u
+    _residual(a, b, d, q, uu, r)
+    r *= r
+    return u.copy(), r[0] + r[1]
+
+
+def _residual(
+    a: np.ndarray, b: np.ndarray, d: np.ndarray, q: np.ndarray, u: np.ndarray, out: np.ndarray
+) -> None:
+    """``out`` = ((a u + b) u + d) u − q, element-wise in place."""
+    np.multiply(a, u, out=out)
+    out += b
+    out *= u
+    out += d
+    out *= u
+    out -= q
 
 
 def nearest_on_cubics(
@@ -458,8 +529,7 @@ def nearest_on_cubics(
         j = np.argmin(d2, axis=1)
         best = d2[np.arange(len(q)), j]
         u0 = su[j]
-        ccf = tuple(a[sl] for a in cf)
-        u, dn = newton_nearest_many(ccf, q[:, 0], q[:, 1], u0, iters)
+        u, dn = newton_nearest_many(cf[:, :, sl], q.T, u0, iters)
         better = dn < best
         t_out[sl] = np.where(better, u, u0)
         d_out[sl] = np.sqrt(np.where(better, dn, best))

@@ -26,8 +26,9 @@ true chain finds most reaches already known. Seeds and batching change only how 
 chain is found, never which points it keeps. Paths likely to need the DP below (short, few
 sampled starts with reaches over 8 points, or mid-sized with most samples closing within
 24) are instead swept whole to the DP window: the DP needs that table anyway, and it holds
-every reach of at most 24 points. The sweep's last steps, once few starts are left, run as
-one 2-D block (same arithmetic per cell). (The walk's wedge test is
+every reach of at most 24 points. The sweep's last steps, once few starts are left (or not
+many, past the first 8 steps, on a dense stretch where starts no longer stop), run as one
+2-D block (same arithmetic per cell). (The walk's wedge test is
 strict, the sweep's has a 1e-9 rad slack before the exact check; where that slack mattered
 for a start, its reach is still found by the walk, so the result is the same either way.)
 
@@ -91,8 +92,12 @@ _SUB24 = 4
 #: below this many points per kept line the greedy result is improved by the window DP
 _DP_RATIO = 16
 _DP_WINDOW = 24
-#: at most this many starts left: the sweep's remaining steps are done as one 2-D block
+#: at most this many starts left, or (past _SWEEP) at most _FEW_DENSE while at least the
+#: fraction _SURVIVE of them survived the last step: the sweep's remaining steps are done as
+#: one 2-D block
 _FEW = 256
+_FEW_DENSE = 512
+_SURVIVE = 0.9
 #: slack of the wedge prefilter (radians): a candidate this close outside is checked exactly
 _LOOSE = 1e-9
 #: margin inside the wedge for the "sure" shortcut (no exact check)
@@ -206,13 +211,20 @@ def _sweep_steps(
     blk: tuple[np.ndarray, np.ndarray] | None = None
     all_has = bool(st.has.all())  # (then no direction of reference is set any more)
     with np.errstate(divide="ignore", invalid="ignore"):
+        k_last = 0  # starts of the step before (0: none yet)
         for d in range(st.d + 1, d_max + 1):
-            if len(st.s) == 0:
+            k = len(st.s)
+            if k == 0:
                 break
-            if len(st.s) <= _FEW and d < d_max:
-                # few starts left: the remaining steps at once (2-D, same decisions)
+            if d < d_max and (
+                k <= _FEW or (d > _SWEEP and k <= _FEW_DENSE and 0 < _SURVIVE * k_last <= k)
+            ):
+                # few starts left, or not many on a dense stretch (open after _SWEEP steps
+                # and still not stopping: the block pays for every cell up to d_max): the
+                # remaining steps at once (2-D, same decisions)
                 blk = _sweep_block(x, y, eps, st, ok, d - 1, d_max, fuzzy)
                 break
+            k_last = k
             j = st.s + d
             vx = x[j] - st.xs
             vy = y[j] - st.ys
@@ -234,12 +246,6 @@ def _sweep_steps(
                 maybe = (th >= lo - _LOOSE) & (th <= hi + _LOOSE)
                 maybe |= near
                 maybe &= rmax <= r + eps
-                if fuzzy is not None:  # (th, lo, hi are never NaN)
-                    fz = (th < lo) | (th > hi)
-                    fz &= far
-                    fz &= maybe
-                    if fz.any():
-                        fuzzy[st.row[fz]] = True
                 # no point before farther from s than j: ray distance == segment distance,
                 # so the wedge alone decides (kept a hair inside against rounding)
                 sure = (th >= lo + _TINY) & (th <= hi - _TINY)
@@ -252,6 +258,13 @@ def _sweep_steps(
                 if rest.any():
                     chk_rows.append(st.row[rest])
                     chk_d.append(d)
+                    if fuzzy is not None:  # (th, lo, hi are never NaN; such a far
+                        # candidate has a direction, so it is never sure: it is in rest)
+                        fz = (th < lo) | (th > hi)
+                        fz &= far
+                        fz &= rest
+                        if fz.any():
+                            fuzzy[st.row[fz]] = True
             w = np.arcsin(eps / np.where(far, r, 0.0))  # NaN for near points: no bound
             np.fmax(lo, th - w, out=lo)
             np.fmin(hi, th + w, out=hi)
@@ -347,10 +360,6 @@ def _sweep_block(
     maybe &= run[:, :-1]
     if d0 == 0:
         maybe[:, 0] = False  # (d = 1: always valid, set by the caller)
-    if fuzzy is not None:
-        fz = maybe & far & ~((th >= lb) & (th <= hb))
-        fz |= run[:, :-1] & alive & (lo[:, 1:] > hi[:, 1:])
-        fuzzy[st.row[fz.any(axis=1)]] = True
     # no point before farther from s than j: the wedge alone decides (a hair inside)
     sure = (th >= lb + _TINY) & (th <= hb - _TINY)
     sure |= ~has
@@ -360,6 +369,14 @@ def _sweep_block(
     ok[st.row[ri], ci + (d0 + 1)] = True
     maybe &= ~sure
     ri, ci = np.nonzero(maybe)
+    if fuzzy is not None:
+        fz = run[:, :-1] & alive & (lo[:, 1:] > hi[:, 1:])
+        fuzzy[st.row[fz.any(axis=1)]] = True
+        # a far candidate outside the strict wedge (never sure: it has a direction) is
+        # among those to check
+        t = th[ri, ci]
+        out = far[ri, ci] & ~((t >= lb[ri, ci]) & (t <= hb[ri, ci]))
+        fuzzy[st.row[ri[out]]] = True
     out_rows = st.row[ri]
     out_d = ci + (d0 + 1)
     last = run[:, -1]
@@ -486,6 +503,8 @@ def _reach_rows(
     n_win = np.minimum(lim, k_win)
     mstop = np.where(has_e, e0, n_win)
     retry = ~has_e & (lim > k_win)
+    if retry.all():  # (every wedge still open: nothing to pick yet)
+        return s + 1, mstop, retry
     mm = np.minimum(mstop + 1, n_win)
     # candidates lie below mm: drop the columns no row needs
     k_use = max(2, int(mm.max()))
@@ -671,7 +690,9 @@ def _walk(
     ren = np.flatnonzero(last) + 1
     long_runs = np.flatnonzero(ren - rs >= _RUN_MIN)
     sd = rs[long_runs]
-    sd = sd[np.isin(sd, starts, invert=True)]
+    is_start = np.zeros(n, dtype=bool)
+    is_start[starts] = True
+    sd = sd[~is_start[sd]]
     # a seed's cap is the next seed of its path (or the path end)
     cap = np.append(sd[1:], n)
     cap = np.where(pend[cap.clip(max=n - 1)] == pend[sd], cap, pend[sd] + 1)
@@ -1124,6 +1145,8 @@ def _dp_table(
 #: shortcut in :func:`_dp_edges`), plus _WORD_EDGES per 64 points of the pieces it works on
 _LEVEL_EDGES = 6
 _WORD_EDGES = 0.33
+#: shortcut lengths per group in a breadth-first round (see :func:`_dp_levels`)
+_SHIFT_GROUP = 4
 #: most (round x point) cells unpacked at once when the rounds' bit sets become distances
 _UNPACK_CELLS = 1 << 22
 
@@ -1146,9 +1169,11 @@ def _dp_levels(
     ``width - 1`` points long); ``ep -> eb`` the greedy long shortcuts. The search finds
     each point's distance (lines from its piece start), one round per level, on Python
     integers as bit sets: a round is a shift, an and and an or per shortcut length,
-    whatever the number of pieces. Each piece gets its own bit range
-    (its end a copy that is never expanded), the pieces with most greedy lines
-    (``rounds_est``) in the lowest bits, so the sets shrink as the short pieces finish.
+    whatever the number of pieces (the lengths in groups of ``_SHIFT_GROUP``: a round stops
+    at the first group whose lengths and all longer ones start nowhere in its front). Each
+    piece gets its own bit range (its end a copy that is never expanded), the pieces with
+    most greedy lines (``rounds_est``) in the lowest bits, so the sets shrink as the short
+    pieces finish.
     Then, vectorised over the shortcuts, a point's predecessor is the smallest start among
     the table shortcuts into it from one level below, else the greedy long shortcut (when
     only that one reaches it from there): the order of the edge-by-edge relaxation
@@ -1164,20 +1189,32 @@ def _dp_levels(
     n = len(pred)
     # the table shortcuts from inside the pieces, one bit set per length
     src = np.zeros(n, dtype=bool)
-    src[gpos[~is_end]] = True
+    inner = np.flatnonzero(~is_end)
+    src[gpos[inner]] = True
     bit_of = np.zeros(n, dtype=np.intp)
-    bit_of[gpos[~is_end]] = np.flatnonzero(~is_end)
+    bit_of[gpos[inner]] = inner
     sel = src[ii]
-    ia = ii[sel]
-    ja = jj[sel]
+    ia, ja = (ii, jj) if sel.all() else (ii[sel], jj[sel])
     tab = np.zeros((width, total), dtype=bool)
-    tab[ja - ia, bit_of[ia]] = True
+    tab.reshape(-1)[(ja - ia) * total + bit_of[ia]] = True
     packed = np.packbits(tab, axis=1, bitorder="little")
+    nb = packed.shape[1]
+    raw = packed.tobytes()
     shifts = [
-        (d, int.from_bytes(packed[d].tobytes(), "little"))
+        (d, b)
         for d in range(1, width)
-        if packed[d].any()
+        if (b := int.from_bytes(raw[d * nb : (d + 1) * nb], "little"))
     ]
+    # the lengths in groups of _SHIFT_GROUP, each with the union of its and all longer
+    # lengths' sets: a round skips the rest once the front has none of those starts
+    groups: list[tuple[int, list[tuple[int, int]]]] = []
+    later = 0
+    for g in range((len(shifts) - 1) // _SHIFT_GROUP * _SHIFT_GROUP, -1, -_SHIFT_GROUP):
+        grp = shifts[g : g + _SHIFT_GROUP]
+        for _, b in grp:
+            later |= b
+        groups.append((later, grp))
+    groups.reverse()
     # greedy long shortcuts inside the pieces, as bits
     pk = np.searchsorted(seg_a, ep, side="right") - 1
     inside = (pk >= 0) & (ep < seg_e[pk.clip(min=0)])
@@ -1191,10 +1228,13 @@ def _dp_levels(
     rounds: list[int] = []
     while front:
         nxt = 0
-        for d, b in shifts:
-            t = front & b
-            if t:
-                nxt |= t << d
+        for later, grp in groups:
+            if not front & later:
+                break
+            for d, b in grp:
+                t = front & b
+                if t:
+                    nxt |= t << d
         if long_bits and front & long_bits:
             for p, e in lpairs:
                 if front >> p & 1:

@@ -385,11 +385,14 @@ def test_block_sweep_decides_as_step_by_step(monkeypatch, eps):
     y = np.ascontiguousarray(pts[:, 1])
     starts = np.arange(0, len(pts), 3)
     out = []
-    for few in (0, 10**9):
+    # one step at a time; the block from the start; steps, then a block once past _SWEEP
+    for few, few_dense in ((0, 0), (10**9, 0), (0, 10**9)):
         monkeypatch.setattr(thin_mod, "_FEW", few)
+        monkeypatch.setattr(thin_mod, "_FEW_DENSE", few_dense)
         fz = np.zeros(len(starts), dtype=bool)
         ok, op, _ = thin_mod._sweep(x, y, pend, eps, starts, 24, fuzzy=fz)
         out.append((ok, op, fz))
-    for a, b in zip(out[0], out[1], strict=True):
-        np.testing.assert_array_equal(a, b)
+    for other in out[1:]:
+        for a, b in zip(out[0], other, strict=True):
+            np.testing.assert_array_equal(a, b)
     assert out[0][0][:, 2:].any()
