@@ -417,8 +417,9 @@ def newton_nearest_many(
 ) -> tuple[np.ndarray, np.ndarray]:
     """Newton on f(u) = B'(u)·(B(u) − p) for every point with its own cubic (``cf`` the
     (4, 2, K) block, see above, or (4, 2, 1) for one cubic), points ``p`` (2, K), u kept in
-    [lo, hi] (default [0, 1]); a step where f' <= 0 is not taken. Returns ``(u, squared
-    distance)``.
+    [lo, hi] (default [0, 1]); where f' <= 0 (the distance is not convex there, Newton
+    would climb) u goes halfway to the end of its bracket that the distance falls
+    towards. Returns ``(u, squared distance)``.
 
     Any returned u gives an upper bound of the true distance (it is the distance to a point
     of the curve), so a test ``dist <= tol`` made with it is never too lenient.
@@ -477,9 +478,16 @@ def _newton_block(
         d1 *= d1
         fp += d1[0]
         fp += d1[1]
-        fp[fp <= 0.0] = np.inf
-        f /= fp
-        u -= f
+        bad = fp <= 0.0
+        if bad.any():  # not a minimum here: halve the way towards the bracket end downhill
+            end = np.where(f < 0.0, hi, lo)[bad]
+            fp[bad] = np.inf
+            f /= fp
+            u -= f
+            u[bad] = 0.5 * (u[bad] + end)
+        else:
+            f /= fp
+            u -= f
         u.clip(lo, hi, out=u)
         uu[1] = u
     _residual(a, b, d, q, uu, r)

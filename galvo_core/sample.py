@@ -791,7 +791,8 @@ def _min_step_filter(pts: np.ndarray, prot: np.ndarray, min_step: float,
     dropped only when the chord j → i + 1 that replaces j → i → i + 1 holds; otherwise j is
     dropped instead when j is unprotected, the chord from the kept mark before j to i
     holds and is long enough; when neither holds i is dropped (the minimum step wins) and
-    i is appended to ``forced``."""
+    i is appended to ``forced``. A protected mark i whose chord from the kept mark before
+    it no longer holds after the marks too close to it were dropped is appended too."""
     n = len(pts)
     if min_step <= 0.0 or n < 3:
         return np.arange(n)
@@ -830,9 +831,14 @@ def _min_step_filter(pts: np.ndarray, prot: np.ndarray, min_step: float,
         if hyp(x[i] - x[j], y[i] - y[j]) >= min_step:
             keep.append(i)
         elif pr[i]:
+            popped = False
             while len(keep) > 1 and not pr[keep[-1]] and hyp(
                     x[i] - x[keep[-1]], y[i] - y[keep[-1]]) < min_step:
                 keep.pop()
+                popped = True
+            if popped and forced is not None and merge_ok is not None \
+                    and not merge_ok(keep[-1], i):
+                forced.append(i)
             keep.append(i)
         elif merge_ok is not None and not merge_ok(j, i + 1):
             k = keep[-2] if len(keep) > 1 else -1

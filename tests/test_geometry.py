@@ -58,6 +58,9 @@ def test_cubic_length_of_straight_cubic():
 @given(ctrl_st, st.lists(st.tuples(coord, coord), min_size=1, max_size=20).map(np.array))
 # a cusp: the nearest point lies in the bracket of a sample farther than the best one
 @example(c=np.array([(0.0, 2.0), (0.0, 0.0), (0.5, -5.0), (0.0, 1.0)]), pts=np.array([[0.0, 0.0]]))
+# a straight cubic whose distance is concave at the best sample (Newton would climb)
+@example(c=np.array([(0.0, 6.103515625e-05), (0.0, 0.0), (0.0, -1.0), (0.0, -1.0)]),
+         pts=np.array([[0.0, 0.0]]))
 def test_nearest_on_cubic_is_the_true_nearest(c, pts):
     """Agrees with brute force over 200k samples (loops and cusps included)."""
     t, d = nearest_on_cubic(c, pts)

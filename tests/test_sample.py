@@ -8,7 +8,7 @@ import math
 import numpy as np
 import pytest
 from _util import SAMPLES, circle_plt
-from hypothesis import HealthCheck, assume, given, settings
+from hypothesis import HealthCheck, assume, example, given, settings
 from hypothesis import strategies as st
 
 from galvo_core.errors import ParamError
@@ -74,6 +74,8 @@ coord = st.floats(-3000, 3000, allow_nan=False)
 @settings(max_examples=60, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 @given(ctrl=st.lists(st.tuples(coord, coord), min_size=4, max_size=4),
        tol=st.sampled_from([0.25, 1.0, 3.0]))
+# a cusp folded back on itself (found by hypothesis)
+@example(ctrl=[(0.0, 0.0), (0.0, 21.0), (0.0, 0.0), (2.0, 0.0)], tol=0.25)
 def test_chord_height_within_bound_on_random_cubics(ctrl, tol):
     c = np.asarray(ctrl, float) + 5000.0
     assume(np.ptp(c, axis=0).max() > 20.0)
