@@ -399,22 +399,27 @@ def _check(drawing: Drawing, kerf_mm: float, side: str, method: str, fm: FieldMa
 # --------------------------------------------------------------------------- inputs
 def _split(drawing: Drawing) -> tuple[list[int], set[int]]:
     """Indices of closed rings that enclose area, and of everything else."""
-    rings: list[int] = []
-    other: set[int] = set()
-    for i, p in enumerate(drawing.paths):
-        pts = p.points
-        if p.closed and len(pts) >= 4 and _has_area(pts):
-            rings.append(i)
-        else:
-            other.add(i)
-    return rings, other
+    cand = [i for i, p in enumerate(drawing.paths) if p.closed and len(p.points) >= 4]
+    area = _have_area([drawing.paths[i].points for i in cand]) if cand else np.zeros(0, bool)
+    rings = [i for i, a in zip(cand, area.tolist(), strict=True) if a]
+    return rings, set(range(len(drawing.paths))) - set(rings)
 
 
-def _has_area(pts: np.ndarray) -> bool:
-    """False when all points lie on one line (a ring that encloses nothing)."""
-    v = pts - pts[0]
-    far = v[int(np.argmax((v * v).sum(axis=1)))]
-    return bool(np.any(np.abs(v[:, 0] * far[1] - v[:, 1] * far[0]) > 0))
+def _have_area(rings: list[np.ndarray]) -> np.ndarray:
+    """Per ring, False when all its points lie on one line (a ring that encloses nothing):
+    every point's cross product with the point farthest from the first (the first such)
+    is zero."""
+    sizes = np.array([len(r) for r in rings])
+    start = np.cumsum(sizes) - sizes
+    owner = np.repeat(np.arange(len(rings)), sizes)
+    pts = np.concatenate(rings).astype(np.float64, copy=False)
+    v = pts - pts[start][owner]
+    n2 = (v * v).sum(axis=1)
+    # the first farthest point of each ring: the last of its ring in this order
+    order = np.lexsort((-np.arange(len(pts)), n2, owner))
+    far = v[order[start + sizes - 1]][owner]
+    cross = np.abs(v[:, 0] * far[:, 1] - v[:, 1] * far[:, 0]) > 0
+    return np.logical_or.reduceat(cross, start)
 
 
 def _by_pen(drawing: Drawing, rings: list[int]) -> dict[int, list[int]]:
@@ -431,7 +436,7 @@ def _signed_area(pts: np.ndarray) -> float:
 
 def _closed(pts: np.ndarray) -> np.ndarray:
     pts = np.asarray(pts, dtype=np.float64)
-    if len(pts) and not np.array_equal(pts[0], pts[-1]):
+    if len(pts) and (pts[0] != pts[-1]).any():
         pts = np.vstack([pts, pts[:1]])
     return pts
 
@@ -606,12 +611,12 @@ def _crossings(pts: np.ndarray, a: np.ndarray, b: np.ndarray) -> np.ndarray:
 
 def _polygonal(geom: BaseGeometry) -> BaseGeometry:
     """Keep only the polygons of a geometry (GEOS may return collections)."""
-    parts = [g for g in shapely.get_parts(geom)
-             if g.geom_type in ("Polygon", "MultiPolygon") and not g.is_empty]
-    polys = [q for g in parts for q in shapely.get_parts(g)]
-    if not polys:
+    parts = shapely.get_parts(shapely.get_parts(geom))  # a collection's multis flattened too
+    polys = parts[(shapely.get_type_id(parts) == shapely.GeometryType.POLYGON)
+                  & ~shapely.is_empty(parts)]
+    if not len(polys):
         return shapely.Polygon()
-    return shapely.MultiPolygon(polys) if len(polys) > 1 else polys[0]
+    return shapely.multipolygons(polys) if len(polys) > 1 else polys[0]
 
 
 # --------------------------------------------------------------------------- methods
