@@ -220,7 +220,7 @@ def nearest_on_cubic_each(
         cq = c[pid]
     pt = p.T
     for m in range(_NEAREST_CANDIDATES):
-        u = newton_nearest_many(cf, pt, u0[m], iters, lo=lo[m], hi=hi[m])[0]
+        u = newton_nearest_many(cf, pt, u0[m], iters, lo=lo[m], hi=hi[m], downhill=True)[0]
         r = _bernstein_each(cq, u) - p
         dn = r[:, 0] * r[:, 0] + r[:, 1] * r[:, 1]
         better = ok[m] & (dn < best_d2)
@@ -414,19 +414,21 @@ def newton_nearest_many(
     *,
     lo: np.ndarray | float = 0.0,
     hi: np.ndarray | float = 1.0,
+    downhill: bool = False,
 ) -> tuple[np.ndarray, np.ndarray]:
     """Newton on f(u) = B'(u)·(B(u) − p) for every point with its own cubic (``cf`` the
     (4, 2, K) block, see above, or (4, 2, 1) for one cubic), points ``p`` (2, K), u kept in
-    [lo, hi] (default [0, 1]); where f' <= 0 (the distance is not convex there, Newton
-    would climb) u goes halfway to the end of its bracket that the distance falls
-    towards. Returns ``(u, squared distance)``.
+    [lo, hi] (default [0, 1]). Where f' <= 0 (the distance is not convex there, Newton
+    would climb) no step is taken, or, with ``downhill`` (for narrow brackets around a
+    sample), u goes halfway to the end of its bracket that the distance falls towards.
+    Returns ``(u, squared distance)``.
 
     Any returned u gives an upper bound of the true distance (it is the distance to a point
     of the curve), so a test ``dist <= tol`` made with it is never too lenient.
     """
     k = len(u)
     if k <= _NEWTON_BLOCK:
-        return _newton_block(cf, p, u, iters, lo, hi)
+        return _newton_block(cf, p, u, iters, lo, hi, downhill)
     u_out = np.empty(k)
     d2_out = np.empty(k)
     for c in range(0, k, _NEWTON_BLOCK):
@@ -438,6 +440,7 @@ def newton_nearest_many(
             iters,
             lo[s] if isinstance(lo, np.ndarray) else lo,
             hi[s] if isinstance(hi, np.ndarray) else hi,
+            downhill,
         )
     return u_out, d2_out
 
@@ -449,6 +452,7 @@ def _newton_block(
     iters: int,
     lo: np.ndarray | float,
     hi: np.ndarray | float,
+    downhill: bool,
 ) -> tuple[np.ndarray, np.ndarray]:
     """:func:`newton_nearest_many` on one block: x and y as the rows of (2, K) arrays, u
     in both rows (so no operation broadcasts), in place."""
@@ -479,13 +483,14 @@ def _newton_block(
         fp += d1[0]
         fp += d1[1]
         bad = fp <= 0.0
-        if bad.any():  # not a minimum here: halve the way towards the bracket end downhill
+        if downhill and bad.any():  # not convex here: halve the way to the end downhill
             end = np.where(f < 0.0, hi, lo)[bad]
             fp[bad] = np.inf
             f /= fp
             u -= f
             u[bad] = 0.5 * (u[bad] + end)
         else:
+            fp[bad] = np.inf
             f /= fp
             u -= f
         u.clip(lo, hi, out=u)
