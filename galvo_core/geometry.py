@@ -483,16 +483,14 @@ def _newton_block(
         fp += d1[0]
         fp += d1[1]
         bad = fp <= 0.0
-        if downhill and bad.any():  # not convex here: halve the way to the end downhill
+        halve = downhill and bool(bad.any())
+        if halve:  # not convex here: halve the way to the bracket end downhill
             end = np.where(f < 0.0, hi, lo)[bad]
-            fp[bad] = np.inf
-            f /= fp
-            u -= f
+        fp[bad] = np.inf
+        f /= fp
+        u -= f
+        if halve:
             u[bad] = 0.5 * (u[bad] + end)
-        else:
-            fp[bad] = np.inf
-            f /= fp
-            u -= f
         u.clip(lo, hi, out=u)
         uu[1] = u
     _residual(a, b, d, q, uu, r)
