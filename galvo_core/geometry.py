@@ -9,13 +9,15 @@ Conventions
 * Curve parameters ``t`` / ``u`` are in [0, 1].
 * Point sets are arrays of shape (K, 2).
 
-Nothing here loops over points in Python: the work is done on whole arrays, chunked where a
+Nothing here loops over points in Python: the work is done on whole arrays (the Newton
+refinement of nearest points in a compiled loop, numba), chunked where a
 pairwise table could otherwise grow large.
 """
 
 from __future__ import annotations
 
 import numpy as np
+from numba import njit
 
 __all__ = [
     "cubic_eval",
@@ -454,60 +456,74 @@ def _newton_block(
     hi: np.ndarray | float,
     downhill: bool,
 ) -> tuple[np.ndarray, np.ndarray]:
-    """:func:`newton_nearest_many` on one block: x and y as the rows of (2, K) arrays, u
-    in both rows (so no operation broadcasts), in place."""
-    a, b, d, e = cf
-    q = p - e
-    a3 = 3.0 * a
-    b2 = 2.0 * b
-    a6 = 6.0 * a
-    uu = np.empty(q.shape)
-    uu[:] = u
-    u = uu[0]
-    r = np.empty(q.shape)
-    d1 = np.empty(q.shape)
-    g = np.empty(q.shape)
-    for _ in range(iters):
-        _residual(a, b, d, q, uu, r)  # B(u) - p
-        np.multiply(a3, uu, out=d1)  # B'(u) = (3a u + 2b) u + d
-        d1 += b2
-        d1 *= uu
-        d1 += d
-        np.multiply(d1, r, out=g)  # f = B'·(B - p)
-        f = g[0] + g[1]
-        np.multiply(a6, uu, out=g)  # f' = (6a u + 2b)·(B - p) + |B'|^2
-        g += b2
-        g *= r
-        fp = g[0] + g[1]
-        d1 *= d1
-        fp += d1[0]
-        fp += d1[1]
-        bad = fp <= 0.0
-        halve = downhill and bool(bad.any())
-        if halve:  # not convex here: halve the way to the bracket end downhill
-            end = np.where(f < 0.0, hi, lo)[bad]
-        fp[bad] = np.inf
-        f /= fp
-        u -= f
-        if halve:
-            u[bad] = 0.5 * (u[bad] + end)
-        u.clip(lo, hi, out=u)
-        uu[1] = u
-    _residual(a, b, d, q, uu, r)
-    r *= r
-    return u.copy(), r[0] + r[1]
+    """:func:`newton_nearest_many` on one block (compiled, :func:`_newton_kernel`)."""
+    k = len(u)
+    u_out = np.array(u, dtype=np.float64)  # (a copy: the caller's u is not changed)
+    d2 = np.empty(k)
+    lo_a = np.ascontiguousarray(lo, dtype=np.float64).reshape(-1)
+    hi_a = np.ascontiguousarray(hi, dtype=np.float64).reshape(-1)
+    _newton_kernel(
+        np.ascontiguousarray(cf, dtype=np.float64),
+        np.ascontiguousarray(p, dtype=np.float64),
+        u_out,
+        d2,
+        iters,
+        lo_a,
+        hi_a,
+        downhill,
+    )
+    return u_out, d2
 
 
-def _residual(
-    a: np.ndarray, b: np.ndarray, d: np.ndarray, q: np.ndarray, u: np.ndarray, out: np.ndarray
-) -> None:
-    """``out`` = ((a u + b) u + d) u − q, element-wise in place."""
-    np.multiply(a, u, out=out)
-    out += b
-    out *= u
-    out += d
-    out *= u
-    out -= q
+@njit(cache=True, nogil=True)
+def _newton_kernel(cf, p, u, d2, iters, lo, hi, downhill):  # type: ignore[no-untyped-def]
+    """Newton on f(u) = B'(u)·(B(u) − p) per point, in place on ``u``; ``d2`` gets the
+    squared distances at the final u. ``cf`` (4, 2, K) or (4, 2, 1); ``lo``, ``hi`` of
+    length K or 1. (Scalar IEEE arithmetic in the order of the former numpy version, so the
+    results are the same bit for bit.)"""
+    k_n = u.shape[0]
+    one_c = cf.shape[2] == 1
+    one_lo = lo.shape[0] == 1
+    one_hi = hi.shape[0] == 1
+    for k in range(k_n):
+        c = 0 if one_c else k
+        ax = cf[0, 0, c]
+        ay = cf[0, 1, c]
+        bx = cf[1, 0, c]
+        by = cf[1, 1, c]
+        dx = cf[2, 0, c]
+        dy = cf[2, 1, c]
+        qx = p[0, k] - cf[3, 0, c]
+        qy = p[1, k] - cf[3, 1, c]
+        a3x = 3.0 * ax
+        a3y = 3.0 * ay
+        b2x = 2.0 * bx
+        b2y = 2.0 * by
+        a6x = 6.0 * ax
+        a6y = 6.0 * ay
+        lo_k = lo[0] if one_lo else lo[k]
+        hi_k = hi[0] if one_hi else hi[k]
+        uk = u[k]
+        for _ in range(iters):
+            rx = ((ax * uk + bx) * uk + dx) * uk - qx  # B(u) - p
+            ry = ((ay * uk + by) * uk + dy) * uk - qy
+            d1x = (a3x * uk + b2x) * uk + dx  # B'(u)
+            d1y = (a3y * uk + b2y) * uk + dy
+            f = d1x * rx + d1y * ry  # f = B'·(B - p)
+            fp = (a6x * uk + b2x) * rx + (a6y * uk + b2y) * ry  # f' = B''·(B - p) + |B'|^2
+            fp += d1x * d1x
+            fp += d1y * d1y
+            if fp <= 0.0:  # not convex here: no step, or halve the way downhill
+                if downhill:
+                    end = hi_k if f < 0.0 else lo_k
+                    uk = 0.5 * (uk + end)
+            else:
+                uk -= f / fp
+            uk = min(max(uk, lo_k), hi_k)
+        rx = ((ax * uk + bx) * uk + dx) * uk - qx
+        ry = ((ay * uk + by) * uk + dy) * uk - qy
+        u[k] = uk
+        d2[k] = rx * rx + ry * ry
 
 
 def nearest_on_cubics(
