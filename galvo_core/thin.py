@@ -106,38 +106,29 @@ def thin(points: object, eps_line: float, *, closed: bool = False) -> np.ndarray
 def thin_many(paths: Sequence[object], eps_line: float) -> list[np.ndarray]:
     """:func:`thin` for many paths in one go (the same result as one call per path).
 
-    All paths are deduplicated and concatenated, then thinned by one compiled call.
+    All paths are concatenated, then deduplicated and thinned by one compiled call.
     """
     eps = check_positive("eps_line", eps_line)
     arrs = [np.asarray(p, dtype=np.float64).reshape(-1, 2) for p in paths]
     if not arrs:
         return []
-    lens0 = np.array([len(p) for p in arrs], dtype=np.intp)
-    o0 = np.concatenate(([0], np.cumsum(lens0)))
+    lens0 = np.array([len(p) for p in arrs], dtype=np.int64)
+    o0 = np.zeros(len(arrs) + 1, dtype=np.int64)
+    np.cumsum(lens0, out=o0[1:])
     pts = np.concatenate(arrs) if len(arrs) > 1 else arrs[0]
-    # duplicates: a point equal to its predecessor in the same path is dropped
-    keep = np.ones(len(pts), dtype=bool)
-    if len(pts) > 1:
-        # (two column compares: np.any along a length-2 axis is far slower)
-        keep[1:] = (pts[1:, 0] != pts[:-1, 0]) | (pts[1:, 1] != pts[:-1, 1])
-    keep[o0[:-1][lens0 > 0]] = True
-    kidx = np.flatnonzero(keep)  # original (concatenated) index of every distinct point
-    ck = np.searchsorted(kidx, o0)  # first distinct point of each path
-    q = pts[kidx]
-    sel = _thin_all(
-        np.ascontiguousarray(q[:, 0]),
-        np.ascontiguousarray(q[:, 1]),
-        ck.astype(np.int64),
+    kept, cnt = _thin_paths(
+        np.ascontiguousarray(pts[:, 0]),
+        np.ascontiguousarray(pts[:, 1]),
+        o0,
         eps,
         _DP_RATIO,
         _DP_WINDOW,
         _SLACK,
     )
-    kept = kidx[sel]
-    cut = np.searchsorted(kept, o0)
-    got = kept - np.repeat(o0[:-1], np.diff(cut))
-    cl = cut.tolist()
-    return [got[c0:c1] for c0, c1 in zip(cl[:-1], cl[1:], strict=True)]
+    if len(arrs) == 1:
+        return [kept]
+    cl = [0, *np.cumsum(cnt).tolist()]
+    return [kept[c0:c1] for c0, c1 in zip(cl[:-1], cl[1:], strict=True)]
 
 
 def warm_up() -> None:
@@ -260,6 +251,41 @@ def _reach(x, y, i, end, eps, slack, cand, sure, rr):  # type: ignore[no-untyped
         if sure[c] == 2 or _serves(x, y, i, j, e2, rr, sure[c] == 1):
             return j
     return i + 1
+
+
+@njit(cache=True, nogil=True)
+def _thin_paths(x0, y0, o0, eps, dp_ratio, window, slack):  # type: ignore[no-untyped-def]
+    """Every path [o0[p], o0[p + 1]) of the points x0, y0: duplicates dropped (a point equal
+    to its predecessor in the same path), thinned. Returns the kept indices into each path's
+    own points, concatenated, and how many each path keeps."""
+    n0 = x0.shape[0]
+    n_p = o0.shape[0] - 1
+    kidx = np.empty(n0, dtype=np.int64)  # original index of every distinct point
+    offs = np.empty(n_p + 1, dtype=np.int64)  # first distinct point of each path
+    m = 0
+    for p in range(n_p):
+        offs[p] = m
+        for k in range(o0[p], o0[p + 1]):
+            if k == o0[p] or x0[k] != x0[k - 1] or y0[k] != y0[k - 1]:
+                kidx[m] = k
+                m += 1
+    offs[n_p] = m
+    x = np.empty(m)
+    y = np.empty(m)
+    for k in range(m):
+        x[k] = x0[kidx[k]]
+        y[k] = y0[kidx[k]]
+    keep = _thin_all(x, y, offs, eps, dp_ratio, window, slack)
+    kept = np.empty(m, dtype=np.int64)
+    cnt = np.zeros(n_p, dtype=np.int64)
+    nk = 0
+    for p in range(n_p):
+        for k in range(offs[p], offs[p + 1]):
+            if keep[k]:
+                kept[nk] = kidx[k] - o0[p]
+                nk += 1
+                cnt[p] += 1
+    return kept[:nk], cnt
 
 
 @njit(cache=True, nogil=True)
