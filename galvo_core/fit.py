@@ -72,7 +72,7 @@ from galvo_core.geometry import (
     power_coeffs_many,
 )
 from galvo_core.runs import segmented_cumsum, split_pieces_many
-from galvo_core.thin import check_positive, thin_many, warm_up
+from galvo_core.thin import check_positive, thin_many
 
 __all__ = [
     "DEFAULT_EPS_LINE",
@@ -804,6 +804,13 @@ def fit_drawing(
 
 class FitCancelled(Exception):
     """Raised by :func:`fit_drawing` when its ``cancel`` callback says stop."""
+
+
+def warm_up() -> None:
+    """Load (or, the first time on a machine, compile) the fitter's compiled kernels (the
+    thinning, the Newton refinement) now, so that a timed first fit does not pay for it."""
+    t = np.linspace(0.0, 2.0 * np.pi, 97)
+    fit_paths([np.c_[40.0 * np.cos(t), 25.0 * np.sin(t)]], [True])
 
 
 def fit_report(

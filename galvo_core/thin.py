@@ -49,7 +49,7 @@ from numba import njit
 
 from galvo_core.errors import ParamError
 
-__all__ = ["thin", "thin_many", "dedup_indices", "check_positive", "warm_up"]
+__all__ = ["thin", "thin_many", "dedup_indices", "check_positive"]
 
 #: below this many points per kept line the greedy result is improved by the window DP
 _DP_RATIO = 16
@@ -129,13 +129,6 @@ def thin_many(paths: Sequence[object], eps_line: float) -> list[np.ndarray]:
         return [kept]
     cl = [0, *np.cumsum(cnt).tolist()]
     return [kept[c0:c1] for c0, c1 in zip(cl[:-1], cl[1:], strict=True)]
-
-
-def warm_up() -> None:
-    """Load (or, the first time on a machine, compile) the compiled kernels now, so that a
-    timed or interactive first call does not pay for it."""
-    t = np.linspace(0.0, 3.0, 40)
-    thin_many([np.c_[t, np.round(np.sin(t) * 4.0)]], 0.5)
 
 
 # --- compiled kernels -------------------------------------------------------------------
