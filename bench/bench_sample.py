@@ -315,7 +315,8 @@ def main() -> int:
     load = os.getloadavg()[0] if hasattr(os, "getloadavg") else float("nan")
     lines = [HEAD, ""]
     lines.append(
-        f"Date 2026-11-23. Machine: {platform.machine()} {cpu}, {os.cpu_count()} CPUs "
+        f"Date {time.strftime('%Y-%m-%d', time.gmtime())}. Machine: {platform.machine()} {cpu}, "
+        f"{os.cpu_count()} CPUs "
         f"(load average {load:.1f} at the start: other sessions share it, so times are "
         f"noisy), Python {platform.python_version()}, numpy {np.__version__}. Command: "
         "`bash bench/run_sample.sh`. Method: paper 004's step search in the curve "
