@@ -20,3 +20,6 @@ if [ ! -f "$stamp" ]; then
   rm -f .venv/.installed-*
   touch "$stamp"
 fi
+# build the compiled kernels (numba, cached in galvo_core/__pycache__) now rather than on the
+# first fit; a no-op when the cache is current
+.venv/bin/python -c "from galvo_core.fit import warm_up; warm_up()" >&2
