@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Fill and order benchmarks (issue 7): makes bench/.venv-fill (numpy, shapely, vpype, elkai,
+# Fill and order benchmarks (issue 7): makes bench/.venv-fill (numpy, shapely, numba, vpype, elkai,
 # meerk40t if installable) and runs bench/bench_fill.py and bench/bench_order.py.
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -7,7 +7,7 @@ VENV=bench/.venv-fill
 if [ ! -x "$VENV/bin/python" ]; then
     python3 -m venv "$VENV"
 fi
-"$VENV/bin/pip" install -q numpy "shapely>=2.0" vpype elkai
+"$VENV/bin/pip" install -q numpy "shapely>=2.0" "numba>=0.60" vpype elkai
 "$VENV/bin/pip" install -q meerk40t || echo "meerk40t is not installable here; compared without it"
 echo "## fill"
 "$VENV/bin/python" bench/bench_fill.py

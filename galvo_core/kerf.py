@@ -91,6 +91,7 @@ from galvo_core.drawing import Drawing, Path, Warning
 from galvo_core.errors import ParamError
 from galvo_core.field import FieldMap
 from galvo_core.geometry import point_segment_distance
+from galvo_core.offset_arcs import two_sided_arcs
 from galvo_core.params import KERF_METHODS, KERF_SIDES
 
 #: default raster size limit (pixels) and largest disc radius (pixels) for ``raster``
@@ -228,7 +229,8 @@ def reduce_tol_for(d: float, tol: float) -> float:
     return max(0.0, tol - arc_sagitta(d, quad_segs_for(d, tol)))
 
 
-def reduce_vertices(geom: BaseGeometry, eps: float) -> BaseGeometry:
+def reduce_vertices(geom: BaseGeometry, eps: float, keep: np.ndarray | None = None
+                    ) -> BaseGeometry:
     """``geom`` (a valid (Multi)Polygon) with fewer vertices, each ring moved by at most
     ``eps`` (symmetric Hausdorff distance between the old and the new ring).
 
@@ -244,7 +246,8 @@ def reduce_vertices(geom: BaseGeometry, eps: float) -> BaseGeometry:
     no repair of the whole geometry), for a polygon that comes out invalid from GEOS's
     topology-preserving variant on that polygon (its rings cannot cross or collapse). Each
     ring's first vertex is kept: GEOS drops a ring's end point by looking at that vertex
-    alone, which can leave vertices dropped before it beyond ``eps``."""
+    alone, which can leave vertices dropped before it beyond ``eps``. Vertices at the
+    coordinates ``keep`` (K, 2) are never dropped."""
     if eps <= 0 or geom.is_empty:
         return geom
     parts = shapely.get_parts(geom)
@@ -252,7 +255,9 @@ def reduce_vertices(geom: BaseGeometry, eps: float) -> BaseGeometry:
     owner = np.repeat(np.arange(len(parts)), n_holes + 1)  # part of each ring
     rings = shapely.get_rings(parts)
     xy, ring = shapely.get_coordinates(rings, return_index=True)
-    kept = _kept_of(xy, ring, shapely.simplify(rings, eps, preserve_topology=False), eps)
+    fixed = _at(xy, keep)
+    kept = _kept_of(xy, ring, shapely.simplify(rings, eps, preserve_topology=False), eps,
+                    fixed)
     polys = _polys_of(xy, ring, kept, owner)
     bad = np.flatnonzero(~shapely.is_valid(polys))
     if len(bad):
@@ -264,7 +269,8 @@ def reduce_vertices(geom: BaseGeometry, eps: float) -> BaseGeometry:
             tps_rings = None
         if tps_rings is not None and np.all(shapely.get_type_id(tps) == 3) and np.array_equal(
                 shapely.get_num_interior_rings(tps), n_holes[bad]):
-            sub = _kept_of(xy[on], np.unique(ring[on], return_inverse=True)[1], tps_rings, eps)
+            sub = _kept_of(xy[on], np.unique(ring[on], return_inverse=True)[1], tps_rings, eps,
+                           fixed[on] if fixed is not None else None)
             kept[on] = sub
         else:
             kept[on] = True
@@ -287,8 +293,15 @@ def reduce_vertices(geom: BaseGeometry, eps: float) -> BaseGeometry:
     return out
 
 
-def _kept_of(xy: np.ndarray, ring: np.ndarray, simplified: np.ndarray, eps: float
-             ) -> np.ndarray:
+def _at(xy: np.ndarray, pts: np.ndarray | None) -> np.ndarray | None:
+    """Mask of the rows of ``xy`` equal to some row of ``pts`` (None when there are none)."""
+    if pts is None or not len(pts):
+        return None
+    return np.isin(xy[:, 0] + 1j * xy[:, 1], pts[:, 0] + 1j * pts[:, 1])
+
+
+def _kept_of(xy: np.ndarray, ring: np.ndarray, simplified: np.ndarray, eps: float,
+             fixed: np.ndarray | None = None) -> np.ndarray:
     """Mask of the vertices ``xy`` (ring numbers ``ring``, 0..R-1, rows in ring order, each
     ring closed) that the simplified rings (an array of R geometries) kept, plus each
     ring's first and closing vertex. A ring is kept whole when fewer than 4 of its
@@ -309,6 +322,8 @@ def _kept_of(xy: np.ndarray, ring: np.ndarray, simplified: np.ndarray, eps: floa
     starts = np.flatnonzero(np.diff(ring, prepend=-1))
     kept[starts] = True  # each ring's first vertex ...
     kept[np.append(starts[1:] - 1, len(xy) - 1)] = True  # ... and its closing copy
+    if fixed is not None:
+        kept |= fixed
     n_rings = int(ring[-1]) + 1 if len(ring) else 0
     whole = np.bincount(ring[kept], minlength=n_rings) < 4
     whole[_far_rings(xy, ring, kept, eps, n_rings)] = True
@@ -657,7 +672,10 @@ def _vector(region: BaseGeometry, d: float, side: str, tol: float) -> BaseGeomet
     if not polys:
         return shapely.Polygon()
     out = polys[0] if len(polys) == 1 else shapely.MultiPolygon(polys)
-    return reduce_vertices(out, reduce_tol_for(d, tol))
+    # round joins redrawn with the error on both sides of the arc (fewer vertices), kept
+    # as they are by the thinning, which has the rest of the outline
+    out, joins = two_sided_arcs(out, d, tol)
+    return reduce_vertices(out, reduce_tol_for(d, tol), keep=joins)
 
 
 def _grown_groups(grown: np.ndarray) -> list[BaseGeometry]:

@@ -9,13 +9,13 @@ circle of radius d - tol, which allows chords of up to ``2 acos((d - tol) / (d +
 3 chords for that join (what Clipper2 draws there, at 1.0009 tol). Every point of the new
 join stays within ``tol`` of the true arc.
 
-:func:`two_sided_arcs` finds the joins in an outline (runs of at least three consecutive
-vertices on one circle of radius ``d`` around an input vertex, turning one way), keeps
-each run's end vertices (where the straight offset edges attach) and replaces its inner
-vertices when that saves at least one. A polygon whose new rings are not valid keeps its
-old rings. It works on GEOS's outline before any thinning (where each join still ends on
-its tangent points) and says which vertices a thinning must keep. Input units throughout
-(the caller's arc tolerance converted from bits).
+:func:`two_sided_arcs` finds the joins in an outline (runs of vertices on one circle of
+radius ``d``, turning one way), keeps each run's end vertices (where the straight offset
+edges attach) and replaces its inner vertices when that saves at least one. A polygon
+whose new rings are not valid keeps its old rings. It works on GEOS's outline before any
+thinning (where each join still ends on its tangent points) and says which vertices a
+thinning must keep. Input units throughout (the caller's arc tolerance converted from
+bits).
 """
 
 from __future__ import annotations
@@ -28,8 +28,12 @@ from shapely.geometry.base import BaseGeometry
 
 __all__ = ["two_sided_arcs", "join_vertices"]
 
-#: a vertex is on the circle of radius d around C when | |v - C| - d | <= this * d
-_ON_CIRCLE = 1e-9
+#: an inner join vertex: the circle through it and its neighbours has radius d within
+#: this * d (GEOS's arc vertices are on the circle to rounding; the circle through three of
+#: them is found to about 1e-16 d / (chord angle)^2)
+_ON_CIRCLE = 1e-7
+#: neighbouring inner vertices of one join: their circles' centres within this * d
+_SAME_CENTRE = 1e-6
 #: radii tried for the inner vertices, as fractions of tol above d
 _RADII = np.linspace(1.0 - 1e-9, 0.0, 41)
 
@@ -39,144 +43,164 @@ def join_vertices(d: float, tol: float, phi: float) -> tuple[int, float] | None:
     equally spaced in angle) that draw a join of angle ``phi`` (radians, 0 < phi < 2 pi)
     and radius ``d`` from its end points on the circle within ``tol`` of the arc on both
     sides; ``None`` when tol >= d (no room) or nothing beats the one-sided count."""
-    if not (0.0 < tol < d) or not (0.0 < phi < 2.0 * math.pi):
-        return None
-    one_sided = math.ceil(phi / (2.0 * math.acos(1.0 - tol / d)) - 1e-12)
-    k0 = max(1, math.ceil(phi / (2.0 * math.acos((d - tol) / (d + tol))) - 1e-12))
-    for k in range(k0, one_sided):
-        a = phi / k
-        for f in _RADII:
-            r = d + f * tol
-            if k > 1 and r * math.cos(a / 2.0) < d - tol:
-                continue  # an inner chord dips below d - tol
-            if k == 1:
-                if d * math.cos(a / 2.0) >= d - tol:
-                    return 1, d
-                break
-            # end chord from (d, 0) to (r cos a, r sin a): its closest point to C
-            ex = r * math.cos(a) - d
-            ey = r * math.sin(a)
-            t = min(1.0, max(0.0, -d * ex / (ex * ex + ey * ey)))
-            px = d + t * ex
-            py = t * ey
-            if math.hypot(px, py) >= d - tol:
-                return k, r
-    return None
+    k, r = join_plan(d, tol, np.array([phi], dtype=np.float64))
+    return (int(k[0]), float(r[0])) if k[0] else None
 
 
-def two_sided_arcs(
-    geom: BaseGeometry, centres: np.ndarray, d: float, tol: float
-) -> tuple[BaseGeometry, np.ndarray]:
+def join_plan(d: float, tol: float, phi: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`join_vertices` for many join angles at once: ``(k, R)`` per angle, k = 0
+    where nothing beats the one-sided count (or tol >= d)."""
+    phi = np.asarray(phi, dtype=np.float64)
+    k_out = np.zeros(len(phi), dtype=np.int64)
+    r_out = np.zeros(len(phi))
+    if not (0.0 < tol < d) or not len(phi):
+        return k_out, r_out
+    ok_phi = (phi > 0.0) & (phi < 2.0 * math.pi)
+    one_sided = np.ceil(phi / (2.0 * math.acos(1.0 - tol / d)) - 1e-12)
+    k0 = np.maximum(2.0, np.ceil(phi / (2.0 * math.acos((d - tol) / (d + tol))) - 1e-12))
+    r = d + _RADII * tol  # (F,), largest first
+    for extra in range(3):
+        k = k0 + extra
+        todo = ok_phi & (k_out == 0) & (k < one_sided)
+        if not todo.any():
+            break
+        a = (phi[todo] / k[todo])[:, None]  # (n, 1)
+        inner = r * np.cos(a / 2.0) >= d - tol  # no inner chord dips below d - tol
+        # end chord from (d, 0) to (r cos a, r sin a): its point closest to the centre
+        ex = r * np.cos(a) - d
+        ey = r * np.sin(a)
+        t = np.clip(-d * ex / (ex * ex + ey * ey), 0.0, 1.0)
+        good = inner & (np.hypot(d + t * ex, t * ey) >= d - tol)
+        hit = good.any(axis=1)
+        idx = np.flatnonzero(todo)[hit]
+        k_out[idx] = k[idx].astype(np.int64)
+        r_out[idx] = r[np.argmax(good[hit], axis=1)]
+    return k_out, r_out
+
+
+def two_sided_arcs(geom: BaseGeometry, d: float, tol: float) -> tuple[BaseGeometry, np.ndarray]:
     """``geom`` (valid (Multi)Polygon: GEOS's offset by ``d``, round joins, before any
-    thinning, of a region whose vertices are ``centres`` (M, 2)) with its round joins
-    redrawn by :func:`join_vertices`, and the (K, 2) vertices of the redrawn joins (their
-    ends included), which a later thinning must keep: the joins already use the whole
-    tolerance. Rings, polygons and their order are kept; a polygon that would come out
-    invalid is kept as it was."""
+    thinning) with its round joins redrawn by :func:`join_plan`, and the (K, 2) vertices
+    of the redrawn joins (their ends included), which a later thinning must keep: the
+    joins already use the whole tolerance. Rings, polygons and their order are kept; a
+    polygon that would come out invalid is kept as it was. Vectorised over all rings.
+
+    A join is found from the outline alone: its inner vertices are those whose circle
+    through them and their two neighbours has radius d (GEOS puts every arc vertex on the
+    circle), with one centre along the run."""
     none = np.zeros((0, 2))
-    if geom.is_empty or not (0.0 < tol < d) or len(centres) == 0:
+    if geom.is_empty or not (0.0 < tol < d):
         return geom, none
     parts = shapely.get_parts(geom)
     n_holes = shapely.get_num_interior_rings(parts)
-    owner = np.repeat(np.arange(len(parts)), n_holes + 1)
-    rings = shapely.get_rings(parts)
-    xy, ring = shapely.get_coordinates(rings, return_index=True)
-    tree = shapely.STRtree(shapely.points(centres))
-    near, dist = tree.query_nearest(
-        shapely.points(xy), return_distance=True, all_matches=False
-    )
-    cen = np.full(len(xy), -1, dtype=np.int64)
-    cen[near[0]] = near[1]
-    dd = np.full(len(xy), np.inf)
-    dd[near[0]] = dist
-    on = np.abs(dd - d) <= _ON_CIRCLE * d
-    starts = np.flatnonzero(np.diff(ring, prepend=-1))
-    ends = np.append(starts[1:], len(xy))
-    new_rings: list[np.ndarray] = []
-    fixed: list[list[np.ndarray]] = []
+    owner = np.repeat(np.arange(len(parts)), n_holes + 1)  # polygon of each ring
+    xy_c, ring_c = shapely.get_coordinates(shapely.get_rings(parts), return_index=True)
+    # distinct vertices of each ring (drop the closing copy)
+    last = np.append(ring_c[1:] != ring_c[:-1], True)
+    xy = xy_c[~last]
+    ring = ring_c[~last]
+    n_r = len(owner)
+    size = np.bincount(ring, minlength=n_r)
+    start = np.concatenate(([0], np.cumsum(size)[:-1]))
+    pos = np.arange(len(xy)) - start[ring]
+    prev = start[ring] + (pos - 1) % size[ring]
+    nxt = start[ring] + (pos + 1) % size[ring]
+    cc, rad = _circumcircles(xy[prev], xy, xy[nxt])
+    inner = (np.abs(rad - d) <= _ON_CIRCLE * d) & (size[ring] >= 4)
+    # "same": the edge from a vertex's predecessor to it is a chord of one join
+    with np.errstate(invalid="ignore"):  # (collinear triples: no finite centre)
+        near_c = np.hypot(*(cc - cc[prev]).T) <= _SAME_CENTRE * d
+    same = (inner | inner[prev]) & ~(inner & inner[prev] & ~near_c)
+    # rotate every ring to begin at a vertex that starts a run (rings that are one whole
+    # run, or have no join, are left alone)
+    brk = ~same
+    has_brk = np.bincount(ring, weights=brk, minlength=n_r) > 0
+    big = np.iinfo(np.int64).max
+    first_brk = np.full(n_r, big, dtype=np.int64)
+    np.minimum.at(first_brk, ring[brk], pos[brk])
+    first_brk[~has_brk] = 0
+    rot = start[ring] + (pos + first_brk[ring]) % size[ring]  # new order -> old index
+    xy, cc, inner, same = xy[rot], cc[rot], inner[rot], same[rot]
+    same &= has_brk[ring]
+    same[start] = False  # (a run never wraps past a ring's new start)
+    # runs: maximal stretches start..end with same[] inside
+    run_id = np.cumsum(~same) - 1
+    n_run = int(run_id[-1]) + 1 if len(run_id) else 0
+    r_len = np.bincount(run_id, minlength=n_run)
+    r_first = np.flatnonzero(~same)
+    r_last = r_first + r_len - 1
+    cand = r_len >= 3
+    if not cand.any():
+        return geom, none
+    ctr = cc[np.minimum(r_first + 1, len(xy) - 1)]  # (its first inner vertex's circle)
+    # turning of each candidate run around its centre: every step the same way
+    v = xy - ctr[run_id]
+    step = np.arctan2(v[:-1, 0] * v[1:, 1] - v[:-1, 1] * v[1:, 0],
+                      v[:-1, 0] * v[1:, 0] + v[:-1, 1] * v[1:, 1])
+    step = np.append(step, 0.0)
+    inner_steps = same[1:]  # step i -> i + 1 lies inside a run
+    stp = np.where(np.append(inner_steps, False), step, 0.0)
+    pos_n = np.bincount(run_id, weights=(stp > 0), minlength=n_run)
+    neg_n = np.bincount(run_id, weights=(stp < 0), minlength=n_run)
+    phi_s = np.bincount(run_id, weights=stp, minlength=n_run)
+    one_way = (pos_n == r_len - 1) | (neg_n == r_len - 1)
+    cand &= one_way
+    k, rr = join_plan(d, tol, np.where(cand, np.abs(phi_s), 0.0))
+    use = cand & (k > 0) & (k < r_len - 1)
+    if not use.any():
+        return geom, none
+    # the new joins: first vertex, k - 1 inner ones, last vertex
+    u = np.flatnonzero(use)
+    ku = k[u]
+    a0 = np.arctan2(xy[r_first[u], 1] - ctr[u, 1], xy[r_first[u], 0] - ctr[u, 0])
+    n_in = ku - 1
+    jrun = np.repeat(np.arange(len(u)), n_in)
+    jj = np.arange(int(n_in.sum())) - np.repeat(np.cumsum(n_in) - n_in, n_in) + 1
+    th = a0[jrun] + phi_s[u][jrun] * jj / ku[jrun]
+    new_xy = ctr[u][jrun] + rr[u][jrun, None] * np.c_[np.cos(th), np.sin(th)]
+    new_key = r_first[u][jrun] + jj / ku[jrun]  # between the run's first and last
+    drop = np.zeros(len(xy), dtype=bool)
+    inner_v = same.copy()  # a run's vertices past its first ...
+    inner_v[r_last] = False  # ... and before its last
+    drop[inner_v & use[run_id]] = True
+    key = np.concatenate([np.flatnonzero(~drop).astype(np.float64), new_key])
+    all_xy = np.concatenate([xy[~drop], new_xy])
+    all_ring = np.concatenate([ring[~drop], ring[r_first[u]][jrun]])
+    order = np.lexsort((key, all_ring))
+    all_xy, all_ring = all_xy[order], all_ring[order]
+    # close the rings and build the polygons; a polygon that is not valid keeps its rings
+    starts2 = np.flatnonzero(np.diff(all_ring, prepend=-1))
+    closed_xy = np.insert(all_xy, np.append(starts2[1:], len(all_xy)), all_xy[starts2], axis=0)
+    closed_ring = np.insert(all_ring, np.append(starts2[1:], len(all_ring)), all_ring[starts2])
+    polys = shapely.polygons(shapely.linearrings(closed_xy, indices=closed_ring), indices=owner)
     changed = np.zeros(len(parts), dtype=bool)
-    for r, (s, e) in enumerate(zip(starts.tolist(), ends.tolist(), strict=True)):
-        pts = xy[s:e]
-        got = _ring_joins(pts, cen[s:e], on[s:e], centres, d, tol)
-        keep: list[np.ndarray] = []
-        if got is not None:
-            changed[owner[r]] = True
-            pts, keep = got
-        new_rings.append(pts)
-        fixed.append(keep)
+    changed[owner[np.unique(ring[r_first[u]])]] = True
+    bad = changed & ~(shapely.is_valid(polys) & ~shapely.is_empty(polys))
+    polys[bad] = parts[bad]
+    changed &= ~bad
     if not changed.any():
         return geom, none
-    polys = list(parts)
-    protect: list[np.ndarray] = []
-    for p in np.flatnonzero(changed).tolist():
-        mine = np.flatnonzero(owner == p).tolist()
-        rs = [new_rings[i] for i in mine]
-        cand = shapely.Polygon(rs[0], rs[1:])
-        if cand.is_valid and not cand.is_empty:
-            polys[p] = cand
-            for i in mine:
-                protect.extend(fixed[i])
-    out = polys[0] if len(polys) == 1 else shapely.MultiPolygon(polys)
+    out = polys[0] if len(polys) == 1 else shapely.MultiPolygon(list(polys))
     if not out.is_valid:
         return geom, none
-    return out, (np.concatenate(protect) if protect else none)
+    kept = changed[owner[ring[r_first[u]]]]  # per used run: its polygon took it
+    protect = np.concatenate([xy[r_first[u][kept]], xy[r_last[u][kept]], new_xy[kept[jrun]]])
+    return out, protect
 
 
-def _ring_joins(
-    pts: np.ndarray, cen: np.ndarray, on: np.ndarray, centres: np.ndarray, d: float,
-    tol: float,
-) -> tuple[np.ndarray, list[np.ndarray]] | None:
-    """One closed ring (first point repeated last) with its joins redrawn, and the
-    vertices of each redrawn join; None when nothing changes."""
-    n = len(pts) - 1  # distinct vertices
-    if n < 4:
-        return None
-    c = cen[:n]
-    o = on[:n]
-    # runs of consecutive on-circle vertices with one centre; start after a break so a run
-    # never wraps past index 0 unless the whole ring is one run (then leave it alone)
-    same = o & np.roll(o, 1) & (c == np.roll(c, 1))
-    if same.all() or not o.any():
-        return None
-    first = int(np.flatnonzero(~same)[0])
-    order = (np.arange(n) + first) % n
-    out: list[np.ndarray] = []
-    joins: list[np.ndarray] = []
-    i = 0
-    while i < n:
-        j = i + 1
-        while j < n and same[order[j]]:
-            j += 1
-        run = order[i:j]  # a maximal run (or a single vertex)
-        if len(run) >= 3 and o[run[0]]:
-            rep = _join(pts[run], centres[c[run[0]]], d, tol)
-            if rep is not None:
-                out.append(rep)
-                joins.append(rep)
-                i = j
-                continue
-        out.append(pts[run])
-        i = j
-    if not joins:
-        return None
-    body = np.concatenate(out)
-    return np.vstack([body, body[:1]]), joins
 
-
-def _join(run: np.ndarray, ctr: np.ndarray, d: float, tol: float) -> np.ndarray | None:
-    """The vertices of one join (first and last kept, inner ones redrawn) or None."""
-    v = run - ctr
-    ang = np.unwrap(np.arctan2(v[:, 1], v[:, 0]))
-    step = np.diff(ang)
-    if not (np.all(step > 0) or np.all(step < 0)):
-        return None  # not turning one way: not a join
-    phi = float(abs(ang[-1] - ang[0]))
-    got = join_vertices(d, tol, phi)
-    if got is None:
-        return None
-    k, r = got
-    if k >= len(run) - 1:
-        return None
-    th = ang[0] + (ang[-1] - ang[0]) * np.arange(1, k) / k
-    inner = ctr + r * np.c_[np.cos(th), np.sin(th)]
-    return np.vstack([run[:1], inner, run[-1:]])
+def _circumcircles(a: np.ndarray, b: np.ndarray, c: np.ndarray
+                   ) -> tuple[np.ndarray, np.ndarray]:
+    """Centre (K, 2) and radius (K,) of the circle through a[k], b[k], c[k] (inf radius
+    where they are collinear)."""
+    ax, ay = a[:, 0] - b[:, 0], a[:, 1] - b[:, 1]
+    cx, cy = c[:, 0] - b[:, 0], c[:, 1] - b[:, 1]
+    den = 2.0 * (ax * cy - ay * cx)
+    a2 = ax * ax + ay * ay
+    c2 = cx * cx + cy * cy
+    with np.errstate(divide="ignore", invalid="ignore"):
+        ux = (cy * a2 - ay * c2) / den
+        uy = (ax * c2 - cx * a2) / den
+    r = np.hypot(ux, uy)
+    r[~np.isfinite(r)] = np.inf
+    return np.c_[ux + b[:, 0], uy + b[:, 1]], r

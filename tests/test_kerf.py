@@ -160,12 +160,15 @@ def test_three_methods_agree_on_simple_shapes(side: str) -> None:
     fm = field_for(dr)
     region = region_of(dr)
     exact = shapely.buffer(region, d if side == "outside" else -d, quad_segs=256)
+    ref_err = arc_sagitta(d, 256)  # (the reference's own chords cut inside its arcs)
     for method in METHODS:
         out = compensate(dr, kerf_mm=kerf_for(fm, d), side=side, method=method, fm=fm)
         got = region_of(out)
         assert got.is_valid
         dev = shapely.hausdorff_distance(got.boundary, exact.boundary, densify=0.25)
-        assert dev <= tolerance(method, d, side=side, min_angle_deg=60.0), (method, dev)
+        # (1e-6: the field's bit is 0.1 units only to about 1e-8)
+        assert dev <= (tolerance(method, d, side=side, min_angle_deg=60.0) + ref_err) * (
+            1 + 1e-6), (method, dev)
 
 
 def test_merging_and_splitting_keep_source_index() -> None:

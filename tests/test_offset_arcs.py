@@ -58,7 +58,7 @@ def _offset_error(geom, src, d):
 def test_grown_rectangle_has_clipper_like_joins_within_tolerance(d, tol):
     rect = shapely.Polygon([(0, 0), (200, 0), (200, 100), (0, 100)])
     g = rect.buffer(d, quad_segs=64)
-    new, keep = two_sided_arcs(g, shapely.get_coordinates(rect)[:-1], d, tol)
+    new, keep = two_sided_arcs(g, d, tol)
     assert new.is_valid
     k = join_vertices(d, tol, math.pi / 2)[0]
     # every corner: its two tangent points and k - 1 vertices between, ring closed
@@ -75,7 +75,7 @@ def test_shrunk_ring_with_a_hole_and_notch():
     poly = shapely.Polygon(outer, [hole])
     d, tol = 6.0, 0.05
     g = poly.buffer(-d, quad_segs=64)
-    new, keep = two_sided_arcs(g, shapely.get_coordinates(poly), d, tol)
+    new, keep = two_sided_arcs(g, d, tol)
     assert new.is_valid and len(keep) > 0
     assert len(shapely.get_coordinates(new)) < len(shapely.get_coordinates(g))
     assert shapely.get_num_interior_rings(new) == 1
@@ -86,9 +86,9 @@ def test_shrunk_ring_with_a_hole_and_notch():
 def test_nothing_to_do_is_returned_unchanged():
     tri = shapely.Polygon([(0, 0), (10, 0), (0, 10)])
     g = tri.buffer(-1.0, quad_segs=8)  # a shrunk convex polygon has no round joins
-    new, keep = two_sided_arcs(g, shapely.get_coordinates(tri), 1.0, 0.01)
+    new, keep = two_sided_arcs(g, 1.0, 0.01)
     assert new is g and len(keep) == 0
-    assert two_sided_arcs(g, shapely.get_coordinates(tri), 1.0, 2.0)[0] is g  # tol >= d
+    assert two_sided_arcs(g, 1.0, 2.0)[0] is g  # tol >= d
 
 
 @settings(max_examples=60, deadline=None)
@@ -106,7 +106,7 @@ def test_random_polygons_stay_valid_and_within_tolerance(seed, d, tol):
         g = poly.buffer(side, quad_segs=q)
         if g.is_empty:
             continue
-        new, _ = two_sided_arcs(g, shapely.get_coordinates(poly), d, tol)
+        new, _ = two_sided_arcs(g, d, tol)
         assert new.is_valid
         assert len(shapely.get_coordinates(new)) <= len(shapely.get_coordinates(g))
         err = _offset_error(new, poly, d)
