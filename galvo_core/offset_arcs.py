@@ -34,8 +34,9 @@ __all__ = ["two_sided_arcs", "join_vertices"]
 _ON_CIRCLE = 1e-7
 #: neighbouring inner vertices of one join: their circles' centres within this * d
 _SAME_CENTRE = 1e-6
-#: radii tried for the inner vertices, as fractions of tol above d
-_RADII = np.linspace(1.0 - 1e-9, 0.0, 41)
+#: radii tried for the inner vertices, as fractions of tol above d (a hair under 1: the
+#: centre is known to rounding only)
+_RADII = np.linspace(1.0 - 1e-6, 0.0, 41)
 
 
 def join_vertices(d: float, tol: float, phi: float) -> tuple[int, float] | None:
@@ -132,11 +133,18 @@ def two_sided_arcs(geom: BaseGeometry, d: float, tol: float) -> tuple[BaseGeomet
     cand = r_len >= 3
     if not cand.any():
         return geom, none
-    ctr = cc[np.minimum(r_first + 1, len(xy) - 1)]  # (its first inner vertex's circle)
+    # each join's centre from its two ends and middle vertex (far apart: a well-conditioned
+    # circle, where three neighbours a small angle apart would carry the rounding of large
+    # coordinates into the centre)
+    r_mid = r_first + r_len // 2
+    ctr, rad = _circumcircles(xy[r_first], xy[r_mid], xy[r_last])
+    cand &= np.abs(rad - d) <= _ON_CIRCLE * d
+    ctr[~cand] = 0.0
     # turning of each candidate run around its centre: every step the same way
     v = xy - ctr[run_id]
-    step = np.arctan2(v[:-1, 0] * v[1:, 1] - v[:-1, 1] * v[1:, 0],
-                      v[:-1, 0] * v[1:, 0] + v[:-1, 1] * v[1:, 1])
+    with np.errstate(invalid="ignore", over="ignore"):  # (only candidate runs are read)
+        step = np.arctan2(v[:-1, 0] * v[1:, 1] - v[:-1, 1] * v[1:, 0],
+                          v[:-1, 0] * v[1:, 0] + v[:-1, 1] * v[1:, 1])
     step = np.append(step, 0.0)
     inner_steps = same[1:]  # step i -> i + 1 lies inside a run
     stp = np.where(np.append(inner_steps, False), step, 0.0)

@@ -408,3 +408,29 @@ def test_dp_is_the_definition_with_its_tie_rule(eps):
             assert got == chain
             kinds.add("greedy")
     assert kinds == {"dp", "greedy"}
+
+
+@pytest.mark.parametrize(
+    "p",
+    [
+        # P1 is 1 ulp farther than eps from P0 (its tangents are ill-conditioned); the float
+        # test finds P1 exactly eps from [P0, P2], so the farthest valid end is P2
+        [[0.0, 0.0], [-0.4825834180282613, 0.13081760066657866],
+         [1.7796976777253253, 6.565267853846727]],
+        # P1's computed distance from P0 is eps exactly, and P1 lies behind P0
+        [[1.2910892834597443, -0.15166979352694648], [1.0462417882921353, -0.587616698677273],
+         [2.3373310717518794, -0.7392864922042195]],
+    ],
+)
+def test_points_eps_from_the_start_to_the_last_bit(p):
+    """Found by a review fuzzer: a point whose distance from P_i is eps to rounding must
+    neither lose a valid end nor let an invalid one through; the exact test decides."""
+    q = np.array(p)
+    x = np.ascontiguousarray(q[:, 0])
+    y = np.ascontiguousarray(q[:, 1])
+    cand = np.empty(4, dtype=np.int64)
+    sure = np.empty(4, dtype=np.int8)
+    rr = np.empty(4)
+    r = thin_mod._reach(x, y, 0, 2, 0.5, thin_mod._SLACK, cand, sure, rr)
+    assert r == _valid_ends(q, 0, 2, 0.5)[-1]
+    assert thin(q, 0.5).tolist() == ([0, 2] if r == 2 else [0, 1, 2])
