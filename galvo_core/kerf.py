@@ -1149,23 +1149,55 @@ def _nest_rings(rings: list[np.ndarray]) -> BaseGeometry:
 
 
 # --------------------------------------------------------------------------- output
-def _nearest_segment(tree: shapely.STRtree, pts: np.ndarray, a: np.ndarray, b: np.ndarray,
+#: consecutive segments per LineString in the trees that find candidate segments
+CHUNK_SEGMENTS = 4
+
+
+def _chunk_tree(a: np.ndarray, b: np.ndarray, sizes: Sequence[int],
+                k: int = CHUNK_SEGMENTS) -> tuple[shapely.STRtree, np.ndarray, np.ndarray]:
+    """An STRtree of LineStrings of up to ``k`` consecutive segments (a[s], b[s]) of one
+    ring each (rings of ``sizes`` segments, in order), the index of each chunk's first
+    segment and its number of segments. Far fewer geometries than one per segment, which
+    is what costs time; distances are then taken segment by segment."""
+    sizes = np.asarray(sizes, dtype=np.int64)
+    n = len(a)
+    ring = np.repeat(np.arange(len(sizes)), sizes)
+    pos = np.arange(n) - np.repeat(np.cumsum(sizes) - sizes, sizes)
+    new = pos % k == 0
+    chunk = np.cumsum(new) - 1
+    first = np.flatnonzero(new)
+    last = np.ones(n, dtype=bool)
+    last[:-1] = new[1:] | (ring[1:] != ring[:-1])
+    xy = np.concatenate([a, b[last]])
+    ids = np.concatenate([chunk, chunk[last]])
+    order = np.argsort(np.concatenate([2 * np.arange(n), 2 * np.flatnonzero(last) + 1]))
+    tree = shapely.STRtree(shapely.linestrings(xy[order], indices=ids[order]))
+    return tree, first, np.diff(np.append(first, n))
+
+
+def _nearest_segment(pts: np.ndarray, a: np.ndarray, b: np.ndarray, sizes: Sequence[int],
                      reach: float) -> np.ndarray:
-    """Index of the segment (a[k], b[k]) nearest to each point. Candidates within ``reach``
-    come from one bulk STRtree query (much faster than GEOS nearest-neighbour queries);
-    points with none fall back to the nearest-neighbour query."""
+    """Index of the segment (a[k], b[k]) nearest to each point (the lowest index among
+    equally near ones). Candidates within ``reach`` come from one bulk STRtree query of
+    chunks of segments (much faster than GEOS nearest-neighbour queries); points with
+    none fall back to the nearest-neighbour query."""
     n = len(pts)
-    pi, si = tree.query(shapely.points(pts), predicate="dwithin", distance=reach)
+    tree, first, count = _chunk_tree(a, b, sizes)
+    pi, ci = tree.query(shapely.points(pts), predicate="dwithin", distance=reach)
+    cnt = count[ci]
+    pi = np.repeat(pi, cnt)
+    si = np.repeat(first[ci], cnt) + (np.arange(len(pi)) - np.repeat(np.cumsum(cnt) - cnt, cnt))
     best = np.full(n, -1, dtype=np.int64)
     if len(pi):
         dd = point_segment_distance(pts[pi], a[si], b[si])
         order = np.lexsort((si, dd, pi))  # per point: smallest distance first
-        first = np.ones(len(order), dtype=bool)
-        first[1:] = pi[order][1:] != pi[order][:-1]
-        best[pi[order][first]] = si[order][first]
+        first_ = np.ones(len(order), dtype=bool)
+        first_[1:] = pi[order][1:] != pi[order][:-1]
+        best[pi[order][first_]] = si[order][first_]
     miss = np.nonzero(best < 0)[0]
     if len(miss):
-        _, seg = tree.query_nearest(shapely.points(pts[miss]), all_matches=False)
+        seg_tree = shapely.STRtree(shapely.linestrings(np.stack([a, b], axis=1)))
+        _, seg = seg_tree.query_nearest(shapely.points(pts[miss]), all_matches=False)
         best[miss] = seg
     return best
 
@@ -1194,8 +1226,8 @@ def _nearest_source(pts: np.ndarray, sources: list[np.ndarray], reach: float) ->
         subset = [sources[j] for j in cand.tolist()]
         a, b = _segments(subset)
         owner = np.repeat(cand, [len(s) - 1 for s in subset])
-        tree = shapely.STRtree(shapely.linestrings(np.stack([a, b], axis=1)))
-        near[rest] = owner[_nearest_segment(tree, pts[rest], a, b, reach)]
+        near[rest] = owner[_nearest_segment(pts[rest], a, b, [len(s) - 1 for s in subset],
+                                            reach)]
     return near
 
 
