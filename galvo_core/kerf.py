@@ -833,16 +833,27 @@ def _without_false_holes(polys: list[BaseGeometry], region: BaseGeometry, d: flo
     across (bounding-box diagonal) is false when no probe point inside it lies farther
     than ``d`` from the region (every point of a true hole does); probes: a
     ``PROBE_GRID`` grid over its box, its centroid and a point on its surface."""
-    out = []
-    for p in polys:
-        holes = list(p.interiors)
-        small = [k for k, h in enumerate(holes) if _across(h) < size]
-        if not small:
-            out.append(p)
-            continue
-        false = {k for k in small if not _farther_inside(shapely.Polygon(holes[k]), region, d)}
-        out.append(shapely.Polygon(p.exterior, [h for k, h in enumerate(holes)
-                                                if k not in false]))
+    if not polys:
+        return polys
+    arr = np.array(polys, dtype=object)
+    n_holes = shapely.get_num_interior_rings(arr)
+    if not n_holes.any():
+        return polys
+    rings, owner = shapely.get_rings(arr, return_index=True)
+    hole = np.ones(len(rings), dtype=bool)
+    hole[np.cumsum(n_holes + 1) - n_holes - 1] = False  # each polygon's exterior first
+    b = shapely.bounds(rings)
+    small = np.flatnonzero(hole & (np.hypot(b[:, 2] - b[:, 0], b[:, 3] - b[:, 1]) < size))
+    false = [k for k in small.tolist()
+             if not _farther_inside(shapely.Polygon(rings[k]), region, d)]
+    if not false:
+        return polys
+    drop = np.zeros(len(rings), dtype=bool)
+    drop[false] = True
+    out = list(polys)
+    for i in np.unique(owner[false]).tolist():
+        mine = np.flatnonzero(owner == i)
+        out[i] = shapely.Polygon(rings[mine[0]], [rings[k] for k in mine[1:] if not drop[k]])
     return out
 
 
@@ -857,8 +868,10 @@ def _without_false_slivers(pieces: np.ndarray, sources: np.ndarray, d: float,
     does. (Probing for a point deeper than ``d``, as for holes, misses true remnants
     narrower than the probe grid.)"""
     thin = 2.0 * shapely.area(pieces) < width * shapely.length(shapely.get_exterior_ring(pieces))
-    return [p for p, src, t in zip(pieces, sources, thin, strict=True)
-            if not t or _meets_fine_offset(p, src, d)]
+    keep = ~thin
+    if thin.any():
+        keep[thin] = _meets_fine_offset(pieces[thin], sources[thin], d)
+    return list(pieces[keep])
 
 
 #: segments per quarter circle of the fine local offset that judges a thin shrunk polygon
@@ -866,15 +879,19 @@ def _without_false_slivers(pieces: np.ndarray, sources: np.ndarray, d: float,
 FINE_QUAD_SEGS = 64
 
 
-def _meets_fine_offset(poly: BaseGeometry, region: BaseGeometry, d: float) -> bool:
-    x0, y0, x1, y1 = poly.bounds
+def _meets_fine_offset(polys: np.ndarray, regions: np.ndarray, d: float) -> np.ndarray:
+    """Per polygon: whether the fine inward offset of its region, clipped around it,
+    meets it."""
+    b = shapely.bounds(polys)
     m = 1.5 * d
-    near = shapely.intersection(region, shapely.box(x0 - m, y0 - m, x1 + m, y1 + m))
+    near = shapely.intersection(regions, shapely.box(b[:, 0] - m, b[:, 1] - m, b[:, 2] + m,
+                                                     b[:, 3] + m))
     fine = shapely.buffer(near, -d, quad_segs=FINE_QUAD_SEGS, join_style="round")
-    return bool(shapely.intersects(fine, poly))
+    return np.asarray(shapely.intersects(fine, polys), dtype=bool)
 
 
 def _across(ring: BaseGeometry) -> float:
+    """Bounding-box diagonal of a ring (the size :func:`_without_false_holes` compares)."""
     x0, y0, x1, y1 = ring.bounds
     return math.hypot(x1 - x0, y1 - y0)
 
