@@ -166,16 +166,20 @@ def compensate_indexed(
         for ring, j in assign:
             out_by_src.setdefault(idx[j], []).append(ring)
 
+    starts = _starts_near([(ring, drawing.paths[i].points[0])
+                           for i in sorted(out_by_src) for ring in out_by_src[i]])
     paths: list[Path] = []
     origin: list[int] = []
+    k = 0
     for i, p in enumerate(drawing.paths):
         if i in passthrough:
             paths.append(p)
             origin.append(i)
             continue
-        for ring in out_by_src.get(i, []):
-            paths.append(p.with_points(_start_near(ring, p.points[0]), closed=True))
+        for _ in out_by_src.get(i, []):
+            paths.append(p.with_points(starts[k], closed=True))
             origin.append(i)
+            k += 1
 
     warnings: list[Warning] = []
     if passthrough:
@@ -245,8 +249,13 @@ def reduce_vertices(geom: BaseGeometry, eps: float) -> BaseGeometry:
     topology-preserving variant on that polygon (its rings cannot cross or collapse). Each
     ring's first vertex is kept: GEOS drops a ring's end point by looking at that vertex
     alone, which can leave vertices dropped before it beyond ``eps``."""
+    return _reduce(geom, eps)[0]
+
+
+def _reduce(geom: BaseGeometry, eps: float) -> tuple[BaseGeometry, bool]:
+    """:func:`reduce_vertices`, and whether the result was checked to be valid."""
     if eps <= 0 or geom.is_empty:
-        return geom
+        return geom, False
     parts = shapely.get_parts(geom)
     n_holes = shapely.get_num_interior_rings(parts)
     owner = np.repeat(np.arange(len(parts)), n_holes + 1)  # part of each ring
@@ -255,6 +264,7 @@ def reduce_vertices(geom: BaseGeometry, eps: float) -> BaseGeometry:
     kept = _kept_of(xy, ring, shapely.simplify(rings, eps, preserve_topology=False), eps)
     polys = _polys_of(xy, ring, kept, owner)
     bad = np.flatnonzero(~shapely.is_valid(polys))
+    checked = True  # the result is known to be valid
     if len(bad):
         on = np.isin(owner, bad)[ring]
         try:
@@ -273,8 +283,9 @@ def reduce_vertices(geom: BaseGeometry, eps: float) -> BaseGeometry:
         if len(still):
             kept[np.isin(owner, still)[ring]] = True
             polys = _polys_of(xy, ring, kept, owner)
+            checked = False
     if len(polys) == 1:
-        return polys[0]
+        return polys[0], checked
     out = shapely.MultiPolygon(list(polys))
     if not out.is_valid:
         # thinned polygons that now meet: those go back as they were
@@ -283,8 +294,8 @@ def reduce_vertices(geom: BaseGeometry, eps: float) -> BaseGeometry:
         kept[np.isin(owner, meet)[ring]] = True
         out = shapely.MultiPolygon(list(_polys_of(xy, ring, kept, owner)))
         if not out.is_valid:
-            return geom
-    return out
+            return geom, False
+    return out, True
 
 
 def _kept_of(xy: np.ndarray, ring: np.ndarray, simplified: np.ndarray, eps: float
@@ -441,6 +452,20 @@ def _closed(pts: np.ndarray) -> np.ndarray:
     return pts
 
 
+def _all_closed(rings: Sequence[np.ndarray]) -> list[np.ndarray]:
+    """:func:`_closed` of each ring (one comparison for all)."""
+    rings = [np.asarray(r, dtype=np.float64) for r in rings]
+    rings = [r for r in rings if len(r)]
+    if not rings:
+        return []
+    sizes = np.array([len(r) for r in rings])
+    pts = np.concatenate(rings)
+    ends = np.cumsum(sizes)
+    open_ = np.any(pts[ends - sizes] != pts[ends - 1], axis=1)
+    return [np.vstack([r, r[:1]]) if o else r
+            for r, o in zip(rings, open_.tolist(), strict=True)]
+
+
 def _segments(rings: Sequence[np.ndarray]) -> tuple[np.ndarray, np.ndarray]:
     """All edges of closed rings as (S, 2) start and end points."""
     a = np.concatenate([r[:-1] for r in rings]) if rings else np.zeros((0, 2))
@@ -460,7 +485,7 @@ def even_odd_region(rings: Sequence[np.ndarray]) -> BaseGeometry:
     node the remaining linework, polygonize it and keep the faces with an odd ray-crossing
     count.
     """
-    rings = [_closed(r) for r in rings]
+    rings = _all_closed(rings)
     rings = [r for r in rings if len(r) >= 4]
     if not rings:
         return shapely.Polygon()
@@ -732,19 +757,21 @@ def _apply(region: BaseGeometry, d: float, side: str, method: str, tol: float,
            res: float, res_auto: bool) -> BaseGeometry:
     if region.is_empty or d <= 0:
         return region
+    checked = False  # known to be valid
     if method == "vector":
-        out = _vector(region, d, side, tol)
+        out, checked = _vector(region, d, side, tol)
     elif method == "raster":
         out = _raster(region, d, side, res, res_auto)
     else:
         out = _rectangle(region, d, side)
     out = _polygonal(out)
-    if not out.is_valid:
+    if not checked and not out.is_valid:
         out = _polygonal(shapely.make_valid(out))
     return shapely.orient_polygons(out)
 
 
-def _vector(region: BaseGeometry, d: float, side: str, tol: float) -> BaseGeometry:
+def _vector(region: BaseGeometry, d: float, side: str, tol: float
+            ) -> tuple[BaseGeometry, bool]:
     """GEOS buffer of each polygon of the region on its own (the offset of a union is the
     union of the offsets), except that polygons no more than ``2 d`` apart (their grown
     versions may meet) are buffered together, group by group, as one MultiPolygon; shrunk
@@ -763,9 +790,9 @@ def _vector(region: BaseGeometry, d: float, side: str, tol: float) -> BaseGeomet
     else:
         polys = _without_false_holes(_grown_groups(parts, d, q), region, d, tol)
     if not polys:
-        return shapely.Polygon()
+        return shapely.Polygon(), True
     out = polys[0] if len(polys) == 1 else shapely.MultiPolygon(polys)
-    return reduce_vertices(out, reduce_tol_for(d, tol))
+    return _reduce(out, reduce_tol_for(d, tol))
 
 
 #: a group of grown polygons with at most this many meeting pairs per polygon is buffered
@@ -1176,10 +1203,10 @@ def _chunk_tree(a: np.ndarray, b: np.ndarray, sizes: Sequence[int],
     ring each (rings of ``sizes`` segments, in order), the index of each chunk's first
     segment and its number of segments. Far fewer geometries than one per segment, which
     is what costs time; distances are then taken segment by segment."""
-    sizes = np.asarray(sizes, dtype=np.int64)
+    per = np.asarray(sizes, dtype=np.int64)
     n = len(a)
-    ring = np.repeat(np.arange(len(sizes)), sizes)
-    pos = np.arange(n) - np.repeat(np.cumsum(sizes) - sizes, sizes)
+    ring = np.repeat(np.arange(len(per)), per)
+    pos = np.arange(n) - np.repeat(np.cumsum(per) - per, per)
     new = pos % k == 0
     chunk = np.cumsum(new) - 1
     first = np.flatnonzero(new)
@@ -1227,8 +1254,10 @@ def _nearest_source(pts: np.ndarray, sources: list[np.ndarray], reach: float) ->
     them (short pieces: a whole ring would make every distance O(ring size))."""
     n, m = len(pts), len(sources)
     near = np.full(n, -1, dtype=np.int64)
-    lo = np.array([s.min(axis=0) for s in sources]) - reach
-    hi = np.array([s.max(axis=0) for s in sources]) + reach
+    begin = np.cumsum([0] + [len(s) for s in sources[:-1]])
+    pts_all = np.concatenate(sources)
+    lo = np.minimum.reduceat(pts_all, begin, axis=0) - reach
+    hi = np.maximum.reduceat(pts_all, begin, axis=0) + reach
     boxes = shapely.STRtree(shapely.box(lo[:, 0], lo[:, 1], hi[:, 0], hi[:, 1]))
     pi, si = boxes.query(shapely.points(pts))  # (point, box) pairs: the point is in the box
     count = np.bincount(pi, minlength=n)
@@ -1281,8 +1310,18 @@ def _assign(result: BaseGeometry, sources: list[np.ndarray], reach: float
     return [(r, int(j)) for r, j in zip(rings, lowest, strict=True)], contrib
 
 
-def _start_near(ring: np.ndarray, p: np.ndarray) -> np.ndarray:
-    """The closed ring rotated to start at its vertex nearest to ``p``."""
-    body = ring[:-1]
-    k = int(np.argmin(((body - p) ** 2).sum(axis=1)))
-    return np.concatenate([body[k:], body[:k + 1]])
+def _starts_near(rings_points: list[tuple[np.ndarray, np.ndarray]]) -> list[np.ndarray]:
+    """Each closed ring rotated to start at its vertex nearest to its point (the first
+    such vertex), all rings at once."""
+    if not rings_points:
+        return []
+    bodies = [r[:-1] for r, _ in rings_points]
+    sizes = np.array([len(b) for b in bodies])
+    xy = np.concatenate(bodies)
+    ring = np.repeat(np.arange(len(bodies)), sizes)
+    p = np.array([q for _, q in rings_points], dtype=np.float64)
+    d2 = ((xy - p[ring]) ** 2).sum(axis=1)
+    order = np.lexsort((np.arange(len(xy)), d2, ring))  # per ring: nearest, then first
+    begin = np.cumsum(sizes) - sizes
+    k = order[begin] - begin
+    return [np.concatenate([b[j:], b[:j + 1]]) for b, j in zip(bodies, k.tolist(), strict=True)]
