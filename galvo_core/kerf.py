@@ -571,12 +571,11 @@ def _sharing_an_edge(faces: np.ndarray) -> np.ndarray:
 def _group_rows(key: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Classes of equal rows of a float array: per row its class, per class its first row
     and its size (like ``np.unique(..., return_index, return_inverse, return_counts)`` on
-    rows, classes in no particular order; -0.0 equals 0.0). Rows are sorted by a 64-bit
-    hash and the neighbours compared exactly (np.unique on rows when two rows collide)."""
+    rows, classes in no particular order; -0.0 equals 0.0). Rows whose 64-bit hash is
+    unique are classes of their own; the others are sorted by hash and neighbours
+    compared exactly (sorted as rows when two different rows share a hash)."""
     key = np.ascontiguousarray(key, dtype=np.float64) + 0.0
     n = len(key)
-    if n == 0:
-        return np.zeros(0, np.int64), np.zeros(0, np.int64), np.zeros(0, np.int64)
     bits = key.view(np.uint64)
     h = np.zeros(n, dtype=np.uint64)
     with np.errstate(over="ignore"):
@@ -585,20 +584,32 @@ def _group_rows(key: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
             h ^= h >> np.uint64(29)
             h *= np.uint64(0xBF58476D1CE4E5B9)
             h ^= h >> np.uint64(32)
-    order = np.argsort(h, kind="stable")
-    hs = h[order]
-    same_h = hs[1:] == hs[:-1]
-    same = np.all(key[order[1:]] == key[order[:-1]], axis=1)
-    if np.any(same_h & ~same):  # a hash collision: sort the rows themselves
-        _, first, inv, cnt = np.unique(key, axis=0, return_index=True, return_inverse=True,
-                                       return_counts=True)
-        return inv.ravel(), first, cnt
-    new = np.ones(n, dtype=bool)
-    new[1:] = ~same
-    grp = np.cumsum(new) - 1
-    inv = np.empty(n, dtype=np.int64)
-    inv[order] = grp
-    return inv, order[new], np.bincount(grp)
+    hs = np.sort(h)
+    rep = hs[1:][hs[1:] == hs[:-1]]  # hash values of more than one row
+    inv = np.arange(n)
+    if not len(rep):
+        return inv, np.arange(n), np.ones(n, dtype=np.int64)
+    many = np.flatnonzero(np.isin(h, rep))
+    order = np.argsort(h[many], kind="stable")
+    hm, km = h[many][order], key[many][order]
+    same = np.all(km[1:] == km[:-1], axis=1)
+    if np.any((hm[1:] == hm[:-1]) & ~same):  # a hash collision: sort the rows themselves
+        _, ufirst, uinv, ucnt = np.unique(key[many], axis=0, return_index=True,
+                                          return_inverse=True, return_counts=True)
+    else:
+        start = np.ones(len(many), dtype=bool)
+        start[1:] = ~same
+        grp = np.cumsum(start) - 1
+        uinv = np.empty(len(many), dtype=np.int64)
+        uinv[order] = grp
+        ufirst, ucnt = order[start], np.bincount(grp)
+    single = np.ones(n, dtype=bool)
+    single[many] = False
+    one = np.flatnonzero(single)
+    inv[one] = np.arange(len(one))
+    inv[many] = len(one) + uinv.ravel()
+    return (inv, np.concatenate([one, many[ufirst]]),
+            np.concatenate([np.ones(len(one), dtype=np.int64), ucnt]))
 
 
 def _box_groups(bounds: np.ndarray) -> np.ndarray:
@@ -1220,24 +1231,29 @@ def _chunk_tree(a: np.ndarray, b: np.ndarray, sizes: Sequence[int],
 
 
 def _nearest_segment(pts: np.ndarray, a: np.ndarray, b: np.ndarray, sizes: Sequence[int],
-                     reach: float) -> np.ndarray:
+                     reach: float, points: np.ndarray | None = None) -> np.ndarray:
     """Index of the segment (a[k], b[k]) nearest to each point (the lowest index among
     equally near ones). Candidates within ``reach`` come from one bulk STRtree query of
     chunks of segments (much faster than GEOS nearest-neighbour queries); points with
-    none fall back to the nearest-neighbour query."""
+    none fall back to the nearest-neighbour query. ``points``: ``pts`` as shapely Points,
+    if at hand."""
     n = len(pts)
     tree, first, count = _chunk_tree(a, b, sizes)
-    pi, ci = tree.query(shapely.points(pts), predicate="dwithin", distance=reach)
+    if points is None:
+        points = shapely.points(pts)
+    pi, ci = tree.query(points, predicate="dwithin", distance=reach)
     cnt = count[ci]
     pi = np.repeat(pi, cnt)
     si = np.repeat(first[ci], cnt) + (np.arange(len(pi)) - np.repeat(np.cumsum(cnt) - cnt, cnt))
-    best = np.full(n, -1, dtype=np.int64)
+    none_ = np.iinfo(np.int64).max
+    best = np.full(n, none_, dtype=np.int64)
     if len(pi):
         dd = point_segment_distance(pts[pi], a[si], b[si])
-        order = np.lexsort((si, dd, pi))  # per point: smallest distance first
-        first_ = np.ones(len(order), dtype=bool)
-        first_[1:] = pi[order][1:] != pi[order][:-1]
-        best[pi[order][first_]] = si[order][first_]
+        dmin = np.full(n, np.inf)
+        np.minimum.at(dmin, pi, dd)  # per point: the smallest distance ...
+        at = dd == dmin[pi]
+        np.minimum.at(best, pi[at], si[at])  # ... and the lowest segment at it
+    best[best == none_] = -1
     miss = np.nonzero(best < 0)[0]
     if len(miss):
         seg_tree = shapely.STRtree(shapely.linestrings(np.stack([a, b], axis=1)))
@@ -1259,7 +1275,8 @@ def _nearest_source(pts: np.ndarray, sources: list[np.ndarray], reach: float) ->
     lo = np.minimum.reduceat(pts_all, begin, axis=0) - reach
     hi = np.maximum.reduceat(pts_all, begin, axis=0) + reach
     boxes = shapely.STRtree(shapely.box(lo[:, 0], lo[:, 1], hi[:, 0], hi[:, 1]))
-    pi, si = boxes.query(shapely.points(pts))  # (point, box) pairs: the point is in the box
+    points = shapely.points(pts)
+    pi, si = boxes.query(points)  # (point, box) pairs: the point is in the box
     count = np.bincount(pi, minlength=n)
     one = count[pi] == 1
     near[pi[one]] = si[one]
@@ -1273,7 +1290,7 @@ def _nearest_source(pts: np.ndarray, sources: list[np.ndarray], reach: float) ->
         a, b = _segments(subset)
         owner = np.repeat(cand, [len(s) - 1 for s in subset])
         near[rest] = owner[_nearest_segment(pts[rest], a, b, [len(s) - 1 for s in subset],
-                                            reach)]
+                                            reach, points[rest])]
     return near
 
 
