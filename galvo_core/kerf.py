@@ -426,9 +426,11 @@ def _have_area(rings: list[np.ndarray]) -> np.ndarray:
     pts = np.concatenate(rings).astype(np.float64, copy=False)
     v = pts - pts[start][owner]
     n2 = (v * v).sum(axis=1)
-    # the first farthest point of each ring: the last of its ring in this order
-    order = np.lexsort((-np.arange(len(pts)), n2, owner))
-    far = v[order[start + sizes - 1]][owner]
+    # the first farthest point of each ring
+    top = np.maximum.reduceat(n2, start)
+    at = np.flatnonzero(n2 == top[owner])
+    first = at[np.r_[True, owner[at][1:] != owner[at][:-1]]]  # one per ring, in order
+    far = v[first][owner]
     cross = np.abs(v[:, 0] * far[:, 1] - v[:, 1] * far[:, 0]) > 0
     return np.logical_or.reduceat(cross, start)
 
@@ -500,8 +502,7 @@ def even_odd_region(rings: Sequence[np.ndarray]) -> BaseGeometry:
         # the rings of the other groups with more than one ring: do they touch?
         cand = np.flatnonzero(~bad[label] & (size[label] > 1))
         if len(cand):
-            ci, cj = shapely.STRtree(lrs[cand]).query(lrs[cand], predicate="intersects")
-            bad[label[cand[ci[ci != cj]]]] = True
+            _touching_groups(lrs, cand, label, bad)
         general = bad[label]
     if not general.any():
         return _nest(polys)
@@ -512,6 +513,30 @@ def even_odd_region(rings: Sequence[np.ndarray]) -> BaseGeometry:
     parts = np.concatenate([simple, shapely.get_parts(region)]) if not region.is_empty \
         else simple
     return shapely.multipolygons(parts) if len(parts) > 1 else parts[0]
+
+
+def _touching_groups(lrs: np.ndarray, cand: np.ndarray, label: np.ndarray,
+                     bad: np.ndarray) -> None:
+    """Mark in ``bad`` (per group) the groups in which two of the rings ``lrs[cand]``
+    intersect. Pairs whose boxes meet are tested a few per group at a time, and a group
+    is not tested further once it is marked (most groups of rings that overlap are
+    found at their first pairs)."""
+    ci, cj = shapely.STRtree(lrs[cand]).query(lrs[cand])
+    k = ci < cj
+    i, j = cand[ci[k]], cand[cj[k]]
+    order = np.argsort(label[i], kind="stable")
+    i, j = i[order], j[order]
+    g = label[i]
+    rank = np.arange(len(g)) - np.searchsorted(g, g)  # place of the pair in its group
+    lo = 0
+    hi = 4
+    while len(i):
+        now = (rank >= lo) & (rank < hi)
+        hit = shapely.intersects(lrs[i[now]], lrs[j[now]])
+        bad[g[now][hit]] = True
+        left = (rank >= hi) & ~bad[g]
+        i, j, g, rank = i[left], j[left], g[left], rank[left]
+        lo, hi = hi, 4 * hi
 
 
 def _even_odd_general(rings: list[np.ndarray]) -> BaseGeometry:
