@@ -307,11 +307,9 @@ def _kept_of(xy: np.ndarray, ring: np.ndarray, simplified: np.ndarray, eps: floa
     result is built from the rings' own vertices and checked, whatever GEOS did.)"""
     oxy, oring = shapely.get_coordinates(simplified, return_index=True)
     okeys = _xy_hash(oxy, oring)
-    order = np.argsort(okeys)
     keys = _xy_hash(xy, ring)
-    pos = np.minimum(np.searchsorted(okeys[order], keys), max(len(order) - 1, 0))
-    if len(order):
-        cand = order[pos]
+    if len(okeys):
+        cand = _lookup(okeys, keys)
         # exact (ring, x, y) matches (a hash collision only drops a vertex, which the
         # chord check below then judges)
         kept = (okeys[cand] == keys) & (oring[cand] == ring) & np.all(oxy[cand] == xy, axis=1)
@@ -325,6 +323,28 @@ def _kept_of(xy: np.ndarray, ring: np.ndarray, simplified: np.ndarray, eps: floa
     whole[_far_rings(xy, ring, kept, eps, n_rings)] = True
     kept[whole[ring]] = True
     return kept
+
+
+def _lookup(table_keys: np.ndarray, keys: np.ndarray) -> np.ndarray:
+    """For each of ``keys`` (64-bit hashes), the index of an equal one in ``table_keys``
+    (non-empty) if there is one, else of some other. An open-addressed table on the low
+    bits, at least four times as many slots as keys; keys whose slot several table keys
+    share are looked up by binary search among those."""
+    size = 1 << (4 * len(table_keys)).bit_length()
+    mask = np.uint64(size - 1)
+    tslot = (table_keys & mask).astype(np.int64)
+    count = np.bincount(tslot, minlength=size)
+    table = np.zeros(size, dtype=np.int64)
+    table[tslot] = np.arange(len(table_keys))
+    slot = (keys & mask).astype(np.int64)
+    out = table[slot]
+    shared = count[slot] > 1
+    if shared.any():
+        sub = np.flatnonzero(count[tslot] > 1)
+        sub = sub[np.argsort(table_keys[sub])]
+        pos = np.searchsorted(table_keys[sub], keys[shared])
+        out[shared] = sub[np.minimum(pos, len(sub) - 1)]
+    return out
 
 
 def _polys_of(xy: np.ndarray, ring: np.ndarray, kept: np.ndarray, owner: np.ndarray
