@@ -1268,10 +1268,13 @@ def _chunk_tree(a: np.ndarray, b: np.ndarray, sizes: Sequence[int],
     first = np.flatnonzero(new)
     last = np.ones(n, dtype=bool)
     last[:-1] = new[1:] | (ring[1:] != ring[:-1])
-    xy = np.concatenate([a, b[last]])
-    ids = np.concatenate([chunk, chunk[last]])
-    order = np.argsort(np.concatenate([2 * np.arange(n), 2 * np.flatnonzero(last) + 1]))
-    tree = shapely.STRtree(shapely.linestrings(xy[order], indices=ids[order]))
+    # each segment's start, then its end where it is the last of its chunk
+    at = np.arange(n) + np.cumsum(last) - last
+    xy = np.empty((n + int(last.sum()), 2))
+    ids = np.empty(len(xy), dtype=np.int64)
+    xy[at], ids[at] = a, chunk
+    xy[at[last] + 1], ids[at[last] + 1] = b[last], chunk[last]
+    tree = shapely.STRtree(shapely.linestrings(xy, indices=ids))
     return tree, first, np.diff(np.append(first, n))
 
 
