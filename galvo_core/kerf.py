@@ -548,6 +548,8 @@ def _touching_groups(lrs: np.ndarray, cand: np.ndarray, label: np.ndarray,
     i, j = i[order], j[order]
     g = label[i]
     rank = np.arange(len(g)) - np.searchsorted(g, g)  # place of the pair in its group
+    first = np.unique(i)
+    shapely.prepare(lrs[first[shapely.get_num_coordinates(lrs[first]) >= 256]])
     lo = 0
     hi = 4
     while len(i):
@@ -873,6 +875,10 @@ def _grown_groups(parts: np.ndarray, d: float, q: int) -> list[BaseGeometry]:
         shapely.box(lo[:, 0] - m, lo[:, 1] - m, lo[:, 2] + m, lo[:, 3] + m))
     k = i < j
     i, j = i[k], j[k]
+    first = np.unique(i)
+    # prepared, large parts answer fast (a part in another's hole: 25x on seal.plt); for
+    # small ones preparing costs more than it saves
+    shapely.prepare(parts[first[shapely.get_num_coordinates(parts[first]) >= 256]])
     near = shapely.dwithin(parts[i], parts[j], m)
     i, j = i[near], j[near]
     label = _components(len(parts), i, j)
