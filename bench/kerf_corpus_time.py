@@ -2,20 +2,25 @@
 
 Per corpus file with closed paths and side: ``compensate_indexed`` (vector, kerf 0.1 mm at
 the fit-field magnification, 1 bit arc tolerance) against Clipper2's even-odd union +
-InflatePaths per pen (numpy in and out), best of 3 each. Prints the totals, the ratios over
-the runs where Clipper2 takes at least 5 ms (below that both are a few milliseconds and the
-ratio is fixed per-call cost), and the runs above 1.2x Clipper2's vertex count, each with
-both outlines' reference-free offset error (largest | distance to the input outline - d |,
-densified to 0.1 bit) in bits.
+InflatePaths per pen (numpy in and out), best of 3 each (``--repeat N``: best of N, for a
+busy machine; ``--clock cpu``: the process's CPU time instead of wall time, which other
+processes on a busy machine do not inflate; both sides are single-threaded). Prints the
+totals, the ratios over the runs where Clipper2 takes at least 5 ms (below that both are a
+few milliseconds and the ratio is fixed per-call cost), and the runs above 1.2x Clipper2's
+vertex count, each with both outlines' reference-free offset error (largest | distance to
+the input outline - d |, densified to 0.1 bit) in bits.
 
 Run with the benchmark's own environment (made by run_kerf.sh):
-``PYTHONPATH=. bench/.venv-kerf/bin/python bench/kerf_corpus_time.py``
+``PYTHONPATH=. bench/.venv-kerf/bin/python bench/kerf_corpus_time.py [--repeat N]
+[--clock cpu]``
 """
 
 from __future__ import annotations
 
+import argparse
 import os
 import sys
+import time
 
 import numpy as np
 
@@ -49,7 +54,19 @@ def offset_errors(dr: Drawing, side: str) -> tuple[float, float]:
     return ours, theirs
 
 
-def runs(drawings: dict[str, Drawing]) -> list[tuple[str, str, float, float, int, int]]:
+def timed_cpu(fn, repeat=3):
+    """Like bench_kerf.timed, in CPU time of this process."""
+    ts = []
+    out = None
+    for _ in range(repeat):
+        t = time.process_time()
+        out = fn()
+        ts.append(time.process_time() - t)
+    return out, min(ts)
+
+
+def runs(drawings: dict[str, Drawing], repeat: int = 3
+         ) -> list[tuple[str, str, float, float, int, int]]:
     """(file, side, our time, Clipper2 time, our vertices, Clipper2 vertices) per run."""
     rows = []
     for name, dr in drawings.items():
@@ -61,13 +78,13 @@ def runs(drawings: dict[str, Drawing]) -> list[tuple[str, str, float, float, int
         bit = fm.bits_to_units(1.0)
         for side in ("outside", "inside"):
             (out, _), t = bk.timed(lambda side=side, dr=dr, fm=fm: kerf.compensate_indexed(
-                dr, kerf_mm=KERF_MM, side=side, method="vector", fm=fm), 3)
+                dr, kerf_mm=KERF_MM, side=side, method="vector", fm=fm), repeat)
             tc, nc = 0.0, 0
             for pen in sorted({p.pen for p in dr.paths}):
                 rings = bk.pen_rings(dr, pen)
                 if rings:
                     paths, t1 = bk.timed(lambda rings=rings, d=d, side=side, bit=bit:
-                                         bk.clipper_offset(rings, d, side, bit), 3)
+                                         bk.clipper_offset(rings, d, side, bit), repeat)
                     tc += t1
                     nc += sum(len(p) for p in paths)
             nv = sum(len(p.points) - 1 for p in out.paths if p.closed)
@@ -76,8 +93,14 @@ def runs(drawings: dict[str, Drawing]) -> list[tuple[str, str, float, float, int
 
 
 def main() -> None:
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--repeat", type=int, default=3, help="best of this many runs each")
+    ap.add_argument("--clock", choices=("wall", "cpu"), default="wall")
+    args = ap.parse_args()
+    if args.clock == "cpu":
+        bk.timed = timed_cpu
     drawings = dict(bk.corpus_drawings())
-    rows = runs(drawings)
+    rows = runs(drawings, args.repeat)
     t = np.array([r[2] for r in rows])
     c = np.array([r[3] for r in rows])
     nv = np.array([r[4] for r in rows])

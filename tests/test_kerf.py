@@ -525,3 +525,113 @@ def test_parts_grown_one_by_one_match_one_buffer_of_all() -> None:
         assert len(shapely.get_parts(ours)) == len(shapely.get_parts(whole))
         # within the arc tolerance of each other (ours: chords within 0.05 of the arcs)
         assert shapely.hausdorff_distance(ours.boundary, whole.boundary, densify=0.1) <= 0.051
+
+
+# ------------------------------------------------------------------ even-odd fast paths
+@st.composite
+def clustered_rings(draw):
+    """Clusters of rings on a coarse grid of cells, each cluster one of: nested squares
+    (simple, the nesting fast path), a bow tie, two crossing squares, two squares sharing
+    an edge, a square drawn twice (the general path)."""
+    rings = []
+    for cx in range(draw(st.integers(1, 4))):
+        for cy in range(draw(st.integers(1, 3))):
+            x, y = 100.0 * cx, 100.0 * cy
+            kind = draw(st.sampled_from(["nested", "bow", "cross", "share", "twice"]))
+            if kind == "nested":
+                for k in range(draw(st.integers(1, 3))):
+                    rings.append(square(x + 10 * k, y + 10 * k, 80 - 20 * k,
+                                        ccw=draw(st.booleans())))
+            elif kind == "bow":
+                rings.append(np.array([(x, y), (x + 60, y + 60), (x + 60, y), (x, y + 60),
+                                       (x, y)]))
+            elif kind == "cross":
+                rings += [square(x, y, 50), square(x + 25, y + 25, 50)]
+            elif kind == "share":
+                rings += [square(x, y, 40), square(x + 40, y, 40)]
+            else:
+                rings += [square(x, y, 40), square(x, y, 40)[::-1]]
+    return [rings[k] for k in draw(st.permutations(range(len(rings))))]
+
+
+@settings(max_examples=60, deadline=None, database=None)
+@given(clustered_rings())
+def test_even_odd_groups_give_the_general_paths_region(rings) -> None:
+    """Rings in groups that need the general path and groups that nesting handles give the
+    same region as the general path on all rings at once."""
+    from galvo_core.kerf import _even_odd_general
+
+    region = even_odd_region(rings)
+    general = _even_odd_general([np.asarray(r, float) for r in rings])
+    assert region.is_valid
+    assert math.isclose(region.area, general.area, rel_tol=1e-12, abs_tol=1e-9)
+    assert shapely.symmetric_difference(region, general).area <= 1e-9
+
+
+def test_box_groups_keep_touching_boxes_together() -> None:
+    from galvo_core.kerf import _box_groups
+
+    rng = np.random.default_rng(5)
+    lo = rng.uniform(0, 100, (300, 2))
+    b = np.column_stack([lo, lo + rng.uniform(0.1, 8, (300, 2))])
+    b[:5] = [[0, 0, 1, 1], [1, 0, 2, 1], [2, 2, 3, 3], [200, 200, 210, 201],
+             [210, 200, 211, 201]]  # touching along an edge or at a corner
+    label = _box_groups(b)
+    meet = ((b[:, None, 0] <= b[None, :, 2]) & (b[None, :, 0] <= b[:, None, 2])
+            & (b[:, None, 1] <= b[None, :, 3]) & (b[None, :, 1] <= b[:, None, 3]))
+    i, j = np.nonzero(meet)
+    assert np.array_equal(label[i], label[j])
+    assert label[3] == label[4] and label[3] != label[0]
+    # a pinwheel of four boxes around a fifth: no axis-parallel cut separates them
+    pin = np.array([[0, 0, 2, 1], [2, 0, 3, 2], [1, 2, 3, 3], [0, 1, 1, 3],
+                    [1.2, 1.2, 1.8, 1.8], [10, 10, 11, 11]], float)
+    assert len(set(_box_groups(pin)[:5].tolist())) == 1 and _box_groups(pin)[5] != 0
+
+
+def test_components_and_row_groups_match_plain_references() -> None:
+    from galvo_core.kerf import _components, _group_rows
+
+    rng = np.random.default_rng(11)
+    n = 400
+    i, j = rng.integers(0, n, 300), rng.integers(0, n, 300)
+    label = _components(n, i, j)
+    ref = np.arange(n)  # plain label propagation
+    while True:
+        new = ref.copy()
+        np.minimum.at(new, i, ref[j])
+        np.minimum.at(new, j, ref[i])
+        if np.array_equal(new, ref):
+            break
+        ref = new
+    assert np.array_equal(label, ref)
+    rows = rng.integers(-2, 3, (2000, 4)).astype(float)
+    rows[rows == 0] = -0.0  # -0.0 and 0.0 are one value
+    rows[::7, 1] = 0.0
+    inv, first, cnt = _group_rows(rows)
+    _, ufirst, uinv, ucnt = np.unique(rows + 0.0, axis=0, return_index=True,
+                                      return_inverse=True, return_counts=True)
+    assert np.array_equal(rows[first][inv] + 0.0, rows + 0.0)
+    assert sorted(first.tolist()) == sorted(ufirst.tolist())
+    assert sorted(cnt.tolist()) == sorted(ucnt.tolist())
+    assert len(set(zip(inv.tolist(), uinv.ravel().tolist(), strict=True))) == len(cnt)
+
+
+def test_dense_and_sparse_groups_are_grown_alike(monkeypatch: pytest.MonkeyPatch) -> None:
+    """Groups of meeting polygons are buffered as one MultiPolygon or one by one and
+    unioned (dense groups): both give the same region within the arc tolerance."""
+    import galvo_core.kerf as kerf_mod
+
+    rng = np.random.default_rng(8)
+    parts = [shapely.box(x, y, x + w, y + h) for x, y, w, h in
+             zip(rng.uniform(0, 120, 80), rng.uniform(0, 120, 80), rng.uniform(1, 6, 80),
+                 rng.uniform(1, 6, 80), strict=True)]
+    region = shapely.union_all(parts)
+    out = {}
+    for share in (0.0, 1e9):
+        monkeypatch.setattr(kerf_mod, "GROUP_PAIRS_PER_PART", share)
+        out[share] = compensate_geometry(region, 3.0, side="outside", method="vector",
+                                         tol=0.05, res=0.05)
+        assert out[share].is_valid
+    assert len(shapely.get_parts(out[0.0])) == len(shapely.get_parts(out[1e9]))
+    assert shapely.hausdorff_distance(out[0.0].boundary, out[1e9].boundary,
+                                      densify=0.1) <= 0.1
