@@ -108,7 +108,7 @@ MAX_QUAD_SEGS = 512
 GEOS_MIN_QUAD_SEGS = 8
 #: the vector method's GEOS arcs are drawn with chords whose sagitta is at most this share
 #: of the arc tolerance; the rest of the tolerance is the budget of the vertex reduction
-ARC_SHARE = 1.0 / 16.0
+ARC_SHARE = 1.0 / 4.0
 #: output vertices sampled when mapping rings back to their sources
 ASSIGN_STRIDE = 4
 #: scan spacing of the rectangle method as a fraction of d
@@ -252,14 +252,19 @@ def reduce_vertices(geom: BaseGeometry, eps: float, keep: np.ndarray | None = No
     no repair of the whole geometry), for a polygon that comes out invalid from GEOS's
     topology-preserving variant on that polygon (its rings cannot cross or collapse). Each
     ring's first vertex is kept: GEOS drops a ring's end point by looking at that vertex
-    alone, which can leave vertices dropped before it beyond ``eps``. Vertices at the
-    coordinates ``keep`` (K, 2) are never dropped."""
+    alone, which can leave vertices dropped before it beyond ``eps``. The vertices where
+    the mask ``keep`` is set (over the coordinates of the rings, polygon by polygon, each
+    ring closed) are never dropped."""
     return _reduce(geom, eps, keep)[0]
 
 
-def _reduce(geom: BaseGeometry, eps: float, keep: np.ndarray | None = None
-            ) -> tuple[BaseGeometry, bool]:
-    """:func:`reduce_vertices`, and whether the result was checked to be valid."""
+def _reduce(geom: BaseGeometry, eps: float, keep: np.ndarray | None = None,
+            fallback: BaseGeometry | None = None) -> tuple[BaseGeometry, bool]:
+    """:func:`reduce_vertices`, and whether the result was checked to be valid. With
+    ``fallback`` (a valid geometry with the same polygons in the same order, of which
+    ``geom`` is a retouched, unchecked copy), a polygon that is not valid even with all
+    its vertices is replaced by the fallback's, and a whole that is not valid becomes the
+    fallback's reduction."""
     if eps <= 0 or geom.is_empty:
         return geom, False
     parts = shapely.get_parts(geom)
@@ -267,7 +272,7 @@ def _reduce(geom: BaseGeometry, eps: float, keep: np.ndarray | None = None
     owner = np.repeat(np.arange(len(parts)), n_holes + 1)  # part of each ring
     rings = shapely.get_rings(parts)
     xy, ring = shapely.get_coordinates(rings, return_index=True)
-    fixed = _at(xy, keep)
+    fixed = keep if keep is not None and len(keep) == len(xy) else None
     kept = _kept_of(xy, ring, shapely.simplify(rings, eps, preserve_topology=False), eps,
                     fixed)
     polys = _polys_of(xy, ring, kept, owner)
@@ -292,7 +297,10 @@ def _reduce(geom: BaseGeometry, eps: float, keep: np.ndarray | None = None
         if len(still):
             kept[np.isin(owner, still)[ring]] = True
             polys = _polys_of(xy, ring, kept, owner)
-            checked = False
+            if fallback is not None:
+                polys[still] = _reduced_parts(fallback, still, eps)
+            else:
+                checked = False
     if len(polys) == 1:
         return polys[0], checked
     out = shapely.MultiPolygon(list(polys))
@@ -301,17 +309,27 @@ def _reduce(geom: BaseGeometry, eps: float, keep: np.ndarray | None = None
         i, j = shapely.STRtree(polys).query(polys, predicate="intersects")
         meet = np.unique(np.concatenate([i[i != j], j[i != j]]))
         kept[np.isin(owner, meet)[ring]] = True
-        out = shapely.MultiPolygon(list(_polys_of(xy, ring, kept, owner)))
+        polys = _polys_of(xy, ring, kept, owner)
+        out = shapely.MultiPolygon(list(polys))
+        if not out.is_valid and fallback is not None:
+            polys[meet] = _reduced_parts(fallback, meet, eps)
+            out = shapely.MultiPolygon(list(polys))
+            if not out.is_valid:
+                return _reduce(fallback, eps)
         if not out.is_valid:
             return geom, False
     return out, True
 
 
-def _at(xy: np.ndarray, pts: np.ndarray | None) -> np.ndarray | None:
-    """Mask of the rows of ``xy`` equal to some row of ``pts`` (None when there are none)."""
-    if pts is None or not len(pts):
-        return None
-    return np.isin(xy[:, 0] + 1j * xy[:, 1], pts[:, 0] + 1j * pts[:, 1])
+def _reduced_parts(geom: BaseGeometry, idx: np.ndarray, eps: float) -> np.ndarray:
+    """The polygons ``idx`` of ``geom``, each thinned by :func:`_reduce` on its own (each
+    valid: a polygon that does not thin validly stays as it is)."""
+    parts = shapely.get_parts(geom)[idx]
+    out = np.empty(len(parts), dtype=object)
+    for k, p in enumerate(parts):
+        r, ok = _reduce(p, eps)
+        out[k] = r if ok and r.geom_type == "Polygon" else p
+    return out
 
 
 def _kept_of(xy: np.ndarray, ring: np.ndarray, simplified: np.ndarray, eps: float,
@@ -870,8 +888,12 @@ def _vector(region: BaseGeometry, d: float, side: str, tol: float
     out = polys[0] if len(polys) == 1 else shapely.MultiPolygon(polys)
     # round joins redrawn with the error on both sides of the arc (fewer vertices), kept
     # as they are by the thinning, which has the rest of the outline
-    out, joins = two_sided_arcs(out, d, tol)
-    return _reduce(out, reduce_tol_for(d, tol), joins)
+    # (their validity is checked once, on the thinned result, which falls back to GEOS's
+    # polygons where the redrawn ones are not valid)
+    joined, joins = two_sided_arcs(out, d, tol, check=False)
+    if not len(joins):
+        return _reduce(out, reduce_tol_for(d, tol))
+    return _reduce(joined, reduce_tol_for(d, tol), joins, fallback=out)
 
 
 #: a group of grown polygons with at most this many meeting pairs per polygon is buffered

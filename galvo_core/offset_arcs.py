@@ -79,17 +79,22 @@ def join_plan(d: float, tol: float, phi: np.ndarray) -> tuple[np.ndarray, np.nda
     return k_out, r_out
 
 
-def two_sided_arcs(geom: BaseGeometry, d: float, tol: float) -> tuple[BaseGeometry, np.ndarray]:
+def two_sided_arcs(geom: BaseGeometry, d: float, tol: float, *, check: bool = True
+                   ) -> tuple[BaseGeometry, np.ndarray]:
     """``geom`` (valid (Multi)Polygon: GEOS's offset by ``d``, round joins, before any
-    thinning) with its round joins redrawn by :func:`join_plan`, and the (K, 2) vertices
-    of the redrawn joins (their ends included), which a later thinning must keep: the
-    joins already use the whole tolerance. Rings, polygons and their order are kept; a
-    polygon that would come out invalid is kept as it was. Vectorised over all rings.
+    thinning) with its round joins redrawn by :func:`join_plan`, and a mask over the
+    result's vertices (``shapely.get_coordinates`` of its rings, polygon by polygon, each
+    ring closed; empty when nothing changed) of those of the redrawn joins, their ends
+    included, which a later thinning must keep: the joins already use the whole
+    tolerance. Rings, polygons and their order are kept; a
+    polygon that would come out invalid is kept as it was (with ``check=False`` the
+    caller checks the result, which may then be invalid, and has ``geom`` to fall back
+    on). Vectorised over all rings.
 
     A join is found from the outline alone: its inner vertices are those whose circle
     through them and their two neighbours has radius d (GEOS puts every arc vertex on the
     circle), with one centre along the run."""
-    none = np.zeros((0, 2))
+    none = np.zeros(0, dtype=bool)
     if geom.is_empty or not (0.0 < tol < d):
         return geom, none
     parts = shapely.get_parts(geom)
@@ -171,29 +176,62 @@ def two_sided_arcs(geom: BaseGeometry, d: float, tol: float) -> tuple[BaseGeomet
     inner_v = same.copy()  # a run's vertices past its first ...
     inner_v[r_last] = False  # ... and before its last
     drop[inner_v & use[run_id]] = True
-    key = np.concatenate([np.flatnonzero(~drop).astype(np.float64), new_key])
-    all_xy = np.concatenate([xy[~drop], new_xy])
-    all_ring = np.concatenate([ring[~drop], ring[r_first[u]][jrun]])
-    order = np.lexsort((key, all_ring))
-    all_xy, all_ring = all_xy[order], all_ring[order]
+    ends_v = np.zeros(len(xy), dtype=bool)  # the used joins' end vertices
+    ends_v[r_first[u]] = True
+    ends_v[r_last[u]] = True
+    # merge the kept vertices (positions in xy, rings in order) and the new ones (after
+    # their run's first vertex): both lists are sorted, so each one's place in the merged
+    # list is its own rank plus the count of the other list before it
+    kept_at = np.flatnonzero(~drop)
+    n_all = len(kept_at) + len(new_key)
+    p_new = np.searchsorted(kept_at, new_key) + np.arange(len(new_key))
+    p_old = np.searchsorted(new_key, kept_at) + np.arange(len(kept_at))
+    all_xy = np.empty((n_all, 2))
+    all_xy[p_old] = xy[kept_at]
+    all_xy[p_new] = new_xy
+    all_ring = np.empty(n_all, dtype=ring.dtype)
+    all_ring[p_old] = ring[kept_at]
+    all_ring[p_new] = ring[r_first[u]][jrun]
+    all_prot = np.ones(n_all, dtype=bool)
+    all_prot[p_old] = ends_v[kept_at]
     # close the rings and build the polygons; a polygon that is not valid keeps its rings
     starts2 = np.flatnonzero(np.diff(all_ring, prepend=-1))
-    closed_xy = np.insert(all_xy, np.append(starts2[1:], len(all_xy)), all_xy[starts2], axis=0)
-    closed_ring = np.insert(all_ring, np.append(starts2[1:], len(all_ring)), all_ring[starts2])
+    at = np.append(starts2[1:], len(all_xy))
+    closed_xy = np.insert(all_xy, at, all_xy[starts2], axis=0)
+    closed_ring = np.insert(all_ring, at, all_ring[starts2])
+    closed_prot = np.insert(all_prot, at, all_prot[starts2])
     polys = shapely.polygons(shapely.linearrings(closed_xy, indices=closed_ring), indices=owner)
     changed = np.zeros(len(parts), dtype=bool)
     changed[owner[np.unique(ring[r_first[u]])]] = True
-    bad = changed & ~(shapely.is_valid(polys) & ~shapely.is_empty(polys))
+    ch = np.flatnonzero(changed)
+    bad = ch[~(shapely.is_valid(polys[ch]) & ~shapely.is_empty(polys[ch]))] if check else ch[:0]
     polys[bad] = parts[bad]
-    changed &= ~bad
+    changed[bad] = False
+    if check and len(polys) > 1 and changed.any():
+        # the polygons were valid together; a changed one that now meets another (even
+        # at a point) keeps its old rings, and so does the other if it changed
+        ch = np.flatnonzero(changed)
+        i, j = shapely.STRtree(polys).query(polys[ch], predicate="intersects")
+        meet = np.unique(np.concatenate([ch[i][ch[i] != j], j[ch[i] != j]]))
+        meet = meet[changed[meet]]
+        polys[meet] = parts[meet]
+        changed[meet] = False
+        if len(meet) and not shapely.MultiPolygon(list(polys)).is_valid:
+            return geom, none  # (a reverted polygon meets another changed one: rare)
     if not changed.any():
         return geom, none
     out = polys[0] if len(polys) == 1 else shapely.MultiPolygon(list(polys))
-    if not out.is_valid:
-        return geom, none
-    kept = changed[owner[ring[r_first[u]]]]  # per used run: its polygon took it
-    protect = np.concatenate([xy[r_first[u][kept]], xy[r_last[u][kept]], new_xy[kept[jrun]]])
-    return out, protect
+    # the mask over the result's vertices (rings in order, each closed): a changed ring's
+    # from closed_prot, the others' all False
+    new_ring = changed[owner]
+    cnt = np.where(new_ring, np.bincount(closed_ring, minlength=n_r), size + 1)
+    first = np.concatenate(([0], np.cumsum(cnt)[:-1]))
+    mask = np.zeros(int(cnt.sum()), dtype=bool)
+    sel = new_ring[closed_ring]
+    row0 = np.concatenate(([0], np.cumsum(np.bincount(closed_ring, minlength=n_r))[:-1]))
+    dest = first[closed_ring[sel]] + (np.flatnonzero(sel) - row0[closed_ring[sel]])
+    mask[dest] = closed_prot[sel]
+    return out, mask
 
 
 
