@@ -414,7 +414,8 @@ def main() -> int:
                     help="methods for the corpus sweep (comma-separated; default all)")
     args = ap.parse_args()
     lines = ["## Kerf (issue 6)", ""]
-    lines.append(f"Date 2026-11-23. Machine: {platform.machine()} {platform.processor() or ''} "
+    lines.append(f"Date {time.strftime('%Y-%m-%d', time.gmtime())}. Machine: "
+                 f"{platform.machine()} {platform.processor() or ''} "
                  f"{os.cpu_count()} CPUs, Python {platform.python_version()}, shapely "
                  f"{shapely.__version__} (GEOS {shapely.geos_version_string}), clipper2-py "
                  f"{getattr(clipper2, '__version__', 'missing')} (Clipper2 "

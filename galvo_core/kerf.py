@@ -21,12 +21,16 @@ even-odd region by shapely/GEOS ``buffer`` with round joins. At a convex corner 
 is an arc of radius ``d`` around the corner (the paper replaces the far-away intersection at
 acute corners by that arc); concave corners are exact intersections. GEOS draws the arcs
 finely, with ``quad_segs`` segments per quarter circle chosen so the sagitta of every chord,
-``d (1 - cos(θ/2))``, is within 1/16 of the arc tolerance ``tol`` (``arc_tol_bits`` galvo
+``d (1 - cos(θ/2))``, is within 1/4 of the arc tolerance ``tol`` (``arc_tol_bits`` galvo
 bits), and never fewer than 8 (GEOS is less exact below 8; see :func:`quad_segs_for`).
-The outline is then thinned by Douglas-Peucker within the rest of the budget,
-``tol - sagitta`` (:func:`reduce_vertices`: valid, same rings, else unthinned), so every
-point stays within ``tol`` of GEOS's exact offset while arcs end up with about as many
-chords as Clipper2 draws at the same tolerance, and densely sampled input curves lose the
+Each round join is then redrawn with its inner vertices just inside ``d + tol`` (the error
+on both sides of the arc: :mod:`galvo_core.offset_arcs`), which takes fewer chords than
+GEOS's on-circle ones (a right angle at d/tol = 30: 3 instead of 4, as Clipper2 draws it),
+and the rest of the outline is thinned by Douglas-Peucker within the rest of the budget,
+``tol - sagitta`` (:func:`reduce_vertices`: valid, same rings, else unthinned; the redrawn
+joins are kept, and a polygon they would make invalid falls back to GEOS's), so every
+point stays within ``tol`` of GEOS's exact offset while arcs end up with no more chords
+than Clipper2 draws at the same tolerance, and densely sampled input curves lose the
 vertices the tolerance does not need. (GEOS also drops concave input vertices less than
 ``d/100`` deep before buffering, as its exact reference does; bench/RESULTS.md compares
 both with Clipper2 at a fine tolerance.) GEOS handles holes,
