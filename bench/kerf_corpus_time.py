@@ -18,6 +18,7 @@ Run with the benchmark's own environment (made by run_kerf.sh):
 from __future__ import annotations
 
 import argparse
+import functools
 import os
 import sys
 import time
@@ -54,15 +55,6 @@ def offset_errors(dr: Drawing, side: str) -> tuple[float, float]:
     return ours, theirs
 
 
-def timed_cpu(fn, repeat=3):
-    """Like bench_kerf.timed, in CPU time of this process."""
-    ts = []
-    out = None
-    for _ in range(repeat):
-        t = time.process_time()
-        out = fn()
-        ts.append(time.process_time() - t)
-    return out, min(ts)
 
 
 def runs(drawings: dict[str, Drawing], repeat: int = 3
@@ -98,7 +90,7 @@ def main() -> None:
     ap.add_argument("--clock", choices=("wall", "cpu"), default="wall")
     args = ap.parse_args()
     if args.clock == "cpu":
-        bk.timed = timed_cpu
+        bk.timed = functools.partial(bk.timed, clock=time.process_time)
     drawings = dict(bk.corpus_drawings())
     rows = runs(drawings, args.repeat)
     t = np.array([r[2] for r in rows])
