@@ -21,7 +21,7 @@ even-odd region by shapely/GEOS ``buffer`` with round joins. At a convex corner 
 is an arc of radius ``d`` around the corner (the paper replaces the far-away intersection at
 acute corners by that arc); concave corners are exact intersections. GEOS draws the arcs
 finely, with ``quad_segs`` segments per quarter circle chosen so the sagitta of every chord,
-``d (1 - cos(θ/2))``, is within 1/4 of the arc tolerance ``tol`` (``arc_tol_bits`` galvo
+``d (1 - cos(θ/2))``, is within 1/16 of the arc tolerance ``tol`` (``arc_tol_bits`` galvo
 bits), and never fewer than 8 (GEOS is less exact below 8; see :func:`quad_segs_for`).
 Each round join is then redrawn with its inner vertices just inside ``d + tol`` (the error
 on both sides of the arc: :mod:`galvo_core.offset_arcs`), which takes fewer chords than
@@ -112,7 +112,7 @@ MAX_QUAD_SEGS = 512
 GEOS_MIN_QUAD_SEGS = 8
 #: the vector method's GEOS arcs are drawn with chords whose sagitta is at most this share
 #: of the arc tolerance; the rest of the tolerance is the budget of the vertex reduction
-ARC_SHARE = 1.0 / 4.0
+ARC_SHARE = 1.0 / 16.0
 #: output vertices sampled when mapping rings back to their sources
 ASSIGN_STRIDE = 4
 #: scan spacing of the rectangle method as a fraction of d
