@@ -126,7 +126,7 @@ def two_sided_arcs(geom: BaseGeometry, d: float, tol: float, *, check: bool = Tr
     np.minimum.at(first_brk, ring[brk], pos[brk])
     first_brk[~has_brk] = 0
     rot = start[ring] + (pos + first_brk[ring]) % size[ring]  # new order -> old index
-    xy, cc, inner, same = xy[rot], cc[rot], inner[rot], same[rot]
+    xy, same = xy[rot], same[rot]
     same &= has_brk[ring]
     same[start] = False  # (a run never wraps past a ring's new start)
     # runs: maximal stretches start..end with same[] inside
@@ -203,6 +203,7 @@ def two_sided_arcs(geom: BaseGeometry, d: float, tol: float, *, check: bool = Tr
     polys = shapely.polygons(shapely.linearrings(closed_xy, indices=closed_ring), indices=owner)
     changed = np.zeros(len(parts), dtype=bool)
     changed[owner[np.unique(ring[r_first[u]])]] = True
+    polys[~changed] = parts[~changed]  # (the others exactly as they came)
     ch = np.flatnonzero(changed)
     bad = ch[~(shapely.is_valid(polys[ch]) & ~shapely.is_empty(polys[ch]))] if check else ch[:0]
     polys[bad] = parts[bad]
