@@ -210,6 +210,7 @@ class ParamGroup:
     __slots__ = ()
     STAGE: ClassVar[str] = ""
     TITLE: ClassVar[str] = ""
+    _NAMED: ClassVar[dict[str, Spec]] = {}
 
     def __post_init__(self) -> None:
         for f in fields(self):  # type: ignore[arg-type]
@@ -228,20 +229,20 @@ class ParamGroup:
         return {f.name: getattr(self, f.name) for f in fields(self)}  # type: ignore[arg-type]
 
 
-_SPECS: dict[tuple[type, str], Spec] = {}
-
-
 def spec_of(cls: type, name: str) -> Spec:
     """The Spec of field ``name`` of group class ``cls`` (named after the field and group)."""
-    key = (cls, name)
-    s = _SPECS.get(key)
-    if s is None:
-        f = {f.name: f for f in fields(cls)}[name]  # type: ignore[arg-type]
-        s = dataclasses.replace(f.metadata["spec"], name=name, group=cls.STAGE)  # type: ignore[attr-defined]
-        _SPECS[key] = s
-    return s
+    return cls._NAMED[name]  # type: ignore[attr-defined,no-any-return]
 
 
+def _named(cls: type[ParamGroup]) -> type[ParamGroup]:
+    """Class decorator (after ``@dataclass``): each field's Spec with its name and group."""
+    cls._NAMED = {  # type: ignore[attr-defined]
+        f.name: dataclasses.replace(f.metadata["spec"], name=f.name, group=cls.STAGE)
+        for f in fields(cls)}  # type: ignore[arg-type]
+    return cls
+
+
+@_named
 @dataclass(frozen=True, slots=True, kw_only=True)
 class FitParams(ParamGroup):
     """Thinning and fitting, input units (paper 000 §2-3)."""
@@ -262,6 +263,7 @@ class FitParams(ParamGroup):
         help="the dichotomy stops when the signed error sum is below this")
 
 
+@_named
 @dataclass(frozen=True, slots=True, kw_only=True)
 class FieldParams(ParamGroup):
     """How input units map to galvo bits."""
@@ -292,6 +294,7 @@ class FieldParams(ParamGroup):
         help="clamp marks that leave the field (with a warning) instead of refusing")
 
 
+@_named
 @dataclass(frozen=True, slots=True, kw_only=True)
 class SampleParams(ParamGroup):
     """Marking points (paper 000 §4, paper 004, paper 001's fixed step as a baseline)."""
@@ -326,6 +329,7 @@ class SampleParams(ParamGroup):
             raise ParamError("max_step_bits must be >= min_step_bits")
 
 
+@_named
 @dataclass(frozen=True, slots=True, kw_only=True)
 class KerfParams(ParamGroup):
     """Kerf compensation (paper 003)."""
@@ -348,6 +352,7 @@ class KerfParams(ParamGroup):
         help="largest deviation of the offset's round corners from true arcs")
 
 
+@_named
 @dataclass(frozen=True, slots=True, kw_only=True)
 class FillParams(ParamGroup):
     """Hatch fill (paper 002)."""
@@ -379,6 +384,7 @@ class FillParams(ParamGroup):
         help="distance kept between the fill lines and the outline")
 
 
+@_named
 @dataclass(frozen=True, slots=True, kw_only=True)
 class OrderParams(ParamGroup):
     """The order strokes are marked in."""
@@ -395,6 +401,7 @@ class OrderParams(ParamGroup):
         help="most time the optimized order may spend improving")
 
 
+@_named
 @dataclass(frozen=True, slots=True, kw_only=True)
 class LaserParams(ParamGroup):
     """The laser and scanner settings of a job (defaults: a typical fibre-laser galvo)."""
