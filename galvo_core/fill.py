@@ -17,8 +17,9 @@ horizontal, ``spacing`` apart, centred in each region's height.
   and left side (the laser stays on). Cells are joined into one stroke along a path that
   visits each cell once (a semi-Hamiltonian path of the cell graph, searched depth-first with
   Warnsdorff's rule, component by component, within a number of steps linear in the cells;
-  when they are spent, greedy walks cover the rest: strokes <= cells always); the join from one cell to the next is the piece
-  of boundary between the exit corner and the next cell's corner. Theorem 2 of the paper (a
+  when they are spent, greedy walks cover the rest: strokes <= cells always); the join from
+  one cell to the next is the piece of boundary between the exit corner and the next cell's
+  corner. Theorem 2 of the paper (a
   convex cell can be covered from any boundary point to any other) makes the exit corner a
   free choice: a cell whose zig-zag would end on the wrong side gets one more hatch line
   half-way between two of its lines (in its narrowest strip), and a cell entered and left at
@@ -46,6 +47,7 @@ from shapely.geometry import LineString, MultiLineString, Polygon
 from shapely.geometry.base import BaseGeometry
 
 from galvo_core.drawing import Drawing
+from galvo_core.kerf import _components
 
 FILL_METHODS = ("scanline", "zigzag")
 #: search steps for long cell paths per monotone cell of a region piece (plus EFFORT_BASE);
@@ -301,25 +303,11 @@ class _Hatch:
     def cells(self) -> None:
         """Monotone cells: chains of segments joined by one-to-one strips."""
         ns = self.n_seg
-        parent = list(range(2 * ns))
-
-        def find(a: int) -> int:
-            while parent[a] != a:
-                parent[a] = parent[parent[a]]
-                a = parent[a]
-            return a
-
-        seg = self.seg
-        sa = self.side_after
-        nxt = self.next
-        for c in range(self.n):
-            d = int(nxt[c])
-            # piece c -> d: on side sa[c] of c's line; at d it lies on side 1 - sa[d]
-            u = find(2 * int(seg[c]) + int(sa[c]))
-            v = find(2 * int(seg[d]) + 1 - int(sa[d]))
-            if u != v:
-                parent[u] = v
-        roots = np.array([find(a) for a in range(2 * ns)], dtype=np.int64)
+        # piece c -> next[c]: on side sa[c] of c's line; at next[c] it lies on side
+        # 1 - sa[next[c]]; the strips (segment, side) a piece joins are one strip
+        d = self.next
+        roots = _components(2 * ns, 2 * self.seg + self.side_after,
+                            2 * self.seg[d] + 1 - self.side_after[d])
         self.comp_dn = roots[0::2]
         self.comp_up = roots[1::2]
         n_b = np.bincount(self.comp_up, minlength=2 * ns)  # segments below each strip
@@ -392,7 +380,9 @@ class _Hatch:
         jj = np.where(np.repeat(fwd, cnt), jj, cr - 1 - jj)
         idx = (np.repeat(ea, cnt) + 1 + jj) % np.repeat(nv, cnt) + np.repeat(
             self._ring_off[ring], cnt)
-        return np.split(self._ring_cat[idx], first[1:])
+        pts = self._ring_cat[idx]
+        ends = (first + cnt).tolist()
+        return [pts[i:j] for i, j in zip(first.tolist(), ends, strict=True)]
 
     def _split(self, p0: np.ndarray, piece: np.ndarray, p1: np.ndarray, ym: float
                ) -> tuple[float, np.ndarray, np.ndarray] | None:

@@ -119,6 +119,8 @@ ASSIGN_STRIDE = 4
 RECT_SPACING = 0.25
 #: the even-odd ray test cuts the plane into columns of about this many edge ends each
 CROSS_COLUMN_EDGES = 128
+#: ... unless the plain ray count pairs at most this many times (points + edges)
+CROSS_PLAIN_PAIRS = 8
 
 
 # --------------------------------------------------------------------------- public API
@@ -824,6 +826,12 @@ def _odd_crossings(pts: np.ndarray, a: np.ndarray, b: np.ndarray) -> np.ndarray:
     n, m = len(pts), len(a)
     if n == 0 or m == 0:
         return np.zeros(n, dtype=bool)
+    # few point-edge pairs (most layouts of a few drawings): the plain count is cheaper
+    sy = np.sort(pts[:, 1])
+    ylo_, yhi_ = np.minimum(a[:, 1], b[:, 1]), np.maximum(a[:, 1], b[:, 1])
+    pairs = int(np.maximum(np.searchsorted(sy, yhi_) - np.searchsorted(sy, ylo_), 0).sum())
+    if pairs <= CROSS_PLAIN_PAIRS * (n + m):
+        return _crossings(pts, a, b) % 2 == 1
     n_col = min(m // CROSS_COLUMN_EDGES, 1 << 16)
     xs = np.sort(np.concatenate([a[:, 0], b[:, 0]]))
     if n_col >= 2:

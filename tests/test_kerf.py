@@ -665,6 +665,7 @@ def test_odd_crossings_is_the_parity_of_the_plain_ray_count(grid: bool,
     from galvo_core.kerf import _crossings, _odd_crossings, _odd_edges
 
     rng = np.random.default_rng(21 if grid else 20)
+    monkeypatch.setattr(kerf_mod, "CROSS_PLAIN_PAIRS", 0)  # always the column path
     for cols in (4, 16, 128):
         monkeypatch.setattr(kerf_mod, "CROSS_COLUMN_EDGES", cols)
         rings = _tiled_rings(rng, 12, grid=grid)
