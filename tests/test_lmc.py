@@ -1,0 +1,210 @@
+"""LMC (BJJCZ) list export: golden tests against galvoplotter's own encoder, and the
+independent decoder's replay of exported jobs."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from galvo_core.errors import InputError
+from galvo_core.field import FieldMap
+from galvo_core.job import Job, Stroke
+from galvo_core.layers import LayerSettings, PenTable
+from galvo_core.lmc import (
+    END_OF_LIST,
+    JUMP_TO,
+    MARK_TO,
+    Orientation,
+    bits_per_mm,
+    decode,
+    encode_job,
+    expected_strokes,
+    to_bytes,
+    to_text,
+)
+from galvo_core.params import LaserParams
+
+galvo = pytest.importorskip("galvo", reason="galvoplotter (the lmc extra) is not installed")
+
+
+def make_job(strokes: list[tuple[int, list[tuple[int, int]]]], *, size_mm: float = 110.0,
+             bits: int = 65536, laser: LaserParams | None = None) -> Job:
+    fm = FieldMap(1.0, (0.0, 0.0), bits, size_mm)
+    ss = tuple(Stroke("contour", i, False, np.array(m, dtype=np.int64), (), pen)
+               for i, (pen, m) in enumerate(strokes))
+    return Job("t.plt", "0" * 64, fm, {}, (laser or LaserParams()).as_dict(), ss)
+
+
+def rng_strokes(seed: int, n: int, pens: tuple[int, ...]) -> list[tuple[int, list]]:
+    """Random open strokes whose first mark never sits where the last one ended (so that
+    galvoplotter's goto(), which skips a jump to the current position, jumps every time)."""
+    rng = np.random.default_rng(seed)
+    out = []
+    for i in range(n):
+        k = int(rng.integers(2, 40))
+        start = rng.integers(1000, 64000, size=2)
+        steps = rng.integers(-900, 900, size=(k - 1, 2))
+        m = np.clip(np.vstack([start, start + np.cumsum(steps, axis=0)]), 0, 65535)
+        out.append((pens[i % len(pens)], [tuple(int(v) for v in p) for p in m]))
+    return out
+
+
+def galvoplotter_records(job: Job, table: PenTable) -> np.ndarray:
+    """The same job built with galvoplotter's GalvoController(mock=True): layers by pen
+    number, passes repeated, goto() to each stroke's start and mark() through its marks;
+    the list packets it sends, padding (end-of-list records) stripped, one end-of-list
+    appended."""
+    bpm = bits_per_mm(job)
+    by_pen: dict[int, list[Stroke]] = {}
+    for s in job.strokes:
+        by_pen.setdefault(s.pen, []).append(s)
+    layers = [table.settings(p) for p in sorted(by_pen)]
+    first = layers[0]
+    la = first.laser
+    c = galvo.GalvoController(
+        mock=True, galvos_per_mm=bpm, mark_speed=la.mark_speed_mm_s,
+        travel_speed=la.jump_speed_mm_s, power=la.power_percent, frequency=la.frequency_khz,
+        pulse_width=first.pulse_width_ns, delay_laser_on=la.laser_on_delay_us,
+        delay_laser_off=la.laser_off_delay_us, delay_polygon=la.polygon_delay_us,
+        delay_jump_short=la.jump_delay_us, delay_jump_long=la.jump_delay_long_us)
+    c.source = table.source
+    packets: list[bytes] = []
+
+    def send(data, read=True):  # noqa: ANN001 - galvoplotter's signature
+        if len(data) == 0xC00:
+            packets.append(bytes(data))
+        return (0, 0, 0, 0x20)  # ready, not busy
+
+    c.send = send
+    c.marking_configuration()
+    for k, layer in enumerate(layers):
+        lp = layer.laser
+        if k:
+            c.delay_polygon = lp.polygon_delay_us  # its set() ignores delay_polygon=
+            c.set(mark_speed=lp.mark_speed_mm_s, travel_speed=lp.jump_speed_mm_s,
+                  power=lp.power_percent, frequency=lp.frequency_khz,
+                  pulse_width=layer.pulse_width_ns, delay_on=lp.laser_on_delay_us,
+                  delay_off=lp.laser_off_delay_us)
+        for _ in range(layer.passes):
+            for s in by_pen[layer.pen]:
+                m = s.marks
+                c.goto(int(m[0, 0]), int(m[0, 1]), long=lp.jump_delay_long_us,
+                       short=lp.jump_delay_us, distance_limit=lp.long_jump_mm * bpm)
+                for x, y in m[1:]:
+                    c.mark(int(x), int(y))
+    c.initial_configuration()
+    rec = np.frombuffer(b"".join(packets), dtype="<u2").reshape(-1, 6)
+    pad = np.array([END_OF_LIST, 0, 0, 0, 0, 0])
+    n = len(rec)
+    while n and (rec[n - 1] == pad).all():
+        n -= 1
+    return np.vstack([rec[:n], pad]).astype(np.uint16)
+
+
+def two_pen_table(source: str = "fiber") -> PenTable:
+    base = LayerSettings(0, LaserParams(mark_speed_mm_s=500, jump_speed_mm_s=3000,
+                                        power_percent=40, frequency_khz=30,
+                                        laser_on_delay_us=110, laser_off_delay_us=120,
+                                        polygon_delay_us=50, jump_delay_us=20,
+                                        jump_delay_long_us=300, long_jump_mm=5))
+    p1 = base.replace(pen=1, passes=2, power_percent=35.5)
+    p2 = base.replace(pen=2, mark_speed_mm_s=250, power_percent=80, frequency_khz=60,
+                      laser_on_delay_us=90, polygon_delay_us=75)
+    return PenTable(base, (p1, p2), source)
+
+
+@pytest.mark.parametrize("source", ["fiber", "co2"])
+def test_golden_two_pens_passes_matches_galvoplotter(source):
+    table = two_pen_table(source)
+    job = make_job(rng_strokes(1, 30, (2, 1)))  # pens interleaved in job order
+    ours = encode_job(job, table)
+    theirs = galvoplotter_records(job, table)
+    assert len(ours) > 0xC00 // 12  # more than one of galvoplotter's packets
+    assert ours.shape == theirs.shape
+    bad = np.flatnonzero((ours != theirs).any(axis=1))
+    assert not len(bad), f"record {bad[0]}: ours {ours[bad[0]]} galvoplotter {theirs[bad[0]]}"
+
+
+def test_golden_field_size_pulse_width_and_one_pen():
+    """A 70 mm field (its own bits per mm), a MOPA pulse width, default delays."""
+    base = LayerSettings(0, LaserParams(mark_speed_mm_s=1234.5, jump_speed_mm_s=4000,
+                                        power_percent=12.3, frequency_khz=45.7),
+                         pulse_width_ns=200)
+    table = PenTable(base, (), "fiber")
+    job = make_job(rng_strokes(7, 12, (3,)), size_mm=70.0)
+    np.testing.assert_array_equal(encode_job(job, table), galvoplotter_records(job, table))
+
+
+def test_units_of_the_words():
+    table = two_pen_table()
+    job = make_job(rng_strokes(3, 4, (1, 2)), size_mm=110.0)
+    dec = decode(to_bytes(encode_job(job, table)))
+    bpm = 65536 / 110.0
+    s1 = dec.strokes[0].settings
+    assert s1["mark_speed"] == int(500 * bpm / 1000) == 297
+    assert s1["jump_speed"] == int(3000 * bpm / 1000)
+    assert s1["mark_current"] == round(35.5 * 4095 / 100)
+    assert s1["q_switch_period"] == round(20000 / 30)
+    assert s1["laser_on_delay"] == (110, 0)
+    last = dec.strokes[-1].settings
+    assert last["mark_speed"] == int(250 * bpm / 1000)
+    assert last["mark_current"] == round(80 * 4095 / 100)
+    assert last["q_switch_period"] == round(20000 / 60)
+    assert last["polygon_delay"] == (75, 0)
+
+
+def test_decoder_replays_every_stroke_of_every_pass_in_layer_order():
+    table = two_pen_table()
+    job = make_job(rng_strokes(5, 9, (2, 1, 1)))
+    dec = decode(to_bytes(encode_job(job, table)))
+    assert dec.ended
+    want = expected_strokes(job, table)
+    # pen 1 (2 passes of its 6 strokes) then pen 2 (3 strokes)
+    assert [la.pen for la, _ in want] == [1] * 12 + [2] * 3
+    assert len(dec.strokes) == len(want)
+    for (layer, m), got in zip(want, dec.strokes, strict=True):
+        np.testing.assert_array_equal(got.marks, m)
+        assert got.settings["mark_current"] == round(layer.laser.power_percent * 40.95)
+
+
+def test_closed_stroke_passes_keep_their_jumps():
+    """A closed stroke marked twice: the second pass starts where the first ended; the list
+    still jumps (length 0) so each pass is its own laser-on run (galvoplotter's goto() would
+    skip that jump and merge the passes)."""
+    sq = [(100, 100), (900, 100), (900, 900), (100, 900), (100, 100)]
+    table = PenTable(LayerSettings(0), (LayerSettings(1, passes=3),))
+    rec = encode_job(make_job([(1, sq)]), table)
+    jumps = rec[rec[:, 0] == JUMP_TO]
+    assert len(jumps) == 3 and list(jumps[1, 1:5]) == [100, 100, 0, 0]
+    assert (rec[:, 0] == MARK_TO).sum() == 12
+    assert len(decode(to_bytes(rec)).strokes) == 3
+
+
+def test_disabled_layer_and_dots():
+    table = PenTable(LayerSettings(0), (LayerSettings(2, enabled=False),))
+    job = make_job([(1, [(10, 10), (20, 20)]), (2, [(50, 50), (60, 60)]), (1, [(5, 5)])])
+    dec = decode(to_bytes(encode_job(job, table)))
+    assert [len(s.marks) for s in dec.strokes] == [2, 1]
+    assert dec.strokes[1].dots == 1
+
+
+def test_orientation_and_field_refusal():
+    job = make_job([(1, [(0, 10), (65535, 20)])])
+    rec = encode_job(job, orientation=Orientation(swap_xy=True, flip_x=True))
+    marks = rec[(rec[:, 0] == JUMP_TO) | (rec[:, 0] == MARK_TO)][:, 1:3]
+    # swap: (10, 0), (20, 65535); then flip x: 65535 - x
+    assert marks.tolist() == [[65525, 0], [65515, 65535]]
+    # e.g. pushed out by a field correction: refused, naming the stroke and the mark
+    out = make_job([(1, [(5, 5), (6, 6)]), (1, [(0, 0), (-3, 5)])])
+    with pytest.raises(InputError, match=r"strokes\[1\] mark 1 \(-3, 5\)"):
+        encode_job(out)
+    with pytest.raises(InputError, match="controller takes at most 65536"):
+        encode_job(make_job([(1, [(0, 0)])], bits=1 << 17))
+
+
+def test_text_dump_one_line_per_record():
+    rec = encode_job(make_job([(1, [(10, 10), (20, 20)])]))
+    lines = to_text(rec).splitlines()
+    assert len(lines) == len(rec)
+    assert lines[-1] == "8002:0000:0000:0000:0000:0000 listEndOfList"
+    assert any(ln.startswith("8005:0014:0014:0000:000e:0000 listMarkTo") for ln in lines)
