@@ -266,3 +266,36 @@ def pen_table_from_layers(rows: Iterable[Mapping[str, Any]], source: str = "fibe
         pens.append(_check(lambda lk=lk, ek=ek, pen=pen: LayerSettings(
             pen, LaserParams(**lk), **ek), where, name))
     return _check(lambda: PenTable(LayerSettings(0), tuple(pens), source), "layers", name)
+
+
+# ---------------------------------------------------------------------------- jobs
+def apply_pens(job: Any, pens: PenTable) -> Any:
+    """``job`` (a :class:`galvo_core.job.Job`) with its ``layers`` table (one row per pen
+    its strokes use, in pen order), the laser source, and the time estimate redone layer by
+    layer with each layer's settings and passes (disabled layers neither marked nor timed):
+    ``stats["layers"]`` gives each layer's pen, strokes, passes and estimated_time_s; the
+    job's time (estimated_time_s, mark_time_s, jump_time_s, delay_time_s) becomes the sum
+    over the enabled layers; the counts and lengths of the job's strokes stay as they were."""
+    from galvo_core.timing import estimate_layers
+
+    by_pen: dict[int, list[Any]] = {}
+    for s in job.strokes:
+        by_pen.setdefault(int(s.pen), []).append(s.marks)
+    layers = pens.layers(by_pen)
+    enabled = [la for la in layers if la.enabled]
+    total, per = estimate_layers([(by_pen[la.pen], la.laser, la.passes) for la in enabled],
+                                 job.field_map.mm_per_bit)
+    rows: list[dict[str, Any]] = []
+    it = iter(per)
+    for la in layers:
+        t = next(it) if la.enabled else None
+        rows.append({"pen": la.pen, "enabled": la.enabled, "strokes": len(by_pen[la.pen]),
+                     "passes": la.passes,
+                     "estimated_time_s": float(t["estimated_time_s"]) if t else 0.0,
+                     "mark_length_mm": float(t["mark_length_mm"]) if t else 0.0})
+    stats = dict(job.stats)
+    for k in ("estimated_time_s", "mark_time_s", "jump_time_s", "delay_time_s"):
+        stats[k] = float(total[k])
+    stats["layers"] = rows
+    return dataclasses.replace(job, layers=tuple(la.as_dict() for la in layers),
+                               laser_source=pens.source, stats=stats)
