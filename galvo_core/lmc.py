@@ -121,6 +121,10 @@ class Board:
     open_mo_delay_ms: float = 8.0  # fiber: wait after opening the master oscillator
 
 
+AS_IS = Orientation()
+DEFAULT_BOARD = Board()
+
+
 # ---------------------------------------------------------------------------- units
 def speed_word(mm_s: float, bits_per_mm: float) -> int:
     """Speed in bits per ms, as the drivers convert it (truncated, at most 0xFFFF)."""
@@ -155,7 +159,7 @@ class ListWriter:
     """Records (N, 6) uint16 under construction, with the settings already on the board
     (a word is written only when it changes) and the beam's position."""
 
-    def __init__(self, bits_per_mm: float, source: str = "fiber", board: Board = Board()):
+    def __init__(self, bits_per_mm: float, source: str = "fiber", board: Board = DEFAULT_BOARD):
         if source not in ("fiber", "co2"):
             raise ParamError(f"source must be fiber or co2, not {source!r}")
         self.bits_per_mm = bits_per_mm
@@ -277,7 +281,7 @@ def check_field(marks: np.ndarray, where: str, name: str) -> None:
                                f"field 0..{FIELD_MAX}; nothing was written")
 
 
-def oriented_strokes(job: Job, orientation: Orientation = Orientation()) -> list[np.ndarray]:
+def oriented_strokes(job: Job, orientation: Orientation = AS_IS) -> list[np.ndarray]:
     """Each stroke's marks as the galvos get them, checked against 0..65535."""
     if job.field_map.field_bits > FIELD_MAX + 1:
         raise InputError(job.source_name, f"the job's field has {job.field_map.field_bits} "
@@ -291,7 +295,7 @@ def oriented_strokes(job: Job, orientation: Orientation = Orientation()) -> list
 
 
 def encode_job(job: Job, pens: PenTable | None = None,
-               orientation: Orientation = Orientation(), board: Board = Board()) -> np.ndarray:
+               orientation: Orientation = AS_IS, board: Board = DEFAULT_BOARD) -> np.ndarray:
     """The job as list records (N, 6) uint16 in marking order (see the module docstring)."""
     table = job_pen_table(job, pens)
     marks = oriented_strokes(job, orientation)
@@ -411,7 +415,7 @@ def decode(data: bytes) -> Decoded:
 
 
 def expected_strokes(job: Job, pens: PenTable | None = None,
-                     orientation: Orientation = Orientation()
+                     orientation: Orientation = AS_IS
                      ) -> list[tuple[LayerSettings, np.ndarray]]:
     """What a list of ``job`` must mark, stroke by stroke (each pass), with repeated marks
     dropped: for tests and for checking a written file."""
