@@ -94,7 +94,13 @@ class FieldCorrection:
         m = np.asarray(marks, dtype=np.float64).reshape(-1, 2)
         if len(m) < 2:
             return m
-        a, b = m[:-1], m[1:]
+        pts, _ = self._split_vectors(m[:-1], m[1:], tol_bits)
+        return np.vstack([pts, m[-1:]])
+
+    def _split_vectors(self, a: np.ndarray, b: np.ndarray,
+                       tol_bits: float) -> tuple[np.ndarray, np.ndarray]:
+        """For vectors a -> b (V, 2): the points of each (its start, then the points
+        added), in order, and the vector each belongs to."""
         nv = len(a)
         d = b - a
         ids = [np.arange(nv)]
@@ -150,8 +156,31 @@ class FieldCorrection:
             np.maximum.at(worst, v, off)
             drop = np.zeros(len(pts), dtype=bool)
             drop[np.flatnonzero(added)] = worst[v] <= tol_bits / 2
-            pts = pts[~drop]
-        return np.vstack([pts, m[-1:]])
+            pts, pv = pts[~drop], pv[~drop]
+        return pts, pv
+
+    def apply_many(self, strokes: list[np.ndarray], tol_bits: float = 0.25
+                   ) -> list[np.ndarray]:
+        """:meth:`apply` to many polylines at once (whole arrays, no loop per stroke)."""
+        sizes = np.array([len(m) for m in strokes], dtype=np.int64)
+        if not sizes.sum():
+            return [np.zeros((0, 2), dtype=np.int64) for _ in strokes]
+        allm = np.concatenate([np.asarray(m, dtype=np.float64).reshape(-1, 2)
+                               for m in strokes])
+        sid = np.repeat(np.arange(len(sizes)), sizes)
+        inside = np.flatnonzero(sid[1:] == sid[:-1])  # vectors within a stroke
+        pts, pv = self._split_vectors(allm[inside], allm[inside + 1], tol_bits)
+        ends = np.cumsum(sizes)[sizes > 0] - 1  # each stroke's last mark
+        key = np.concatenate([inside[pv], ends])
+        order = np.argsort(key, kind="stable")
+        p = np.vstack([pts, allm[ends]])[order]
+        ps = sid[key[order]]
+        c = np.floor(p + self.shift(p) + 0.5).astype(np.int64)
+        keep = np.ones(len(c), dtype=bool)
+        keep[1:] = (c[1:] != c[:-1]).any(axis=1) | (ps[1:] != ps[:-1])
+        c, ps = c[keep], ps[keep]
+        cuts = np.searchsorted(ps, np.arange(1, len(sizes)))
+        return np.split(c, cuts)
 
     def apply(self, marks: np.ndarray, tol_bits: float = 0.25) -> np.ndarray:
         """Corrected marks (K, 2) int64: subdivided, shifted, rounded; consecutive repeats
@@ -178,11 +207,11 @@ def apply_to_job(job: Any, corr: FieldCorrection, tol_bits: float = 0.25) -> Any
     if job.field_map.field_bits != 65536:
         raise InputError(job.source_name, "a field correction needs a 65536-bit field, the "
                                           f"job has {job.field_map.field_bits}")
+    out = corr.apply_many([s.marks for s in job.strokes], tol_bits)
     strokes = []
-    for k, s in enumerate(job.strokes):
-        c = corr.apply(s.marks, tol_bits)
-        bad = np.flatnonzero(((c < 0) | (c > 65535)).any(axis=1))
-        if len(bad):
+    for k, (s, c) in enumerate(zip(job.strokes, out, strict=True)):
+        if len(c) and (c.min() < 0 or c.max() > 65535):
+            bad = np.flatnonzero(((c < 0) | (c > 65535)).any(axis=1))
             raise InputError(job.source_name, f"strokes[{k}]: the field correction moves a "
                              f"mark to {tuple(int(v) for v in c[bad[0]])}, outside 0..65535")
         strokes.append(dataclasses.replace(s, marks=c))

@@ -244,6 +244,72 @@ class ListWriter:
         self.chunks.append(rows)
         self.x, self.y = int(full[-1, 0]), int(full[-1, 1])
 
+    def strokes(self, allm: np.ndarray, sizes: np.ndarray, laser: LaserParams) -> None:
+        """Many strokes at once, the same records as :meth:`jump` to each stroke's first
+        mark then :meth:`marks` (or :meth:`dot`) for each, in whole arrays: ``allm`` (N, 2)
+        their marks concatenated, ``sizes`` (K,) their lengths (each >= 1)."""
+        sizes = np.asarray(sizes, dtype=np.int64)
+        n = len(sizes)
+        if n == 0:
+            return
+        allm = np.asarray(allm, dtype=np.int64).reshape(-1, 2)
+        sid = np.repeat(np.arange(n), sizes)
+        first = np.zeros(len(allm), dtype=bool)
+        first[np.cumsum(sizes) - sizes] = True
+        keep = np.ones(len(allm), dtype=bool)
+        keep[1:] = ~((allm[1:] == allm[:-1]).all(axis=1) & ~first[1:])
+        m, first, sid = allm[keep], first[keep], sid[keep]
+        prev = np.empty_like(m)
+        prev[0] = (self.x, self.y)
+        prev[1:] = m[:-1]
+        d = (m - prev).astype(np.float64)
+        dist = np.hypot(d[:, 0], d[:, 1]).astype(np.int64)
+        rows = np.zeros((len(m), 6), dtype=np.uint16)
+        rows[:, 0] = np.where(first, JUMP_TO, MARK_TO)
+        rows[:, 1:3] = m
+        rows[:, 4] = np.minimum(dist, FIELD_MAX)
+        keys = [2 * np.arange(len(m))]
+        parts = [rows]
+        fi = np.flatnonzero(first)
+        # strokes left with one mark: a laser-on point after their jump
+        dots = fi[np.bincount(sid, minlength=n) == 1]
+        if len(dots):
+            drow = np.zeros((len(dots), 6), dtype=np.uint16)
+            drow[:, 0] = LASER_ON_POINT
+            drow[:, 1] = max(1, int(round(laser.point_period_us / 10.0)))
+            keys.append(2 * dots + 1)
+            parts.append(drow)
+        # jump delays: short or long by the (uncapped) distance; written when they change
+        limit = laser.long_jump_mm * self.bits_per_mm
+        words: list[tuple[int, int]] = []
+        code = np.full(len(fi), -1, dtype=np.int64)
+        far = (dist[fi] > limit) if limit else np.zeros(len(fi), dtype=bool)
+        for sel, delay in ((~far, laser.jump_delay_us), (far, laser.jump_delay_long_us)):
+            if not delay:
+                continue  # no delay word for these jumps (the drivers write none)
+            wd = delay_words(delay, "jump delay")
+            if wd not in words:
+                words.append(wd)
+            code[sel] = words.index(wd)
+        init = self.state.get(JUMP_DELAY)
+        init_code = words.index(init) if init in words else -2
+        last = np.where(code >= 0, np.arange(len(fi)), -1)
+        np.maximum.accumulate(last, out=last)
+        after = np.where(last >= 0, code[np.maximum(last, 0)], init_code)
+        before = np.concatenate([[init_code], after[:-1]])
+        emit = (code >= 0) & (code != before)
+        if emit.any():
+            jrow = np.zeros((int(emit.sum()), 6), dtype=np.uint16)
+            jrow[:, 0] = JUMP_DELAY
+            jrow[:, 1:3] = np.array(words, dtype=np.uint16)[code[emit]]
+            keys.append(2 * fi[emit] - 1)
+            parts.append(jrow)
+        if after[-1] >= 0:
+            self.state[JUMP_DELAY] = words[int(after[-1])]
+        order = np.argsort(np.concatenate(keys), kind="stable")
+        self.chunks.append(np.concatenate(parts)[order])
+        self.x, self.y = int(m[-1, 0]), int(m[-1, 1])
+
     def dot(self, laser: LaserParams) -> None:
         self.write(LASER_ON_POINT, max(1, int(round(laser.point_period_us / 10.0))))
 
@@ -281,40 +347,56 @@ def check_field(marks: np.ndarray, where: str, name: str) -> None:
                                f"field 0..{FIELD_MAX}; nothing was written")
 
 
-def oriented_strokes(job: Job, orientation: Orientation = AS_IS) -> list[np.ndarray]:
-    """Each stroke's marks as the galvos get them, checked against 0..65535."""
+def oriented_marks(job: Job, orientation: Orientation = AS_IS
+                   ) -> tuple[np.ndarray, np.ndarray]:
+    """Every stroke's marks as the galvos get them, concatenated (N, 2), and the strokes'
+    start offsets (K + 1,), checked against 0..65535 (InputError naming the stroke and the
+    mark otherwise)."""
     if job.field_map.field_bits > FIELD_MAX + 1:
         raise InputError(job.source_name, f"the job's field has {job.field_map.field_bits} "
                                           f"bits; the controller takes at most {FIELD_MAX + 1}")
-    out = []
-    for i, s in enumerate(job.strokes):
-        m = orientation.apply(s.marks, job.field_map.max_bit)
-        check_field(m, f"strokes[{i}]", job.source_name)
-        out.append(m)
-    return out
+    sizes = np.fromiter((len(s.marks) for s in job.strokes), dtype=np.int64,
+                        count=len(job.strokes))
+    off = np.concatenate([[0], np.cumsum(sizes)])
+    if not off[-1]:
+        return np.zeros((0, 2), dtype=np.int64), off
+    allm = orientation.apply(np.concatenate([np.asarray(s.marks).reshape(-1, 2)
+                                             for s in job.strokes]), job.field_map.max_bit)
+    bad = np.flatnonzero(((allm < 0) | (allm > FIELD_MAX)).any(axis=1))
+    if len(bad):
+        k = int(np.searchsorted(off, bad[0], side="right") - 1)
+        check_field(allm[off[k]:off[k + 1]], f"strokes[{k}]", job.source_name)
+    return allm, off
+
+
+def oriented_strokes(job: Job, orientation: Orientation = AS_IS) -> list[np.ndarray]:
+    """Each stroke's marks as the galvos get them, checked against 0..65535."""
+    allm, off = oriented_marks(job, orientation)
+    return [allm[off[i]:off[i + 1]] for i in range(len(off) - 1)]
 
 
 def encode_job(job: Job, pens: PenTable | None = None,
                orientation: Orientation = AS_IS, board: Board = DEFAULT_BOARD) -> np.ndarray:
     """The job as list records (N, 6) uint16 in marking order (see the module docstring)."""
     table = job_pen_table(job, pens)
-    marks = oriented_strokes(job, orientation)
+    allm, off = oriented_marks(job, orientation)
     w = ListWriter(bits_per_mm(job), table.source, board)
     w.begin_marking()
     for layer, idx in layer_order(job, table):
         if not layer.enabled:
             continue
+        ids = np.asarray(idx, dtype=np.int64)
+        ids = ids[off[ids + 1] > off[ids]]  # strokes with marks
+        if not len(ids):
+            continue
+        sizes = off[ids + 1] - off[ids]
+        if len(ids) == len(off) - 1:
+            marks = allm  # every stroke of the job, in job order
+        else:
+            marks = np.concatenate([allm[off[i]:off[i + 1]] for i in ids.tolist()])
         w.settings(layer)
         for _ in range(layer.passes):
-            for i in idx:
-                m = marks[i]
-                if not len(m):
-                    continue
-                w.jump(int(m[0, 0]), int(m[0, 1]), layer.laser)
-                if not (m[1:] != m[0]).any():  # one mark, or all at one place: a dot
-                    w.dot(layer.laser)
-                else:
-                    w.marks(m[1:])
+            w.strokes(marks, sizes, layer.laser)
     return w.end()
 
 

@@ -158,3 +158,14 @@ def test_job_is_corrected_once():
     far = grid_of(lambda p: np.tile([[-2000.0, 0.0]], (len(p), 1)))
     with pytest.raises(InputError, match=r"strokes\[0\].*outside 0\.\.65535"):
         apply_to_job(job, far)
+
+
+def test_many_strokes_at_once_equal_one_by_one():
+    corr = grid_of(lambda p: -pincushion(p, 4e-8))
+    rng = np.random.default_rng(5)
+    strokes = [rng.integers(2000, 63000, size=(int(k), 2)) for k in rng.integers(0, 9, 40)]
+    strokes[3] = np.array([[5000, 5000], [5000, 5000], [5000, 5000]])  # collapses to one
+    many = corr.apply_many(strokes)
+    assert len(many) == len(strokes)
+    for m, got in zip(strokes, many, strict=True):
+        np.testing.assert_array_equal(got, corr.apply(m))

@@ -113,6 +113,27 @@ def test_golden_field_size_pulse_width_and_one_pen():
     np.testing.assert_array_equal(encode_job(job, table), galvoplotter_records(job, table))
 
 
+def test_golden_jump_delays_short_long_and_none_repeated_marks():
+    """Jumps on both sides of long_jump_mm, a short delay of 0 (no delay word: the drivers
+    write none), marks repeated inside strokes (dropped, as galvoplotter's mark() does)."""
+    rng = np.random.default_rng(11)
+    strokes = []
+    for i in range(60):
+        c = rng.integers(20000, 45000, size=2) if i % 3 else rng.integers(2000, 63000, size=2)
+        k = int(rng.integers(2, 12))
+        m = c + np.cumsum(rng.integers(-300, 300, size=(k, 2)), axis=0)
+        m = np.repeat(m, rng.integers(1, 3, size=k), axis=0)  # repeated marks
+        strokes.append((1 + i % 2, [tuple(int(v) for v in p) for p in m]))
+    las = LaserParams(jump_delay_us=0, jump_delay_long_us=250, long_jump_mm=15)
+    table = PenTable(LayerSettings(0, las), (LayerSettings(2, las.__class__(
+        **{**las.as_dict(), "jump_delay_us": 40.0, "long_jump_mm": 8.0})),))
+    job = make_job(strokes)
+    ours = encode_job(job, table)
+    np.testing.assert_array_equal(ours, galvoplotter_records(job, table))
+    kinds = ours[ours[:, 0] == 0x800D][:, 1].tolist()
+    assert 250 in kinds and 40 in kinds
+
+
 def test_units_of_the_words():
     table = two_pen_table()
     job = make_job(rng_strokes(3, 4, (1, 2)), size_mm=110.0)
