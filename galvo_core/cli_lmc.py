@@ -234,9 +234,10 @@ def cmd_send(a: argparse.Namespace) -> int:
         raise GalvoError(f"{a.job}: the job's marks are already field-corrected "
                          f"({job.field_correction.get('source', '?')}); not applying a "
                          "correction twice")
+    job_pen_table(job, name=a.job)  # the job's own layers table, checked naming the file
     job = apply_controller_options(job, a)
     orient = _orientation(a)
-    table = job_pen_table(job)
+    table = job_pen_table(job, name=a.job)
     bpm = job.field_map.field_bits / job.field_map.field_size_mm
     if a.frame:
         first = table.layers({s.pen for s in job.strokes} or {1})[0].laser

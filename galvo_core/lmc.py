@@ -318,15 +318,32 @@ class ListWriter:
         return np.concatenate(self.chunks) if self.chunks else np.zeros((0, 6), np.uint16)
 
 
-def job_pen_table(job: Job, pens: PenTable | None = None) -> PenTable:
+def job_pen_table(job: Job, pens: PenTable | None = None, name: str | None = None
+                  ) -> PenTable:
     """The pen table a job is marked with: ``pens`` if given, else the job's own ``layers``
-    table, else its one ``laser`` setting for every pen."""
+    table, else its one ``laser`` setting for every pen. A table the job holds that cannot
+    be used raises InputError naming ``name`` (default: the job's source)."""
     if pens is not None:
         return pens
+    where = name or job.source_name
     if job.layers:
-        return pen_table_from_layers(job.layers, job.laser_source, job.source_name)
-    return PenTable.from_laser(LaserParams(**{k: v for k, v in job.laser.items()
-                                              if k in LASER_KEYS}))
+        return pen_table_from_layers(job.layers, job.laser_source, where)
+    try:
+        return PenTable.from_laser(LaserParams(**{k: float(v) for k, v in job.laser.items()
+                                                  if k in LASER_KEYS}))
+    except (ParamError, TypeError, ValueError) as exc:
+        raise InputError(where, f"laser: {exc}") from None
+
+
+def write_lmc(job: Job, path: str, pens: PenTable | None = None,
+              orientation: Orientation = AS_IS, text: bool = False) -> int:
+    """Encode ``job`` and write it atomically (the GUI's File > Export): the records, or with
+    ``text`` MeerK40t's readable dump. Returns the number of records."""
+    from galvo_core.job import atomic_write_bytes
+
+    rec = encode_job(job, pens, orientation)
+    atomic_write_bytes(path, to_text(rec).encode("ascii") if text else to_bytes(rec))
+    return len(rec)
 
 
 def layer_order(job: Job, pens: PenTable) -> list[tuple[LayerSettings, list[int]]]:

@@ -207,3 +207,20 @@ def test_text_dump_one_line_per_record():
     assert len(lines) == len(rec)
     assert lines[-1] == "8002:0000:0000:0000:0000:0000 listEndOfList"
     assert any(ln.startswith("8005:0014:0014:0000:000e:0000 listMarkTo") for ln in lines)
+
+
+def test_write_lmc_and_bad_layers_named(tmp_path):
+    from galvo_core.job import load_job, write_job
+    from galvo_core.layers import apply_pens
+    from galvo_core.lmc import job_pen_table, write_lmc
+
+    job = apply_pens(make_job([(1, [(10, 10), (20, 20)])]), two_pen_table())
+    n = write_lmc(job, str(tmp_path / "a.lmc"))
+    assert (tmp_path / "a.lmc").stat().st_size == 12 * n
+    write_lmc(job, str(tmp_path / "a.txt"), text=True)
+    assert len((tmp_path / "a.txt").read_text().splitlines()) == n
+    write_job(job, tmp_path / "j.json")
+    doc = (tmp_path / "j.json").read_text().replace('"power_percent":35.5', '"power_percent":-3')
+    (tmp_path / "j.json").write_text(doc)
+    with pytest.raises(InputError, match=r"j\.json: layers\[0\]: power_percent must be"):
+        job_pen_table(load_job(tmp_path / "j.json"), name=str(tmp_path / "j.json"))
