@@ -39,6 +39,7 @@ from galvo_core.lmc import (
 from galvo_core.params import LaserParams
 
 DEFAULT_FRAME_LOOPS = 20
+FRAME_LOOPS_PER_LIST = 10  # send: loops per list sent to the board while framing
 
 
 def _positive_int(text: str) -> int:
@@ -242,7 +243,8 @@ def cmd_send(a: argparse.Namespace) -> int:
     if a.frame:
         first = table.layers({s.pen for s in job.strokes} or {1})[0].laser
         path = outline(job, a.frame_shape, orient)
-        rec = frame_records(path, 1, job, first, a.light_speed_mm_s)
+        per_list = 1 if a.dry_run else FRAME_LOOPS_PER_LIST  # a dry run counts loops
+        rec = frame_records(path, per_list, job, first, a.light_speed_mm_s)
     else:
         rec = encode_job(job, orientation=orient)
     c = _controller(a.dry_run, bpm, a.machine_index)
@@ -252,10 +254,10 @@ def cmd_send(a: argparse.Namespace) -> int:
     t0 = time.perf_counter()
     try:
         if a.frame:
-            # until Ctrl-C (a dry run stops after --frame-loops)
+            # lists of a few loops each, until Ctrl-C (a dry run stops after --frame-loops)
             while not a.dry_run or loops < a.frame_loops:
                 sent += _run_list(c, rec, light=True, fiber=table.source == "fiber")
-                loops += 1
+                loops += per_list
         else:
             sent += _run_list(c, rec, light=False, fiber=table.source == "fiber")
     except KeyboardInterrupt:
@@ -263,6 +265,9 @@ def cmd_send(a: argparse.Namespace) -> int:
         if not a.frame:
             raise GalvoError(f"{a.job}: marking stopped (Ctrl-C)") from None
     finally:
+        if a.frame:  # the pointer off again
+            c.port_off(c.light_pin)
+            c.write_port()
         c.shutdown()
     out = {"job": a.job, "dry_run": bool(a.dry_run), "what": "frame" if a.frame else "mark",
            "records": int(len(rec)), "packets": sent, "seconds": time.perf_counter() - t0}

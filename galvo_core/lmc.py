@@ -459,7 +459,7 @@ def decode(data: bytes) -> Decoded:
     cur: list[tuple[int, int]] | None = None
     cur_dots = 0
     ends = []
-    x, y = CENTRE, CENTRE
+    x, y = 0x8000, 0x8000  # the drivers' start: the field's centre
 
     def close() -> None:
         nonlocal cur, cur_dots
