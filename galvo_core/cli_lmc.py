@@ -187,7 +187,24 @@ def _controller(mock: bool, bits_per_mm: float, machine_index: int) -> Any:
     return c
 
 
+def _board_present() -> str | None:
+    """None when a BJJCZ board is on the USB bus, else why not (asked once, quickly:
+    galvoplotter itself retries for about 6 s before giving up)."""
+    try:
+        import usb.core
+
+        found = usb.core.find(idVendor=0x9588, idProduct=0x9899)
+    except Exception as exc:  # noqa: BLE001 - no libusb backend, no permission
+        return str(exc) or type(exc).__name__
+    return None if found is not None else "no device"
+
+
 def _connect(c: Any) -> None:
+    if not c.mock:
+        why = _board_present()
+        if why is not None:
+            raise GalvoError(f"no BJJCZ (LMC) board answered on USB 9588:9899 ({why}); "
+                             "connect it, check permissions, or use --dry-run")
     try:
         c.connect_if_needed()
     except Exception as exc:  # noqa: BLE001 - no board, no libusb, no permission: one line

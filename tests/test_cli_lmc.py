@@ -158,7 +158,16 @@ def test_send_without_board_is_one_line(files, monkeypatch, capsys):
     def refuse(self):  # what galvoplotter raises after its retries
         raise ConnectionRefusedError("Could not connect to the LMC controller.")
 
+    from galvo_core import cli_lmc
+
     monkeypatch.setattr(galvo.GalvoController, "connect_if_needed", refuse)
+    monkeypatch.setattr(cli_lmc, "_board_present", lambda: None)  # seen, then refuses
     assert cli.main(["send", str(tmp / "j.json")]) == 2
     err = capsys.readouterr().err
     assert err.startswith("error: no BJJCZ (LMC) board") and err.count("\n") == 1
+    assert "Could not connect" in err
+    # no board on the bus at all (as on this machine): the same one line, at once
+    monkeypatch.setattr(cli_lmc, "_board_present", lambda: "no device")
+    assert cli.main(["send", str(tmp / "j.json")]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith("error: no BJJCZ (LMC) board") and "(no device)" in err
