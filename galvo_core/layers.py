@@ -268,6 +268,30 @@ def pen_table_from_layers(rows: Iterable[Mapping[str, Any]], source: str = "fibe
     return _check(lambda: PenTable(LayerSettings(0), tuple(pens), source), "layers", name)
 
 
+def dump_pen_table(table: PenTable) -> str:
+    """The table as TOML that :func:`load_pen_table` reads back to an equal table: the
+    profile under ``[laser]``, each listed pen's settings that differ from it."""
+    def lines(s: LayerSettings, ref: LayerSettings | None) -> list[str]:
+        out = []
+        for k in LASER_KEYS:
+            v = getattr(s.laser, k)
+            if ref is None or v != getattr(ref.laser, k):
+                out.append(f"{k} = {float(v)!r}")
+        for k in EXTRA_KEYS:
+            v = getattr(s, k)
+            if v is None or (k == "colour" and not v):
+                continue
+            if ref is None or v != getattr(ref, k):
+                out.append(f"{k} = " + ("true" if v is True else "false" if v is False
+                                         else f'"{v}"' if isinstance(v, str) else str(v)))
+        return out
+
+    text = [f'source = "{table.source}"', "", "[laser]"] + lines(table.default, None)
+    for p in table.pens:
+        text += ["", f"[pen.{p.pen}]"] + lines(p, table.default)
+    return "\n".join(text) + "\n"
+
+
 # ---------------------------------------------------------------------------- jobs
 def apply_pens(job: Any, pens: PenTable) -> Any:
     """``job`` (a :class:`galvo_core.job.Job`) with its ``layers`` table (one row per pen

@@ -28,6 +28,9 @@ encoder writes what galvoplotter's ``GalvoController`` sends for the same job, w
 * passes repeat a layer's strokes; disabled layers are left out; one end-of-list (0x8002)
   closes the list.
 
+``mark_delay_us`` (the mark-end delay) has no list command in these drivers; it counts in
+the time estimate only.
+
 Orientation (swap x/y, then flip x, flip y) is applied here, at export. A mark outside
 0..65535 after it is refused (:class:`~galvo_core.errors.InputError` naming the stroke and
 the mark): the drivers silently drop such moves.

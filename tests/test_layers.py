@@ -130,3 +130,12 @@ def test_job_layers_round_trip(tmp_path):
     t2 = job_pen_table(back)
     for pen in (1, 2):
         assert t2.settings(pen) == t.settings(pen).replace(colour=t.settings(pen).display_colour)
+
+
+def test_dump_round_trip(tmp_path):
+    from galvo_core.layers import dump_pen_table
+
+    t = load_pen_table(write(tmp_path, GOOD))
+    t = t.with_pen(t.settings(5).replace(passes=4, enabled=False, jump_delay_us=12.5))
+    p = write(tmp_path, dump_pen_table(t), "dump.toml")
+    assert load_pen_table(p) == t

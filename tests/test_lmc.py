@@ -6,6 +6,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 from _lmc_util import make_job, rng_strokes
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from galvo_core.errors import InputError
 from galvo_core.job import Job, Stroke
@@ -224,3 +226,33 @@ def test_write_lmc_and_bad_layers_named(tmp_path):
     (tmp_path / "j.json").write_text(doc)
     with pytest.raises(InputError, match=r"j\.json: layers\[0\]: power_percent must be"):
         job_pen_table(load_job(tmp_path / "j.json"), name=str(tmp_path / "j.json"))
+
+
+coord = st.integers(0, 65535)
+stroke_st = st.tuples(st.integers(0, 4), st.lists(st.tuples(coord, coord), min_size=1,
+                                                  max_size=8))
+
+
+@settings(max_examples=60, deadline=None)
+@given(st.lists(stroke_st, min_size=1, max_size=12), st.integers(1, 3), st.booleans(),
+       st.booleans(), st.booleans(), st.sampled_from(["fiber", "co2"]))
+def test_any_job_replays_exactly(strokes, passes, swap, fx, disable, source):
+    """Whatever the strokes (dots, repeats, strokes starting where the last ended), pens,
+    passes, orientation and source: the decoder finds exactly the expected strokes with
+    their pen's words, and one end-of-list at the end."""
+    table = PenTable(LayerSettings(0), (
+        LayerSettings(1, LaserParams(mark_speed_mm_s=123, power_percent=11), passes=passes),
+        LayerSettings(3, LaserParams(mark_speed_mm_s=456, power_percent=77),
+                      enabled=not disable)), source)
+    job = make_job(strokes)
+    o = Orientation(swap_xy=swap, flip_x=fx)
+    dec = decode(to_bytes(encode_job(job, table, o)))
+    want = expected_strokes(job, table, o)
+    assert dec.ended and len(dec.strokes) == len(want)
+    bpm = bits_per_mm(job)
+    for (layer, m), got in zip(want, dec.strokes, strict=True):
+        if len(m) > 1 and (m[1:] != m[0]).any():
+            np.testing.assert_array_equal(got.marks, m)
+        else:
+            assert got.dots == 1 and got.marks.tolist() == [m[0].tolist()]
+        assert got.settings["mark_speed"] == int(layer.laser.mark_speed_mm_s * bpm / 1000)
