@@ -119,13 +119,14 @@ def _pens(a: argparse.Namespace, job: Job) -> PenTable | None:
 
 
 def apply_controller_options(job: Job, a: argparse.Namespace) -> Job:
-    """Pens (layers table and time per layer) and field correction, as asked."""
+    """Field correction and pens (layers table, time per layer on the marks as sent), as
+    asked; both files are read before either is applied."""
     pens = _pens(a, job)
-    if pens is not None:
-        job = apply_pens(job, pens)
     corr = _correction(a, job)
     if corr is not None:
         job = apply_to_job(job, corr, a.correction_tol_bits)
+    if pens is not None:
+        job = apply_pens(job, pens)
     return job
 
 
