@@ -20,7 +20,7 @@ from __future__ import annotations
 from collections.abc import Iterable, Mapping
 from typing import Any
 
-from PySide6.QtCore import Signal
+from PySide6.QtCore import Qt, Signal
 from PySide6.QtGui import QColor
 from PySide6.QtWidgets import (
     QAbstractSpinBox,
@@ -125,6 +125,7 @@ class LayersPanel(QWidget):
             for i, pen in enumerate(self._pens):
                 s = self._table.settings(pen)
                 item = QTableWidgetItem(f"{pen}")
+                item.setFlags(Qt.ItemFlag.ItemIsEnabled)
                 item.setBackground(QColor(s.display_colour))
                 item.setForeground(QColor("white"))
                 g.setItem(i, 0, item)
@@ -136,8 +137,9 @@ class LayersPanel(QWidget):
                 for k, (key, _h, lo, hi, dec) in enumerate(COLUMNS):
                     g.setCellWidget(i, len(FIXED) + k, self._spin(pen, s, key, lo, hi, dec))
                 t = self._times.get(pen)
-                g.setItem(i, g.columnCount() - 1,
-                          QTableWidgetItem("" if t is None else f"{t:.3f}"))
+                ti = QTableWidgetItem("" if t is None else f"{t:.3f}")
+                ti.setFlags(Qt.ItemFlag.ItemIsEnabled)
+                g.setItem(i, g.columnCount() - 1, ti)
         finally:
             self._building = False
 
@@ -153,6 +155,8 @@ class LayersPanel(QWidget):
         if dec == 0:
             box = QSpinBox()
             box.setRange(int(lo), int(hi))
+            if key == "pulse_width_ns":
+                box.setSpecialValueText("off")  # 0: the board keeps its own
             box.setValue(int(round(value)))
             box.valueChanged.connect(lambda v, pen=pen, key=key: self._edit(pen, key, int(v)))
             sp = box
