@@ -101,9 +101,14 @@ def test_cor_layouts(tmp_path):
     assert (tmp_path / "b.cor").stat().st_size == 0x24 + 65 * 65 * 8
     # galvoplotter reads the same integer table (its sign-magnitude words)
     galvo = pytest.importorskip("galvo")
-    words = galvo.GalvoController(mock=True)._read_correction_file(str(tmp_path / "b.cor"))
-    dx0 = int(table[0, 0, 0])
-    assert words[0][0] == (dx0 if dx0 >= 0 else -dx0 + 0x8000)
+    def sign_magnitude(v):
+        v = int(v)
+        return v if v >= 0 else -v + 0x8000
+
+    want = [[sign_magnitude(dx), sign_magnitude(dy)] for dx, dy in table.reshape(-1, 2)]
+    reader = galvo.GalvoController(mock=True)
+    assert reader._read_correction_file(str(tmp_path / "b.cor")) == want  # integer layout
+    assert reader._read_correction_file(str(tmp_path / "a.cor")) == want  # LMC1COR_1.0
     (tmp_path / "c.cor").write_bytes(b"short")
     with pytest.raises(InputError, match="c.cor: not a .cor"):
         read_cor(tmp_path / "c.cor")
