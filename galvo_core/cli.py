@@ -14,7 +14,7 @@ import time
 from collections.abc import Callable, Sequence
 from typing import Any, NoReturn
 
-from galvo_core import __version__
+from galvo_core import __version__, cli_lmc
 from galvo_core.errors import GalvoError, ParamError
 from galvo_core.export import write_plt, write_svg
 from galvo_core.fit import fit_report
@@ -90,17 +90,20 @@ def cmd_process(a: argparse.Namespace) -> int:
     params = _params_from_args(a)
     d = read_file(a.file)
     job = Pipeline().run(d, params).job
+    job = cli_lmc.prepare_job(job, a)  # pens, field correction; LMC files checked
     write_job(job, a.output)
     if a.plt:
         write_plt(job, a.plt, what=a.plt_what)
     if a.svg:
         write_svg(job, a.svg, marks=a.svg_marks)
+    controller = cli_lmc.write_controller_outputs(job, a)
     _print_json({
         "file": d.name,
         "output": a.output,
         "magnification": job.field_map.magnification,
         "stats": job.stats,
         "warnings": [w.as_dict() for w in job.warnings],
+        **controller,
     })
     return 0
 
@@ -186,6 +189,7 @@ def build_parser() -> argparse.ArgumentParser:
     ex.add_argument("--svg", metavar="OUT.svg", help="also write the fitted geometry as SVG (mm)")
     ex.add_argument("--svg-marks", action="store_true", help="draw the marks in the SVG too")
     _add_processing_args(pp)
+    cli_lmc.add_controller_options(pp)
     pp.set_defaults(func=cmd_process)
     pr = sub.add_parser("report", help="paper 000's Table 1 for a file",
                         description="Input points, points after thinning, control points, "
@@ -196,6 +200,7 @@ def build_parser() -> argparse.ArgumentParser:
     pr.add_argument("--json", action="store_true", help="print JSON instead of a table")
     _add_processing_args(pr, report=True)
     pr.set_defaults(func=cmd_report)
+    cli_lmc.add_send_parser(sub)
     return p
 
 

@@ -68,12 +68,18 @@ class Job:
     strokes: tuple[Stroke, ...]
     stats: dict[str, Any] = dc_field(default_factory=dict)
     warnings: tuple[Warning, ...] = ()
+    # pen layers (issue 19): one row per pen the strokes use (galvo_core.layers
+    # LayerSettings.as_dict()), the laser source, and whether a software field correction
+    # was applied to the marks (None: not applied). Written only when set.
+    layers: tuple[dict[str, Any], ...] = ()
+    laser_source: str = "fiber"
+    field_correction: dict[str, Any] | None = None
 
     def to_json(self) -> dict[str, Any]:
         stats = dict(self.stats)
         stats["warnings"] = [w.as_dict() for w in self.warnings]
         fm = self.field_map
-        return {
+        out: dict[str, Any] = {
             "format": FORMAT,
             "version": VERSION,
             "generator": GENERATOR,
@@ -86,6 +92,12 @@ class Job:
             "strokes": [s.to_json() for s in self.strokes],
             "stats": _jsonable(stats),
         }
+        if self.layers:
+            out["layers"] = _jsonable(list(self.layers))
+            out["laser_source"] = self.laser_source
+        if self.field_correction is not None:
+            out["field_correction"] = _jsonable(self.field_correction)
+        return out
 
 
 def _jsonable(v: Any) -> Any:
@@ -211,9 +223,15 @@ def job_from_json(doc: Any, name: str = "<job>") -> Job:
         Warning(int(w.get("line", 0)), int(w.get("col", 0)), str(w.get("message", "")))
         for w in stats.pop("warnings", []) if isinstance(w, dict)
     )
+    layers = doc.get("layers", [])
+    if not (isinstance(layers, list) and all(isinstance(r, dict) for r in layers)):
+        raise InputError(name, "layers must be a list of tables")
+    corr = doc.get("field_correction")
+    if corr is not None and not isinstance(corr, dict):
+        raise InputError(name, "field_correction must be a table")
     return Job(str(src.get("name", "")), str(src.get("sha256", "")), fm,
                dict(doc.get("params", {})), dict(doc.get("laser", {})), tuple(strokes), stats,
-               warns)
+               warns, tuple(layers), str(doc.get("laser_source", "fiber")), corr)
 
 
 def strokes_marks(strokes: Sequence[Stroke]) -> list[np.ndarray]:
