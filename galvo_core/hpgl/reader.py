@@ -101,6 +101,9 @@ KNOWN = frozenset(
     ).split()
 )
 
+#: commands that only HP-GL/2 (and PCL's HP-GL/2) has: a file using one is read as HP-GL/2
+HPGL2_ONLY = frozenset("BP BR BZ CR FR LA MC MG NP PC PE PP PS PW QL RF SV TR WU".split())
+
 # one ordinary command with its leading separators: mnemonic, parameters, optional ';'
 _CMD_RE = re.compile(rb"[\x00-\x1a\x1c-\x20;,]*([A-Za-z]{2})([^A-Za-z;\x1b]*)(;?)")
 _RUN_RE = re.compile(
@@ -162,6 +165,10 @@ class _Reader:
         self._no_term_after: dict[int, int] = {}
         self._pe_cache = PECache()
         self.hpgl_mode = True
+        # dialect: HP-GL/2 once the file shows it (PCL/PJL entry, an HP-GL/2-only command)
+        self.hpgl2 = False
+        self.pen_selected = False  # no SP yet: drawn with pen 1 (warned)
+        self.unselected_paths = 0
         # geometry state
         self.reset()
         self.pen = 1
@@ -193,11 +200,17 @@ class _Reader:
         self.term = ETX
         self.poly: list[list[tuple[float, float]]] | None = None  # rings while in PM
         self.poly_ring: list[tuple[float, float]] = []
-        self.poly_buffer: list[list[tuple[float, float]]] = []
+        self.poly_down: list[bool] = []  # pen state of each edge of poly_ring
+        # sub-polygons: points, pen-down flag of each edge (the closing edge last)
+        self.poly_buffer: list[tuple[list[tuple[float, float]], list[bool]]] = []
         self.poly_emitted = True
+        self.poly_edged: tuple[int, int] | None = None  # self.paths range EP emitted
         self.poly_fresh = False
         self.poly_offset = 0
         self.tick = (0.5, 0.5)
+        self.char_size: tuple[float, float] | None = None  # SI: width, height (plotter units)
+        self.char_rel: tuple[float, float] | None = None  # SR: % of P2-P1
+        self.label_dir = (1.0, 0.0)  # DI/DR: unit vector of the text direction
         self.cur: list[float] = []  # current pen-down path, flat x, y (plotter units)
         self.cur_offset = 0
 
@@ -212,6 +225,9 @@ class _Reader:
         self.term = ETX
         self.poly = None
         self.tick = (0.5, 0.5)
+        self.char_size = None
+        self.char_rel = None
+        self.label_dir = (1.0, 0.0)
 
     # ------------------------------------------------------------------ units
     def to_plotter(self, x: float, y: float) -> tuple[float, float]:
@@ -309,6 +325,8 @@ class _Reader:
                 else len(piece) >= 4 and piece[0, 0] == piece[-1, 0] and piece[0, 1] == piece[-1, 1]
             )
             self.paths.append((piece, self.pen, bool(is_closed), offset))
+            if not self.pen_selected:
+                self.unselected_paths += 1
 
     def flush(self) -> None:
         cur = getattr(self, "cur", None)
@@ -324,9 +342,11 @@ class _Reader:
             ring_pts = ring_pts.copy()
             ring_pts[-1] = ring_pts[0]
         if self.poly is not None:
-            self._poly_close_ring()
-            self.poly_buffer.append([tuple(p) for p in ring_pts.tolist()])
+            self._poly_close_ring(self.pen_down)
+            ring = [tuple(p) for p in ring_pts.tolist()]
+            self.poly_buffer.append((ring, [True] * (len(ring) - 1) + [True]))
             self.poly_ring = [(self.x, self.y)]
+            self.poly_down = []
             return
         self.emit(ring_pts, offset, closed=len(ring_pts) >= 4)
 
@@ -416,21 +436,28 @@ class _Reader:
             # whatever the pen state (HP-GL/2 PM; hp2xx and ezhpgl read it so too)
             self.poly_fresh = False
             self.poly_ring = [(x, y)]
+            self.poly_down = []
             return
         if self.pen_down:
             self.poly_ring.append((x, y))
+            self.poly_down.append(True)
         else:
+            # a pen-up move ends the sub-polygon (its closing edge is a pen-up edge); the
+            # fill region of each piece is its own ring, not one ring joined by pen-up edges
             if len(self.poly_ring) > 1:
-                self._poly_close_ring()
+                self._poly_close_ring(False)
             self.poly_ring = [(x, y)]
+            self.poly_down = []
 
-    def _poly_close_ring(self) -> None:
+    def _poly_close_ring(self, down: bool) -> None:
+        """End the current sub-polygon; its closing edge has pen state ``down`` (PM1/PM2
+        close with the current pen state: a pen-up closure is part of the fill region's
+        boundary but EP does not draw it)."""
         ring = self.poly_ring
         if len(ring) > 1:
-            if ring[0] != ring[-1]:
-                ring = ring + [ring[0]]
-            self.poly_buffer.append(ring)
+            self.poly_buffer.append((ring, self.poly_down + [down]))
         self.poly_ring = [(self.x, self.y)]
+        self.poly_down = []
 
     def do_pm(self, v: list[float], offset: int) -> None:
         mode = int(v[0]) if v else 0
@@ -441,34 +468,62 @@ class _Reader:
             self.poly = []
             self.poly_buffer = []
             self.poly_ring = [(self.x, self.y)]
+            self.poly_down = []
             self.poly_fresh = False
             self.poly_emitted = False
+            self.poly_edged = None
             self.poly_offset = offset
         elif mode == 1:
             if self.poly is None:
                 self.warn(offset, "PM1 outside polygon mode ignored")
                 return
-            self._poly_close_ring()
+            self._poly_close_ring(self.pen_down)
             self.poly_fresh = True
         elif mode == 2:
             if self.poly is None:
                 self.warn(offset, "PM2 outside polygon mode ignored")
                 return
-            self._poly_close_ring()
+            self._poly_close_ring(self.pen_down)
             self.poly = None
         else:
             self.warn(offset, f"PM{mode}: unknown polygon mode ignored")
 
     def do_edge_fill(self, mn: str, offset: int) -> None:
+        """EP draws the pen-down edges of the polygon buffer; FP fills it: every sub-polygon
+        is one closed ring (its region). A buffer is geometry, not paint: edged and filled
+        it is one region (FP after EP replaces EP's edges by the rings, EP after FP adds
+        nothing: its edges lie on the rings)."""
         if self.poly is not None:
             self.warn(offset, f"{mn} inside polygon mode ignored")
             return
-        if self.poly_emitted:
-            return  # the same buffer edged and filled: one region
+        if mn == "EP":
+            if self.poly_emitted:
+                return
+            self.poly_emitted = True
+            first = len(self.paths)
+            for ring, downs in self.poly_buffer:
+                for run in _pen_down_runs(ring, downs):
+                    self.emit(np.array(run, dtype=np.float64), self.poly_offset)
+            self.poly_edged = (first, len(self.paths))
+            return
+        if self.poly_emitted and self.poly_edged is None:
+            return  # filled already
+        rings = []
+        for ring, _downs in self.poly_buffer:
+            pts = ring if ring[0] == ring[-1] else ring + [ring[0]]
+            rings.append(np.array(pts, dtype=np.float64))
+        if self.poly_edged is not None:
+            a, b = self.poly_edged
+            tail = self.paths[b:]
+            del self.paths[a:]
+            for pts in rings:
+                self.emit(pts, self.poly_offset, closed=len(pts) >= 4)
+            self.paths.extend(tail)
+        else:
+            for pts in rings:
+                self.emit(pts, self.poly_offset, closed=len(pts) >= 4)
         self.poly_emitted = True
-        for ring in self.poly_buffer:
-            pts = np.array(ring, dtype=np.float64)
-            self.emit(pts, self.poly_offset, closed=len(pts) >= 4)
+        self.poly_edged = None
 
     # ------------------------------------------------------------------ commands
     def do_arc(self, cx: float, cy: float, sweep: float, chord_arg: float | None,
@@ -690,11 +745,15 @@ class _Reader:
                 mn = m.group(1).upper().decode()
                 start = m.start(1)
                 if mn in _SPECIAL:
+                    if mn == "PE":
+                        self.hpgl2 = True
                     commands[mn] += 1
                     self.recognised += 1
                     i = _SPECIAL[mn](self, start + 2)
                     continue
                 commands[mn] += 1
+                if mn in HPGL2_ONLY:
+                    self.hpgl2 = True
                 h = handlers.get(mn)
                 if h is not None:
                     self.recognised += 1
@@ -873,10 +932,15 @@ class _Reader:
             return h
 
         def pen(params: bytes, off: int, mn: str) -> None:
+            # HP-GL/2: "the pen remains down ... until a PU or IN" (SP ends the path: the
+            # next move starts a new one with the new pen); an HP-GL/1 plotter puts the
+            # pen back in its stall, so there SP lifts it (see self.hpgl2)
             v = _nums(params)
             self.flush()
-            self.pen_down = False
+            if not self.hpgl2:
+                self.pen_down = False
             self.pen = int(v[0]) if v else 0
+            self.pen_selected = True
 
         def ro(params: bytes, off: int, mn: str) -> None:
             v = _nums(params)
@@ -889,6 +953,10 @@ class _Reader:
 
         def ps(params: bytes, off: int, mn: str) -> None:
             v = _nums(params)
+            if any(x <= 0 for x in v[:2]):
+                # "if a length is <= 0 the device ignores the instruction"
+                self.warn(off, "PS with a length <= 0 ignored", key="args-PS")
+                return
             if len(v) >= 2:
                 w, h = abs(v[0]), abs(v[1])
             elif len(v) == 1:
@@ -907,6 +975,28 @@ class _Reader:
         def tl(params: bytes, off: int, mn: str) -> None:
             v = _nums(params)
             self.tick = (v[0] if v else 0.5, v[1] if len(v) > 1 else (0.0 if v else 0.5))
+
+        def si(params: bytes, off: int, mn: str) -> None:
+            v = _nums(params)
+            if len(v) >= 2:
+                self.char_size = (abs(v[0]) * 400.0, abs(v[1]) * 400.0)  # cm -> units
+            else:
+                self.char_size = None
+            self.char_rel = None
+
+        def sr(params: bytes, off: int, mn: str) -> None:
+            v = _nums(params)
+            self.char_rel = (abs(v[0]), abs(v[1])) if len(v) >= 2 else (0.75, 1.5)
+            self.char_size = None
+
+        def di(params: bytes, off: int, mn: str) -> None:
+            v = _nums(params)
+            run, rise = (v[0], v[1]) if len(v) >= 2 else (1.0, 0.0)
+            if mn == "DR":
+                (p1x, p1y), (p2x, p2y) = self.p1, self.p2
+                run, rise = run * (p2x - p1x) / 100.0, rise * (p2y - p1y) / 100.0
+            r = math.hypot(run, rise)
+            self.label_dir = (run / r, rise / r) if r > 0 and math.isfinite(r) else (1.0, 0.0)
 
         def pg(params: bytes, off: int, mn: str) -> None:
             self.flush()
@@ -962,6 +1052,10 @@ class _Reader:
             "DF": df,
             "PG": pg,
             "LT": lt,
+            "SI": si,
+            "SR": sr,
+            "DI": di,
+            "DR": di,
         }
 
     # ------------------------------------------------------------------ text-like commands
@@ -980,15 +1074,73 @@ class _Reader:
         return self.n if j < 0 else j + 1
 
     def label(self, pos: int) -> int:
-        """LB/BL/WD: skip text to the terminator; returns the offset after it."""
+        """LB/BL/WD: skip text to the terminator; returns the offset after it.
+
+        The letters are not drawn, but LB moves the pen as the plotter would: one character
+        cell per character along the label direction, CR back to the line's start, LF one
+        line down, BS one cell back (see :meth:`label_advance`). BL (buffer) and WD (a
+        display) do not move it.
+        """
         self.labels += 1
+        mn = self.data[pos - 2 : pos].upper()
         j = self._find_term(pos, self.term)
         if j < 0:
             end = self._end_of_line(pos)
             self.warn(pos - 2, "label without its terminator: ended at the end of the line",
                       key="label-unterminated")
-            return end
-        return j + 1
+            text_end = end
+        else:
+            text_end, end = j, j + 1
+        if mn == b"LB":
+            self.label_advance(self.data[pos:text_end])
+        return end
+
+    def char_cell(self) -> tuple[float, float]:
+        """(advance along the text, line spacing) in plotter units.
+
+        The character cell of the HP stick font: 1.5 x the character width along the line,
+        2 x the character height between lines (HP 7475A manual, SI; the HP-GL/2 default
+        font, 9 characters per inch, is within 1 % of the same 0.187 cm x 1.5). Width and
+        height come from SI (cm), from SR (% of P2 - P1) or are SI's defaults, 0.187 x
+        0.269 cm.
+        """
+        if self.char_rel is not None:
+            (p1x, p1y), (p2x, p2y) = self.p1, self.p2
+            w = self.char_rel[0] / 100.0 * abs(p2x - p1x)
+            h = self.char_rel[1] / 100.0 * abs(p2y - p1y)
+        elif self.char_size is not None:
+            w, h = self.char_size
+        else:
+            w, h = 0.187 * 400.0, 0.269 * 400.0
+        return 1.5 * w, 2.0 * h
+
+    def label_advance(self, text: bytes) -> None:
+        """Move the current position over ``text`` as LB does (the pen state is kept: the
+        path being drawn ends at the label, the next pen-down move starts at its end)."""
+        if not text:
+            return
+        adv, line = self.char_cell()
+        ux, uy = self.label_dir
+        nx, ny = uy, -ux  # one line down: to the right of the direction of the text
+        col = 0.0
+        row = 0.0
+        for c in text:
+            if c == 0x0D:
+                col = 0.0
+            elif c == 0x0A:
+                row += 1.0
+            elif c == 0x08:
+                col -= 1.0
+            elif c >= 0x20:
+                col += 1.0
+        if col == 0.0 and row == 0.0:
+            return
+        self.flush_if_drawing()
+        x = self.x + col * adv * ux + row * line * nx
+        y = self.y + col * adv * uy + row * line * ny
+        if self.poly is not None:
+            self._poly_move(x, y)  # pen-up (or pen-down) move in the polygon buffer
+        self.x, self.y = x, y
 
     def dt(self, pos: int) -> int:
         data, n = self.data, self.n
@@ -1040,6 +1192,7 @@ class _Reader:
             if item.kind == "pen":
                 self.flush()
                 self.pen = item.value
+                self.pen_selected = True
                 continue
             if item.pen_up:
                 self.set_pen_down(False, pos)
@@ -1079,7 +1232,9 @@ class _Reader:
     def _skip_pcl_data(self, m: re.Match[bytes]) -> int:
         end = m.end()
         term = m.group(5)
-        if term in (b"W", b"X") and (term == b"W" or m.group(2) == b"p"):
+        # ESC ... #W (raster, font, pattern data) and ESC&p#X (transparent print data)
+        # carry # bytes of data; ESC*p#X is cursor positioning and carries none
+        if term == b"W" or (term == b"X" and m.group(1) == b"&" and m.group(2) == b"p"):
             try:
                 count = int(float(m.group(4) or b"0"))
             except ValueError:
@@ -1097,12 +1252,14 @@ class _Reader:
             lang = m.group(1).upper().replace(b"-", b"")
             if lang.startswith(b"HPGL"):
                 self.hpgl_mode = True
+                self.hpgl2 = True
             return m.end()
         e = _PCL_ESC_RE.match(data, m.start())
         if e is None:
             return m.start() + 1
         if e.group(1) == b"%" and e.group(5) == b"B":
             self.hpgl_mode = True
+            self.hpgl2 = True
             return e.end()
         return self._skip_pcl_data(e)
 
@@ -1116,6 +1273,34 @@ _SPECIAL: dict[str, Callable[[_Reader, int], int]] = {
     "PE": _Reader.pe,
     "SM": _Reader.sm,
 }
+
+
+def _pen_down_runs(ring: list[tuple[float, float]],
+                   downs: list[bool]) -> list[list[tuple[float, float]]]:
+    """The pieces of a sub-polygon that EP draws: runs of pen-down edges.
+
+    ``downs[k]`` is the pen state of the edge from ``ring[k]`` to ``ring[k + 1]``; the last
+    entry is the closing edge back to ``ring[0]`` (none when the ring already ends there).
+    A ring whose edges are all pen-down comes back as one closed run.
+    """
+    pts = list(ring)
+    flags = list(downs[: len(ring) - 1])
+    if ring[0] != ring[-1]:
+        pts.append(ring[0])
+        flags.append(downs[-1] if len(downs) >= len(ring) else False)
+    runs: list[list[tuple[float, float]]] = []
+    cur: list[tuple[float, float]] = []
+    for k, down in enumerate(flags):
+        if down:
+            if not cur:
+                cur = [pts[k]]
+            cur.append(pts[k + 1])
+        elif cur:
+            runs.append(cur)
+            cur = []
+    if cur:
+        runs.append(cur)
+    return runs
 
 
 def _near(a: np.ndarray, b: np.ndarray) -> bool:
@@ -1215,6 +1400,9 @@ def read_bytes(data: bytes, name: str = "<bytes>") -> Drawing:
         rd.warn(-1, "line types (LT) are not applied: every line is imported solid")
     if rd.text_symbols:
         rd.warn(-1, "symbol mode (SM) characters are not drawn")
+    if rd.unselected_paths:
+        rd.warn(-1, f"{rd.unselected_paths} path(s) drawn before any pen was selected (SP): "
+                   "imported with pen 1 (an HP-GL/2 device would not draw them)")
     pen0 = sum(1 for p in rd.paths if p[1] == 0)
     if pen0:
         rd.warn(-1, f"{pen0} path(s) drawn with pen 0 (SP0 puts the pen away: a pen plotter "
