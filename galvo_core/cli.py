@@ -17,10 +17,7 @@ from typing import Any, NoReturn
 
 from galvo_core import __version__
 from galvo_core.errors import GalvoError, ParamError
-from galvo_core.export import write_plt, write_svg
-from galvo_core.fit import fit_report
 from galvo_core.hpgl import read_file
-from galvo_core.job import write_job
 from galvo_core.params import (
     FILLS,
     INTERPOLATIONS,
@@ -30,7 +27,6 @@ from galvo_core.params import (
     LaserParams,
     Params,
 )
-from galvo_core.pipeline import Pipeline
 
 
 class _Parser(argparse.ArgumentParser):
@@ -143,6 +139,11 @@ def cmd_info(a: argparse.Namespace) -> int:
 
 
 def cmd_process(a: argparse.Namespace) -> int:
+    # imported here: info and --help need none of the pipeline (numba, scipy, shapely)
+    from galvo_core.export import write_plt, write_svg
+    from galvo_core.job import write_job
+    from galvo_core.pipeline import Pipeline
+
     params = _params_from_args(a)
     d = read_file(a.file)
     job = Pipeline().run(d, params)
@@ -162,6 +163,9 @@ def cmd_process(a: argparse.Namespace) -> int:
 
 
 def cmd_report(a: argparse.Namespace) -> int:
+    from galvo_core.fit import fit_report
+    from galvo_core.pipeline import Pipeline
+
     params = _params_from_args(a)
     d = read_file(a.file)
     row = fit_report(d, eps_line=params.eps_line, e_per=params.e_per, eps_sum=params.eps_sum)
