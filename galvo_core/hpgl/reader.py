@@ -60,11 +60,14 @@ skipped with a warning naming line and column. Time and memory are linear in the
 
 from __future__ import annotations
 
+import gc
 import math
 import os
 import re
+import sys
 from collections import Counter
 from collections.abc import Callable
+from itertools import repeat
 
 import numpy as np
 
@@ -110,6 +113,42 @@ _RUN_RE = re.compile(
     rb"(?:[\x00-\x1a\x1c-\x20;,]*[Pp][UuDdAaRr][-+0-9.,;\x00-\x1a\x1c-\x20]*)+"
 )
 _FAST_MIN_BYTES = 256  # shorter runs go command by command
+#: inputs from this size on are read with the compiled scanner (:mod:`.scan`, numba); smaller
+#: ones with the numpy runs of :mod:`.fastrun` -- unless numba is loaded already (the GUI,
+#: ``process``), so that ``galvo-core info small.plt`` does not pay numba's import
+_COMPILED_MIN_BYTES = 1 << 20
+_CHUNK_POINTS = 1 << 16  # points per output chunk of the compiled scanner
+
+
+def _use_compiled(size: int) -> bool:
+    return size >= _COMPILED_MIN_BYTES or "numba" in sys.modules
+
+
+class _Chunk:
+    """Output of the compiled scanner: points and the segments (paths) found in them."""
+
+    __slots__ = ("pts", "seg_start", "seg_off", "npts", "nseg")
+
+    def __init__(self, cap: int) -> None:
+        self.pts = np.empty((cap, 2), dtype=np.float64)
+        self.seg_start = np.empty(cap // 2 + 4, dtype=np.int32)
+        self.seg_off = np.empty(cap // 2 + 4, dtype=np.int32)
+        self.npts = 0
+        self.nseg = 0
+
+
+class _Batch:
+    """Paths the compiled scanner read: ``pts[starts[k]:ends[k]]``, all with one pen."""
+
+    __slots__ = ("chunk", "starts", "ends", "offs", "pen")
+
+    def __init__(self, chunk: _Chunk, starts: np.ndarray, ends: np.ndarray, offs: np.ndarray,
+                 pen: int) -> None:
+        self.chunk = chunk
+        self.starts = starts
+        self.ends = ends
+        self.offs = offs
+        self.pen = pen
 _SEP_RE = re.compile(rb"[\x00-\x1a\x1c-\x20;,]*")
 _NUM_RE = re.compile(rb"[-+]?(?:\d+\.?\d*|\.\d+)")
 _JUNK_PARAM_RE = re.compile(rb"[^\s,0-9.+\-\x00]+")
@@ -125,6 +164,7 @@ _PCL_SCAN_RE = re.compile(
 _VENDOR_RE = re.compile(rb"!([A-Za-z]{2})([^;\x1b\n]*);?")
 _PCL_START_RE = re.compile(rb"[\x00-\x20]*(?:\x1bE|\x1b%-12345X|@PJL|\x1b[&*(]|\x1b%-?\d*A)")
 
+_POW10 = 10.0 ** np.arange(0, 23)
 _WARN_CAP = 20  # warnings of one kind kept verbatim; the rest are counted
 
 
@@ -164,6 +204,10 @@ class _Reader:
         self.term = ETX
         self._no_term_after: dict[int, int] = {}
         self._pe_cache = PECache()
+        self.compiled = _use_compiled(self.n)
+        self._chunk: _Chunk | None = None
+        self.chunks: list[_Chunk] = []
+        self.batched = 0  # paths in _Batch items of self.paths
         self.hpgl_mode = True
         # dialect: HP-GL/2 once the file shows it (PCL/PJL entry, an HP-GL/2-only command)
         self.hpgl2 = False
@@ -212,6 +256,7 @@ class _Reader:
         self.char_rel: tuple[float, float] | None = None  # SR: % of P2-P1
         self.label_dir = (1.0, 0.0)  # DI/DR: unit vector of the text direction
         self.cur: list[float] = []  # current pen-down path, flat x, y (plotter units)
+        self.cur_parts: list[np.ndarray] = []  # its earlier points, read by the scanner
         self.cur_offset = 0
 
     def defaults(self) -> None:
@@ -330,7 +375,15 @@ class _Reader:
 
     def flush(self) -> None:
         cur = getattr(self, "cur", None)
-        if cur:
+        parts = getattr(self, "cur_parts", None)
+        if parts:
+            if cur:
+                parts.append(np.array(cur, dtype=np.float64).reshape(-1, 2))
+            pts = parts[0].copy() if len(parts) == 1 else np.concatenate(parts)
+            self.cur = []
+            self.cur_parts = []
+            self.emit(pts, self.cur_offset)
+        elif cur:
             self.emit(np.array(cur, dtype=np.float64).reshape(-1, 2), self.cur_offset)
             self.cur = []
 
@@ -356,7 +409,7 @@ class _Reader:
         if self.poly is not None:
             self._poly_move(x, y)
         elif self.pen_down:
-            if not self.cur:
+            if not self.cur and not self.cur_parts:
                 self.cur = [self.x, self.y]
                 self.cur_offset = offset
             self.cur.append(x)
@@ -371,7 +424,7 @@ class _Reader:
             for px, py in pts.tolist():
                 self._poly_move(px, py)
         elif self.pen_down:
-            if not self.cur:
+            if not self.cur and not self.cur_parts:
                 self.cur = [self.x, self.y]
                 self.cur_offset = offset
             self.cur.extend(pts.ravel().tolist())
@@ -566,7 +619,7 @@ class _Reader:
         self.emit_ring(pts, offset)
 
     def flush_if_drawing(self) -> None:
-        if self.poly is None and self.cur:
+        if self.poly is None and (self.cur or self.cur_parts):
             self.flush()
             if self.pen_down:
                 self.cur = []
@@ -733,7 +786,12 @@ class _Reader:
             if not self.hpgl_mode:
                 i = self._pcl(i)
                 continue
-            if self.poly is None and i >= slow_until:
+            if self.compiled and self.poly is None:
+                j = self._compiled_run(i)
+                if j != i:
+                    i = j
+                    continue
+            elif self.poly is None and i >= slow_until:
                 rm = run_match(data, i)
                 if rm is not None:
                     if rm.end() - i >= _FAST_MIN_BYTES and self._fast_run(i, rm.end()):
@@ -804,6 +862,110 @@ class _Reader:
             self.warn(self.poly_offset,
                       "polygon defined with PM but never edged or filled (EP/FP): not drawn")
 
+    # ------------------------------------------------------------------ compiled runs
+    def _new_chunk(self, need: int) -> _Chunk:
+        cap = max(need + 2, min(_CHUNK_POINTS, self.n // 2 + 8))
+        ch = _Chunk(cap)
+        self._chunk = ch
+        self.chunks.append(ch)
+        return ch
+
+    def _compiled_run(self, i: int) -> int:
+        """Read the PU/PD/PA/PR commands from ``i`` on with the compiled scanner; returns
+        the offset where it stopped (``i`` when the next command is not one it reads)."""
+        from galvo_core.hpgl import scan
+
+        if not hasattr(self, "_u8"):
+            self._u8 = np.frombuffer(self.data, dtype=np.uint8)
+            self._ist = np.zeros(scan.N_ISTATE, dtype=np.int64)
+            self._fst = np.zeros(scan.N_FSTATE, dtype=np.float64)
+        ist, fst = self._ist, self._fst
+        while True:
+            ch = self._chunk
+            if ch is None or len(ch.pts) - ch.npts < 2 or len(ch.seg_start) - ch.nseg < 3:
+                ch = self._new_chunk(0)
+            was_open = self.pen_down and bool(self.cur or self.cur_parts)
+            ist[:] = 0
+            ist[scan.I_POS] = i
+            ist[scan.I_PEN] = self.pen_down
+            ist[scan.I_ABS] = self.absolute
+            ist[scan.I_OPEN] = was_open
+            ist[scan.I_NPTS] = ch.npts
+            ist[scan.I_NSEG] = ch.nseg
+            fst[scan.F_X] = self.x
+            fst[scan.F_Y] = self.y
+            if self.sc is None:
+                fst[scan.F_SC] = 0.0
+            else:
+                fst[scan.F_AX], fst[scan.F_BX], fst[scan.F_AY], fst[scan.F_BY] = self.sc
+                fst[scan.F_SC] = 1.0
+            scan.scan_moves(self._u8, ist, fst, ch.pts, ch.seg_start, ch.seg_off, _POW10)
+            self._take_segments(ch, ist)
+            self.x = float(fst[scan.F_X])
+            self.y = float(fst[scan.F_Y])
+            self.pen_down = bool(ist[scan.I_PEN])
+            self.absolute = bool(ist[scan.I_ABS])
+            ncmd = 0
+            for name, slot in (("PU", scan.I_NU), ("PD", scan.I_ND), ("PA", scan.I_NA),
+                               ("PR", scan.I_NR)):
+                c = int(ist[slot])
+                if c:
+                    self.commands[name] += c
+                    ncmd += c
+            self.recognised += ncmd
+            i = int(ist[scan.I_POS])
+            if not ist[scan.I_FULL]:
+                return i
+            self._new_chunk(int(ist[scan.I_NEED]))
+
+    def _take_segments(self, ch: _Chunk, ist: np.ndarray) -> None:
+        from galvo_core.hpgl import scan
+
+        s0, s1 = ch.nseg, int(ist[scan.I_NSEG])
+        p1 = int(ist[scan.I_NPTS])
+        ch.nseg, ch.npts = s1, p1
+        if s1 == s0:
+            return
+        starts = ch.seg_start[s0:s1].astype(np.int64)
+        ends = np.empty_like(starts)
+        ends[:-1] = starts[1:]
+        ends[-1] = p1
+        offs = ch.seg_off[s0:s1]
+        a, b = 0, s1 - s0
+        still_open = bool(ist[scan.I_OPEN])
+        if ist[scan.I_CONT]:
+            st, en = int(starts[0]), int(ends[0])
+            if en > st:
+                if self.cur:
+                    self.cur_parts.append(np.array(self.cur, dtype=np.float64).reshape(-1, 2))
+                    self.cur = []
+                self.cur_parts.append(ch.pts[st:en])
+            if b > 1 or not still_open:
+                self.flush()
+            a = 1
+        open_last = still_open and b > a
+        if open_last:
+            b -= 1
+        if b > a:
+            self._add_batch(ch, starts[a:b], ends[a:b], offs[a:b])
+        if open_last:
+            self.cur = []
+            self.cur_parts = [ch.pts[int(starts[b]) : int(ends[b])]]
+            self.cur_offset = int(offs[b])
+
+    def _add_batch(self, ch: _Chunk, starts: np.ndarray, ends: np.ndarray,
+                   offs: np.ndarray) -> None:
+        span = ch.pts[int(starts[0]) : int(ends[-1])]
+        if self.window is None and self.rot == 0 and np.isfinite(span).all():
+            self.paths.append(_Batch(ch, starts.copy(), ends.copy(),  # type: ignore[arg-type]
+                                     offs.astype(np.int64), self.pen))
+            self.batched += len(starts)
+            if not self.pen_selected:
+                self.unselected_paths += len(starts)
+            return
+        for s, e, off in zip(starts.tolist(), ends.tolist(), offs.tolist(), strict=True):
+            self.emit(ch.pts[s:e].copy(), off)
+
     def _fast_run(self, start: int, end: int) -> bool:
         """Read a run of PU/PD/PA/PR commands in one vectorised step (see fastrun).
 
@@ -861,13 +1023,11 @@ class _Reader:
         # continuation of a path open before the run
         cont = d_idx[d_path < 0]
         if len(cont):
-            if not self.cur:  # the pen is down but the path was ended (CI, SP, IW...)
+            if not self.cur and not self.cur_parts:  # pen down, path ended (CI, SP, IW..)
                 self.cur = [self.x, self.y]
                 self.cur_offset = start + int(tok.cmd_pos[pair_cmd[cont[0]]])
             self.cur.extend(q[cont + 1].ravel().tolist())
-        elif self.pen_down and not self.cur:
-            pass
-        if self.cur and (len(trans) or not bool(pen_after[-1])):
+        if (self.cur or self.cur_parts) and (len(trans) or not bool(pen_after[-1])):
             self.flush()
         npaths = len(trans)
         if npaths:
@@ -1353,16 +1513,71 @@ def _clip_polyline(pts: np.ndarray, win: tuple[float, float, float, float]) -> l
     return out
 
 
-def _line_cols(data: bytes, offsets: list[int]) -> list[tuple[int, int]]:
-    if not offsets:
-        return []
+def _line_cols_arrays(data: bytes, offs: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """1-based line and column of each byte offset (one pass over the newlines)."""
+    if not len(offs):
+        return np.zeros(0, np.int64), np.zeros(0, np.int64)
     nl = np.flatnonzero(np.frombuffer(data, dtype=np.uint8) == 10)
-    offs = np.asarray(offsets, dtype=np.int64)
     idx = np.searchsorted(nl, offs, side="left")  # newlines strictly before offset
-    line_start = np.where(idx > 0, nl[np.maximum(idx - 1, 0)] + 1 if len(nl) else 0, 0)
-    lines = idx + 1
-    cols = offs - line_start + 1
-    return list(zip(lines.tolist(), cols.tolist(), strict=True))
+    if len(nl):
+        line_start = np.where(idx > 0, nl[np.maximum(idx - 1, 0)] + 1, 0)
+    else:
+        line_start = np.zeros_like(offs)
+    return idx + 1, offs - line_start + 1
+
+
+_new_obj = object.__new__
+_set_attr = object.__setattr__
+
+
+def _new_path(points: np.ndarray, pen: int, closed: bool, line: int, col: int) -> Path:
+    """A Path without the copy its constructor makes: ``points`` is a read-only float64
+    (N, 2) array already (a view of the scanner's frozen chunk, or the reader's own)."""
+    sp = _new_obj(SourcePos)
+    _set_attr(sp, "line", line)
+    _set_attr(sp, "col", col)
+    p = _new_obj(Path)
+    _set_attr(p, "points", points)
+    _set_attr(p, "pen", pen)
+    _set_attr(p, "closed", closed)
+    _set_attr(p, "start", sp)
+    return p
+
+
+def _batch_paths(b: _Batch, lines: list[int], cols: list[int], k: int,
+                 out: list[Path]) -> int:
+    """Append the paths of a scanner batch to ``out``; returns the next position index.
+
+    Tens of thousands of paths: the objects are made and filled by ``map`` (loops in C),
+    each path's points a view of the frozen chunk.
+    """
+    pts = b.chunk.pts
+    starts, ends = b.starts, b.ends
+    m = len(starts)
+    first = pts[starts]
+    last = pts[ends - 1]
+    closed = ((ends - starts >= 4) & (first[:, 0] == last[:, 0])
+              & (first[:, 1] == last[:, 1])).tolist()
+    views = list(map(pts.__getitem__, map(slice, starts.tolist(), ends.tolist())))
+    sps = list(map(_new_obj, repeat(SourcePos, m)))
+    any(map(_SP_LINE, sps, lines[k : k + m]))
+    any(map(_SP_COL, sps, cols[k : k + m]))
+    objs = list(map(_new_obj, repeat(Path, m)))
+    any(map(_P_POINTS, objs, views))
+    any(map(_P_PEN, objs, repeat(b.pen, m)))
+    any(map(_P_CLOSED, objs, closed))
+    any(map(_P_START, objs, sps))
+    out.extend(objs)
+    return k + m
+
+
+# slot setters of the frozen dataclasses (member descriptors: no frozen __setattr__)
+_SP_LINE = SourcePos.line.__set__  # type: ignore[attr-defined]
+_SP_COL = SourcePos.col.__set__  # type: ignore[attr-defined]
+_P_POINTS = Path.points.__set__  # type: ignore[attr-defined]
+_P_PEN = Path.pen.__set__  # type: ignore[attr-defined]
+_P_CLOSED = Path.closed.__set__  # type: ignore[attr-defined]
+_P_START = Path.start.__set__  # type: ignore[attr-defined]
 
 
 def read_bytes(data: bytes, name: str = "<bytes>") -> Drawing:
@@ -1375,6 +1590,18 @@ def read_bytes(data: bytes, name: str = "<bytes>") -> Drawing:
     reason = refusal_reason(head)
     if reason is not None:
         raise InputError(name, reason)
+    # the reader makes tens of thousands of objects that all live on (paths, positions):
+    # the cyclic garbage collector would walk them again and again for nothing
+    gc_was_on = gc.isenabled()
+    gc.disable()
+    try:
+        return _read(data, name)
+    finally:
+        if gc_was_on:
+            gc.enable()
+
+
+def _read(data: bytes, name: str) -> Drawing:
     rd = _Reader(data, name)
     try:
         with np.errstate(all="ignore"):  # out-of-range numbers are dropped, not warned twice
@@ -1403,7 +1630,9 @@ def read_bytes(data: bytes, name: str = "<bytes>") -> Drawing:
     if rd.unselected_paths:
         rd.warn(-1, f"{rd.unselected_paths} path(s) drawn before any pen was selected (SP): "
                    "imported with pen 1 (an HP-GL/2 device would not draw them)")
-    pen0 = sum(1 for p in rd.paths if p[1] == 0)
+    pen0 = sum(
+        (len(p.starts) if p.pen == 0 else 0) if isinstance(p, _Batch) else int(p[1] == 0)
+        for p in rd.paths)
     if pen0:
         rd.warn(-1, f"{pen0} path(s) drawn with pen 0 (SP0 puts the pen away: a pen plotter "
                    "would not draw them); imported anyway")
@@ -1413,14 +1642,29 @@ def read_bytes(data: bytes, name: str = "<bytes>") -> Drawing:
         if count > _WARN_CAP:
             rd._warn.append((-1, f"... and {count - _WARN_CAP} more warnings like: {key}"))
     # positions
-    offsets = [p[3] for p in rd.paths]
-    w_offsets = [w[0] for w in rd._warn]
-    lc = _line_cols(data, offsets + w_offsets)
-    paths = []
-    for (pts, pen, closed, _), (line, col) in zip(rd.paths, lc[: len(offsets)], strict=True):
-        paths.append(Path(pts, pen=pen, closed=closed, start=SourcePos(line, col)))
+    off_parts = [
+        p.offs if isinstance(p, _Batch) else np.array([p[3]], dtype=np.int64) for p in rd.paths
+    ]
+    off_parts.append(np.array([w[0] for w in rd._warn], dtype=np.int64))
+    lines, cols = _line_cols_arrays(data, np.concatenate(off_parts))
+    lines_l = lines.tolist()
+    cols_l = cols.tolist()
+    for ch in rd.chunks:
+        ch.pts.setflags(write=False)
+    paths: list[Path] = []
+    k = 0
+    for item in rd.paths:
+        if isinstance(item, _Batch):
+            k = _batch_paths(item, lines_l, cols_l, k, paths)
+        else:
+            pts, pen, closed, _ = item
+            pts = np.ascontiguousarray(pts, dtype=np.float64)
+            pts.setflags(write=False)
+            paths.append(_new_path(pts, pen, closed, lines_l[k], cols_l[k]))
+            k += 1
+    lc = list(zip(lines_l[k:], cols_l[k:], strict=True))
     warnings = []
-    for (off, msg), (line, col) in zip(rd._warn, lc[len(offsets) :], strict=True):
+    for (off, msg), (line, col) in zip(rd._warn, lc, strict=True):
         if off < 0:
             line, col = 0, 0
         warnings.append(Warning(line, col, msg))
