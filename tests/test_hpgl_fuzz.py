@@ -45,6 +45,10 @@ def count_calls(fn, *args) -> int:
         if event == "call" or event == "c_call":
             n += 1
 
+    try:  # once first: lazy imports (numba for the compiled scanner) are not the input's work
+        fn(*args)
+    except InputError:
+        pass
     sys.setprofile(prof)
     try:
         fn(*args)
@@ -227,9 +231,15 @@ def model(program: list[tuple[str, list[tuple[str, str]]]]) -> list[np.ndarray]:
 
 
 @contextmanager
-def fast_min_bytes(value: int):
-    with mock.patch.object(reader, "_FAST_MIN_BYTES", value):
+def fast_min_bytes(value: int, compiled: bool = False):
+    """Which reader reads the PU/PD/PA/PR runs: numpy runs from ``value`` bytes on (0: all,
+    10**12: none, command by command), or the compiled scanner (``compiled``)."""
+    with mock.patch.object(reader, "_FAST_MIN_BYTES", value), \
+            mock.patch.object(reader, "_use_compiled", lambda size: compiled):
         yield
+
+
+MODES = [(0, False), (None, False), (10**12, False), (None, True)]  # numpy, default, slow, compiled
 
 
 def assert_matches_model(data: bytes, want: list[np.ndarray]) -> None:
@@ -256,14 +266,19 @@ def test_writer_programs_read_back_exactly(data, program) -> None:
     text = data.draw(spelled(program))
     assume(text.strip())
     want = model(program)
-    for limit in (0, reader._FAST_MIN_BYTES, 10**12):  # all fast, default, all slow
-        with fast_min_bytes(limit):
+    for limit, compiled in MODES:
+        with fast_min_bytes(reader._FAST_MIN_BYTES if limit is None else limit, compiled):
             assert_matches_model(text, want)
 
 
 OTHER = [b"CI5;", b"SP2;", b"EA10,10;", b"IW-100000,-100000,100000,100000;", b"XT;",
-         b"LBhi\x03", b"AA0,0,45;", b"PM0;", b"PM2;", b"EP;", b"IN;", b"RO90;", b"RO;"]
-PREFIX = [b"", b"IN;", b"IN;SC0,1000,0,1000;", b"IP0,0,500,700;SC-10,10,-5,5;", b"PS9000,9000;"]
+         b"LBhi\x03", b"AA0,0,45;", b"PM0;", b"PM2;", b"EP;", b"IN;", b"RO90;", b"RO;",
+         # pens (SP inside the compiled scanner, per dialect), interruptions, numbers that
+         # only the general reader reads (it warns), odd counts
+         b"SP1;", b"SP;", b"SP 3;", b"SP1,2;", b"BP;", b"LT;", b"PD1:2;", b"PR1,2,3;",
+         b"PA1.2.3,4;", b"PD12345678901234567,1;", b"PU-,5;"]
+PREFIX = [b"", b"IN;", b"IN;SC0,1000,0,1000;", b"IP0,0,500,700;SC-10,10,-5,5;", b"PS9000,9000;",
+          b"SP1;", b"IN;SP2;SC0,1000,0,1000;"]
 
 
 @settings(max_examples=80, deadline=None, suppress_health_check=[HealthCheck.too_slow])
@@ -272,22 +287,23 @@ PREFIX = [b"", b"IN;", b"IN;SC0,1000,0,1000;", b"IP0,0,500,700;SC-10,10,-5,5;", 
 def test_fast_and_slow_paths_agree(data, prefix, items) -> None:
     parts = [it if isinstance(it, bytes) else data.draw(spelled([it])) for it in items]
     text = prefix + b"".join(parts)
-    with fast_min_bytes(0):
-        fast = read_bytes(text)
     with fast_min_bytes(10**12):
         slow = read_bytes(text)
-    assert len(fast.paths) == len(slow.paths)
-    for a, b in zip(fast.paths, slow.paths, strict=True):
-        assert np.array_equal(a.points, b.points)
-        assert (a.pen, a.closed, a.start) == (b.pen, b.closed, b.start)
-    assert fast.warnings == slow.warnings
-    assert dict(fast.commands) == dict(slow.commands)
+    for limit, compiled in ((0, False), (10**12, True)):
+        with fast_min_bytes(limit, compiled):
+            fast = read_bytes(text)
+        assert len(fast.paths) == len(slow.paths)
+        for a, b in zip(fast.paths, slow.paths, strict=True):
+            assert np.array_equal(a.points, b.points)
+            assert (a.pen, a.closed, a.start) == (b.pen, b.closed, b.start)
+        assert fast.warnings == slow.warnings
+        assert dict(fast.commands) == dict(slow.commands)
 
 
 def test_relative_square_closes_exactly_on_both_paths() -> None:
     body = b"PA1000.1,7.3;PD;" + b"PR0.1,0,0,0.1,-0.1,0,0,-0.1;" * 40
-    for limit in (0, 10**12):
-        with fast_min_bytes(limit):
+    for limit, compiled in ((0, False), (10**12, False), (10**12, True)):
+        with fast_min_bytes(limit, compiled):
             d = read_bytes(b"IN;PR5.5,3.3;" + body)
         assert len(d.paths) == 1 and d.paths[0].closed
 

@@ -120,6 +120,10 @@ _COMPILED_MIN_BYTES = 1 << 20
 _CHUNK_POINTS = 1 << 16  # points per output chunk of the compiled scanner
 
 
+def _is_letter_or_esc(c: int) -> bool:
+    return 65 <= c <= 90 or 97 <= c <= 122 or c == 0x1B
+
+
 def _use_compiled(size: int) -> bool:
     return size >= _COMPILED_MIN_BYTES or "numba" in sys.modules
 
@@ -127,28 +131,29 @@ def _use_compiled(size: int) -> bool:
 class _Chunk:
     """Output of the compiled scanner: points and the segments (paths) found in them."""
 
-    __slots__ = ("pts", "seg_start", "seg_off", "npts", "nseg")
+    __slots__ = ("pts", "seg_start", "seg_off", "seg_pen", "npts", "nseg")
 
     def __init__(self, cap: int) -> None:
         self.pts = np.empty((cap, 2), dtype=np.float64)
         self.seg_start = np.empty(cap // 2 + 4, dtype=np.int32)
         self.seg_off = np.empty(cap // 2 + 4, dtype=np.int32)
+        self.seg_pen = np.empty(cap // 2 + 4, dtype=np.int32)
         self.npts = 0
         self.nseg = 0
 
 
 class _Batch:
-    """Paths the compiled scanner read: ``pts[starts[k]:ends[k]]``, all with one pen."""
+    """Paths the compiled scanner read: ``pts[starts[k]:ends[k]]`` drawn with ``pens[k]``."""
 
-    __slots__ = ("chunk", "starts", "ends", "offs", "pen")
+    __slots__ = ("chunk", "starts", "ends", "offs", "pens")
 
     def __init__(self, chunk: _Chunk, starts: np.ndarray, ends: np.ndarray, offs: np.ndarray,
-                 pen: int) -> None:
+                 pens: np.ndarray) -> None:
         self.chunk = chunk
         self.starts = starts
         self.ends = ends
         self.offs = offs
-        self.pen = pen
+        self.pens = pens
 _SEP_RE = re.compile(rb"[\x00-\x1a\x1c-\x20;,]*")
 _NUM_RE = re.compile(rb"[-+]?(?:\d+\.?\d*|\.\d+)")
 _JUNK_PARAM_RE = re.compile(rb"[^\s,0-9.+\-\x00]+")
@@ -794,8 +799,16 @@ class _Reader:
             elif self.poly is None and i >= slow_until:
                 rm = run_match(data, i)
                 if rm is not None:
-                    if rm.end() - i >= _FAST_MIN_BYTES and self._fast_run(i, rm.end()):
-                        i = rm.end()
+                    end = rm.end()
+                    if end < n and not _is_letter_or_esc(data[end]):
+                        # the run stops inside a command's parameters (``PD1:2``): that
+                        # command is read by the general reader, which warns
+                        k = end - 1
+                        while k > i and not _is_letter_or_esc(data[k]):
+                            k -= 1
+                        end = k - 1
+                    if end > i and end - i >= _FAST_MIN_BYTES and self._fast_run(i, end):
+                        i = end
                         continue
                     slow_until = rm.end()  # read this run command by command
             m = cmd_match(data, i)
@@ -892,6 +905,9 @@ class _Reader:
             ist[scan.I_OPEN] = was_open
             ist[scan.I_NPTS] = ch.npts
             ist[scan.I_NSEG] = ch.nseg
+            ist[scan.I_PENNO] = self.pen
+            ist[scan.I_HPGL2] = self.hpgl2
+            ist[scan.I_SPOK] = self.pen_selected
             fst[scan.F_X] = self.x
             fst[scan.F_Y] = self.y
             if self.sc is None:
@@ -899,15 +915,17 @@ class _Reader:
             else:
                 fst[scan.F_AX], fst[scan.F_BX], fst[scan.F_AY], fst[scan.F_BY] = self.sc
                 fst[scan.F_SC] = 1.0
-            scan.scan_moves(self._u8, ist, fst, ch.pts, ch.seg_start, ch.seg_off, _POW10)
+            scan.scan_moves(self._u8, ist, fst, ch.pts, ch.seg_start, ch.seg_off, ch.seg_pen,
+                            _POW10)
             self._take_segments(ch, ist)
             self.x = float(fst[scan.F_X])
             self.y = float(fst[scan.F_Y])
             self.pen_down = bool(ist[scan.I_PEN])
             self.absolute = bool(ist[scan.I_ABS])
+            self.pen = int(ist[scan.I_PENNO])
             ncmd = 0
             for name, slot in (("PU", scan.I_NU), ("PD", scan.I_ND), ("PA", scan.I_NA),
-                               ("PR", scan.I_NR)):
+                               ("PR", scan.I_NR), ("SP", scan.I_NSP)):
                 c = int(ist[slot])
                 if c:
                     self.commands[name] += c
@@ -931,6 +949,7 @@ class _Reader:
         ends[:-1] = starts[1:]
         ends[-1] = p1
         offs = ch.seg_off[s0:s1]
+        pens = ch.seg_pen[s0:s1]
         a, b = 0, s1 - s0
         still_open = bool(ist[scan.I_OPEN])
         if ist[scan.I_CONT]:
@@ -947,24 +966,28 @@ class _Reader:
         if open_last:
             b -= 1
         if b > a:
-            self._add_batch(ch, starts[a:b], ends[a:b], offs[a:b])
+            self._add_batch(ch, starts[a:b], ends[a:b], offs[a:b], pens[a:b])
         if open_last:
             self.cur = []
             self.cur_parts = [ch.pts[int(starts[b]) : int(ends[b])]]
             self.cur_offset = int(offs[b])
 
     def _add_batch(self, ch: _Chunk, starts: np.ndarray, ends: np.ndarray,
-                   offs: np.ndarray) -> None:
+                   offs: np.ndarray, pens: np.ndarray) -> None:
         span = ch.pts[int(starts[0]) : int(ends[-1])]
         if self.window is None and self.rot == 0 and np.isfinite(span).all():
             self.paths.append(_Batch(ch, starts.copy(), ends.copy(),  # type: ignore[arg-type]
-                                     offs.astype(np.int64), self.pen))
+                                     offs.astype(np.int64), pens.copy()))
             self.batched += len(starts)
-            if not self.pen_selected:
+            if not self.pen_selected:  # (the scanner reads SP only once a pen was selected)
                 self.unselected_paths += len(starts)
             return
-        for s, e, off in zip(starts.tolist(), ends.tolist(), offs.tolist(), strict=True):
+        pen = self.pen
+        for s, e, off, p in zip(starts.tolist(), ends.tolist(), offs.tolist(), pens.tolist(),
+                                strict=True):
+            self.pen = p
             self.emit(ch.pts[s:e].copy(), off)
+        self.pen = pen
 
     def _fast_run(self, start: int, end: int) -> bool:
         """Read a run of PU/PD/PA/PR commands in one vectorised step (see fastrun).
@@ -1564,7 +1587,7 @@ def _batch_paths(b: _Batch, lines: list[int], cols: list[int], k: int,
     any(map(_SP_COL, sps, cols[k : k + m]))
     objs = list(map(_new_obj, repeat(Path, m)))
     any(map(_P_POINTS, objs, views))
-    any(map(_P_PEN, objs, repeat(b.pen, m)))
+    any(map(_P_PEN, objs, b.pens.tolist()))
     any(map(_P_CLOSED, objs, closed))
     any(map(_P_START, objs, sps))
     out.extend(objs)
@@ -1631,8 +1654,7 @@ def _read(data: bytes, name: str) -> Drawing:
         rd.warn(-1, f"{rd.unselected_paths} path(s) drawn before any pen was selected (SP): "
                    "imported with pen 1 (an HP-GL/2 device would not draw them)")
     pen0 = sum(
-        (len(p.starts) if p.pen == 0 else 0) if isinstance(p, _Batch) else int(p[1] == 0)
-        for p in rd.paths)
+        int((p.pens == 0).sum()) if isinstance(p, _Batch) else int(p[1] == 0) for p in rd.paths)
     if pen0:
         rd.warn(-1, f"{pen0} path(s) drawn with pen 0 (SP0 puts the pen away: a pen plotter "
                    "would not draw them); imported anyway")

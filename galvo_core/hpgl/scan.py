@@ -24,8 +24,8 @@ from numba import njit
 
 # int state slots
 (I_POS, I_PEN, I_ABS, I_OPEN, I_NPTS, I_NSEG, I_CONT, I_NU, I_ND, I_NA, I_NR, I_FULL,
- I_NEED) = range(13)
-N_ISTATE = 13
+ I_NEED, I_PENNO, I_HPGL2, I_NSP, I_SPOK) = range(17)
+N_ISTATE = 17
 # float state slots
 F_X, F_Y, F_AX, F_BX, F_AY, F_BY, F_SC = range(7)
 N_FSTATE = 7
@@ -46,86 +46,61 @@ def _is_letter(c: int) -> bool:
 
 
 @njit(cache=True, nogil=True, boundscheck=False)
-def _check_params(b, j, n):
-    """Validate the parameters starting at ``j``: returns (end, numbers) or (-1, 0) when
-    the general reader must read them. ``end`` is the offset after the parameters (after
-    the ';' when there is one)."""
-    count = 0
-    while j < n:
-        c = b[j]
-        if c == 59:  # ';'
-            return j + 1, count
-        if c == 27 or _is_letter(c):
-            return j, count
-        if _is_sep(c):
-            j += 1
-            continue
-        # a number: [+-]? digits [. digits] | [+-]? . digits
-        k = j
-        if c == 43 or c == 45:
-            k += 1
-        nd = 0
-        while k < n and 48 <= b[k] <= 57:
-            k += 1
-            nd += 1
-        if k < n and b[k] == 46:
-            k += 1
-            while k < n and 48 <= b[k] <= 57:
-                k += 1
-                nd += 1
-            if k < n and b[k] == 46:
-                return -1, 0  # "1.2.3": read by the general reader
-        if nd == 0 or nd > 15:
-            return -1, 0
-        count += 1
-        j = k
-        if j < n:
-            c = b[j]
-            # a number ends at a separator, a sign, ';', a letter or ESC
-            if not (c == 59 or c == 27 or c == 43 or c == 45 or _is_sep(c) or _is_letter(c)):
-                return -1, 0
-    return j, count
-
-
-@njit(cache=True, nogil=True, boundscheck=False)
-def _parse_number(b, j, pow10):
-    """(value, end) of the number at ``j`` (already validated)."""
+def _read_number(b, j, n, pow10):
+    """The number at ``j``: (value, end), end = -1 when the general reader must read it
+    ("1.2.3", a sign or point without digits, more than 15 digits, junk right after)."""
     neg = False
     c = b[j]
     if c == 43 or c == 45:
         neg = c == 45
         j += 1
     mant = 0
+    nd = 0
     frac = 0
-    seen_dot = False
-    n = b.shape[0]
     while j < n:
         c = b[j]
         if 48 <= c <= 57:
             mant = mant * 10 + (c - 48)
-            if seen_dot:
-                frac += 1
-        elif c == 46 and not seen_dot:
-            seen_dot = True
+            nd += 1
+            j += 1
         else:
             break
+    if j < n and b[j] == 46:
         j += 1
+        while j < n:
+            c = b[j]
+            if 48 <= c <= 57:
+                mant = mant * 10 + (c - 48)
+                nd += 1
+                frac += 1
+                j += 1
+            else:
+                break
+        if j < n and b[j] == 46:
+            return 0.0, -1
+    if nd == 0 or nd > 15:
+        return 0.0, -1
+    if j < n:
+        c = b[j]
+        # a number ends at a separator, a sign, ';', a letter or ESC
+        if not (c == 59 or c == 27 or c == 43 or c == 45 or _is_sep(c) or _is_letter(c)):
+            return 0.0, -1
     v = float(mant)
     if frac:
         v = v / pow10[frac]
-    if neg:
-        v = -v
-    return v, j
+    return (-v if neg else v), j
 
 
 @njit(cache=True, nogil=True, boundscheck=False)
-def scan_moves(b, ist, fst, pts, seg_start, seg_off, pow10):
-    """Read PU/PD/PA/PR commands from ``ist[I_POS]`` on; see the module docstring.
+def scan_moves(b, ist, fst, pts, seg_start, seg_off, seg_pen, pow10):
+    """Read PU/PD/PA/PR (and SP) commands from ``ist[I_POS]`` on; see the module docstring.
 
     ``ist``/``fst`` hold the state in and out (position, pen down, absolute mode, path
-    open, points and segments used in the chunk, counts per command); ``pts`` (cap, 2),
-    ``seg_start``/``seg_off`` (segment capacity) are the chunk. Stops at the first command
-    it does not read, or (``I_FULL`` = 1) before a command that would not fit the chunk.
+    open, points and segments used in the chunk, counts per command, pen number, dialect);
+    ``pts`` (cap, 2) and the segment arrays are the chunk. One pass: a command is applied as
+    it is read and rolled back (state restored, nothing kept) when it turns out to need
+    the general reader. Stops at the first command it does not read, or (``I_FULL`` = 1)
+    before a command that does not fit the chunk (``I_NEED`` points asked for).
     """
     n = b.shape[0]
     i = ist[I_POS]
@@ -134,6 +109,8 @@ def scan_moves(b, ist, fst, pts, seg_start, seg_off, pow10):
     is_open = ist[I_OPEN]
     npts = ist[I_NPTS]
     nseg = ist[I_NSEG]
+    pen_no = ist[I_PENNO]
+    hpgl2 = ist[I_HPGL2] != 0
     cap = pts.shape[0]
     scap = seg_start.shape[0]
     x = fst[F_X]
@@ -149,8 +126,14 @@ def scan_moves(b, ist, fst, pts, seg_start, seg_off, pow10):
         # the caller's open path goes on here (an empty segment if it ends at once)
         seg_start[nseg] = npts
         seg_off[nseg] = i
+        seg_pen[nseg] = pen_no
         nseg += 1
         ist[I_CONT] = 1
+    nu = 0
+    nd_ = 0
+    na = 0
+    nr = 0
+    nsp = 0
     while True:
         # separators before a command
         j = i
@@ -161,83 +144,136 @@ def scan_moves(b, ist, fst, pts, seg_start, seg_off, pow10):
             else:
                 break
         if j + 1 >= n:
-            i = j if j >= n else i
+            if j >= n:
+                i = n
             break
         c0 = b[j] | 32
         c1 = b[j + 1] | 32
-        if c0 != 112:  # 'p'
-            break
-        if c1 == 117:
-            code = 0
-        elif c1 == 100:
-            code = 1
-        elif c1 == 97:
-            code = 2
-        elif c1 == 114:
-            code = 3
-        else:
-            break
         if not _is_letter(b[j]) or not _is_letter(b[j + 1]):
             break
+        if c0 == 112:  # 'p'
+            if c1 == 117:
+                code = 0
+            elif c1 == 100:
+                code = 1
+            elif c1 == 97:
+                code = 2
+            elif c1 == 114:
+                code = 3
+            else:
+                break
+        elif c0 == 115 and c1 == 112 and ist[I_SPOK] != 0:  # 'sp' (once a pen was selected)
+            code = 4
+        else:
+            break
         cmd_at = j
-        end, count = _check_params(b, j + 2, n)
-        if end < 0 or count % 2 == 1:
-            break
-        npairs = count // 2
-        # room: the pairs, plus a path's start point, plus two segments
-        if npts + npairs + 1 > cap or nseg + 2 > scap:
-            ist[I_FULL] = 1
-            ist[I_NEED] = npairs + 1
-            break
+        # state at the command's start, to roll back to
+        r_pen, r_absm, r_open, r_npts, r_nseg, r_x, r_y = pen, absm, is_open, npts, nseg, x, y
+        r_pen_no = pen_no
+        k = j + 2
+        if code == 4:
+            # SP [n]: ends the path; HP-GL/2 keeps the pen down, HP-GL/1 lifts it
+            count = 0
+            val = 0.0
+            ok = True
+            while k < n:
+                c = b[k]
+                if c == 59:
+                    k += 1
+                    break
+                if c == 27 or _is_letter(c):
+                    break
+                if _is_sep(c):
+                    k += 1
+                    continue
+                v, e = _read_number(b, k, n, pow10)
+                if e < 0 or count == 1:
+                    ok = False
+                    break
+                val = v
+                count += 1
+                k = e
+            if not ok:
+                break
+            pen_no = int(val) if count else 0
+            is_open = 0
+            if not hpgl2:
+                pen = 0
+            nsp += 1
+            i = k
+            continue
         if code == 0:
-            ist[I_NU] += 1
             if pen == 1:
                 pen = 0
                 is_open = 0
         elif code == 1:
-            ist[I_ND] += 1
             if pen == 0:
                 pen = 1
+                if npts + 1 > cap or nseg + 2 > scap:
+                    ist[I_FULL] = 1
+                    ist[I_NEED] = 2
+                    pen, is_open = r_pen, r_open
+                    break
                 seg_start[nseg] = npts
                 seg_off[nseg] = cmd_at
+                seg_pen[nseg] = pen_no
                 nseg += 1
                 pts[npts, 0] = x
                 pts[npts, 1] = y
                 npts += 1
                 is_open = 1
         elif code == 2:
-            ist[I_NA] += 1
             absm = 1
         else:
-            ist[I_NR] += 1
             absm = 0
-        k = j + 2
-        for _ in range(npairs):
-            while _is_sep(b[k]):
+        # the pairs, applied as read
+        ok = True
+        full = False
+        half = False
+        vx = 0.0
+        while k < n:
+            c = b[k]
+            if c == 59:
                 k += 1
-            vx, k = _parse_number(b, k, pow10)
-            while _is_sep(b[k]):
+                break
+            if c == 27 or _is_letter(c):
+                break
+            if _is_sep(c):
                 k += 1
-            vy, k = _parse_number(b, k, pow10)
+                continue
+            v, e = _read_number(b, k, n, pow10)
+            if e < 0:
+                ok = False
+                break
+            k = e
+            if not half:
+                vx = v
+                half = True
+                continue
+            half = False
             if absm == 1:
                 if has_sc:
                     nx = ax * vx + bx
-                    ny = ay * vy + by
+                    ny = ay * v + by
                 else:
                     nx = vx
-                    ny = vy
+                    ny = v
             elif has_sc:
                 nx = x + ax * vx
-                ny = y + ay * vy
+                ny = y + ay * v
             else:
                 nx = x + vx
-                ny = y + vy
+                ny = y + v
             if pen == 1:
+                if npts + 2 > cap or nseg + 2 > scap:
+                    full = True
+                    break
                 if is_open == 0:
                     # the pen is down but the path was ended (SP, CI, ...): a new path
                     # starts at the current point
                     seg_start[nseg] = npts
                     seg_off[nseg] = cmd_at
+                    seg_pen[nseg] = pen_no
                     nseg += 1
                     pts[npts, 0] = x
                     pts[npts, 1] = y
@@ -248,12 +284,34 @@ def scan_moves(b, ist, fst, pts, seg_start, seg_off, pow10):
                 npts += 1
             x = nx
             y = ny
-        i = end
+        if full or not ok or half:
+            # roll back: the general reader reads this command (or a larger chunk is made)
+            pen, absm, is_open, npts, nseg, x, y = r_pen, r_absm, r_open, r_npts, r_nseg, r_x, r_y
+            pen_no = r_pen_no
+            if full:
+                ist[I_FULL] = 1
+                ist[I_NEED] = 2 * cap
+            break
+        if code == 0:
+            nu += 1
+        elif code == 1:
+            nd_ += 1
+        elif code == 2:
+            na += 1
+        else:
+            nr += 1
+        i = k
     ist[I_POS] = i
     ist[I_PEN] = pen
     ist[I_ABS] = absm
     ist[I_OPEN] = is_open
     ist[I_NPTS] = npts
     ist[I_NSEG] = nseg
+    ist[I_PENNO] = pen_no
+    ist[I_NU] = nu
+    ist[I_ND] = nd_
+    ist[I_NA] = na
+    ist[I_NR] = nr
+    ist[I_NSP] = nsp
     fst[F_X] = x
     fst[F_Y] = y
