@@ -916,7 +916,7 @@ class _Reader:
                 fst[scan.F_AX], fst[scan.F_BX], fst[scan.F_AY], fst[scan.F_BY] = self.sc
                 fst[scan.F_SC] = 1.0
             scan.scan_moves(self._u8, ist, fst, ch.pts, ch.seg_start, ch.seg_off, ch.seg_pen,
-                            _POW10)
+                            _POW10, scan.CLASS)
             self._take_segments(ch, ist)
             self.x = float(fst[scan.F_X])
             self.y = float(fst[scan.F_Y])
@@ -1631,7 +1631,8 @@ def _read(data: bytes, name: str) -> Drawing:
             rd.run()
     except RecursionError as exc:  # pragma: no cover - defensive
         raise InputError(name, "file too deeply nested to read") from exc
-    body = len(data) - data.count(b"\x00")
+    # bytes that are not NUL padding (counted only when some bytes were not HP-GL)
+    body = len(data) - data.count(b"\x00") if rd.junk_bytes else len(data)
     if rd.recognised == 0:
         if not rd.hpgl_mode or _PCL_START_RE.match(data.lstrip(b"\x00")):
             raise InputError(name, "a PCL/PJL print job without HP-GL/2 graphics")

@@ -32,21 +32,22 @@ N_FSTATE = 7
 
 _POW10 = 10.0 ** np.arange(0, 23)
 
+# byte classes (one table look-up per byte in the loops)
+C_OTHER, C_SEP, C_LETTER, C_DIGIT, C_SIGN, C_DOT, C_SEMI, C_ESC, C_CTRL = range(9)
+CLASS = np.full(256, C_OTHER, dtype=np.uint8)
+CLASS[list(range(1, 9)) + list(range(14, 27)) + list(range(28, 32))] = C_CTRL
+CLASS[[0, 9, 10, 11, 12, 13, 32, 44]] = C_SEP
+CLASS[65:91] = C_LETTER
+CLASS[97:123] = C_LETTER
+CLASS[48:58] = C_DIGIT
+CLASS[[43, 45]] = C_SIGN
+CLASS[46] = C_DOT
+CLASS[59] = C_SEMI
+CLASS[27] = C_ESC
+
 
 @njit(cache=True, nogil=True, boundscheck=False)
-def _is_sep(c: int) -> bool:
-    # separators the general reader accepts in parameters without a warning:
-    # NUL, TAB, LF, VT, FF, CR, space, comma
-    return c == 44 or c == 32 or c == 0 or (9 <= c <= 13)
-
-
-@njit(cache=True, nogil=True, boundscheck=False)
-def _is_letter(c: int) -> bool:
-    return (65 <= c <= 90) or (97 <= c <= 122)
-
-
-@njit(cache=True, nogil=True, boundscheck=False)
-def _read_number(b, j, n, pow10):
+def _read_number(b, j, n, pow10, cls):
     """The number at ``j``: (value, end), end = -1 when the general reader must read it
     ("1.2.3", a sign or point without digits, more than 15 digits, junk right after)."""
     neg = False
@@ -57,33 +58,25 @@ def _read_number(b, j, n, pow10):
     mant = 0
     nd = 0
     frac = 0
-    while j < n:
-        c = b[j]
-        if 48 <= c <= 57:
-            mant = mant * 10 + (c - 48)
-            nd += 1
-            j += 1
-        else:
-            break
+    while j < n and cls[b[j]] == C_DIGIT:
+        mant = mant * 10 + (b[j] - 48)
+        nd += 1
+        j += 1
     if j < n and b[j] == 46:
         j += 1
-        while j < n:
-            c = b[j]
-            if 48 <= c <= 57:
-                mant = mant * 10 + (c - 48)
-                nd += 1
-                frac += 1
-                j += 1
-            else:
-                break
+        while j < n and cls[b[j]] == C_DIGIT:
+            mant = mant * 10 + (b[j] - 48)
+            nd += 1
+            frac += 1
+            j += 1
         if j < n and b[j] == 46:
             return 0.0, -1
     if nd == 0 or nd > 15:
         return 0.0, -1
     if j < n:
-        c = b[j]
+        k = cls[b[j]]
         # a number ends at a separator, a sign, ';', a letter or ESC
-        if not (c == 59 or c == 27 or c == 43 or c == 45 or _is_sep(c) or _is_letter(c)):
+        if not (k == C_SEP or k == C_SIGN or k == C_SEMI or k == C_LETTER or k == C_ESC):
             return 0.0, -1
     v = float(mant)
     if frac:
@@ -92,7 +85,7 @@ def _read_number(b, j, n, pow10):
 
 
 @njit(cache=True, nogil=True, boundscheck=False)
-def scan_moves(b, ist, fst, pts, seg_start, seg_off, seg_pen, pow10):
+def scan_moves(b, ist, fst, pts, seg_start, seg_off, seg_pen, pow10, cls):
     """Read PU/PD/PA/PR (and SP) commands from ``ist[I_POS]`` on; see the module docstring.
 
     ``ist``/``fst`` hold the state in and out (position, pen down, absolute mode, path
@@ -138,8 +131,8 @@ def scan_moves(b, ist, fst, pts, seg_start, seg_off, seg_pen, pow10):
         # separators before a command
         j = i
         while j < n:
-            c = b[j]
-            if c == 59 or c == 44 or (c <= 32 and c != 27):
+            k = cls[b[j]]
+            if k == C_SEP or k == C_SEMI or k == C_CTRL:
                 j += 1
             else:
                 break
@@ -149,7 +142,7 @@ def scan_moves(b, ist, fst, pts, seg_start, seg_off, seg_pen, pow10):
             break
         c0 = b[j] | 32
         c1 = b[j + 1] | 32
-        if not _is_letter(b[j]) or not _is_letter(b[j + 1]):
+        if cls[b[j]] != C_LETTER or cls[b[j + 1]] != C_LETTER:
             break
         if c0 == 112:  # 'p'
             if c1 == 117:
@@ -177,16 +170,16 @@ def scan_moves(b, ist, fst, pts, seg_start, seg_off, seg_pen, pow10):
             val = 0.0
             ok = True
             while k < n:
-                c = b[k]
-                if c == 59:
+                t = cls[b[k]]
+                if t == C_SEMI:
                     k += 1
                     break
-                if c == 27 or _is_letter(c):
+                if t == C_ESC or t == C_LETTER:
                     break
-                if _is_sep(c):
+                if t == C_SEP:
                     k += 1
                     continue
-                v, e = _read_number(b, k, n, pow10)
+                v, e = _read_number(b, k, n, pow10, cls)
                 if e < 0 or count == 1:
                     ok = False
                     break
@@ -232,20 +225,61 @@ def scan_moves(b, ist, fst, pts, seg_start, seg_off, seg_pen, pow10):
         half = False
         vx = 0.0
         while k < n:
-            c = b[k]
-            if c == 59:
+            t = cls[b[k]]
+            if t == C_SEMI:
                 k += 1
                 break
-            if c == 27 or _is_letter(c):
+            if t == C_ESC or t == C_LETTER:
                 break
-            if _is_sep(c):
+            if t == C_SEP:
                 k += 1
                 continue
-            v, e = _read_number(b, k, n, pow10)
-            if e < 0:
+            # the number at k, read in place (a call per number costs more than the
+            # number: the arrays' reference counts)
+            neg = False
+            if t == C_SIGN:
+                neg = b[k] == 45
+                k += 1
+            mant = 0
+            nd = 0
+            frac = 0
+            while k < n:
+                c = b[k]
+                if 48 <= c <= 57:
+                    mant = mant * 10 + (c - 48)
+                    nd += 1
+                    k += 1
+                else:
+                    break
+            if k < n and b[k] == 46:
+                k += 1
+                while k < n:
+                    c = b[k]
+                    if 48 <= c <= 57:
+                        mant = mant * 10 + (c - 48)
+                        nd += 1
+                        frac += 1
+                        k += 1
+                    else:
+                        break
+                if k < n and b[k] == 46:
+                    ok = False
+                    break
+            if nd == 0 or nd > 15:
                 ok = False
                 break
-            k = e
+            if k < n:
+                t = cls[b[k]]
+                # a number ends at a separator, a sign, ';', a letter or ESC
+                if not (t == C_SEP or t == C_SIGN or t == C_SEMI or t == C_LETTER
+                        or t == C_ESC):
+                    ok = False
+                    break
+            v = float(mant)
+            if frac:
+                v = v / pow10[frac]
+            if neg:
+                v = -v
             if not half:
                 vx = v
                 half = True
