@@ -926,7 +926,7 @@ RATIO_MIN_BYTES = 100_000
 RATIO_GEN_POINTS = (100_000, 1_000_000, 5_000_000)
 
 _MEM = r"""
-import json, resource, sys
+import json, sys
 sys.path.insert(0, sys.argv[1])
 which, path = sys.argv[2], sys.argv[3]
 data = open(path, "rb").read()
@@ -944,16 +944,26 @@ else:
     ezhpgl.parse(b"IN;SP1;PU0,0;PD10,10;", limits=lim, geometry_limits=glim)
     def parse(b):
         return ezhpgl.parse(b, strict=strict, limits=lim, geometry_limits=glim)
-before = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
+import gc
+import re
+def status():
+    with open("/proc/self/status") as f:
+        text = f.read()
+    return {k: int(re.search(k + r":\s+(\d+)", text).group(1)) for k in ("VmHWM", "VmRSS")}
+gc.collect()
+with open("/proc/self/clear_refs", "w") as f:
+    f.write("5")  # reset the peak RSS (VmHWM) to the current RSS
+before = status()["VmRSS"]
 out = parse(data)
-after = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
+after = status()["VmHWM"]
 print(json.dumps({"extra_kb": after - before, "bytes": len(data)}))
 """
 
 
 def _peak_extra(which: str, path: str, strict: bool) -> float:
-    """Peak memory a parse adds (KiB of peak RSS after minus before, in a new process with
-    the file's bytes already read and the parser warmed up), per input byte."""
+    """Peak memory a parse adds, per input byte: the peak RSS during the call (VmHWM, reset
+    with /proc/self/clear_refs just before) minus the RSS before it, in a new process with
+    the file's bytes already read and the parser warmed up (Linux)."""
     import json
     import subprocess
 
@@ -1046,9 +1056,10 @@ def ratio_report(rows: list[dict], machine: dict[str, str], reps: int) -> str:
         f"median CPU time (`time.process_time`) of {reps} calls. ezhpgl in strict mode; on "
         "files it refuses strictly it runs in lenient mode, which stops or skips at what it "
         "refuses (\"partial\"): those rows are listed but their ratio compares unequal work. "
-        "Memory: the peak RSS a parse adds (KiB of `ru_maxrss` after the call minus before, "
-        "in a new process with the file already read and the parser warmed up), per input "
-        "byte; the result (paths, positions) is part of it.",
+        "Memory: the peak RSS a parse adds (VmHWM after the call, reset through "
+        "/proc/self/clear_refs just before it, minus VmRSS before it; a new process with the "
+        "file already read and the parser warmed up), per input byte; the result (paths, "
+        "positions, ezhpgl's document) is part of it.",
         "",
         "| file | bytes | ours ms | ezhpgl ms | time ratio | ours extra B/B | ezhpgl extra B/B |",
         "| --- | ---: | ---: | ---: | ---: | ---: | ---: |",
