@@ -876,8 +876,10 @@ class _Reader:
                       "polygon defined with PM but never edged or filled (EP/FP): not drawn")
 
     # ------------------------------------------------------------------ compiled runs
-    def _new_chunk(self, need: int) -> _Chunk:
-        cap = max(need + 2, min(_CHUNK_POINTS, self.n // 2 + 8))
+    def _new_chunk(self, need: int, at: int = 0) -> _Chunk:
+        # about one point per 8 bytes still to read (a pair is rarely shorter), at most
+        # _CHUNK_POINTS: a small file does not get a large chunk; more chunks come as needed
+        cap = max(need + 2, min(_CHUNK_POINTS, (self.n - at) // 8 + 64))
         ch = _Chunk(cap)
         self._chunk = ch
         self.chunks.append(ch)
@@ -896,7 +898,7 @@ class _Reader:
         while True:
             ch = self._chunk
             if ch is None or len(ch.pts) - ch.npts < 2 or len(ch.seg_start) - ch.nseg < 3:
-                ch = self._new_chunk(0)
+                ch = self._new_chunk(0, i)
             was_open = self.pen_down and bool(self.cur or self.cur_parts)
             ist[:] = 0
             ist[scan.I_POS] = i
@@ -934,7 +936,7 @@ class _Reader:
             i = int(ist[scan.I_POS])
             if not ist[scan.I_FULL]:
                 return i
-            self._new_chunk(int(ist[scan.I_NEED]))
+            self._new_chunk(int(ist[scan.I_NEED]), i)
 
     def _take_segments(self, ch: _Chunk, ist: np.ndarray) -> None:
         from galvo_core.hpgl import scan
@@ -1673,6 +1675,8 @@ def _read(data: bytes, name: str) -> Drawing:
     lines_l = lines.tolist()
     cols_l = cols.tolist()
     for ch in rd.chunks:
+        if len(ch.pts) - ch.npts > max(ch.npts // 4, 4096):
+            ch.pts = ch.pts[: ch.npts].copy()  # the drawing keeps only what was used
         ch.pts.setflags(write=False)
     paths: list[Path] = []
     k = 0
