@@ -10,6 +10,10 @@ Manual" (HP-GL/1; cited as 7475A with the instruction).
 
 from __future__ import annotations
 
+import bz2
+import gzip
+import lzma
+
 import numpy as np
 import pytest
 
@@ -185,7 +189,35 @@ def test_sp_first_gives_no_pen_warning() -> None:
     assert not any("pen was selected" in m for m in messages(d))
 
 
-def test_non_hpgl_is_refused_with_one_line() -> None:
-    with pytest.raises(InputError) as ei:
-        read(b"\x1f\x8b\x08\x00" + bytes(300))
-    assert "\n" not in str(ei.value) and "rule.plt" in str(ei.value)
+# ------------------------------------------------------------- not HP-GL: refused
+NOT_HPGL = {
+    "gzip": (gzip.compress(b"IN;SP1;PD100,100;" * 40), "gzip"),
+    "bzip2": (bz2.compress(b"IN;SP1;PD100,100;" * 40), "bzip2"),
+    "xz": (lzma.compress(b"IN;SP1;PD100,100;" * 40), "xz"),
+    "zip": (b"PK\x03\x04" + bytes(300), "ZIP"),
+    "gerber": (b"G04 board*\n%FSLAX24Y24*%\n%MOIN*%\nD10*\nX0Y0D02*\nX1000Y0D01*\nM02*\n",
+               "Gerber"),
+    "excellon": (b"M48\nINCH,LZ\nT1C0.035\n%\nT1\nX001Y001\nM30\n", "Excellon"),
+    "dmpl": (b";: EC5 U 0,0 D 100,0 100,100 @", "DM/PL"),
+    "gcode": (b"G21\nG90\nG1 X10 Y10 F100\nG1 X20 Y10\n", "G-code"),
+    "coreldraw": (b"RIFF\x10\x00\x00\x00CDRvvers" + bytes(300), "CorelDRAW"),
+    "pcl-raster": (b"\x1bE\x1b*t300R\x1b*r1A\x1b*b4W\x00\x01\x02\x03\x1b*rB\x1bE",
+                   "PCL/PJL print job without HP-GL/2"),
+}
+
+
+@pytest.mark.parametrize("kind", sorted(NOT_HPGL))
+def test_non_hpgl_is_refused_with_one_line(kind: str, tmp_path, capsys) -> None:
+    """Compressed files, other plot and CAD languages and PCL raster-only jobs are refused
+    with one line naming the file and what it is (the CLI exits 2, no traceback)."""
+    from galvo_core.cli import main
+
+    data, words = NOT_HPGL[kind]
+    with pytest.raises(InputError, match=words) as ei:
+        read(data)
+    assert "\n" not in str(ei.value) and str(ei.value).startswith("rule.plt: ")
+    f = tmp_path / f"{kind}.plt"
+    f.write_bytes(data)
+    assert main(["info", str(f)]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and err.startswith(f"error: {kind}.plt: ") and words in err
