@@ -1551,6 +1551,24 @@ def _line_cols_arrays(data: bytes, offs: np.ndarray) -> tuple[np.ndarray, np.nda
     return idx + 1, offs - line_start + 1
 
 
+def _line_cols_compiled(rd: _Reader, offs: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """As :func:`_line_cols_arrays`, with the compiled scanner's one pass (no per-byte
+    temporary arrays)."""
+    from galvo_core.hpgl import scan
+
+    order = np.argsort(offs, kind="stable")
+    srt = offs[order]
+    ls = np.empty(len(offs), dtype=np.int64)
+    cs = np.empty(len(offs), dtype=np.int64)
+    u8 = rd._u8 if hasattr(rd, "_u8") else np.frombuffer(rd.data, dtype=np.uint8)
+    scan.line_cols(u8, srt, ls, cs)
+    lines = np.empty_like(ls)
+    cols = np.empty_like(cs)
+    lines[order] = ls
+    cols[order] = cs
+    return lines, cols
+
+
 _new_obj = object.__new__
 _set_attr = object.__setattr__
 
@@ -1671,7 +1689,11 @@ def _read(data: bytes, name: str) -> Drawing:
         p.offs if isinstance(p, _Batch) else np.array([p[3]], dtype=np.int64) for p in rd.paths
     ]
     off_parts.append(np.array([w[0] for w in rd._warn], dtype=np.int64))
-    lines, cols = _line_cols_arrays(data, np.concatenate(off_parts))
+    all_offs = np.concatenate(off_parts)
+    if rd.compiled and len(all_offs):
+        lines, cols = _line_cols_compiled(rd, all_offs)
+    else:
+        lines, cols = _line_cols_arrays(data, all_offs)
     lines_l = lines.tolist()
     cols_l = cols.tolist()
     for ch in rd.chunks:

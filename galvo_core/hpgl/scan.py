@@ -349,3 +349,23 @@ def scan_moves(b, ist, fst, pts, seg_start, seg_off, seg_pen, pow10, cls):
     ist[I_NSP] = nsp
     fst[F_X] = x
     fst[F_Y] = y
+
+
+@njit(cache=True, nogil=True, boundscheck=False)
+def line_cols(b, offs, lines, cols):
+    """1-based line and column of each offset in ``offs`` (sorted ascending), in one pass
+    over the bytes up to the last offset."""
+    n = b.shape[0]
+    line = 1
+    last_nl = -1
+    j = 0
+    for k in range(offs.shape[0]):
+        o = offs[k]
+        stop = o if o < n else n
+        while j < stop:
+            if b[j] == 10:
+                line += 1
+                last_nl = j
+            j += 1
+        lines[k] = line
+        cols[k] = o - last_nl
