@@ -131,28 +131,33 @@ def _use_compiled(size: int) -> bool:
 class _Chunk:
     """Output of the compiled scanner: points and the segments (paths) found in them."""
 
-    __slots__ = ("pts", "seg_start", "seg_off", "seg_pen", "npts", "nseg")
+    __slots__ = ("pts", "seg_start", "seg_off", "seg_pen", "seg_line", "seg_col", "npts",
+                 "nseg")
 
     def __init__(self, cap: int) -> None:
         self.pts = np.empty((cap, 2), dtype=np.float64)
         self.seg_start = np.empty(cap // 2 + 4, dtype=np.int32)
         self.seg_off = np.empty(cap // 2 + 4, dtype=np.int32)
         self.seg_pen = np.empty(cap // 2 + 4, dtype=np.int32)
+        self.seg_line = np.empty(cap // 2 + 4, dtype=np.int32)
+        self.seg_col = np.empty(cap // 2 + 4, dtype=np.int32)
         self.npts = 0
         self.nseg = 0
 
 
 class _Batch:
-    """Paths the compiled scanner read: ``pts[starts[k]:ends[k]]`` drawn with ``pens[k]``."""
+    """Paths the compiled scanner read: ``pts[starts[k]:ends[k]]`` drawn with ``pens[k]``,
+    starting at line ``lines[k]``, column ``cols[k]`` of the file."""
 
-    __slots__ = ("chunk", "starts", "ends", "offs", "pens")
+    __slots__ = ("chunk", "starts", "ends", "lines", "cols", "pens")
 
-    def __init__(self, chunk: _Chunk, starts: np.ndarray, ends: np.ndarray, offs: np.ndarray,
-                 pens: np.ndarray) -> None:
+    def __init__(self, chunk: _Chunk, starts: np.ndarray, ends: np.ndarray, lines: np.ndarray,
+                 cols: np.ndarray, pens: np.ndarray) -> None:
         self.chunk = chunk
         self.starts = starts
         self.ends = ends
-        self.offs = offs
+        self.lines = lines
+        self.cols = cols
         self.pens = pens
 _SEP_RE = re.compile(rb"[\x00-\x1a\x1c-\x20;,]*")
 _NUM_RE = re.compile(rb"[-+]?(?:\d+\.?\d*|\.\d+)")
@@ -894,7 +899,14 @@ class _Reader:
             self._u8 = np.frombuffer(self.data, dtype=np.uint8)
             self._ist = np.zeros(scan.N_ISTATE, dtype=np.int64)
             self._fst = np.zeros(scan.N_FSTATE, dtype=np.float64)
+            self._lc = (0, 1, -1)  # offset, its line, the last newline before it
         ist, fst = self._ist, self._fst
+        pos, line, last_nl = self._lc
+        if i != pos:  # the general reader's bytes since the last call
+            cnt = self.data.count(b"\n", pos, i)
+            if cnt:
+                line += cnt
+                last_nl = self.data.rfind(b"\n", pos, i)
         while True:
             ch = self._chunk
             if ch is None or len(ch.pts) - ch.npts < 2 or len(ch.seg_start) - ch.nseg < 3:
@@ -910,6 +922,8 @@ class _Reader:
             ist[scan.I_PENNO] = self.pen
             ist[scan.I_HPGL2] = self.hpgl2
             ist[scan.I_SPOK] = self.pen_selected
+            ist[scan.I_LINE] = line
+            ist[scan.I_LASTNL] = last_nl
             fst[scan.F_X] = self.x
             fst[scan.F_Y] = self.y
             if self.sc is None:
@@ -918,7 +932,7 @@ class _Reader:
                 fst[scan.F_AX], fst[scan.F_BX], fst[scan.F_AY], fst[scan.F_BY] = self.sc
                 fst[scan.F_SC] = 1.0
             scan.scan_moves(self._u8, ist, fst, ch.pts, ch.seg_start, ch.seg_off, ch.seg_pen,
-                            _POW10, scan.CLASS)
+                            ch.seg_line, ch.seg_col, _POW10, scan.CLASS)
             self._take_segments(ch, ist)
             self.x = float(fst[scan.F_X])
             self.y = float(fst[scan.F_Y])
@@ -934,6 +948,8 @@ class _Reader:
                     ncmd += c
             self.recognised += ncmd
             i = int(ist[scan.I_POS])
+            line, last_nl = int(ist[scan.I_LINE]), int(ist[scan.I_LASTNL])
+            self._lc = (i, line, last_nl)
             if not ist[scan.I_FULL]:
                 return i
             self._new_chunk(int(ist[scan.I_NEED]), i)
@@ -952,6 +968,8 @@ class _Reader:
         ends[-1] = p1
         offs = ch.seg_off[s0:s1]
         pens = ch.seg_pen[s0:s1]
+        lines = ch.seg_line[s0:s1]
+        cols = ch.seg_col[s0:s1]
         a, b = 0, s1 - s0
         still_open = bool(ist[scan.I_OPEN])
         if ist[scan.I_CONT]:
@@ -968,18 +986,20 @@ class _Reader:
         if open_last:
             b -= 1
         if b > a:
-            self._add_batch(ch, starts[a:b], ends[a:b], offs[a:b], pens[a:b])
+            self._add_batch(ch, starts[a:b], ends[a:b], offs[a:b], pens[a:b], lines[a:b],
+                            cols[a:b])
         if open_last:
             self.cur = []
             self.cur_parts = [ch.pts[int(starts[b]) : int(ends[b])]]
             self.cur_offset = int(offs[b])
 
     def _add_batch(self, ch: _Chunk, starts: np.ndarray, ends: np.ndarray,
-                   offs: np.ndarray, pens: np.ndarray) -> None:
+                   offs: np.ndarray, pens: np.ndarray, lines: np.ndarray,
+                   cols: np.ndarray) -> None:
         span = ch.pts[int(starts[0]) : int(ends[-1])]
         if self.window is None and self.rot == 0 and np.isfinite(span).all():
             self.paths.append(_Batch(ch, starts.copy(), ends.copy(),  # type: ignore[arg-type]
-                                     offs.astype(np.int64), pens.copy()))
+                                     lines.copy(), cols.copy(), pens.copy()))
             self.batched += len(starts)
             if not self.pen_selected:  # (the scanner reads SP only once a pen was selected)
                 self.unselected_paths += len(starts)
@@ -1551,21 +1571,27 @@ def _line_cols_arrays(data: bytes, offs: np.ndarray) -> tuple[np.ndarray, np.nda
     return idx + 1, offs - line_start + 1
 
 
-def _line_cols_compiled(rd: _Reader, offs: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """As :func:`_line_cols_arrays`, with the compiled scanner's one pass (no per-byte
-    temporary arrays)."""
-    from galvo_core.hpgl import scan
-
-    order = np.argsort(offs, kind="stable")
-    srt = offs[order]
-    ls = np.empty(len(offs), dtype=np.int64)
-    cs = np.empty(len(offs), dtype=np.int64)
-    u8 = rd._u8 if hasattr(rd, "_u8") else np.frombuffer(rd.data, dtype=np.uint8)
-    scan.line_cols(u8, srt, ls, cs)
-    lines = np.empty_like(ls)
-    cols = np.empty_like(cs)
-    lines[order] = ls
-    cols[order] = cs
+def _line_cols(rd: _Reader, offs: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """1-based line and column of each offset: counted between the sorted offsets (bytes
+    counts newlines in C) when there are few, else in one pass over the bytes."""
+    if len(offs) > 2000:
+        return _line_cols_arrays(rd.data, offs)
+    data = rd.data
+    order = np.argsort(offs, kind="stable").tolist()
+    lines = np.empty(len(offs), dtype=np.int64)
+    cols = np.empty(len(offs), dtype=np.int64)
+    pos, line, last_nl = 0, 1, -1
+    offs_l = offs.tolist()
+    for k in order:
+        o = max(offs_l[k], 0)
+        if o > pos:
+            cnt = data.count(b"\n", pos, o)
+            if cnt:
+                line += cnt
+                last_nl = data.rfind(b"\n", pos, o)
+            pos = o
+        lines[k] = line
+        cols[k] = offs_l[k] - last_nl
     return lines, cols
 
 
@@ -1587,9 +1613,8 @@ def _new_path(points: np.ndarray, pen: int, closed: bool, line: int, col: int) -
     return p
 
 
-def _batch_paths(b: _Batch, lines: list[int], cols: list[int], k: int,
-                 out: list[Path]) -> int:
-    """Append the paths of a scanner batch to ``out``; returns the next position index.
+def _batch_paths(b: _Batch, out: list[Path]) -> None:
+    """Append the paths of a scanner batch to ``out``.
 
     Tens of thousands of paths: the objects are made and filled by ``map`` (loops in C),
     each path's points a view of the frozen chunk.
@@ -1603,15 +1628,14 @@ def _batch_paths(b: _Batch, lines: list[int], cols: list[int], k: int,
               & (first[:, 1] == last[:, 1])).tolist()
     views = list(map(pts.__getitem__, map(slice, starts.tolist(), ends.tolist())))
     sps = list(map(_new_obj, repeat(SourcePos, m)))
-    any(map(_SP_LINE, sps, lines[k : k + m]))
-    any(map(_SP_COL, sps, cols[k : k + m]))
+    any(map(_SP_LINE, sps, b.lines.tolist()))
+    any(map(_SP_COL, sps, b.cols.tolist()))
     objs = list(map(_new_obj, repeat(Path, m)))
     any(map(_P_POINTS, objs, views))
     any(map(_P_PEN, objs, b.pens.tolist()))
     any(map(_P_CLOSED, objs, closed))
     any(map(_P_START, objs, sps))
     out.extend(objs)
-    return k + m
 
 
 # slot setters of the frozen dataclasses (member descriptors: no frozen __setattr__)
@@ -1684,16 +1708,10 @@ def _read(data: bytes, name: str) -> Drawing:
     for key, count in rd._warn_count.items():
         if count > _WARN_CAP:
             rd._warn.append((-1, f"... and {count - _WARN_CAP} more warnings like: {key}"))
-    # positions
-    off_parts = [
-        p.offs if isinstance(p, _Batch) else np.array([p[3]], dtype=np.int64) for p in rd.paths
-    ]
-    off_parts.append(np.array([w[0] for w in rd._warn], dtype=np.int64))
-    all_offs = np.concatenate(off_parts)
-    if rd.compiled and len(all_offs):
-        lines, cols = _line_cols_compiled(rd, all_offs)
-    else:
-        lines, cols = _line_cols_arrays(data, all_offs)
+    # positions: the scanner's paths carry theirs; the others' and the warnings' from offsets
+    offs = np.array([p[3] for p in rd.paths if not isinstance(p, _Batch)]
+                    + [w[0] for w in rd._warn], dtype=np.int64)
+    lines, cols = _line_cols(rd, offs)
     lines_l = lines.tolist()
     cols_l = cols.tolist()
     for ch in rd.chunks:
@@ -1704,7 +1722,7 @@ def _read(data: bytes, name: str) -> Drawing:
     k = 0
     for item in rd.paths:
         if isinstance(item, _Batch):
-            k = _batch_paths(item, lines_l, cols_l, k, paths)
+            _batch_paths(item, paths)
         else:
             pts, pen, closed, _ = item
             pts = np.ascontiguousarray(pts, dtype=np.float64)

@@ -24,8 +24,8 @@ from numba import njit
 
 # int state slots
 (I_POS, I_PEN, I_ABS, I_OPEN, I_NPTS, I_NSEG, I_CONT, I_NU, I_ND, I_NA, I_NR, I_FULL,
- I_NEED, I_PENNO, I_HPGL2, I_NSP, I_SPOK) = range(17)
-N_ISTATE = 17
+ I_NEED, I_PENNO, I_HPGL2, I_NSP, I_SPOK, I_LINE, I_LASTNL) = range(19)
+N_ISTATE = 19
 # float state slots
 F_X, F_Y, F_AX, F_BX, F_AY, F_BY, F_SC = range(7)
 N_FSTATE = 7
@@ -85,7 +85,7 @@ def _read_number(b, j, n, pow10, cls):
 
 
 @njit(cache=True, nogil=True, boundscheck=False)
-def scan_moves(b, ist, fst, pts, seg_start, seg_off, seg_pen, pow10, cls):
+def scan_moves(b, ist, fst, pts, seg_start, seg_off, seg_pen, seg_line, seg_col, pow10, cls):
     """Read PU/PD/PA/PR (and SP) commands from ``ist[I_POS]`` on; see the module docstring.
 
     ``ist``/``fst`` hold the state in and out (position, pen down, absolute mode, path
@@ -97,6 +97,10 @@ def scan_moves(b, ist, fst, pts, seg_start, seg_off, seg_pen, pow10, cls):
     """
     n = b.shape[0]
     i = ist[I_POS]
+    # line number at i and offset of the last newline before i (committed with i); tl, tn:
+    # the same, tentatively, over bytes not yet consumed
+    line = ist[I_LINE]
+    last_nl = ist[I_LASTNL]
     pen = ist[I_PEN]
     absm = ist[I_ABS]
     is_open = ist[I_OPEN]
@@ -130,15 +134,22 @@ def scan_moves(b, ist, fst, pts, seg_start, seg_off, seg_pen, pow10, cls):
     while True:
         # separators before a command
         j = i
+        tl = line
+        tn = last_nl
         while j < n:
             k = cls[b[j]]
             if k == C_SEP or k == C_SEMI or k == C_CTRL:
+                if b[j] == 10:
+                    tl += 1
+                    tn = j
                 j += 1
             else:
                 break
         if j + 1 >= n:
             if j >= n:
                 i = n
+                line = tl
+                last_nl = tn
             break
         c0 = b[j] | 32
         c1 = b[j + 1] | 32
@@ -160,6 +171,8 @@ def scan_moves(b, ist, fst, pts, seg_start, seg_off, seg_pen, pow10, cls):
         else:
             break
         cmd_at = j
+        cmd_line = tl
+        cmd_col = j - tn
         # state at the command's start, to roll back to
         r_pen, r_absm, r_open, r_npts, r_nseg, r_x, r_y = pen, absm, is_open, npts, nseg, x, y
         r_pen_no = pen_no
@@ -177,6 +190,9 @@ def scan_moves(b, ist, fst, pts, seg_start, seg_off, seg_pen, pow10, cls):
                 if t == C_ESC or t == C_LETTER:
                     break
                 if t == C_SEP:
+                    if b[k] == 10:
+                        tl += 1
+                        tn = k
                     k += 1
                     continue
                 v, e = _read_number(b, k, n, pow10, cls)
@@ -194,6 +210,8 @@ def scan_moves(b, ist, fst, pts, seg_start, seg_off, seg_pen, pow10, cls):
                 pen = 0
             nsp += 1
             i = k
+            line = tl
+            last_nl = tn
             continue
         if code == 0:
             if pen == 1:
@@ -209,6 +227,8 @@ def scan_moves(b, ist, fst, pts, seg_start, seg_off, seg_pen, pow10, cls):
                     break
                 seg_start[nseg] = npts
                 seg_off[nseg] = cmd_at
+                seg_line[nseg] = cmd_line
+                seg_col[nseg] = cmd_col
                 seg_pen[nseg] = pen_no
                 nseg += 1
                 pts[npts, 0] = x
@@ -232,6 +252,9 @@ def scan_moves(b, ist, fst, pts, seg_start, seg_off, seg_pen, pow10, cls):
             if t == C_ESC or t == C_LETTER:
                 break
             if t == C_SEP:
+                if b[k] == 10:
+                    tl += 1
+                    tn = k
                 k += 1
                 continue
             # the number at k, read in place (a call per number costs more than the
@@ -307,6 +330,8 @@ def scan_moves(b, ist, fst, pts, seg_start, seg_off, seg_pen, pow10, cls):
                     # starts at the current point
                     seg_start[nseg] = npts
                     seg_off[nseg] = cmd_at
+                    seg_line[nseg] = cmd_line
+                    seg_col[nseg] = cmd_col
                     seg_pen[nseg] = pen_no
                     nseg += 1
                     pts[npts, 0] = x
@@ -335,7 +360,11 @@ def scan_moves(b, ist, fst, pts, seg_start, seg_off, seg_pen, pow10, cls):
         else:
             nr += 1
         i = k
+        line = tl
+        last_nl = tn
     ist[I_POS] = i
+    ist[I_LINE] = line
+    ist[I_LASTNL] = last_nl
     ist[I_PEN] = pen
     ist[I_ABS] = absm
     ist[I_OPEN] = is_open
@@ -350,22 +379,3 @@ def scan_moves(b, ist, fst, pts, seg_start, seg_off, seg_pen, pow10, cls):
     fst[F_X] = x
     fst[F_Y] = y
 
-
-@njit(cache=True, nogil=True, boundscheck=False)
-def line_cols(b, offs, lines, cols):
-    """1-based line and column of each offset in ``offs`` (sorted ascending), in one pass
-    over the bytes up to the last offset."""
-    n = b.shape[0]
-    line = 1
-    last_nl = -1
-    j = 0
-    for k in range(offs.shape[0]):
-        o = offs[k]
-        stop = o if o < n else n
-        while j < stop:
-            if b[j] == 10:
-                line += 1
-                last_nl = j
-            j += 1
-        lines[k] = line
-        cols[k] = o - last_nl
