@@ -118,6 +118,7 @@ _FAST_MIN_BYTES = 256  # shorter runs go command by command
 #: ``process``), so that ``galvo-core info small.plt`` does not pay numba's import
 _COMPILED_MIN_BYTES = 1 << 20
 _CHUNK_POINTS = 1 << 16  # points per output chunk of the compiled scanner
+_SCAN_CMDS = frozenset((b"PU", b"PD", b"PA", b"PR", b"SP"))  # what the scanner reads
 
 
 def _is_letter_or_esc(c: int) -> bool:
@@ -216,6 +217,8 @@ class _Reader:
         self._pe_cache = PECache()
         self.compiled = _use_compiled(self.n)
         self._chunk: _Chunk | None = None
+        self._scan = None  # the compiled scanner's module, imported at its first use
+        self._lc = (0, 1, -1)  # scanner position: offset, its line, the newline before it
         self.chunks: list[_Chunk] = []
         self.batched = 0  # paths in _Batch items of self.paths
         self.hpgl_mode = True
@@ -796,11 +799,14 @@ class _Reader:
             if not self.hpgl_mode:
                 i = self._pcl(i)
                 continue
+            m = None
             if self.compiled and self.poly is None:
-                j = self._compiled_run(i)
-                if j != i:
-                    i = j
-                    continue
+                m = cmd_match(data, i)
+                if m is not None and m.group(1).upper() in _SCAN_CMDS:
+                    j = self._compiled_run(i)
+                    if j != i:
+                        i = j
+                        continue
             elif self.poly is None and i >= slow_until:
                 rm = run_match(data, i)
                 if rm is not None:
@@ -816,7 +822,8 @@ class _Reader:
                         i = end
                         continue
                     slow_until = rm.end()  # read this run command by command
-            m = cmd_match(data, i)
+            if m is None:
+                m = cmd_match(data, i)
             if m is not None:
                 mn = m.group(1).upper().decode()
                 start = m.start(1)
@@ -891,15 +898,16 @@ class _Reader:
         return ch
 
     def _compiled_run(self, i: int) -> int:
-        """Read the PU/PD/PA/PR commands from ``i`` on with the compiled scanner; returns
+        """Read the PU/PD/PA/PR/SP commands from ``i`` on with the compiled scanner; returns
         the offset where it stopped (``i`` when the next command is not one it reads)."""
-        from galvo_core.hpgl import scan
+        scan = self._scan
+        if scan is None:
+            from galvo_core.hpgl import scan as scan_module
 
-        if not hasattr(self, "_u8"):
+            scan = self._scan = scan_module
             self._u8 = np.frombuffer(self.data, dtype=np.uint8)
             self._ist = np.zeros(scan.N_ISTATE, dtype=np.int64)
             self._fst = np.zeros(scan.N_FSTATE, dtype=np.float64)
-            self._lc = (0, 1, -1)  # offset, its line, the last newline before it
         ist, fst = self._ist, self._fst
         pos, line, last_nl = self._lc
         if i != pos:  # the general reader's bytes since the last call
@@ -912,53 +920,38 @@ class _Reader:
             if ch is None or len(ch.pts) - ch.npts < 2 or len(ch.seg_start) - ch.nseg < 3:
                 ch = self._new_chunk(0, i)
             was_open = self.pen_down and bool(self.cur or self.cur_parts)
-            ist[:] = 0
-            ist[scan.I_POS] = i
-            ist[scan.I_PEN] = self.pen_down
-            ist[scan.I_ABS] = self.absolute
-            ist[scan.I_OPEN] = was_open
-            ist[scan.I_NPTS] = ch.npts
-            ist[scan.I_NSEG] = ch.nseg
-            ist[scan.I_PENNO] = self.pen
-            ist[scan.I_HPGL2] = self.hpgl2
-            ist[scan.I_SPOK] = self.pen_selected
-            ist[scan.I_LINE] = line
-            ist[scan.I_LASTNL] = last_nl
-            fst[scan.F_X] = self.x
-            fst[scan.F_Y] = self.y
-            if self.sc is None:
-                fst[scan.F_SC] = 0.0
-            else:
-                fst[scan.F_AX], fst[scan.F_BX], fst[scan.F_AY], fst[scan.F_BY] = self.sc
-                fst[scan.F_SC] = 1.0
+            # the state in slot order (see scan.I_*)
+            ist[:] = (i, self.pen_down, self.absolute, was_open, ch.npts, ch.nseg,
+                      0, 0, 0, 0, 0, 0, 0, self.pen, self.hpgl2, 0, self.pen_selected,
+                      line, last_nl)
+            sc = self.sc
+            fst[:] = (self.x, self.y, 0.0, 0.0, 0.0, 0.0, 0.0) if sc is None else \
+                (self.x, self.y, sc[0], sc[1], sc[2], sc[3], 1.0)
             scan.scan_moves(self._u8, ist, fst, ch.pts, ch.seg_start, ch.seg_off, ch.seg_pen,
                             ch.seg_line, ch.seg_col, _POW10, scan.CLASS)
-            self._take_segments(ch, ist)
-            self.x = float(fst[scan.F_X])
-            self.y = float(fst[scan.F_Y])
-            self.pen_down = bool(ist[scan.I_PEN])
-            self.absolute = bool(ist[scan.I_ABS])
-            self.pen = int(ist[scan.I_PENNO])
-            ncmd = 0
-            for name, slot in (("PU", scan.I_NU), ("PD", scan.I_ND), ("PA", scan.I_NA),
-                               ("PR", scan.I_NR), ("SP", scan.I_NSP)):
-                c = int(ist[slot])
-                if c:
-                    self.commands[name] += c
-                    ncmd += c
-            self.recognised += ncmd
-            i = int(ist[scan.I_POS])
-            line, last_nl = int(ist[scan.I_LINE]), int(ist[scan.I_LASTNL])
-            self._lc = (i, line, last_nl)
-            if not ist[scan.I_FULL]:
+            out = ist.tolist()
+            self._take_segments(ch, out)
+            self.x, self.y = fst[0].item(), fst[1].item()
+            self.pen_down = bool(out[scan.I_PEN])
+            self.absolute = bool(out[scan.I_ABS])
+            self.pen = out[scan.I_PENNO]
+            counts = out[scan.I_NU : scan.I_NR + 1] + [out[scan.I_NSP]]
+            if any(counts):
+                for name, c in zip(("PU", "PD", "PA", "PR", "SP"), counts, strict=True):
+                    if c:
+                        self.commands[name] += c
+                self.recognised += sum(counts)
+            i = out[scan.I_POS]
+            self._lc = (i, out[scan.I_LINE], out[scan.I_LASTNL])
+            if not out[scan.I_FULL]:
                 return i
-            self._new_chunk(int(ist[scan.I_NEED]), i)
+            line, last_nl = out[scan.I_LINE], out[scan.I_LASTNL]
+            self._new_chunk(out[scan.I_NEED], i)
 
-    def _take_segments(self, ch: _Chunk, ist: np.ndarray) -> None:
-        from galvo_core.hpgl import scan
-
-        s0, s1 = ch.nseg, int(ist[scan.I_NSEG])
-        p1 = int(ist[scan.I_NPTS])
+    def _take_segments(self, ch: _Chunk, ist: list[int]) -> None:
+        scan = self._scan
+        s0, s1 = ch.nseg, ist[scan.I_NSEG]
+        p1 = ist[scan.I_NPTS]
         ch.nseg, ch.npts = s1, p1
         if s1 == s0:
             return
