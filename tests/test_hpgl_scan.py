@@ -77,3 +77,60 @@ def test_path_open_across_an_interruption_is_one_path() -> None:
     a = _read(data, True, 8)
     assert_same(a, _read(data, False))
     np.testing.assert_array_equal(a.paths[0].points, [[0, 0], [1, 1], [2, 2], [3, 3]])
+
+
+# ------------------------------------------------------------------ PE
+def _pe_both(data: bytes, pos: int = 0):
+    from galvo_core.hpgl import scan
+    from galvo_core.hpgl.pe import PECache, decode_pe
+
+    ref = decode_pe(data, pos, PECache())
+    end, kinds, xs, ys, flags, ni, p_off, p_code, p_val, npb = scan.decode_pe(
+        np.frombuffer(data, np.uint8), pos, np.array([-1, -1, -1, -1], np.int64))
+    got = [("pen", int(x), 0.0, 0.0, False, False) if k == 0 else
+           ("pair", 0, x, y, bool(f & 1), bool(f & 2))
+           for k, x, y, f in zip(kinds[:ni].tolist(), xs[:ni].tolist(), ys[:ni].tolist(),
+                                 flags[:ni].tolist(), strict=True)]
+    want = [(it.kind, it.value if it.kind == "pen" else 0, it.x if it.kind == "pair" else 0.0,
+             it.y if it.kind == "pair" else 0.0, it.pen_up, it.absolute) for it in ref.items]
+    msgs = [reader._PE_MESSAGES[c].format(v) for c, v in zip(p_code[:npb].tolist(),
+                                                            p_val[:npb].tolist(), strict=True)]
+    return (end, got, list(zip(p_off[:npb].tolist(), msgs, strict=True))), \
+        (ref.end, want, ref.problems)
+
+
+@pytest.mark.parametrize("seed", range(40))
+def test_compiled_pe_decoder_matches_the_python_one(seed: int) -> None:
+    from galvo_core.hpgl.pe import encode_number
+
+    rng = random.Random(seed)
+    parts = []
+    for _ in range(rng.randint(0, 60)):
+        r = rng.random()
+        seven = False
+        if r < 0.05:
+            parts.append(b"7")
+            seven = True
+        elif r < 0.15:
+            parts.append(rng.choice([b":", b"<", b">", b"=", b" ", b"\n", b"\x80"]))
+        elif r < 0.2:
+            parts.append(bytes([rng.randrange(256)]))  # noise, maybe the end of the run
+        else:
+            v = rng.choice([rng.randint(-100, 100), rng.randint(-10**6, 10**6),
+                            rng.randint(-10**17, 10**17), rng.randint(0, 30)])
+            parts.append(encode_number(v, seven=seven))
+    data = b"".join(parts) + rng.choice([b";", b"", b"PU;", b"\x1b%0A"])
+    got, want = _pe_both(data)
+    assert got == want
+
+
+def test_compiled_pe_reads_files_as_the_python_decoder() -> None:
+    """A PE-heavy HP-GL/2 job (PCL-wrapped, polygons), read both ways: the same drawing."""
+    from pathlib import Path
+
+    f = Path(__file__).resolve().parents[2] / "shared" / "corpus" / "plt" / \
+        "artifexsoftware__ghostpdl__grashopp.pcl"
+    if not f.is_file():
+        pytest.skip("corpus file not present")
+    data = f.read_bytes()
+    assert_same(_read(data, True), _read(data, False))

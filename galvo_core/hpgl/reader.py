@@ -118,6 +118,12 @@ _FAST_MIN_BYTES = 256  # shorter runs go command by command
 #: ``process``), so that ``galvo-core info small.plt`` does not pay numba's import
 _COMPILED_MIN_BYTES = 1 << 20
 _CHUNK_POINTS = 1 << 16  # points per output chunk of the compiled scanner
+_PE_MESSAGES = {  # scan.PE_* problem codes -> the messages of pe.decode_pe
+    1: "PE number out of range; clamped",
+    2: "PE fractional bits {} out of range 0..26",
+    3: "PE run ends with half a coordinate pair; it was dropped",
+    4: "PE run ends with a flag that has no number",
+}
 _SCAN_CMDS = frozenset((b"PU", b"PD", b"PA", b"PR", b"SP"))  # what the scanner reads
 
 
@@ -1382,30 +1388,65 @@ class _Reader:
         return min(k + 1, n)
 
     def pe(self, pos: int) -> int:
+        if self.compiled:
+            return self._pe_compiled(pos)
         res = decode_pe(self.data, pos, self._pe_cache)
         for off, msg in res.problems:
             self.warn(off, msg, key="pe")
+        items = [(item.kind == "pen", item.value if item.kind == "pen" else 0, item.x, item.y,
+                  item.pen_up, item.absolute) for item in res.items]
+        self._pe_apply(items, pos)
+        return res.end
+
+    def _pe_compiled(self, pos: int) -> int:
+        """PE decoded by the compiled decoder (scan.decode_pe, the same decoding)."""
+        if self._scan is None:
+            from galvo_core.hpgl import scan as scan_module
+
+            self._scan = scan_module
+            self._u8 = np.frombuffer(self.data, dtype=np.uint8)
+            self._ist = np.zeros(scan_module.N_ISTATE, dtype=np.int64)
+            self._fst = np.zeros(scan_module.N_FSTATE, dtype=np.float64)
+        scan = self._scan
+        if not hasattr(self, "_pe_span"):
+            self._pe_span = np.array([-1, -1, -1, -1], dtype=np.int64)
+        end, kinds, xs, ys, flags, ni, p_off, p_code, p_val, npb = scan.decode_pe(
+            self._u8, pos, self._pe_span)
+        for off, code, val in zip(p_off[:npb].tolist(), p_code[:npb].tolist(),
+                                  p_val[:npb].tolist(), strict=True):
+            self.warn(off, _PE_MESSAGES[code].format(val), key="pe")
+        if ni:
+            xl = xs[:ni].tolist()
+            fl = flags[:ni].tolist()
+            items = [(k == 0, int(x) if k == 0 else 0, x, y, bool(f & 1), bool(f & 2))
+                     for k, x, y, f in zip(kinds[:ni].tolist(), xl, ys[:ni].tolist(), fl,
+                                           strict=True)]
+            self._pe_apply(items, pos)
+        return int(end)
+
+    def _pe_apply(self, items: list[tuple[bool, int, float, float, bool, bool]],
+                  pos: int) -> None:
+        """Apply decoded PE items: (is pen select, pen, x, y, pen up, absolute)."""
         saved_abs = self.absolute
-        for item in res.items:
-            if item.kind == "pen":
+        for is_pen, pen, ix, iy, pen_up, absolute in items:
+            if is_pen:
                 self.flush()
-                self.pen = item.value
+                self.pen = pen
                 self.pen_selected = True
                 continue
-            if item.pen_up:
+            if pen_up:
                 self.set_pen_down(False, pos)
             elif not self.pen_down:
                 self.set_pen_down(True, pos)
-            if item.absolute:
-                x, y = self.to_plotter(item.x, item.y)
+            if absolute:
+                x, y = self.to_plotter(ix, iy)
             else:
-                dx, dy = self.delta_to_plotter(item.x, item.y)
+                dx, dy = self.delta_to_plotter(ix, iy)
                 x, y = self.x + dx, self.y + dy
             self.pen_to(x, y, pos)
             # after a pen-up move the next pair (without '<') puts the pen down again; a
             # PE that ends with a pen-up move leaves the pen up (and draws no dot there)
         self.absolute = saved_abs
-        return res.end
 
     # ------------------------------------------------------------------ escapes and PCL
     def _escape_in_hpgl(self, i: int) -> int:

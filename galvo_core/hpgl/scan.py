@@ -379,3 +379,232 @@ def scan_moves(b, ist, fst, pts, seg_start, seg_off, seg_pen, seg_line, seg_col,
     fst[F_X] = x
     fst[F_Y] = y
 
+
+
+# ------------------------------------------------------------------ PE (polyline encoded)
+# item kinds and problem codes of decode_pe (the same decoding as pe.decode_pe)
+PE_PEN, PE_PAIR = 0, 1
+PE_CLAMPED, PE_FRACTION, PE_HALF_PAIR, PE_FLAG = 1, 2, 3, 4
+_PE_MAX = 10**15
+
+
+@njit(cache=True, nogil=True, boundscheck=False)
+def _pe_cont(c, seven):
+    return (63 <= c <= 94) if seven else (63 <= c <= 126)
+
+
+@njit(cache=True, nogil=True, boundscheck=False)
+def _pe_term(c, seven):
+    return (95 <= c <= 126) if seven else (191 <= c <= 254)
+
+
+@njit(cache=True, nogil=True, boundscheck=False)
+def _pe_ign(c, seven):
+    if c <= 32:
+        return True
+    if seven:
+        return c >= 127
+    return (127 <= c <= 190) or c == 255
+
+
+@njit(cache=True, nogil=True, boundscheck=False)
+def _pe_looks_like_number(b, pos, seven, cache):
+    """As pe._looks_like_number; ``cache`` = [start8, end8, start7, end7] of the stretch a
+    failed look-ahead crossed (per mode), so each byte is crossed at most once per mode."""
+    s = 2 if seven else 0
+    if cache[s] <= pos < cache[s + 1]:
+        return False
+    n = b.shape[0]
+    i = pos
+    while i < n:
+        c = b[i]
+        if _pe_term(c, seven):
+            return True
+        if _pe_cont(c, seven) or _pe_ign(c, seven):
+            i += 1
+            continue
+        break
+    cache[s] = pos
+    cache[s + 1] = i
+    return False
+
+
+@njit(cache=True, nogil=True, boundscheck=False)
+def decode_pe(b, pos, cache):
+    """Decode a PE run from ``pos`` (just after the mnemonic), exactly as pe.decode_pe.
+
+    Returns (end, kinds, xs, ys, flags, n_items, prob_off, prob_code, prob_val, n_probs):
+    item k is a pen select (kinds PE_PEN, the pen in xs) or a pair (xs, ys; flags bit 0 pen
+    up, bit 1 absolute); problems are (offset, code, value).
+    """
+    n = b.shape[0]
+    cap = 16
+    kinds = np.empty(cap, np.int8)
+    xs = np.empty(cap, np.float64)
+    ys = np.empty(cap, np.float64)
+    flags = np.empty(cap, np.int8)
+    pcap = 4
+    p_off = np.empty(pcap, np.int64)
+    p_code = np.empty(pcap, np.int8)
+    p_val = np.empty(pcap, np.int64)
+    ni = 0
+    npb = 0
+    seven = False
+    frac_bits = 0
+    pending = 0  # ':' or '>' waiting for its number
+    pen_up_next = False
+    abs_next = False
+    have_x = False
+    cx = 0
+    i = pos
+    while i < n:
+        c = b[i]
+        if c == 59:
+            i += 1
+            break
+        if c == 27:
+            break
+        if c == 58 or c == 60 or c == 62 or c == 61 or c == 55:  # : < > = 7
+            if c == 55:
+                seven = True
+            elif c == 60:
+                pen_up_next = True
+            elif c == 61:
+                abs_next = True
+            else:
+                pending = c
+            i += 1
+            continue
+        if _pe_ign(c, seven):
+            i += 1
+            continue
+        if _pe_cont(c, seven) or _pe_term(c, seven):
+            if not _pe_looks_like_number(b, i, seven, cache):
+                break
+            value = 0
+            shift = 0
+            bits = 5 if seven else 6
+            big = False
+            while i < n:
+                c = b[i]
+                if _pe_cont(c, seven):
+                    if shift < 60:
+                        value |= (c - 63) << shift
+                    elif c != 63:
+                        big = True
+                    shift += bits
+                    i += 1
+                elif _pe_term(c, seven):
+                    d = c - (95 if seven else 191)
+                    if shift < 60:
+                        if shift > 0 and (d >> (62 - shift)) != 0:
+                            big = True
+                        else:
+                            value |= d << shift
+                    elif d != 0:
+                        big = True
+                    i += 1
+                    break
+                elif _pe_ign(c, seven):
+                    i += 1
+                else:
+                    break
+            if big or value > 2 * _PE_MAX + 1:
+                num = _PE_MAX if (value & 1) == 0 else -_PE_MAX
+                clamped = True
+            else:
+                num = -(value >> 1) if value & 1 else value >> 1
+                clamped = num > _PE_MAX or num < -_PE_MAX
+                if clamped:
+                    num = _PE_MAX if num > 0 else -_PE_MAX
+            if clamped:
+                if npb == pcap:
+                    pcap *= 2
+                    p_off = _grow_i64(p_off, pcap)
+                    p_code = _grow_i8(p_code, pcap)
+                    p_val = _grow_i64(p_val, pcap)
+                p_off[npb] = i
+                p_code[npb] = PE_CLAMPED
+                p_val[npb] = 0
+                npb += 1
+            if pending == 58:
+                if ni == cap:
+                    cap *= 2
+                    kinds = _grow_i8(kinds, cap)
+                    xs = _grow_f64(xs, cap)
+                    ys = _grow_f64(ys, cap)
+                    flags = _grow_i8(flags, cap)
+                kinds[ni] = PE_PEN
+                xs[ni] = num
+                ys[ni] = 0.0
+                flags[ni] = 0
+                ni += 1
+                pending = 0
+            elif pending == 62:
+                if 0 <= num <= 26:
+                    frac_bits = num
+                else:
+                    if npb == pcap:
+                        pcap *= 2
+                        p_off = _grow_i64(p_off, pcap)
+                        p_code = _grow_i8(p_code, pcap)
+                        p_val = _grow_i64(p_val, pcap)
+                    p_off[npb] = i
+                    p_code[npb] = PE_FRACTION
+                    p_val[npb] = num
+                    npb += 1
+                pending = 0
+            elif not have_x:
+                cx = num
+                have_x = True
+            else:
+                have_x = False
+                scale = float(1 << frac_bits) if frac_bits else 1.0
+                if ni == cap:
+                    cap *= 2
+                    kinds = _grow_i8(kinds, cap)
+                    xs = _grow_f64(xs, cap)
+                    ys = _grow_f64(ys, cap)
+                    flags = _grow_i8(flags, cap)
+                kinds[ni] = PE_PAIR
+                xs[ni] = cx / scale
+                ys[ni] = num / scale
+                flags[ni] = (1 if pen_up_next else 0) | (2 if abs_next else 0)
+                ni += 1
+                pen_up_next = False
+                abs_next = False
+            continue
+        break
+    for code in (PE_HALF_PAIR, PE_FLAG):
+        if (code == PE_HALF_PAIR and have_x) or (code == PE_FLAG and pending != 0):
+            if npb == pcap:
+                pcap *= 2
+                p_off = _grow_i64(p_off, pcap)
+                p_code = _grow_i8(p_code, pcap)
+                p_val = _grow_i64(p_val, pcap)
+            p_off[npb] = i
+            p_code[npb] = code
+            p_val[npb] = 0
+            npb += 1
+    return i, kinds, xs, ys, flags, ni, p_off, p_code, p_val, npb
+
+
+@njit(cache=True, nogil=True)
+def _grow_i8(a, cap):
+    out = np.empty(cap, np.int8)
+    out[: a.shape[0]] = a
+    return out
+
+
+@njit(cache=True, nogil=True)
+def _grow_i64(a, cap):
+    out = np.empty(cap, np.int64)
+    out[: a.shape[0]] = a
+    return out
+
+
+@njit(cache=True, nogil=True)
+def _grow_f64(a, cap):
+    out = np.empty(cap, np.float64)
+    out[: a.shape[0]] = a
+    return out
