@@ -71,7 +71,8 @@ same classes. Minimal inputs that reproduce each are given so they can be re-che
    `arcs.hp` never send SP; `space-columbia.plt` sends `SP0` before drawing. A plotter draws
    nothing without a pen, and ezhpgl follows that (its operations are simply absent). We
    import them (pen 1 when no SP was sent, pen 0 after SP0), because these files are
-   plainly meant to be drawn. This one rule accounts for most of the paths without partner.
+   plainly meant to be drawn, and say so in a warning (issue 20). This one rule accounts for
+   most of the paths without partner.
 2. **EP after FP, EP after RA/RR/WG: ezhpgl emits the polygon once per command.** A
    `PM2;FP;EP;` polygon is two operations in ezhpgl and one ring in ours (a ring is
    geometry, not paint: see the reader's docstring). These are the "dup" numbers in the last
@@ -91,7 +92,10 @@ same classes. Minimal inputs that reproduce each are given so they can be re-che
    to the end of each label (back to the carriage-return point after a CR) and starts a new
    path after it. We skip labels without moving the pen, so our second triangle's last side
    starts at (2500,2700) where theirs starts at (4080.4,2700), the end of "RIGHT OF POINT".
-   HP-GL does move the pen to the end of the label, so here ezhpgl is right (bug 3 below).
+   HP-GL does move the pen to the end of the label, so here ezhpgl was right (bug 3 below).
+   Since issue 20 we move the pen over the label too (character cell from SI/SR or the
+   default size, CR/LF, DI/DR) but do not apply the label origin LO, so lo.hp still
+   differs (tests/test_hpgl_ezhpgl.py checks it within 10 %).
    Neither parser draws letters: ezhpgl returns labels as glyph boxes in a substitute font
    (TEXT_APPROXIMATION, "labels" column), and we warn that labels are not drawn.
 5. **IW clipping (input-window.hpgl 4 paths, fill.plt 25, iw.hp 1).** We cut pen-down
@@ -112,10 +116,11 @@ same classes. Minimal inputs that reproduce each are given so they can be re-che
    it puts P1 at (0,0). Same shapes, translated.
 8. **The closing edge of PM1/PM2.** ezhpgl stores the edge that PM1/PM2 adds to close an
    open subpolygon as *pen-up*: EP does not stroke it, and its SVG leaves the outline open.
-   We draw it, and so do the corpus goldens (felixfischer polygons: closed rings). The HP
-   manual says only that PM1/PM2 "forces closure by adding a point". The comparison counts
-   that edge as drawn on their side too (see `their_paths`); without that, every open
-   polygon would be a difference.
+   Since issue 20 we give that edge the pen state at PM1/PM2 (PCL5 reference p. 21-37 points
+   to "Pen Status"): drawn when the pen is down (the corpus goldens' closed rings), not drawn
+   when it is up (GNU plotutils' open polylines `PM0;PD;PA...;PU;PM2;EP;`). The comparison
+   counts that edge as drawn on their side (see `their_paths`), which matches us on every
+   polygon closed with the pen down.
 9. **Arcs, circles, wedges, rectangles: no differences.** Every AA/AR/CI/EW/WG/EA/RA path
    in the strict files (apart from classes 3 and 6) agrees point by point within 0.5 units,
    with the same number of points: both flatten by the HP-GL chord rule (5° default chord
@@ -156,14 +161,16 @@ same classes. Minimal inputs that reproduce each are given so they can be re-che
    `(2080,2160),(2480,2160),(2480,2340),(2080,2340),(2080,2160)`. ezhpgl does it this way.
    Check: `python -c "from galvo_core.hpgl import read_file;
    print(read_file('/work/shared/corpus/plt/dgtlrift__hp2xx__pm.hp').paths[1].points)"`.
-3. **LB does not move the current pen position** (class 4 above; `lo.hp`). After a label,
+3. **LB did not move the current pen position (fixed in issue 20, LO aside)** (class 4
+   above; `lo.hp`). After a label,
    HP-GL leaves the pen at the end of the text, or at the carriage-return point after CR/LF.
    A following PD therefore starts there. We keep the label's start point. Fixing it needs
    the character cell (SI/SR/DI/DR/LO/ES and the default size) but not the glyphs. Small
    in practice: it only matters when a file draws from a label's end without moving first.
 
-Not a bug but worth a warning: SP0 followed by drawing (space-columbia.plt) is imported
-silently as pen 0; HP-GL would draw nothing (class 1).
+Not a bug but worth a warning: SP0 followed by drawing (space-columbia.plt) is imported as
+pen 0 with a warning; HP-GL would draw nothing (class 1). Since issue 20 paths drawn before
+any SP are warned about too.
 """
 
 
