@@ -68,6 +68,7 @@ import sys
 from collections import Counter
 from collections.abc import Callable
 from itertools import repeat
+from typing import Any
 
 import numpy as np
 
@@ -223,7 +224,7 @@ class _Reader:
         self._pe_cache = PECache()
         self.compiled = _use_compiled(self.n)
         self._chunk: _Chunk | None = None
-        self._scan = None  # the compiled scanner's module, imported at its first use
+        self._scan: Any = None  # the compiled scanner's module, imported at its first use
         self._lc = (0, 1, -1)  # scanner position: offset, its line, the newline before it
         self.chunks: list[_Chunk] = []
         self.batched = 0  # paths in _Batch items of self.paths
@@ -582,18 +583,18 @@ class _Reader:
             return  # filled already
         rings = []
         for ring, _downs in self.poly_buffer:
-            pts = ring if ring[0] == ring[-1] else ring + [ring[0]]
-            rings.append(np.array(pts, dtype=np.float64))
+            closed_ring = ring if ring[0] == ring[-1] else ring + [ring[0]]
+            rings.append(np.array(closed_ring, dtype=np.float64))
         if self.poly_edged is not None:
             a, b = self.poly_edged
             tail = self.paths[b:]
             del self.paths[a:]
-            for pts in rings:
-                self.emit(pts, self.poly_offset, closed=len(pts) >= 4)
+            for arr in rings:
+                self.emit(arr, self.poly_offset, closed=len(arr) >= 4)
             self.paths.extend(tail)
         else:
-            for pts in rings:
-                self.emit(pts, self.poly_offset, closed=len(pts) >= 4)
+            for arr in rings:
+                self.emit(arr, self.poly_offset, closed=len(arr) >= 4)
         self.poly_emitted = True
         self.poly_edged = None
 
@@ -1673,12 +1674,16 @@ def _batch_paths(b: _Batch, out: list[Path]) -> None:
 
 
 # slot setters of the frozen dataclasses (member descriptors: no frozen __setattr__)
-_SP_LINE = SourcePos.line.__set__  # type: ignore[attr-defined]
-_SP_COL = SourcePos.col.__set__  # type: ignore[attr-defined]
-_P_POINTS = Path.points.__set__  # type: ignore[attr-defined]
-_P_PEN = Path.pen.__set__  # type: ignore[attr-defined]
-_P_CLOSED = Path.closed.__set__  # type: ignore[attr-defined]
-_P_START = Path.start.__set__  # type: ignore[attr-defined]
+def _slot_setter(cls: type, name: str) -> Callable[[object, object], None]:
+    return cls.__dict__[name].__set__  # type: ignore[no-any-return]
+
+
+_SP_LINE = _slot_setter(SourcePos, "line")
+_SP_COL = _slot_setter(SourcePos, "col")
+_P_POINTS = _slot_setter(Path, "points")
+_P_PEN = _slot_setter(Path, "pen")
+_P_CLOSED = _slot_setter(Path, "closed")
+_P_START = _slot_setter(Path, "start")
 
 
 def read_bytes(data: bytes, name: str = "<bytes>") -> Drawing:
