@@ -901,25 +901,33 @@ class _Geometry:
     latest mapping: a re-sample at another tolerance maps nothing again."""
 
     def __init__(self, fitted: Sequence[FittedPath]) -> None:
-        segs = [s for fp in fitted for s in fp.segments]
-        self.path_n = np.fromiter((len(fp.segments) for fp in fitted), dtype=np.int64,
+        # the paths' own arrays (FittedPath: kinds and shared control points), concatenated
+        self.path_n = np.fromiter((len(fp.is_cubic) for fp in fitted), dtype=np.int64,
                                   count=len(fitted))
         self.path_first = np.cumsum(self.path_n) - self.path_n
-        g = len(segs)
-        self.is_cubic = np.fromiter((s.kind == "cubic" for s in segs), dtype=bool, count=g)
+        g = int(self.path_n.sum())
         self.seg_path = np.repeat(np.arange(len(fitted)), self.path_n)
         # (G, 4, 2): a cubic's four control points; a line's P0 and P1 in rows 0 and 3
         self.ctrl_units = np.zeros((g, 4, 2))
         if g:
-            lens = np.fromiter((len(s.points) for s in segs), dtype=np.int64, count=g)
-            pts = np.concatenate([s.points for s in segs]).astype(np.float64, copy=False)
-            row = np.cumsum(lens) - lens  # first row of each segment
+            self.is_cubic = np.concatenate([fp.is_cubic for fp in fitted])
+            pts = np.concatenate([fp.points for fp in fitted]).astype(np.float64, copy=False)
+            npts = np.fromiter((len(fp.points) for fp in fitted), dtype=np.int64,
+                               count=len(fitted))
+            step = np.where(self.is_cubic, 3, 1)
+            # row of each segment's P0: its path's first row + the steps before it in the path
+            cs = np.cumsum(step)
+            row = cs - step
+            base = (np.cumsum(npts) - npts) - np.r_[row, cs[-1:]][self.path_first]
+            row += np.repeat(base, self.path_n)
             rc = row[self.is_cubic]
             for j in range(4):
                 self.ctrl_units[self.is_cubic, j] = pts[rc + j]
             rl = row[~self.is_cubic]
             self.ctrl_units[~self.is_cubic, 0] = pts[rl]
             self.ctrl_units[~self.is_cubic, 3] = pts[rl + 1]
+        else:
+            self.is_cubic = np.zeros(0, dtype=bool)
         self._fielded: OrderedDict[tuple[float, ...], tuple[Any, ...]] = OrderedDict()
         self._lock = threading.Lock()
 
