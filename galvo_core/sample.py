@@ -99,7 +99,7 @@ import numpy as np
 from galvo_core.errors import ParamError
 from galvo_core.field import FieldMap
 from galvo_core.fit import FittedPath
-from galvo_core.geometry import power_coeffs_many
+from galvo_core.geometry import power_coeffs_into
 from galvo_core.timing import CORNER_DEG
 
 __all__ = [
@@ -907,11 +907,13 @@ class _Geometry:
         self.path_first = np.cumsum(self.path_n) - self.path_n
         g = int(self.path_n.sum())
         self.seg_path = np.repeat(np.arange(len(fitted)), self.path_n)
-        # (G, 4, 2): a cubic's four control points; a line's P0 and P1 in rows 0 and 3
-        self.ctrl_units = np.zeros((g, 4, 2))
+        # the shared control points of every path (input units) and the row of each
+        # segment's P0 among them (a line: P0, P1 in rows row, row + 1; a cubic: P0..P3 in
+        # rows row..row + 3): 16 bytes per point and 8 per segment, not a (G, 4, 2) copy
         if g:
             self.is_cubic = np.concatenate([fp.is_cubic for fp in fitted])
-            pts = np.concatenate([fp.points for fp in fitted]).astype(np.float64, copy=False)
+            self.points = np.concatenate([fp.points for fp in fitted]).astype(np.float64,
+                                                                              copy=False)
             npts = np.fromiter((len(fp.points) for fp in fitted), dtype=np.int64,
                                count=len(fitted))
             step = np.where(self.is_cubic, 3, 1)
@@ -920,23 +922,27 @@ class _Geometry:
             row = cs - step
             base = (np.cumsum(npts) - npts) - np.r_[row, cs[-1:]][self.path_first]
             row += np.repeat(base, self.path_n)
-            rc = row[self.is_cubic]
-            for j in range(4):
-                self.ctrl_units[self.is_cubic, j] = pts[rc + j]
-            rl = row[~self.is_cubic]
-            self.ctrl_units[~self.is_cubic, 0] = pts[rl]
-            self.ctrl_units[~self.is_cubic, 3] = pts[rl + 1]
+            self.row = row
         else:
             self.is_cubic = np.zeros(0, dtype=bool)
+            self.points = np.zeros((0, 2))
+            self.row = np.zeros(0, dtype=np.int64)
         self._fielded: OrderedDict[tuple[float, ...], tuple[Any, ...]] = OrderedDict()
         self._lock = threading.Lock()
 
     def ctrl_bits(self, fm: FieldMap) -> np.ndarray:
         """(G, 4, 2) control points in float bits; a line P0→P1 as the cubic with its inner
         control points at 1/3 and 2/3 (computed in bits)."""
-        out = fm.to_bits_float(self.ctrl_units.reshape(-1, 2)).reshape(-1, 4, 2)
-        ln = ~self.is_cubic
-        c0, c1 = out[ln, 0], out[ln, 3]
+        pb = fm.to_bits_float(self.points)
+        row, cub = self.row, self.is_cubic
+        out = np.empty((len(row), 4, 2))
+        out[:, 0] = pb[row]
+        rc = row[cub]
+        for j in (1, 2, 3):
+            out[cub, j] = pb[rc + j]
+        ln = ~cub
+        c0, c1 = out[ln, 0], pb[row[ln] + 1]
+        out[ln, 3] = c1
         out[ln, 1] = c0 + (c1 - c0) / 3.0
         out[ln, 2] = c0 + 2.0 * (c1 - c0) / 3.0
         return out
@@ -954,10 +960,15 @@ class _Geometry:
                 return hit
         ctrl_all = self.ctrl_bits(fm)
         is_cubic = self.is_cubic
-        coef = power_coeffs_many(ctrl_all)
-        coef[~is_cubic, 0] = 0.0
-        coef[~is_cubic, 1] = 0.0
-        coef[~is_cubic, 2] = ctrl_all[~is_cubic, 3] - ctrl_all[~is_cubic, 0]
+        # power coefficients laid out (4, 2, G): each of a, b, d, e in x and y is one
+        # contiguous row, so the eight flat arrays the kernels want are views, not copies
+        ln = ~is_cubic
+        block = np.empty((4, 2, len(ctrl_all)))
+        power_coeffs_into(block, *(ctrl_all[:, k].T for k in range(4)))
+        block[0][:, ln] = 0.0
+        block[1][:, ln] = 0.0
+        block[2][:, ln] = (ctrl_all[ln, 3] - ctrl_all[ln, 0]).T
+        coef = block.transpose(2, 0, 1)  # (G, 4, 2) view
         g = len(ctrl_all)
         corner = np.zeros(g, dtype=bool)
         if g > 1:
@@ -969,7 +980,7 @@ class _Geometry:
             deg = ~(((ax_ != 0) | (ay_ != 0)) & ((bx_ != 0) | (by_ != 0)))
             corner[:-1] = ((ang > CORNER_DEG) | deg) & (self.seg_path[:-1] ==
                                                          self.seg_path[1:])
-        cf = _cf(coef)
+        cf = tuple(block[i, j] for i in range(4) for j in range(2))
         ends = np.ascontiguousarray(ctrl_all[:, ::3])  # P0, P3
         for x in (ends, coef, corner, *cf):
             x.setflags(write=False)

@@ -29,10 +29,42 @@ class RunTokens:
     num_val: np.ndarray  # (K,) float64 values
 
 
+#: bytes tokenised at once: the per-byte work arrays (a few dozen bytes per input byte)
+#: stay small and in cache however large the file
+CHUNK_BYTES = 1 << 20
+
+
 def tokenize_run(buf: bytes | memoryview) -> RunTokens | None:
     """Tokenise a run; None when it holds a number this fast path does not read exactly
-    (more than 15 digits, two decimal points, a sign or point without digits)."""
+    (more than 15 digits, two decimal points, a sign or point without digits).
+
+    A long run is tokenised in pieces of about :data:`CHUNK_BYTES` cut just after a ``;``
+    (a command boundary), with the same result as in one piece."""
     b = np.frombuffer(buf, dtype=np.uint8)
+    if len(b) <= 2 * CHUNK_BYTES:
+        return _tokenize(b)
+    cuts = [0]
+    while len(b) - cuts[-1] > 2 * CHUNK_BYTES:
+        semi = np.flatnonzero(b[cuts[-1] + CHUNK_BYTES:cuts[-1] + 2 * CHUNK_BYTES] == 59)
+        if len(semi) == 0:
+            break
+        cuts.append(cuts[-1] + CHUNK_BYTES + int(semi[0]) + 1)
+    cuts.append(len(b))
+    parts = []
+    n_cmd = 0
+    for a, e in zip(cuts[:-1], cuts[1:], strict=True):
+        t = _tokenize(b[a:e])
+        if t is None:
+            return None
+        t.cmd_pos += a
+        t.num_cmd += n_cmd
+        n_cmd += len(t.cmd_pos)
+        parts.append(t)
+    return RunTokens(*(np.concatenate([getattr(t, f) for t in parts])
+                       for f in ("cmd_pos", "cmd_code", "num_cmd", "num_val")))
+
+
+def _tokenize(b: np.ndarray) -> RunTokens | None:
     is_letter = ((b >= 65) & (b <= 90)) | ((b >= 97) & (b <= 122))
     letters = np.flatnonzero(is_letter)
     cmd_pos = letters[0::2]
