@@ -398,12 +398,17 @@ def _smooth_chains(cf: CF, is_cubic: np.ndarray, corner: np.ndarray, seg_path: n
                        & (seg_path[:-1] == seg_path[1:]))
     if joined.any():
         x, w = np.polynomial.legendre.leggauss(4)
-        est = np.zeros(g)
+        # a line (a = b = 0) has curvature 0: its estimate is exactly 1, only the cubics
+        # are evaluated
+        cub = np.flatnonzero(is_cubic)
+        cfc = tuple(x[cub] for x in cf)
+        ec = np.zeros(len(cub))
         for xi, wi in zip(0.5 * (x + 1.0), 0.5 * w, strict=True):
-            sp, k = _speed_curvature(cf, float(xi))
+            sp, k = _speed_curvature(cfc, float(xi))  # type: ignore[arg-type]
             with np.errstate(invalid="ignore"):
-                est += wi * np.nan_to_num(np.sqrt(k) * sp, posinf=0.0)  # sqrt(κ)·|B'|
-        est = est / math.sqrt(8.0 * tol) + 1.0
+                ec += wi * np.nan_to_num(np.sqrt(k) * sp, posinf=0.0)  # sqrt(κ)·|B'|
+        est = np.ones(g)
+        est[cub] = ec / math.sqrt(8.0 * tol) + 1.0
         # marks gathered before each cubic since the start of its run; cut at multiples
         start = ~np.r_[False, joined[:-1]]
         cum = np.cumsum(est) - est
@@ -930,23 +935,6 @@ class _Geometry:
         self._fielded: OrderedDict[tuple[float, ...], tuple[Any, ...]] = OrderedDict()
         self._lock = threading.Lock()
 
-    def ctrl_bits(self, fm: FieldMap) -> np.ndarray:
-        """(G, 4, 2) control points in float bits; a line P0→P1 as the cubic with its inner
-        control points at 1/3 and 2/3 (computed in bits)."""
-        pb = fm.to_bits_float(self.points)
-        row, cub = self.row, self.is_cubic
-        out = np.empty((len(row), 4, 2))
-        out[:, 0] = pb[row]
-        rc = row[cub]
-        for j in (1, 2, 3):
-            out[cub, j] = pb[rc + j]
-        ln = ~cub
-        c0, c1 = out[ln, 0], pb[row[ln] + 1]
-        out[ln, 3] = c1
-        out[ln, 1] = c0 + (c1 - c0) / 3.0
-        out[ln, 2] = c0 + 2.0 * (c1 - c0) / 3.0
-        return out
-
     def fielded(self, fm: FieldMap) -> tuple[Any, ...]:
         """``(ends, coef, corner, cf)`` for ``fm`` (read-only arrays): the end points in
         bits (G, 2, 2), power coefficients (G, 4, 2; a line exactly a = b = 0), for each
@@ -958,21 +946,39 @@ class _Geometry:
             if hit is not None:
                 self._fielded.move_to_end(key)
                 return hit
-        ctrl_all = self.ctrl_bits(fm)
-        is_cubic = self.is_cubic
+        # control points in float bits, gathered from the shared points: P0 and P3 of every
+        # segment, P1 and P2 of the cubics; a line P0→P1 is the cubic with its inner control
+        # points at 1/3 and 2/3 (computed in bits; used for its end tangents)
+        pb = fm.to_bits_float(self.points)
+        row, is_cubic = self.row, self.is_cubic
+        g = len(row)
+        p0 = pb[row]
+        p3 = pb[row + np.where(is_cubic, 3, 1)]
+        ic = np.flatnonzero(is_cubic)
+        il = np.flatnonzero(~is_cubic)
         # power coefficients laid out (4, 2, G): each of a, b, d, e in x and y is one
-        # contiguous row, so the eight flat arrays the kernels want are views, not copies
-        ln = ~is_cubic
-        block = np.empty((4, 2, len(ctrl_all)))
-        power_coeffs_into(block, *(ctrl_all[:, k].T for k in range(4)))
-        block[0][:, ln] = 0.0
-        block[1][:, ln] = 0.0
-        block[2][:, ln] = (ctrl_all[ln, 3] - ctrl_all[ln, 0]).T
+        # contiguous row, so the eight flat arrays the kernels want are views, not copies;
+        # a line exactly a = b = 0, d = P3 − P0, e = P0
+        block = np.empty((4, 2, g))
+        block[0] = 0.0
+        block[1] = 0.0
+        np.subtract(p3.T, p0.T, out=block[2])
+        block[3] = p0.T
+        ts = np.empty((g, 2))
+        te = np.empty((g, 2))
+        if len(ic):
+            c0, c1, c2, c3 = p0[ic], pb[row[ic] + 1], pb[row[ic] + 2], p3[ic]
+            sub = np.empty((4, 2, len(ic)))
+            power_coeffs_into(sub, c0.T, c1.T, c2.T, c3.T)
+            block[:, :, ic] = sub
+            ts[ic], te[ic] = _tangents(c0, c1, c2, c3)
+        if len(il):
+            c0, c3 = p0[il], p3[il]
+            d = c3 - c0
+            ts[il], te[il] = _tangents(c0, c0 + d / 3.0, c0 + 2.0 * d / 3.0, c3)
         coef = block.transpose(2, 0, 1)  # (G, 4, 2) view
-        g = len(ctrl_all)
         corner = np.zeros(g, dtype=bool)
         if g > 1:
-            ts, te = _tangents_all(ctrl_all)
             a, b = te[:-1], ts[1:]
             ax_, ay_, bx_, by_ = a[:, 0], a[:, 1], b[:, 0], b[:, 1]
             cr = ax_ * by_ - ay_ * bx_
@@ -981,7 +987,7 @@ class _Geometry:
             corner[:-1] = ((ang > CORNER_DEG) | deg) & (self.seg_path[:-1] ==
                                                          self.seg_path[1:])
         cf = tuple(block[i, j] for i in range(4) for j in range(2))
-        ends = np.ascontiguousarray(ctrl_all[:, ::3])  # P0, P3
+        ends = np.stack((p0, p3), axis=1)  # (G, 2, 2): P0, P3
         for x in (ends, coef, corner, *cf):
             x.setflags(write=False)
         out = (ends, coef, corner, cf)
@@ -1189,22 +1195,22 @@ def sample_paths(
     return res
 
 
-def _tangents_all(ctrl: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Start and end tangent directions of every segment (first non-zero control leg)."""
-    p0, p1, p2, p3 = ctrl[:, 0], ctrl[:, 1], ctrl[:, 2], ctrl[:, 3]
+def _first_nonzero(legs: tuple[np.ndarray, ...]) -> np.ndarray:
+    out = legs[0]
+    for alt in legs[1:]:
+        zero = (out[:, 0] == 0) & (out[:, 1] == 0)
+        if zero.any():
+            out = out.copy()
+            out[zero] = alt[zero]
+    return out
 
-    def first_nonzero(legs: tuple[np.ndarray, ...]) -> np.ndarray:
-        out = legs[0]
-        for alt in legs[1:]:
-            zero = (out[:, 0] == 0) & (out[:, 1] == 0)
-            if zero.any():
-                out = out.copy()
-                out[zero] = alt[zero]
-        return out
 
-    s = first_nonzero((p1 - p0, p2 - p0, p3 - p0))
-    e = first_nonzero((p3 - p2, p3 - p1, p3 - p0))
-    return s, e
+def _tangents(p0: np.ndarray, p1: np.ndarray, p2: np.ndarray, p3: np.ndarray
+              ) -> tuple[np.ndarray, np.ndarray]:
+    """Start and end tangent directions of cubics given by their control points (N, 2)
+    each (first non-zero control leg)."""
+    return (_first_nonzero((p1 - p0, p2 - p0, p3 - p0)),
+            _first_nonzero((p3 - p2, p3 - p1, p3 - p0)))
 
 
 def _measure_marks(cs: _CubicSet, sid: np.ndarray, st: np.ndarray, pos: np.ndarray,
