@@ -205,6 +205,43 @@ def worker(src: str, out: str, fill: bool) -> None:
     print(json.dumps(res))
 
 
+def io_bench(n_marks: int, runs: int) -> dict[str, float]:
+    """Write and load a job of ``n_marks`` marks in both forms (CPU and wall, best of
+    ``runs``): strokes of 400 marks with a line per two marks and a cubic per 40, the shape
+    of the generated drawings' jobs."""
+    sys.path.insert(0, str(ROOT))
+    from galvo_core.field import FieldMap
+    from galvo_core.job import Job, Segments, Stroke, load_job, write_job
+
+    rng = np.random.default_rng(1)
+    fm = FieldMap(4.0, (100.0, 100.0), 65536, 110.0)
+    per = 400
+    strokes = []
+    for k in range(max(1, n_marks // per)):
+        m = rng.integers(0, 65536, (per, 2))
+        kinds = rng.random(per // 2) < 0.05
+        pts = rng.uniform(0, 16000, (1 + int(np.where(kinds, 3, 1).sum()), 2))
+        strokes.append(Stroke("contour", k, False, m, Segments(kinds, pts)))
+    job = Job("io.plt", "0" * 64, fm, {}, {}, tuple(strokes), {}, ())
+    out: dict[str, float] = {"marks": float(per * len(strokes))}
+    for ext in ("gjob", "json"):
+        path = OUT / f"io.{ext}"
+        for op in ("write", "load"):
+            best_c = best_w = math.inf
+            for _ in range(runs if ext == "gjob" else 1):
+                w, c = time.perf_counter(), time.process_time()
+                if op == "write":
+                    write_job(job, path)
+                else:
+                    load_job(path)
+                best_c = min(best_c, time.process_time() - c)
+                best_w = min(best_w, time.perf_counter() - w)
+            out[f"{ext}_{op}_cpu"] = best_c
+            out[f"{ext}_{op}_wall"] = best_w
+        out[f"{ext}_mb"] = path.stat().st_size / 1e6
+    return out
+
+
 # ------------------------------------------------------------------------ report
 def exponent(n1: int, t1: float, n2: int, t2: float) -> float | None:
     if max(t1, t2) < 0.02 or t1 <= 0 or t2 <= 0:
@@ -226,6 +263,8 @@ def main(argv: list[str] | None = None) -> int:
                     help="largest size run with fill on (default 1 M)")
     ap.add_argument("--runs", type=int, default=3)
     ap.add_argument("--no-write", action="store_true")
+    ap.add_argument("--io-marks", type=int, default=5_000_000,
+                    help="marks of the job-file write/load measurement (0: skip)")
     ap.add_argument("--stage-worker", nargs=2, metavar=("SRC", "OUT"))
     ap.add_argument("--fill-on", action="store_true")
     a = ap.parse_args(argv)
@@ -233,6 +272,9 @@ def main(argv: list[str] | None = None) -> int:
         worker(a.stage_worker[0], a.stage_worker[1], a.fill_on)
         return 0
     OUT.mkdir(parents=True, exist_ok=True)
+    io = io_bench(a.io_marks, a.runs) if a.io_marks else None
+    if io:
+        print("job file I/O:", json.dumps(io), flush=True)
     results = []
     for kind in a.kinds:
         for fill in a.fill:
@@ -262,7 +304,7 @@ def main(argv: list[str] | None = None) -> int:
                       + " ".join(f"{s}={row['stages'][s]['cpu']:.2f}" for s in STAGES),
                       flush=True)
                 (OUT / "results.json").write_text(json.dumps(results, indent=1))
-    text = report(results)
+    text = report(results, io)
     print(text)
     if not a.no_write:
         sys.path.insert(0, str(HERE))
@@ -272,7 +314,7 @@ def main(argv: list[str] | None = None) -> int:
     return 0
 
 
-def report(results: list[dict]) -> str:  # type: ignore[type-arg]
+def report(results: list[dict], io: dict[str, float] | None) -> str:  # type: ignore[type-arg]
     import platform
 
     load = os.getloadavg()
@@ -324,6 +366,17 @@ def report(results: list[dict]) -> str:  # type: ignore[type-arg]
         e = exponent(a["n"], a["gjob"]["cpu"], b["n"], b["gjob"]["cpu"])
         lines.append(f"| {kind} | {fill} | {a['n']:,} → {b['n']:,} | " + " | ".join(cells)
                      + f" | {'—' if e is None else f'{e:.2f}'} |")
+    if io:
+        lines += ["", f"### Job file: writing and loading {io['marks']:,.0f} marks", "",
+                  "A synthetic job (strokes of 400 marks, a line per two marks, a cubic per 40: "
+                  "the shape of the generated drawings' jobs); CPU and wall seconds, best of "
+                  "the runs (.json: one run).", "",
+                  "| form | MB | write CPU s | write wall s | load CPU s | load wall s |",
+                  "| --- | ---: | ---: | ---: | ---: | ---: |"]
+        for ext, name in (("gjob", "version 2, .gjob"), ("json", "version 1, .json")):
+            lines.append(f"| {name} | {io[ext + '_mb']:.1f} | {io[ext + '_write_cpu']:.2f} | "
+                         f"{io[ext + '_write_wall']:.2f} | {io[ext + '_load_cpu']:.2f} | "
+                         f"{io[ext + '_load_wall']:.2f} |")
     lines.append("")
     return "\n".join(lines) + "\n"
 

@@ -517,28 +517,58 @@ def job_from_json(doc: Any, name: str = "<job>") -> Job:
             raise InputError(name, f"{where}.marks must be a list of [X, Y] integers") from exc
         if len(marks) and (marks.min() < 0 or marks.max() > bits - 1):
             raise InputError(name, f"{where}.marks leave the field 0..{bits - 1}")
-        pairs = []
-        for k, sg in enumerate(_req(s, "segments", where, name)):
-            typ = _req(sg, "type", f"{where}.segments[{k}]", name)
-            try:
-                pts = np.asarray(_req(sg, "points", f"{where}.segments[{k}]", name),
-                                 dtype=float)
-            except (ValueError, TypeError):
-                pts = None
-            want = {"line": 2, "cubic": 4}.get(typ)
-            if want is None or pts is None or pts.shape != (want, 2):
-                raise InputError(name, f"{where}.segments[{k}] is not a line (2 points) or "
-                                       "cubic (4 points)")
-            pairs.append((typ, pts))
-        try:
-            segs = Segments.from_pairs(pairs)
-        except ValueError as exc:
-            raise InputError(name, f"{where}.segments: {exc} (they must be "
-                                   "continuous)") from exc
+        segs = _segments_v1(_req(s, "segments", where, name), where, name)
         strokes.append(Stroke(kind, int(_req(s, "source_index", where, name)),
                               bool(_req(s, "closed", where, name)), marks, segs,
                               int(s.get("pen", 1))))
     return _finish(doc, fm, strokes)
+
+
+_WANT = {"line": 2, "cubic": 4}
+
+
+def _segments_v1(segs_in: Any, where: str, name: str) -> Segments:
+    """A v1 stroke's ``segments`` list as :class:`Segments`: the points of all segments as
+    one array (a few Python operations per segment, one numpy conversion per stroke),
+    validated (kinds, point counts, continuity) with the place of the first problem."""
+    if not isinstance(segs_in, list):
+        raise InputError(name, f"{where}.segments must be a list")
+    if not segs_in:
+        return Segments.empty()
+    try:
+        kinds = [sg["type"] for sg in segs_in]
+        pts_lists = [sg["points"] for sg in segs_in]
+        counts = [len(p) for p in pts_lists]
+        ok = [_WANT.get(k) == c for k, c in zip(kinds, counts, strict=True)]
+        flat = np.array([xy for p in pts_lists for xy in p], dtype=np.float64)
+    except (TypeError, KeyError, ValueError):
+        ok = [False]
+        flat = np.zeros((0, 2))
+    if not all(ok) or flat.ndim != 2 or flat.shape[1:] != (2,):
+        for k, sg in enumerate(segs_in):  # find the place (the slow way, only on errors)
+            here = f"{where}.segments[{k}]"
+            typ = _req(sg, "type", here, name)
+            try:
+                pts = np.asarray(_req(sg, "points", here, name), dtype=float)
+            except (ValueError, TypeError):
+                pts = None
+            if _WANT.get(typ) is None or pts is None or pts.shape != (_WANT[typ], 2):
+                raise InputError(name, f"{here} is not a line (2 points) or cubic (4 points)")
+        raise InputError(name, f"{where}.segments: points must be [x, y] numbers")
+    cnt = np.array(counts)
+    start = np.cumsum(cnt) - cnt
+    # continuity: each segment starts where the previous one ended
+    bad = np.flatnonzero((flat[start[1:]] != flat[start[1:] - 1]).any(axis=1))
+    if len(bad):
+        k = int(bad[0]) + 1
+        raise InputError(name, f"{where}.segments: segment {k} does not start where segment "
+                               f"{k - 1} ended (they must be continuous)")
+    keep = np.ones(len(flat), dtype=bool)
+    keep[start[1:]] = False
+    pts = flat[keep]
+    if not np.isfinite(pts).all():
+        raise InputError(name, f"{where}.segments: points must be finite numbers")
+    return Segments(_read_only(cnt == 4), _read_only(pts))
 
 
 def job_from_compact(raw: bytes, name: str = "<job>") -> Job:
