@@ -19,10 +19,11 @@ and fill setting (off; ``zigzag`` with kerf and optimized order), it measures:
   order, the remaining glue of ``Pipeline.run`` (strokes, stats), write (.gjob), load (.gjob):
   wall and CPU (``time.process_time``) and the peak RSS reached by the end of the stage.
 
-Each number is the median of ``--runs`` runs (3 by default; 1 at 5 M points). The growth
-exponent of a stage between two sizes is log(t2/t1)/log(n2/n1) of its CPU time; the table
-gives it from 100 k to the largest size (stages under 20 ms at both ends are not rated:
-their times are noise). The machine is shared: CPU times are the ones to compare.
+Each number is the median of ``--runs`` runs (3 by default) up to 100 k points, one run
+above. The growth exponent of a stage between two sizes is log(t2/t1)/log(n2/n1) of its
+CPU time; the table gives it from 100 k to the largest size (stages under 20 ms at both ends
+are not rated: their times are noise). The machine is shared: CPU times are the ones to
+compare.
 """
 
 from __future__ import annotations
@@ -265,11 +266,23 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--no-write", action="store_true")
     ap.add_argument("--io-marks", type=int, default=5_000_000,
                     help="marks of the job-file write/load measurement (0: skip)")
+    ap.add_argument("--from-json", metavar="RESULTS_JSON",
+                    help="only write the section from a results.json of an earlier run")
     ap.add_argument("--stage-worker", nargs=2, metavar=("SRC", "OUT"))
     ap.add_argument("--fill-on", action="store_true")
     a = ap.parse_args(argv)
     if a.stage_worker:
         worker(a.stage_worker[0], a.stage_worker[1], a.fill_on)
+        return 0
+    if a.from_json:
+        saved = json.loads(Path(a.from_json).read_text())
+        text = report(saved["results"], saved.get("io"), saved.get("meta"))
+        print(text)
+        if not a.no_write:
+            sys.path.insert(0, str(HERE))
+            from results_md import replace_section
+
+            replace_section("## Pipeline throughput (issue 21)", text)
         return 0
     OUT.mkdir(parents=True, exist_ok=True)
     io = io_bench(a.io_marks, a.runs) if a.io_marks else None
@@ -282,10 +295,12 @@ def main(argv: list[str] | None = None) -> int:
                 if fill == "on" and n > a.fill_max:
                     continue
                 src = generated(n) if kind == "generated" else real(n)
-                runs = a.runs if n < 5_000_000 else 1
+                runs = a.runs if n <= 100_000 else 1
                 on = fill == "on"
                 e2e = [cli_run(src, OUT / "job.gjob", on) for _ in range(runs)]
-                e2e_json = [cli_run(src, OUT / "job.json", on) for _ in range(runs)]
+                # the v1 JSON end to end only without fill (the same stages but the writer)
+                e2e_json = e2e if on else [cli_run(src, OUT / "job.json", on)
+                                           for _ in range(runs)]
                 st = [stage_run(src, OUT / "stage.gjob", on) for _ in range(runs)]
                 row = {
                     "kind": kind, "fill": fill, "n": n, "runs": runs,
@@ -294,7 +309,7 @@ def main(argv: list[str] | None = None) -> int:
                     "stages": {s: {k: statistics.median(r[s][k] for r in st)
                                    for k in ("wall", "cpu", "rss_mb")} for s in STAGES},
                     "gjob_bytes": (OUT / "job.gjob").stat().st_size,
-                    "json_bytes": (OUT / "job.json").stat().st_size,
+                    "json_bytes": (OUT / "job.json").stat().st_size if not on else 0,
                 }
                 results.append(row)
                 g = row["gjob"]
@@ -303,8 +318,9 @@ def main(argv: list[str] | None = None) -> int:
                       f"{row['json']['wall']:.2f} s wall; stages CPU "
                       + " ".join(f"{s}={row['stages'][s]['cpu']:.2f}" for s in STAGES),
                       flush=True)
-                (OUT / "results.json").write_text(json.dumps(results, indent=1))
-    text = report(results, io)
+                (OUT / "results.json").write_text(json.dumps(
+                    {"results": results, "io": io, "meta": meta()}, indent=1))
+    text = report(results, io, meta())
     print(text)
     if not a.no_write:
         sys.path.insert(0, str(HERE))
@@ -314,20 +330,28 @@ def main(argv: list[str] | None = None) -> int:
     return 0
 
 
-def report(results: list[dict], io: dict[str, float] | None) -> str:  # type: ignore[type-arg]
+def meta() -> dict[str, str]:
     import platform
 
-    load = os.getloadavg()
+    return {"date": time.strftime("%Y-%m-%d %H:%M UTC", time.gmtime()),
+            "python": platform.python_version(), "numpy": np.__version__,
+            "cores": str(os.cpu_count()), "load": f"{os.getloadavg()[0]:.1f}"}
+
+
+def report(results: list[dict], io: dict[str, float] | None,  # type: ignore[type-arg]
+           m: dict[str, str] | None = None) -> str:
+    m = m or meta()
     lines = [
         "## Pipeline throughput (issue 21)",
         "",
-        f"`python bench/bench_pipeline.py` on {time.strftime('%Y-%m-%d %H:%M UTC', time.gmtime())}"
-        f", {platform.python_version()}, numpy {np.__version__}, {os.cpu_count()} cores "
-        f"shared with other sessions (load average {load[0]:.1f} at the end): wall times are "
+        f"`python bench/bench_pipeline.py` on {m['date']}, Python {m['python']}, numpy "
+        f"{m['numpy']}, {m['cores']} cores shared with other sessions (load average "
+        f"{m['load']} at the end): wall times are "
         "inflated by the load, CPU times are the ones to compare. End to end = "
         "`galvo-core process FILE -o JOB.gjob|JOB.json --fit-field` in a fresh process "
         "(child's wall, user + system CPU, peak RSS); fill on = `" + " ".join(FILL_ARGS) +
-        "`. Median of the runs given.",
+        "` (its .json column repeats the .gjob run: not measured separately). Median of the "
+        "runs given (3 up to 100 k points, 1 above).",
         "",
         "### End to end through the CLI",
         "",
