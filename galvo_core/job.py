@@ -52,6 +52,7 @@ MAGIC = b"GALVOJOB"
 GENERATOR = f"galvo-workstation {__version__}"
 
 _KIND_NAMES = ("line", "cubic")
+_WANT = {"line": 2, "cubic": 4}
 _STROKE_KINDS = ("contour", "hatch")
 
 
@@ -97,23 +98,22 @@ class Segments:
         pairs = list(pairs)
         if not pairs:
             return cls.empty()
-        kinds = []
-        parts = []
-        prev = None
-        for k, (kind, pts) in enumerate(pairs):
-            p = np.asarray(pts, dtype=np.float64)
-            want = {"line": 2, "cubic": 4}.get(kind)
+        kinds = [k for k, _ in pairs]
+        arrs = [np.asarray(p, dtype=np.float64) for _, p in pairs]
+        for k, (kind, p) in enumerate(zip(kinds, arrs, strict=True)):
+            want = _WANT.get(kind)
             if want is None or p.shape != (want, 2):
                 raise ValueError(f"segment {k} is not a line (2 points) or cubic (4 points)")
-            if prev is None:
-                parts.append(p[:1])
-            elif not np.array_equal(p[0], prev):
-                raise ValueError(f"segment {k} does not start where segment {k - 1} ended")
-            kinds.append(want == 4)
-            parts.append(p[1:])
-            prev = p[-1]
-        return cls(_read_only(np.array(kinds, dtype=bool)),
-                   _read_only(np.concatenate(parts)))
+        flat = np.concatenate(arrs)
+        cnt = np.array([len(p) for p in arrs])
+        start = np.cumsum(cnt) - cnt
+        bad = np.flatnonzero((flat[start[1:]] != flat[start[1:] - 1]).any(axis=1))
+        if len(bad):
+            k = int(bad[0]) + 1
+            raise ValueError(f"segment {k} does not start where segment {k - 1} ended")
+        keep = np.ones(len(flat), dtype=bool)
+        keep[start[1:]] = False
+        return cls(_read_only(cnt == 4), _read_only(flat[keep]))
 
     @property
     def offsets(self) -> np.ndarray:
@@ -522,9 +522,6 @@ def job_from_json(doc: Any, name: str = "<job>") -> Job:
                               bool(_req(s, "closed", where, name)), marks, segs,
                               int(s.get("pen", 1))))
     return _finish(doc, fm, strokes)
-
-
-_WANT = {"line": 2, "cubic": 4}
 
 
 def _segments_v1(segs_in: Any, where: str, name: str) -> Segments:
