@@ -230,3 +230,31 @@ def test_fitted_path_arrays_and_segment_objects_agree():
                                  Segment("line", np.array([[2.0, 0], [3, 0]]), 1, 2)))
     with pytest.raises(AttributeError):
         fp.closed = False  # type: ignore[misc]
+
+
+def test_a_run_and_both_writers_build_no_object_per_segment(tmp_path):
+    """Arrays end to end: processing, ordering (reversing and rotating closed strokes) and
+    writing a job never build a Segment object or a (kind, points) pair per segment."""
+    import galvo_core.job as jobmod
+
+    d = read_file(SAMPLES / "seal.plt")
+    p = Pipeline()
+    calls = {"pairs": 0}
+    real_iter = jobmod.Segments.__iter__
+
+    def counting_iter(self):  # type: ignore[no-untyped-def]
+        calls["pairs"] += 1
+        return real_iter(self)
+
+    jobmod.Segments.__iter__ = counting_iter  # type: ignore[method-assign]
+    try:
+        job = p.run(d, Params(fit_field=True, e_per=0.75, scan_order="greedy", fill="zigzag",
+                              hatch_spacing_mm=0.5))
+        write_job(job, tmp_path / "a.gjob")
+        write_job(job, tmp_path / "a.json")
+    finally:
+        jobmod.Segments.__iter__ = real_iter  # type: ignore[method-assign]
+    assert calls["pairs"] == 0
+    fitted = p.fitted(d, Params(fit_field=True, e_per=0.75))
+    assert all(fp._segments is None for fp in fitted)  # no Segment objects were built
+    assert sum(len(s.segments) for s in job.strokes) == sum(fp.n_segments for fp in fitted)
