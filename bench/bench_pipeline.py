@@ -270,9 +270,20 @@ def main(argv: list[str] | None = None) -> int:
                     help="only write the section from a results.json of an earlier run")
     ap.add_argument("--stage-worker", nargs=2, metavar=("SRC", "OUT"))
     ap.add_argument("--fill-on", action="store_true")
+    ap.add_argument("--io-worker", nargs=2, type=int, metavar=("MARKS", "RUNS"))
+    ap.add_argument("--gen-worker", nargs=2, metavar=("KIND", "N"))
     a = ap.parse_args(argv)
     if a.stage_worker:
         worker(a.stage_worker[0], a.stage_worker[1], a.fill_on)
+        return 0
+    if a.io_worker:
+        OUT.mkdir(parents=True, exist_ok=True)
+        print(json.dumps(io_bench(a.io_worker[0], a.io_worker[1])))
+        return 0
+    if a.gen_worker:
+        OUT.mkdir(parents=True, exist_ok=True)
+        n = int(a.gen_worker[1])
+        print(generated(n) if a.gen_worker[0] == "generated" else real(n))
         return 0
     if a.from_json:
         saved = json.loads(Path(a.from_json).read_text())
@@ -285,16 +296,23 @@ def main(argv: list[str] | None = None) -> int:
             replace_section("## Pipeline throughput (issue 21)", text)
         return 0
     OUT.mkdir(parents=True, exist_ok=True)
-    io = io_bench(a.io_marks, a.runs) if a.io_marks else None
+    # every measurement in a fresh child of this small process: a child's peak RSS
+    # (ru_maxrss) starts from its parent's at the fork, so the parent stays small
+    io = None
+    if a.io_marks:
+        r = _child([PY, str(Path(__file__).resolve()), "--io-worker", str(a.io_marks),
+                    str(a.runs)])
+        io = json.loads(r["stdout"])  # type: ignore[arg-type]
     if io:
         print("job file I/O:", json.dumps(io), flush=True)
     results = []
-    for kind in a.kinds:
-        for fill in a.fill:
+    for fill in a.fill:  # fill off first: the long fill runs last
+        for kind in a.kinds:
             for n in a.sizes:
                 if fill == "on" and n > a.fill_max:
                     continue
-                src = generated(n) if kind == "generated" else real(n)
+                src = Path(_child([PY, str(Path(__file__).resolve()), "--gen-worker", kind,
+                                   str(n)])["stdout"].strip())  # type: ignore[union-attr]
                 runs = a.runs if n <= 100_000 else 1
                 on = fill == "on"
                 e2e = [cli_run(src, OUT / "job.gjob", on) for _ in range(runs)]
