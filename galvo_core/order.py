@@ -36,6 +36,7 @@ import time
 from collections import deque
 from collections.abc import Sequence
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 import shapely
@@ -882,8 +883,7 @@ def _joint_indices(marks: np.ndarray, segments: Sequence[tuple[str, np.ndarray]]
     """Mark indices where a fitted segment starts (where a closed stroke may be cut)."""
     if not segments:
         return None
-    starts = np.array([np.asarray(p)[0] for _, p in segments], dtype=np.float64)
-    sb = fm.to_bits(starts)  # type: ignore[attr-defined]
+    sb = fm.to_bits(_segment_starts(segments))  # type: ignore[attr-defined]
     ring = marks[:-1] if len(marks) > 1 and np.array_equal(marks[0], marks[-1]) else marks
     out = []
     j = 0
@@ -894,6 +894,13 @@ def _joint_indices(marks: np.ndarray, segments: Sequence[tuple[str, np.ndarray]]
         j += int(hit[0])
         out.append(j)
     return np.array(out, dtype=np.int64) if out else np.array([0], dtype=np.int64)
+
+
+def _segment_starts(segs: Any) -> np.ndarray:
+    """(S, 2) start point of every segment: from a job.Segments' arrays, or from pairs."""
+    if hasattr(segs, "offsets"):
+        return np.asarray(segs.points, dtype=np.float64)[segs.offsets]
+    return np.array([np.asarray(p)[0] for _, p in segs], dtype=np.float64)
 
 
 def _reverse_segments(segs: Sequence[tuple[str, np.ndarray]]) -> tuple[
@@ -910,18 +917,21 @@ def apply_to_strokes(strokes: Sequence[object], placements: Sequence[Placement],
     for pl in placements:
         s = strokes[pl.index]
         marks = s.marks  # type: ignore[attr-defined]
-        segs = tuple(s.segments)  # type: ignore[attr-defined]
+        segs = s.segments  # type: ignore[attr-defined]
+        arrays = hasattr(segs, "rotated")  # job.Segments: turned without per-segment objects
+        if not arrays:
+            segs = tuple(segs)
         if pl.rotate and s.closed:  # type: ignore[attr-defined]
             marks = apply_placement(marks, True, Placement(pl.index, False, pl.rotate))
-            if segs:
-                sb = fm.to_bits(np.array([np.asarray(p)[0] for _, p in segs]))  # type: ignore
+            if len(segs):
+                sb = fm.to_bits(_segment_starts(segs))  # type: ignore[attr-defined]
                 hit = np.flatnonzero((sb == marks[0]).all(axis=1))
                 if len(hit):
                     t = int(hit[0])
-                    segs = segs[t:] + segs[:t]
+                    segs = segs.rotated(t) if arrays else segs[t:] + segs[:t]
         if pl.reverse:
             marks = marks[::-1].copy()
-            segs = _reverse_segments(segs)
+            segs = segs.reversed() if arrays else _reverse_segments(segs)
         out.append(replace(s, marks=marks, segments=segs))  # type: ignore[type-var]
     return out
 
