@@ -10,10 +10,12 @@ request the window sends: pipeline run + display geometry (:mod:`galvo_core.prev
 
 from __future__ import annotations
 
+import os
 import threading
 import time
 from collections.abc import Callable
 from dataclasses import dataclass
+from pathlib import Path as FsPath
 from typing import Any
 
 from PySide6.QtCore import QCoreApplication, QElapsedTimer, QObject, QThread, Signal
@@ -43,11 +45,18 @@ class RunResult:
     generation: int = 0
     #: a ParamError of the run (e.g. the drawing leaves the field): only the original shows
     error: str | None = None
+    #: the file the drawing came from / the job file shown (the title and export name)
+    path: FsPath | None = None
+    job_path: FsPath | None = None
+    #: the layers whose geometry the preview holds (the others are empty until shown)
+    layers: frozenset[str] | None = None
 
 
 def pipeline_task(pipeline: Pipeline, cache: PreviewCache, drawing: Drawing,
-                  params: Params) -> Task:
-    """The work of one request: run the (cached) pipeline, then the display geometry."""
+                  params: Params, path: FsPath | None = None,
+                  layers: frozenset[str] | None = None) -> Task:
+    """The work of one request: run the (cached) pipeline, then the display geometry of
+    ``layers`` (all when None)."""
 
     def task(cancel: Callable[[], bool]) -> RunResult:
         t0 = time.perf_counter()
@@ -56,18 +65,20 @@ def pipeline_task(pipeline: Pipeline, cache: PreviewCache, drawing: Drawing,
         fitted = pipeline.fitted(drawing, params, cancel)  # cached by the run
         if cancel():
             raise Cancelled()
-        preview = build_preview(job, drawing, fitted, cache=cache, cancel=cancel)
-        return RunResult(drawing, params, job, fitted, preview, time.perf_counter() - t0, stages)
+        preview = build_preview(job, drawing, fitted, cache=cache, cancel=cancel, layers=layers)
+        return RunResult(drawing, params, job, fitted, preview, time.perf_counter() - t0, stages,
+                         path=path, layers=layers)
 
     return task
 
 
 def pipeline_task_safe(pipeline: Pipeline, cache: PreviewCache, drawing: Drawing,
-                       params: Params) -> Task:
+                       params: Params, path: FsPath | None = None,
+                       layers: frozenset[str] | None = None) -> Task:
     """Like :func:`pipeline_task`, but a ParamError of the run (a drawing that leaves the
     field, …) gives a result with ``error`` set that still shows the original drawing and the
     field (so the operator sees why), instead of failing."""
-    inner = pipeline_task(pipeline, cache, drawing, params)
+    inner = pipeline_task(pipeline, cache, drawing, params, path, layers)
 
     def task(cancel: Callable[[], bool]) -> RunResult:
         t0 = time.perf_counter()
@@ -77,20 +88,82 @@ def pipeline_task_safe(pipeline: Pipeline, cache: PreviewCache, drawing: Drawing
             fm = pipeline.field_map(drawing, params)
             job = Job(drawing.name, drawing.sha256, fm, params.processing_dict(),
                       params.laser.as_dict(), (), {}, tuple(drawing.warnings))
-            preview = build_preview(job, drawing, None, cache=cache, cancel=cancel)
+            preview = build_preview(job, drawing, None, cache=cache, cancel=cancel,
+                                    layers=layers)
             return RunResult(drawing, params, job, None, preview, time.perf_counter() - t0,
-                             tuple(pipeline.last_info.stages_run), error=str(exc))
+                             tuple(pipeline.last_info.stages_run), error=str(exc), path=path,
+                             layers=layers)
 
     return task
 
 
-def job_task(job: Job, drawing: Drawing | None, cache: PreviewCache) -> Task:
+def job_task(job: Job, drawing: Drawing | None, cache: PreviewCache,
+             job_path: FsPath | None = None) -> Task:
     """The work of showing a loaded job file (no pipeline run)."""
 
     def task(cancel: Callable[[], bool]) -> RunResult:
         t0 = time.perf_counter()
         preview = build_preview(job, drawing, None, cache=cache, cancel=cancel)
-        return RunResult(drawing, None, job, None, preview, time.perf_counter() - t0, ())
+        return RunResult(drawing, None, job, None, preview, time.perf_counter() - t0, (),
+                         job_path=job_path)
+
+    return task
+
+
+@dataclass(frozen=True, eq=False)
+class Loaded:
+    """A file read on the worker: the drawing and the facts the GUI needs at once (so the
+    GUI thread never walks its points)."""
+
+    path: FsPath
+    drawing: Drawing
+    bbox: tuple[float, float, float, float] | None
+    size_mm: tuple[float, float]
+
+
+def load_task(path: FsPath, read: Callable[[FsPath], Drawing],
+              pipeline: Pipeline | None = None) -> Task:
+    """Read an HP-GL file on the worker (cancel drops the result: the reader itself runs to
+    its end)."""
+
+    def task(cancel: Callable[[], bool]) -> Loaded:
+        drawing = read(path)
+        if cancel():
+            raise Cancelled()
+        bb = pipeline.bbox(drawing) if pipeline is not None else drawing.bbox()
+        return Loaded(path, drawing, bb, drawing.size_mm())
+
+    return task
+
+
+@dataclass(frozen=True, eq=False)
+class LoadedJob:
+    path: FsPath
+    job: Job
+    source: Drawing | None
+    bbox: tuple[float, float, float, float] | None
+
+
+def job_load_task(path: FsPath, read_job: Callable[[FsPath], Job],
+                  find_source: Callable[[FsPath, Job], Drawing | None]) -> Task:
+    """Read a job file (and its source drawing when it sits beside it) on the worker."""
+
+    def task(cancel: Callable[[], bool]) -> LoadedJob:
+        job = read_job(path)
+        if cancel():
+            raise Cancelled()
+        source = find_source(path, job)
+        return LoadedJob(path, job, source, source.bbox() if source is not None else None)
+
+    return task
+
+
+def export_task(write: Callable[[Job, FsPath], None], job: Job, path: FsPath) -> Task:
+    """Write ``job`` to ``path`` on the worker (atomic writers: a failure leaves nothing)."""
+
+    def task(cancel: Callable[[], bool]) -> FsPath:
+        write(job, path)
+        return path
 
     return task
 

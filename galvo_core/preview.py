@@ -27,11 +27,12 @@ from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
+from numba import njit
 
 from galvo_core.drawing import Drawing, Warning
 from galvo_core.field import FieldMap
 from galvo_core.fit import FittedPath
-from galvo_core.geometry import cubic_eval, flatten_cubic, point_polyline_distance
+from galvo_core.geometry import flatten_cubic
 from galvo_core.job import Job
 from galvo_core.pipeline import Cancelled
 
@@ -64,6 +65,9 @@ __all__ = [
     "units_to_mm",
     "warning_path",
 ]
+
+#: Layers whose geometry is computed only when shown (``build_preview(layers=...)``).
+OPTIONAL_LAYERS = frozenset({"control", "deviation"})
 
 #: An empty (0, 2) point array.
 EMPTY = np.empty((0, 2), dtype=np.float64)
@@ -244,6 +248,72 @@ def _piece_indices(first: int, last: int, n: int, closed: bool) -> np.ndarray:
     return idx[(idx >= 0) & (idx < n)]
 
 
+@njit(cache=True, nogil=True)
+def _deviation_kernel(src: np.ndarray, closed: bool, ctrl: np.ndarray, first: np.ndarray,
+                      last: np.ndarray, ks: np.ndarray, starts: np.ndarray, a_out: np.ndarray,
+                      b_out: np.ndarray, e_out: np.ndarray) -> None:  # pragma: no cover - jit
+    """One path's segments: ``ks[j]`` samples of segment ``j`` (Bernstein form, uniform
+    parameters), each sample's distance to the source points ``first .. last`` (indices
+    modulo ``n`` when ``closed``); chords ``starts[j] ..`` of the outputs."""
+    n = src.shape[0]
+    for j in range(ctrl.shape[0]):
+        k = ks[j]
+        if k == 0:
+            continue
+        p0x, p0y = ctrl[j, 0, 0], ctrl[j, 0, 1]
+        p1x, p1y = ctrl[j, 1, 0], ctrl[j, 1, 1]
+        p2x, p2y = ctrl[j, 2, 0], ctrl[j, 2, 1]
+        p3x, p3y = ctrl[j, 3, 0], ctrl[j, 3, 1]
+        lo = first[j]
+        hi = last[j]
+        if not closed:
+            lo = max(lo, 0)
+            hi = min(hi, n - 1)
+        prev_x = 0.0
+        prev_y = 0.0
+        prev_e = 0.0
+        for i in range(k):
+            t = i / (k - 1)
+            u = 1.0 - t
+            x = u * u * u * p0x + 3.0 * u * u * t * p1x + 3.0 * u * t * t * p2x + t * t * t * p3x
+            y = u * u * u * p0y + 3.0 * u * u * t * p1y + 3.0 * u * t * t * p2y + t * t * t * p3y
+            best = np.inf
+            qx = src[lo % n, 0]
+            qy = src[lo % n, 1]
+            if hi == lo:
+                best = (x - qx) ** 2 + (y - qy) ** 2
+            for m in range(lo + 1, hi + 1):
+                rx = src[m % n, 0]
+                ry = src[m % n, 1]
+                vx = rx - qx
+                vy = ry - qy
+                den = vx * vx + vy * vy
+                dx = x - qx
+                dy = y - qy
+                s = 0.0
+                if den > 0.0:
+                    s = (dx * vx + dy * vy) / den
+                    s = min(max(s, 0.0), 1.0)
+                ex = dx - s * vx
+                ey = dy - s * vy
+                d = ex * ex + ey * ey
+                if d < best:
+                    best = d
+                qx = rx
+                qy = ry
+            e = np.sqrt(best)
+            if i > 0:
+                r = starts[j] + i - 1
+                a_out[r, 0] = prev_x
+                a_out[r, 1] = prev_y
+                b_out[r, 0] = x
+                b_out[r, 1] = y
+                e_out[r] = max(prev_e, e)
+            prev_x = x
+            prev_y = y
+            prev_e = e
+
+
 def deviation_samples(
     drawing: Drawing,
     fitted: Sequence[FittedPath],
@@ -260,35 +330,54 @@ def deviation_samples(
     path). Returns ``(a, b, err)``: the sample chords as start points ``a`` (K, 2) and end
     points ``b`` (K, 2) in input units, and ``err`` (K,) the larger error of the chord's two
     ends, in input units. Segments whose source points are unknown are skipped.
+
+    Compiled (numba): a loop over samples and the source points each segment replaces, so
+    the work is about ``max_samples`` × the input points at most, with no Python per segment.
     """
-    a_out: list[np.ndarray] = []
-    b_out: list[np.ndarray] = []
-    e_out: list[np.ndarray] = []
+    jobs: list[tuple[np.ndarray, bool, np.ndarray, np.ndarray, np.ndarray, np.ndarray]] = []
+    total = 0
     for j, fp in enumerate(fitted):
-        if cancel is not None and j % 32 == 0 and cancel():
+        if cancel is not None and j % 64 == 0 and cancel():
             raise Cancelled()
-        if not 0 <= fp.source_index < len(drawing.paths):
+        if not 0 <= fp.source_index < len(drawing.paths) or not fp.segments:
             continue
-        src = drawing.paths[fp.source_index].points
+        src = np.ascontiguousarray(drawing.paths[fp.source_index].points, dtype=np.float64)
         n = len(src)
-        for s in fp.segments:
-            idx = _piece_indices(s.first, s.last, n, fp.closed)
-            if not len(idx):
-                continue
-            piece = src[idx]
-            k = int(np.clip(2 * len(piece), min_samples, max_samples))
-            t = np.linspace(0.0, 1.0, k)
-            if s.kind == "cubic":
-                pts = cubic_eval(s.points, t)
-            else:
-                pts = s.points[0] + t[:, None] * (s.points[-1] - s.points[0])
-            err = point_polyline_distance(pts, piece)
-            a_out.append(pts[:-1])
-            b_out.append(pts[1:])
-            e_out.append(np.maximum(err[:-1], err[1:]))
-    if not a_out:
+        if not n:
+            continue
+        segs = fp.segments
+        first = np.fromiter((sg.first for sg in segs), dtype=np.int64, count=len(segs))
+        last = np.fromiter((sg.last for sg in segs), dtype=np.int64, count=len(segs))
+        ctrl = np.empty((len(segs), 4, 2))
+        for i, sg in enumerate(segs):
+            pts = sg.points
+            if len(pts) == 4:
+                ctrl[i] = pts
+            else:  # a line as a cubic with its inner points at thirds: B(t) = P0 + t (P3 - P0)
+                d = pts[-1] - pts[0]
+                ctrl[i, 0], ctrl[i, 3] = pts[0], pts[-1]
+                ctrl[i, 1], ctrl[i, 2] = pts[0] + d / 3.0, pts[0] + 2.0 * d / 3.0
+        if fp.closed:
+            count = np.maximum(last - first + 1, 0)
+        else:
+            count = np.maximum(np.minimum(last, n - 1) - np.maximum(first, 0) + 1, 0)
+        ks = np.where(count > 0, np.clip(2 * count, min_samples, max_samples), 0)
+        jobs.append((src, bool(fp.closed), ctrl, first, last, ks))
+        total += int(np.maximum(ks - 1, 0).sum())
+    if not total:
         return EMPTY, EMPTY, np.empty(0)
-    return np.concatenate(a_out), np.concatenate(b_out), np.concatenate(e_out)
+    a = np.empty((total, 2))
+    b = np.empty((total, 2))
+    e = np.empty(total)
+    row = 0
+    for j, (src, closed, ctrl, first, last, ks) in enumerate(jobs):
+        if cancel is not None and j % 64 == 0 and cancel():
+            raise Cancelled()
+        chords = np.maximum(ks - 1, 0)
+        starts = row + np.concatenate(([0], np.cumsum(chords)[:-1]))
+        _deviation_kernel(src, closed, ctrl, first, last, ks, starts, a, b, e)
+        row += int(chords.sum())
+    return a, b, e
 
 
 # ------------------------------------------------------------------ job geometry
@@ -444,6 +533,12 @@ class Preview:
     tolerance_units: float
     #: bounding box (mm) of everything drawn, None when nothing is
     bounds: tuple[float, float, float, float] | None
+    #: the optional layers computed ("control", "deviation"); None: all of them
+    layers: frozenset[str] | None = None
+
+    def has_layer(self, key: str) -> bool:
+        """True when this preview holds the geometry of layer ``key`` (computed)."""
+        return self.layers is None or key not in OPTIONAL_LAYERS or key in self.layers
 
     @property
     def um_per_unit(self) -> float:
@@ -576,8 +671,13 @@ def build_preview(
     *,
     cache: PreviewCache | None = None,
     cancel: Callable[[], bool] | None = None,
+    layers: Iterable[str] | None = None,
 ) -> Preview:
     """All display geometry of a run (or of a loaded job file: no drawing, no fit).
+
+    ``layers`` (keys of the GUI's layers; None: all) limits the costly optional layers to
+    those shown: the control points (``"control"``) and the deviation overlay
+    (``"deviation"``) are left empty when not asked for. ``Preview.layers`` says which were.
 
     Without ``fitted`` the fitted-curve layer is taken from the job's contour strokes' stored
     segments (no control points, no deviation). The kerf layer shows the job's contour-stroke
@@ -604,23 +704,38 @@ def build_preview(
     else:
         original, o_pts, o_ids, o_box = Polylines(), EMPTY, _NO_IDS, None
 
+    want = None if layers is None else frozenset(layers)
+
+    def shown(key: str) -> bool:
+        return want is None or key in want
+
     if fitted is not None:
         fit_tuple = fitted
+        key = (id(fit_tuple), id(drawing), round(tol_units, 12))
 
-        def make_fit() -> tuple[Any, ...]:
+        def make_curve() -> tuple[Any, ...]:
             curve = fitted_curve(fit_tuple, tol_units)
-            c_xy, c_role = control_layer(fit_tuple)
-            if drawing is not None:
-                da, db, de = deviation_samples(drawing, fit_tuple, cancel=cancel)
-            else:
-                da, db, de = EMPTY, EMPTY, np.empty(0)
-            return fit_tuple, drawing, curve, bbox(curve.xy), c_xy, c_role, da, db, de
+            return fit_tuple, drawing, curve, bbox(curve.xy)
 
-        (_, _, curve, c_box, c_xy, c_role, dev_a, dev_b, dev_e) = cache.get(
-            ("fit", id(fit_tuple), id(drawing), round(tol_units, 12)), make_fit)
-        (_, dev_level) = cache.get(
-            ("level", id(dev_e), e_tol),
-            lambda: (dev_e, np.clip(dev_e / e_tol, 0.0, 1.0) if e_tol > 0 else dev_e * 0.0))
+        _, _, curve, c_box = cache.get(("curve", *key), make_curve)
+        if shown("control"):
+            _, c_xy, c_role = cache.get(("control", id(fit_tuple)),
+                                        lambda: (fit_tuple, *control_layer(fit_tuple)))
+        else:
+            c_xy, c_role = EMPTY, np.empty(0, dtype=np.int8)
+        if shown("deviation") and drawing is not None:
+            def make_dev() -> tuple[Any, ...]:
+                return (fit_tuple, drawing,
+                        *deviation_samples(drawing, fit_tuple, cancel=cancel))
+
+            _, _, dev_a, dev_b, dev_e = cache.get(("deviation", id(fit_tuple), id(drawing)),
+                                                  make_dev)
+            (_, dev_level) = cache.get(
+                ("level", id(dev_e), e_tol),
+                lambda: (dev_e, np.clip(dev_e / e_tol, 0.0, 1.0) if e_tol > 0
+                         else dev_e * 0.0))
+        else:
+            dev_a, dev_b, dev_e, dev_level = EMPTY, EMPTY, np.empty(0), np.empty(0)
     else:
         curve = stroke_curves(job, tol_units)
         c_box = bbox(curve.xy)
@@ -660,6 +775,7 @@ def build_preview(
         deviation_level=dev_level,
         tolerance_units=e_tol,
         bounds=bounds,
+        layers=None if want is None else frozenset(want & OPTIONAL_LAYERS),
     )
 
 
