@@ -638,6 +638,15 @@ class WorkView(pg.PlotWidget):
     def data_items(self) -> list[pg.GraphicsObject]:
         return [self.layers[k] for k in self.layers]
 
+    #: opacity of the layers while the view shows an out-of-date result
+    STALE_OPACITY = 0.3
+
+    def set_stale(self, stale: bool) -> None:
+        """Dim every layer (the result shown is out of date) or show it normally."""
+        self.stale = stale
+        for item in self.data_items():
+            item.setOpacity(self.STALE_OPACITY if stale else 1.0)
+
     # --- range ---------------------------------------------------------------------------
     def legend_height(self) -> float:
         """Pixels the legend strip covers at the top of the plot (0 when hidden)."""

@@ -10,7 +10,6 @@ request the window sends: pipeline run + display geometry (:mod:`galvo_core.prev
 
 from __future__ import annotations
 
-import os
 import threading
 import time
 from collections.abc import Callable

@@ -421,12 +421,12 @@ def test_refused_and_empty_files(qtbot, tmp_path, dialogs, circle):
     empty = tmp_path / "empty.plt"
     empty.write_bytes(b"")
     for f in (bad, empty):
-        assert win.load_file(f) is False
+        assert win.load_file(f, wait=True) is False
         assert win.drawing is kept
     assert len(dialogs) == 2 and "empty" in dialogs[1].informativeText()
     no_geometry = tmp_path / "nothing.plt"
     no_geometry.write_bytes(b"IN;SP1;PU;")
-    assert win.load_file(no_geometry) is True
+    assert win.load_file(no_geometry, wait=True) is True
     assert win.wait_for_result(30)
     assert win.processed.counts["marks"] == 0
     assert any("no pen-down" in t for t in win.warnings_panel.texts())
@@ -436,7 +436,7 @@ def test_export_job_png_and_load_the_job_back(qtbot, tmp_path, dialogs):
     src = tmp_path / "circle.plt"
     src.write_bytes(circle_plt())
     win = make_window(qtbot)
-    assert win.load_file(src) and win.wait_for_result(60)
+    assert win.load_file(src, wait=True) and win.wait_for_result(60)
     job_path = tmp_path / "circle.json"
     assert win.export("job", job_path)
     job = load_job(job_path)
@@ -451,13 +451,13 @@ def test_export_job_png_and_load_the_job_back(qtbot, tmp_path, dialogs):
     assert [p.name for p in tmp_path.iterdir() if p.name.startswith(".tmp")] == []
     # the job file back: its marks, and the source found beside it
     n_marks = win.processed.counts["marks"]
-    assert win.load_file(job_path) and win.wait_for_result(30)
+    assert win.load_file(job_path, wait=True) and win.wait_for_result(30)
     assert win.job_path == job_path and win.banner.isVisible()
     assert win.processed.counts["marks"] == n_marks
     assert win.original.counts["original"] > 0
     assert not win.controls.isEnabled()
     src.unlink()  # without the source: the original view is empty
-    assert win.load_job_file(job_path) and win.wait_for_result(30)
+    assert win.load_job_file(job_path, wait=True) and win.wait_for_result(30)
     assert win.original.counts["original"] == 0 and win.processed.counts["marks"] == n_marks
     assert "job" in win.windowTitle() or "circle.json" in win.windowTitle()
 
@@ -483,7 +483,7 @@ def test_reload_when_the_file_changes_on_disk(qtbot, tmp_path):
     f = tmp_path / "live.plt"
     f.write_bytes(b"IN;SP1;PU0,0;PD1000,0,1000,1000;PU;")
     win = make_window(qtbot)
-    assert win.load_file(f) and win.wait_for_result(30)
+    assert win.load_file(f, wait=True) and win.wait_for_result(30)
     assert win.original.counts["original"] == 3
     f.write_bytes(b"IN;SP1;PU0,0;PD1000,0,1000,1000,0,1000,0,0;PU;")
     qtbot.waitUntil(lambda: win.drawing is not None and win.drawing.n_points == 5,
@@ -501,7 +501,7 @@ def test_settings_and_recent_files_persist(qtbot, tmp_path):
     win = MainWindow(settings=QSettings(str(ini), QSettings.Format.IniFormat))
     qtbot.addWidget(win)
     win.show()
-    assert win.load_file(f) and win.wait_for_result(30)
+    assert win.load_file(f, wait=True) and win.wait_for_result(30)
     win.apply_changes({"e_per": 0.123})
     win.layer_boxes["jumps"].setChecked(False)
     win.close()
