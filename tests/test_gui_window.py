@@ -310,7 +310,7 @@ def test_unexpected_exception_becomes_dialog(qtbot, monkeypatch, dialogs, tmp_pa
 def test_unreadable_file_shows_dialog(qtbot, dialogs, tmp_path):
     win = shown(qtbot, MainWindow(square_drawing("keep.plt")))
     kept = win.drawing
-    win.load_file(tmp_path / "does_not_exist.plt", wait=True)  # InputError or OSError from the importer
+    win.load_file(tmp_path / "does_not_exist.plt", wait=True)  # InputError or OSError
     assert len(dialogs) == 1
     assert "does_not_exist.plt" in dialogs[0].informativeText()
     assert win.drawing is kept
