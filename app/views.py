@@ -149,27 +149,38 @@ class DeviationItem(pg.GraphicsObject):
             self._pens.append(pen)
         self.n_chords = 0
 
-    def setData(self, a: np.ndarray, b: np.ndarray, level: np.ndarray) -> None:  # noqa: N802
-        self.prepareGeometryChange()
-        self._paths = []
-        self.n_chords = len(level)
+    @staticmethod
+    def prepare(a: np.ndarray, b: np.ndarray, level: np.ndarray) -> tuple:
+        """The paths per colour bin and the rectangle (any thread: no item touched)."""
         if not len(level):
-            self._rect = QRectF()
-            self.update()
-            return
+            return [], QRectF(), 0
         bins = np.minimum((level * DEVIATION_BINS).astype(np.int64), DEVIATION_BINS - 1)
-        for k in np.unique(bins):
-            sel = bins == k
-            n = int(sel.sum())
+        order = np.argsort(bins, kind="stable")
+        sb = bins[order]
+        cuts = np.flatnonzero(np.diff(sb)) + 1
+        paths = []
+        for idx in np.split(order, cuts):
+            k = int(bins[idx[0]])
+            n = len(idx)
             x = np.empty(2 * n)
             y = np.empty(2 * n)
-            x[0::2], x[1::2] = a[sel, 0], b[sel, 0]
-            y[0::2], y[1::2] = a[sel, 1], b[sel, 1]
-            self._paths.append((self._pens[int(k)], pg.arrayToQPath(x, y, connect="pairs")))
+            x[0::2], x[1::2] = a[idx, 0], b[idx, 0]
+            y[0::2], y[1::2] = a[idx, 1], b[idx, 1]
+            paths.append((k, pg.arrayToQPath(x, y, connect="pairs")))
         lo = np.minimum(a.min(axis=0), b.min(axis=0))
         hi = np.maximum(a.max(axis=0), b.max(axis=0))
-        self._rect = QRectF(QPointF(lo[0], lo[1]), QPointF(hi[0], hi[1]))
+        return paths, QRectF(QPointF(lo[0], lo[1]), QPointF(hi[0], hi[1])), len(level)
+
+    def setPrepared(self, prepared: tuple) -> None:  # noqa: N802
+        paths, rect, n = prepared
+        self.prepareGeometryChange()
+        self._paths = [(self._pens[k], path) for k, path in paths]
+        self._rect = rect
+        self.n_chords = n
         self.update()
+
+    def setData(self, a: np.ndarray, b: np.ndarray, level: np.ndarray) -> None:  # noqa: N802
+        self.setPrepared(self.prepare(a, b, level))
 
     def boundingRect(self) -> QRectF:  # noqa: N802 - Qt API
         return self._rect
@@ -321,15 +332,21 @@ class PointsItem(_FastItem):
         self._xy = np.empty((0, 2))
         self._poly = _polygon(self._xy)
 
-    def setData(self, xy: np.ndarray) -> None:  # noqa: N802 - like pyqtgraph
+    @staticmethod
+    def prepare(xy: np.ndarray) -> tuple:
+        """Finite points, their polygon (small sets) and rectangle (any thread)."""
         xy = np.asarray(xy, dtype=np.float64).reshape(-1, 2)
         if not np.isfinite(xy).all():
             xy = xy[np.isfinite(xy).all(axis=1)]
+        return xy, _small_polygon(xy), _finite_rect(xy)
+
+    def setPrepared(self, prepared: tuple) -> None:  # noqa: N802
         self.prepareGeometryChange()
-        self._xy = xy
-        self._poly = _small_polygon(xy)
-        self._rect = _finite_rect(xy)
+        self._xy, self._poly, self._rect = prepared
         self.update()
+
+    def setData(self, xy: np.ndarray) -> None:  # noqa: N802 - like pyqtgraph
+        self.setPrepared(self.prepare(xy))
 
     def getData(self) -> tuple[np.ndarray, np.ndarray]:  # noqa: N802 - like pyqtgraph
         return self._xy[:, 0], self._xy[:, 1]
@@ -359,23 +376,28 @@ class ControlItem(_FastItem):
         self._xy = np.empty((0, 2))
         self._role = np.empty(0, dtype=np.int8)
 
-    def setData(self, xy: np.ndarray, role: np.ndarray) -> None:  # noqa: N802
-        self.prepareGeometryChange()
-        self._xy = xy = np.asarray(xy, dtype=np.float64).reshape(-1, 2)
-        self._role = role = np.asarray(role)
+    @staticmethod
+    def prepare(xy: np.ndarray, role: np.ndarray) -> tuple:
+        """Handle lines as a path, anchors, knots and the rectangle (any thread)."""
+        xy = np.asarray(xy, dtype=np.float64).reshape(-1, 2)
+        role = np.asarray(role)
         handles = role[: len(xy)] != 1
         hx = xy.copy()
         hx[~handles] = np.nan
-        if len(xy):
-            self._lines = pg.arrayToQPath(hx[:, 0], hx[:, 1], connect="finite")
-        else:
-            self._lines = QPainterPath()
-        self._xy_anchors = xy[role == 1]
-        self._xy_knots = xy[role == 2]
-        self._anchors = _small_polygon(self._xy_anchors)
-        self._knots = _small_polygon(self._xy_knots)
-        self._rect = _finite_rect(xy[role >= 0])
+        lines = pg.arrayToQPath(hx[:, 0], hx[:, 1], connect="finite") if len(xy) \
+            else QPainterPath()
+        anchors, knots = xy[role == 1], xy[role == 2]
+        return (xy, role, lines, anchors, knots, _small_polygon(anchors), _small_polygon(knots),
+                _finite_rect(xy[role >= 0]))
+
+    def setPrepared(self, prepared: tuple) -> None:  # noqa: N802
+        self.prepareGeometryChange()
+        (self._xy, self._role, self._lines, self._xy_anchors, self._xy_knots, self._anchors,
+         self._knots, self._rect) = prepared
         self.update()
+
+    def setData(self, xy: np.ndarray, role: np.ndarray) -> None:  # noqa: N802
+        self.setPrepared(self.prepare(xy, role))
 
     def getData(self) -> tuple[np.ndarray, np.ndarray]:  # noqa: N802
         pts = self._xy[self._role > 0]
@@ -392,6 +414,59 @@ class ControlItem(_FastItem):
         draw_points(p, knots, self._knots, self.knot_pen, grid=3.0)
         draw_points(p, knots, self._knots, self.hole_pen, grid=3.0)
         draw_points(p, anchors, self._anchors, self.anchor_pen, grid=3.0)
+
+
+class LinesItem(_FastItem):
+    """NaN-separated polylines as ONE QPainterPath, built by :meth:`prepare` (on the worker
+    thread: building the path of a million vertices takes a quarter of a second, which the
+    GUI thread must not spend). Big layers are drawn with 1-pixel lines, no antialiasing."""
+
+    def __init__(self, pen: QPen) -> None:
+        super().__init__()
+        self.pen = QPen(pen)
+        self.thin_pen = QPen(pen)
+        self.thin_pen.setWidthF(1.0)
+        self._path = QPainterPath()
+        self._xy = np.empty((0, 2))
+        self._n = 0
+
+    @staticmethod
+    def prepare(xy: np.ndarray) -> tuple:
+        """(xy, path, rectangle, finite vertices) of NaN-separated polylines (any thread)."""
+        xy = np.asarray(xy, dtype=np.float64).reshape(-1, 2)
+        if not len(xy):
+            return xy, QPainterPath(), QRectF(), 0
+        finite = np.isfinite(xy).all(axis=1)
+        n = int(finite.sum())
+        if not n:
+            return xy, QPainterPath(), QRectF(), 0
+        path = pg.arrayToQPath(xy[:, 0], xy[:, 1], connect="finite")
+        return xy, path, _finite_rect(xy[finite]), n
+
+    def setPrepared(self, prepared: tuple) -> None:  # noqa: N802
+        self.prepareGeometryChange()
+        self._xy, self._path, self._rect, self._n = prepared
+        self.update()
+
+    def setData(self, xy: np.ndarray) -> None:  # noqa: N802 - like pyqtgraph
+        self.setPrepared(self.prepare(xy))
+
+    def getData(self) -> tuple[np.ndarray, np.ndarray]:  # noqa: N802 - like pyqtgraph
+        return self._xy[:, 0], self._xy[:, 1]
+
+    def paint(self, p, *args) -> None:
+        if not self._n:
+            return
+        small = self._n < MAX_ANTIALIAS_POINTS
+        p.setRenderHint(p.RenderHint.Antialiasing, small)
+        p.setPen(self.pen if small else self.thin_pen)
+        p.drawPath(self._path)
+
+
+def prepare_layer(key: str, *arrays: np.ndarray) -> tuple:
+    """What the item of layer ``key`` needs from ``arrays`` (QPainterPaths, rectangles):
+    safe to call on a worker thread, then handed to :meth:`WorkView.set_layer`."""
+    return _LAYER_CLASS[key].prepare(*arrays)
 
 
 class ColourBar(pg.GraphicsWidgetAnchor, pg.GraphicsWidget):
@@ -518,10 +593,11 @@ class WorkView(pg.PlotWidget):
 
     # --- data ----------------------------------------------------------------------------
     def set_layer(self, key: str, *arrays: np.ndarray, transform: QTransform,
-                  count: int | None = None, **extra) -> bool:
+                  count: int | None = None, prepared: tuple | None = None, **extra) -> bool:
         """Give a layer its data (native space) and the transform to mm. The data are only
-        re-sent when the first array is another object than last time. Returns True when
-        the data changed."""
+        re-sent when the first array is another object than last time. ``prepared``: the
+        item's data made by :func:`prepare_layer` on a worker (else made here). Returns True
+        when the data changed."""
         item = self.layers[key]
         if item.transform() != transform:  # an equal transform would still repaint
             item.setTransform(transform)
@@ -531,26 +607,11 @@ class WorkView(pg.PlotWidget):
         self._data_ids[key] = ident
         # keep the arrays alive so the id stays theirs
         item._galvo_data = arrays
+        item.setPrepared(prepared if prepared is not None else item.prepare(*arrays))
         if isinstance(item, DeviationItem):
-            item.setData(*arrays)
             self.counts[key] = item.n_chords
             return True
-        xy = arrays[0]
-        if isinstance(item, (PointsItem, ControlItem)):
-            item.setData(*arrays)
-        elif not len(xy):
-            item.setData([], [])
-        else:
-            big = len(xy) >= MAX_ANTIALIAS_POINTS
-            if not hasattr(item, "_galvo_pen"):
-                item._galvo_pen = item.opts["pen"]
-            # big layers: 1-pixel lines without antialiasing (a wide pen is stroked in
-            # software, many times slower); small ones keep their width
-            pen = QPen(item._galvo_pen)
-            if big:
-                pen.setWidthF(1.0)
-            item.setData(xy[:, 0], xy[:, 1], connect="finite", antialias=not big, pen=pen)
-        self.counts[key] = count if count is not None else len(xy)
+        self.counts[key] = count if count is not None else len(arrays[0])
         return True
 
     def set_highlight(self, xy: np.ndarray, transform: QTransform) -> None:
@@ -747,7 +808,7 @@ def _make_layer(key: str) -> tuple[pg.GraphicsObject, pg.PlotDataItem]:
     elif key == "control":
         item = ControlItem()
     else:
-        item = pg.PlotDataItem([], [], name=key, **kw)
+        item = LinesItem(kw["pen"])
     # samples get one point so that pyqtgraph hands their symbol style to the legend
     if key == "control":
         sample = pg.PlotDataItem([0.0], [0.0], pen=_pen(CONTROL, 1.0, alpha=170), symbol="s",
@@ -756,6 +817,13 @@ def _make_layer(key: str) -> tuple[pg.GraphicsObject, pg.PlotDataItem]:
     else:
         sample = pg.PlotDataItem([0.0], [0.0], **kw)
     return item, sample
+
+
+_LAYER_CLASS: dict[str, type] = {
+    "original": LinesItem, "fitted": LinesItem, "jumps": LinesItem, "hatch": LinesItem,
+    "kerf": LinesItem, "original_points": PointsItem, "marks": PointsItem,
+    "control": ControlItem, "deviation": DeviationItem,
+}
 
 
 def _painting_items(item: pg.GraphicsObject) -> list[pg.GraphicsObject]:

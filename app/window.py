@@ -73,10 +73,12 @@ from .worker import (
     LatestRunner,
     Loaded,
     LoadedJob,
+    PreparedCache,
     RunResult,
     export_task,
     job_load_task,
     job_task,
+    layer_arrays,
     load_task,
 )
 
@@ -135,8 +137,10 @@ def _read_for_gui(path: FsPath) -> Drawing:
 
 
 def _read_job_for_gui(path: FsPath) -> Job:
+    from .offload import load_job_file
+
     try:
-        return load_job(path)
+        return load_job_file(path, load_job)
     except Exception as exc:  # noqa: BLE001
         raise GalvoError(describe_load_error(path, exc)) from None
 
@@ -283,6 +287,7 @@ class MainWindow(QMainWindow):
         self.params = Params()
         self.pipeline = Pipeline()
         self.preview_cache = PreviewCache()
+        self.prepared_cache = PreparedCache()
         self.result: RunResult | None = None
         self.run_error: str | None = None
         self.selected: int | None = None
@@ -617,7 +622,7 @@ class MainWindow(QMainWindow):
 
         gen = self.runner.request(pipeline_task_safe(
             self.pipeline, self.preview_cache, self.drawing, self.params, self.file_path,
-            self.wanted_layers()))
+            self.wanted_layers(), self.prepared_cache))
         self._update_stale()
         return gen
 
@@ -815,21 +820,23 @@ class MainWindow(QMainWindow):
         ut = units_transform(pv.units_scale, pv.units_offset)
         bt = scale_transform(pv.mm_per_bit)
         o, p = self.original, self.processed
+        arrays = result.arrays if result.arrays is not None else layer_arrays(pv)
+        prep = result.prepared or {}
         show_points = len(pv.original_points) < views_mod.MAX_MARKER_POINTS
-        o.set_layer("original", pv.original.xy, transform=ut, count=pv.original.n_vertices)
-        o.set_layer("original_points", pv.original_points if show_points else
-                    np.empty((0, 2)), transform=ut)
+        counts = {
+            "original": pv.original.n_vertices,
+            "fitted": pv.fitted.n_vertices,
+            "control": pv.n_control_points,
+            "jumps": len(pv.jumps) // 3 + (1 if len(pv.jumps) else 0),
+            "hatch": pv.hatch.n_vertices,
+            "kerf": pv.kerf.n_vertices,
+        }
+        for key, arr in arrays.items():
+            view = o if key in o.layers else p
+            tr = bt if key in ("marks", "jumps", "hatch") else ut
+            view.set_layer(key, *arr, transform=tr, count=counts.get(key),
+                           prepared=prep.get(key))
         self.markers_shown = show_points and len(pv.original_points) > 0
-        p.set_layer("fitted", pv.fitted.xy, transform=ut, count=pv.fitted.n_vertices)
-        p.set_layer("control", pv.control_xy, pv.control_role, transform=ut,
-                    count=pv.n_control_points)
-        p.set_layer("marks", pv.marks, transform=bt)
-        p.set_layer("jumps", pv.jumps, transform=bt, count=len(pv.jumps) // 3 + (
-            1 if len(pv.jumps) else 0))
-        p.set_layer("hatch", pv.hatch.xy, transform=bt, count=pv.hatch.n_vertices)
-        p.set_layer("kerf", pv.kerf.xy, transform=ut, count=pv.kerf.n_vertices)
-        p.set_layer("deviation", pv.deviation_a, pv.deviation_b, pv.deviation_level,
-                    transform=ut)
         fm = pv.field_map
         label = f"field {fm.field_size_mm:g} mm ({_fmt_int(fm.field_bits)} bits)"
         for v in (o, p):
@@ -1050,7 +1057,8 @@ class MainWindow(QMainWindow):
                             f"are inactive{where}). Open a PLT file to process again.")
         self.banner.show()
         self._add_recent(path)
-        self.runner.request(job_task(loaded.job, source, self.preview_cache, path))
+        self.runner.request(job_task(loaded.job, source, self.preview_cache, path,
+                                     self.prepared_cache))
         self._update_title()
         self._update_status()
         self._update_stale()

@@ -10,13 +10,16 @@ request the window sends: pipeline run + display geometry (:mod:`galvo_core.prev
 
 from __future__ import annotations
 
+import gc
 import threading
 import time
+from collections import OrderedDict
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path as FsPath
 from typing import Any
 
+import numpy as np
 from PySide6.QtCore import QCoreApplication, QElapsedTimer, QObject, QThread, Signal
 
 from galvo_core.drawing import Drawing
@@ -49,11 +52,78 @@ class RunResult:
     job_path: FsPath | None = None
     #: the layers whose geometry the preview holds (the others are empty until shown)
     layers: frozenset[str] | None = None
+    #: per layer: the arrays handed to the view, and the item data made from them on the
+    #: worker (QPainterPaths, rectangles: :func:`app.views.prepare_layer`)
+    arrays: dict[str, tuple[np.ndarray, ...]] | None = None
+    prepared: dict[str, tuple] | None = None
+
+
+_NO_POINTS = np.empty((0, 2))
+
+
+def layer_arrays(pv: Preview) -> dict[str, tuple[np.ndarray, ...]]:
+    """The arrays each layer of the views shows (native space: units or bits)."""
+    from .views import MAX_MARKER_POINTS
+
+    show_points = len(pv.original_points) < MAX_MARKER_POINTS
+    return {
+        "original": (pv.original.xy,),
+        "original_points": (pv.original_points if show_points else _NO_POINTS,),
+        "fitted": (pv.fitted.xy,),
+        "control": (pv.control_xy, pv.control_role),
+        "marks": (pv.marks,),
+        "jumps": (pv.jumps,),
+        "hatch": (pv.hatch.xy,),
+        "kerf": (pv.kerf.xy,),
+        "deviation": (pv.deviation_a, pv.deviation_b, pv.deviation_level),
+    }
+
+
+class PreparedCache:
+    """Item data by layer and the identity of its first array (a small LRU that holds the
+    arrays, so an id is never reused while cached): a run that did not change a layer's
+    arrays does not rebuild its QPainterPath."""
+
+    def __init__(self, size: int = 32) -> None:
+        self.size = size
+        self._data: OrderedDict[tuple[str, int], tuple[tuple, tuple]] = OrderedDict()
+        self._lock = threading.Lock()
+
+    def get(self, key: str, arrays: tuple[np.ndarray, ...]) -> tuple:
+        from .views import prepare_layer
+
+        k = (key, id(arrays[0]))
+        with self._lock:
+            hit = self._data.get(k)
+            if hit is not None and hit[0][0] is arrays[0]:
+                self._data.move_to_end(k)
+                return hit[1]
+        value = prepare_layer(key, *arrays)
+        with self._lock:
+            self._data[k] = (arrays, value)
+            while len(self._data) > self.size:
+                self._data.popitem(last=False)
+        return value
+
+
+def with_prepared(result: RunResult, prepared: PreparedCache | None,
+                  cancel: Callable[[], bool]) -> RunResult:
+    """``result`` with the layers' arrays and their item data made here (worker)."""
+    arrays = layer_arrays(result.preview)
+    if prepared is None:
+        return replace(result, arrays=arrays)
+    out = {}
+    for key, arr in arrays.items():
+        if cancel():
+            raise Cancelled()
+        out[key] = prepared.get(key, arr)
+    return replace(result, arrays=arrays, prepared=out)
 
 
 def pipeline_task(pipeline: Pipeline, cache: PreviewCache, drawing: Drawing,
                   params: Params, path: FsPath | None = None,
-                  layers: frozenset[str] | None = None) -> Task:
+                  layers: frozenset[str] | None = None,
+                  prepared: PreparedCache | None = None) -> Task:
     """The work of one request: run the (cached) pipeline, then the display geometry of
     ``layers`` (all when None)."""
 
@@ -65,19 +135,22 @@ def pipeline_task(pipeline: Pipeline, cache: PreviewCache, drawing: Drawing,
         if cancel():
             raise Cancelled()
         preview = build_preview(job, drawing, fitted, cache=cache, cancel=cancel, layers=layers)
-        return RunResult(drawing, params, job, fitted, preview, time.perf_counter() - t0, stages,
-                         path=path, layers=layers)
+        res = RunResult(drawing, params, job, fitted, preview, 0.0, stages, path=path,
+                        layers=layers)
+        res = with_prepared(res, prepared, cancel)
+        return replace(res, seconds=time.perf_counter() - t0)
 
     return task
 
 
 def pipeline_task_safe(pipeline: Pipeline, cache: PreviewCache, drawing: Drawing,
                        params: Params, path: FsPath | None = None,
-                       layers: frozenset[str] | None = None) -> Task:
+                       layers: frozenset[str] | None = None,
+                       prepared: PreparedCache | None = None) -> Task:
     """Like :func:`pipeline_task`, but a ParamError of the run (a drawing that leaves the
     field, …) gives a result with ``error`` set that still shows the original drawing and the
     field (so the operator sees why), instead of failing."""
-    inner = pipeline_task(pipeline, cache, drawing, params, path, layers)
+    inner = pipeline_task(pipeline, cache, drawing, params, path, layers, prepared)
 
     def task(cancel: Callable[[], bool]) -> RunResult:
         t0 = time.perf_counter()
@@ -89,22 +162,24 @@ def pipeline_task_safe(pipeline: Pipeline, cache: PreviewCache, drawing: Drawing
                       params.laser.as_dict(), (), {}, tuple(drawing.warnings))
             preview = build_preview(job, drawing, None, cache=cache, cancel=cancel,
                                     layers=layers)
-            return RunResult(drawing, params, job, None, preview, time.perf_counter() - t0,
-                             tuple(pipeline.last_info.stages_run), error=str(exc), path=path,
-                             layers=layers)
+            res = RunResult(drawing, params, job, None, preview, time.perf_counter() - t0,
+                            tuple(pipeline.last_info.stages_run), error=str(exc), path=path,
+                            layers=layers)
+            return with_prepared(res, prepared, cancel)
 
     return task
 
 
 def job_task(job: Job, drawing: Drawing | None, cache: PreviewCache,
-             job_path: FsPath | None = None) -> Task:
+             job_path: FsPath | None = None, prepared: PreparedCache | None = None) -> Task:
     """The work of showing a loaded job file (no pipeline run)."""
 
     def task(cancel: Callable[[], bool]) -> RunResult:
         t0 = time.perf_counter()
         preview = build_preview(job, drawing, None, cache=cache, cancel=cancel)
-        return RunResult(drawing, None, job, None, preview, time.perf_counter() - t0, (),
-                         job_path=job_path)
+        res = RunResult(drawing, None, job, None, preview, 0.0, (), job_path=job_path)
+        res = with_prepared(res, prepared, cancel)
+        return replace(res, seconds=time.perf_counter() - t0)
 
     return task
 
@@ -158,10 +233,12 @@ def job_load_task(path: FsPath, read_job: Callable[[FsPath], Job],
 
 
 def export_task(write: Callable[[Job, FsPath], None], job: Job, path: FsPath) -> Task:
-    """Write ``job`` to ``path`` on the worker (atomic writers: a failure leaves nothing)."""
+    """Write ``job`` to ``path`` on the worker (atomic writers: a failure leaves nothing);
+    a big job in a helper process (:mod:`app.offload`: JSON holds the GIL)."""
+    from .offload import write_job_file
 
     def task(cancel: Callable[[], bool]) -> FsPath:
-        write(job, path)
+        write_job_file(write, job, path)
         return path
 
     return task
@@ -179,6 +256,21 @@ class _RunThread(QThread):
         self.cancel_event = threading.Event()
 
     def run(self) -> None:  # worker thread
+        # A run creates millions of small, long-lived objects (segments, arrays); a full
+        # garbage collection walking them holds the GIL for 0.3-0.7 s and freezes the GUI
+        # thread. So the collector is paused during the task, and what the task built is
+        # then frozen (gc.freeze: left out of later collections; acyclic objects are still
+        # freed by reference counting when dropped).
+        gc_on = gc.isenabled()
+        gc.disable()
+        try:
+            self._run_task()
+        finally:
+            if gc_on:
+                gc.freeze()
+                gc.enable()
+
+    def _run_task(self) -> None:
         try:
             result = self.task(self.cancel_event.is_set)
         except Cancelled:

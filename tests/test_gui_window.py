@@ -207,7 +207,7 @@ def test_titles_axes_and_icon(qtbot):
 def _plot_items(view) -> list:
     return [i for i in view.getPlotItem().items
             if isinstance(i, (pg.PlotDataItem, views.DeviationItem, views.PointsItem,
-                              views.ControlItem))]
+                              views.ControlItem, views.LinesItem))]
 
 
 @pytest.mark.parametrize("n_paths", [1, 500, 3000])
@@ -218,7 +218,7 @@ def test_number_of_plot_items_is_fixed(qtbot, n_paths):
     # one item per layer, plus the field outline and the selection highlight
     assert len(_plot_items(win.original)) == n_left + 2
     assert len(_plot_items(win.processed)) == n_right + 2
-    kinds = (pg.PlotDataItem, views.PointsItem)
+    kinds = (pg.PlotDataItem, views.PointsItem, views.LinesItem)
     scene_items = [i for i in win.original.scene().items() if isinstance(i, kinds)]
     assert len(scene_items) == n_left + 2
     assert win.original.counts["original"] == 4 * n_paths
