@@ -9,7 +9,9 @@ and the job travels between the processes as many small pickles (strokes in chun
 most :data:`CHUNK_SEGMENTS` segments): the thread unpickling them releases the GIL between
 chunks, so no single call blocks the GUI for long.
 
-Small jobs are handled in the calling thread (a process start costs about a second).
+Writing needs no second process: :func:`job_json_bytes` makes the very bytes of
+``write_job`` with one small ``json.dumps`` per stroke, so the GIL changes hands between
+them. Small jobs are handled in the calling thread (a process start costs about a second).
 """
 
 from __future__ import annotations
@@ -18,6 +20,7 @@ import dataclasses
 import multiprocessing
 import os
 import pickle
+import tempfile
 from collections.abc import Callable
 from concurrent.futures import ProcessPoolExecutor
 from pathlib import Path as FsPath
@@ -28,7 +31,7 @@ from galvo_core.job import Job, Stroke
 
 #: A job file bigger than this (bytes) is read in a helper process.
 BIG_JOB_BYTES = 8_000_000
-#: A job with more marks + segments than this is written in a helper process.
+#: A job with more marks + segments than this is written stroke by stroke.
 BIG_JOB_ITEMS = 300_000
 #: Strokes travel in pickles of at most this many segments (one stroke is never split).
 CHUNK_SEGMENTS = 20_000
@@ -70,28 +73,21 @@ def job_from_blobs(header: bytes, blobs: list[bytes],
     return dataclasses.replace(job, strokes=tuple(strokes))
 
 
-def _child_load(path: str) -> tuple[str, Any]:  # runs in the helper process
+def _child_load(path: str, out: str) -> tuple[str, Any]:  # runs in the helper process
+    """Read the job file and write it to ``out`` as length-prefixed pickles (header, then
+    stroke chunks); the parent reads them back one by one."""
     from galvo_core.job import load_job
 
     try:
-        return "ok", job_to_blobs(load_job(path))
+        header, blobs = job_to_blobs(load_job(path))
+        with open(out, "wb") as fh:
+            for b in (header, *blobs):
+                fh.write(len(b).to_bytes(8, "little"))
+                fh.write(b)
+        return "ok", len(blobs)
     except GalvoError as exc:
         return "error", str(exc)
     except Exception as exc:  # noqa: BLE001 - reported as one line
-        return "error", f"{path}: {type(exc).__name__}: {exc}"
-
-
-def _child_write(module: str, name: str, header: bytes, blobs: list[bytes],
-                 path: str) -> tuple[str, Any]:  # runs in the helper process
-    import importlib
-
-    try:
-        fn = getattr(importlib.import_module(module), name)
-        fn(job_from_blobs(header, blobs), path)
-        return "ok", path
-    except GalvoError as exc:
-        return "error", str(exc)
-    except Exception as exc:  # noqa: BLE001
         return "error", f"{path}: {type(exc).__name__}: {exc}"
 
 
@@ -106,15 +102,59 @@ def _run(fn: Callable[..., tuple[str, Any]], *args: Any) -> Any:
 
 def load_job_file(path: FsPath, load: Callable[[FsPath], Job],
                   cancel: Callable[[], bool] | None = None) -> Job:
-    """``load(path)`` here for a small file; a big one in a helper process."""
+    """``load(path)`` here for a small file; a big one in a helper process, handed back
+    through a temporary file read chunk by chunk (reading releases the GIL, and each
+    unpickle is small)."""
     try:
         big = os.path.getsize(path) > BIG_JOB_BYTES
     except OSError:
         big = False
     if not big:
         return load(path)
-    header, blobs = _run(_child_load, os.fspath(path))
-    return job_from_blobs(header, blobs, cancel)
+    fd, tmp = tempfile.mkstemp(prefix="galvo-job-", suffix=".pickles")
+    os.close(fd)
+    try:
+        _run(_child_load, os.fspath(path), tmp)
+        blobs: list[bytes] = []
+        with open(tmp, "rb") as fh:
+            while True:
+                n = fh.read(8)
+                if len(n) < 8:
+                    break
+                blobs.append(fh.read(int.from_bytes(n, "little")))
+    finally:
+        try:
+            os.unlink(tmp)
+        except OSError:
+            pass
+    return job_from_blobs(blobs[0], blobs[1:], cancel)
+
+
+_TOKEN = "\x00strokes\x00"
+
+
+def job_json_bytes(job: Job, cancel: Callable[[], bool] | None = None) -> bytes:
+    """Exactly the bytes :func:`galvo_core.job.write_job` writes, made stroke by stroke:
+    many small ``json.dumps`` calls instead of one that holds the GIL for seconds."""
+    import json
+
+    head = dataclasses.replace(job, strokes=()).to_json()
+    head["strokes"] = _TOKEN
+    text = json.dumps(head, separators=(",", ":"), allow_nan=False)
+    token = json.dumps(_TOKEN)
+    assert text.count(token) == 1
+    before, after = text.split(token)
+    parts: list[str] = [before, "["]
+    for i, s in enumerate(job.strokes):
+        if cancel is not None and i % 256 == 0 and cancel():
+            from galvo_core.pipeline import Cancelled
+
+            raise Cancelled()
+        if i:
+            parts.append(",")
+        parts.append(json.dumps(s.to_json(), separators=(",", ":"), allow_nan=False))
+    parts.extend(("]", after))
+    return "".join(parts).encode("utf-8")
 
 
 def job_items(job: Job) -> int:
@@ -122,12 +162,12 @@ def job_items(job: Job) -> int:
 
 
 def write_job_file(write: Callable[[Job, FsPath], None], job: Job, path: FsPath) -> None:
-    """``write(job, path)`` here for a small job or a writer that is not a module-level
-    function of galvo_core; a big job in a helper process."""
-    module, name = getattr(write, "__module__", ""), getattr(write, "__qualname__", "")
-    if (job_items(job) <= BIG_JOB_ITEMS or not module.startswith("galvo_core.")
-            or "." in name or "<" in name):
-        write(job, path)
+    """``write(job, path)``; the job file writer of galvo_core (:func:`write_job`) for a
+    big job is replaced by the same bytes made stroke by stroke (:func:`job_json_bytes`),
+    written atomically the same way."""
+    from galvo_core.job import atomic_write_bytes, write_job
+
+    if write is write_job and job_items(job) > BIG_JOB_ITEMS:
+        atomic_write_bytes(path, job_json_bytes(job))
         return
-    header, blobs = job_to_blobs(job)
-    _run(_child_write, module, name, header, blobs, os.fspath(path))
+    write(job, path)

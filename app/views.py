@@ -375,10 +375,15 @@ class ControlItem(_FastItem):
         self._knots = _polygon(self._xy_knots)
         self._xy = np.empty((0, 2))
         self._role = np.empty(0, dtype=np.int8)
+        self._coarse: tuple | None = None
+        self.last_drawn = ""
 
     @staticmethod
-    def prepare(xy: np.ndarray, role: np.ndarray) -> tuple:
-        """Handle lines as a path, anchors, knots and the rectangle (any thread)."""
+    def prepare(xy: np.ndarray, role: np.ndarray, lod: float | None = None) -> tuple:
+        """Handle lines as a path, anchors, knots and the rectangle (any thread). With
+        ``lod`` a big layer also gets a coarse version for the whole-drawing view: handle
+        lines shorter than ``lod`` left out (under half a pixel: the markers cover them)
+        and one anchor and one knot per ``lod`` grid cell."""
         xy = np.asarray(xy, dtype=np.float64).reshape(-1, 2)
         role = np.asarray(role)
         handles = role[: len(xy)] != 1
@@ -387,13 +392,29 @@ class ControlItem(_FastItem):
         lines = pg.arrayToQPath(hx[:, 0], hx[:, 1], connect="finite") if len(xy) \
             else QPainterPath()
         anchors, knots = xy[role == 1], xy[role == 2]
+        coarse = None
+        if lod is not None and lod > 0 and len(xy) >= MAX_ANTIALIAS_POINTS:
+            # rows are P0, P1, NaN, P2, P3, NaN, ... then the anchors: pairs start where a
+            # handle row follows a NaN (or the start) and is followed by a handle row
+            h = handles & np.isfinite(xy[:, 0])
+            start = np.flatnonzero(h[:-1] & h[1:])
+            d = np.hypot(*(xy[start + 1] - xy[start]).T)
+            long_ = start[d >= lod]
+            if len(long_):
+                px = np.full((3 * len(long_), 2), np.nan)
+                px[0::3], px[1::3] = xy[long_], xy[long_ + 1]
+                c_lines = pg.arrayToQPath(px[:-1, 0], px[:-1, 1], connect="finite")
+            else:
+                c_lines = QPainterPath()
+            coarse = (float(lod), c_lines, _one_per_cell(anchors, lod),
+                      _one_per_cell(knots, lod))
         return (xy, role, lines, anchors, knots, _small_polygon(anchors), _small_polygon(knots),
-                _finite_rect(xy[role >= 0]))
+                _finite_rect(xy[role >= 0]), coarse)
 
     def setPrepared(self, prepared: tuple) -> None:  # noqa: N802
         self.prepareGeometryChange()
         (self._xy, self._role, self._lines, self._xy_anchors, self._xy_knots, self._anchors,
-         self._knots, self._rect) = prepared
+         self._knots, self._rect, self._coarse) = prepared
         self.update()
 
     def setData(self, xy: np.ndarray, role: np.ndarray) -> None:  # noqa: N802
@@ -409,11 +430,21 @@ class ControlItem(_FastItem):
         small = len(self._xy) < MAX_ANTIALIAS_POINTS
         p.setRenderHint(p.RenderHint.Antialiasing, small)
         p.setPen(self.line_pen)
-        p.drawPath(self._lines)
-        knots, anchors = self._xy_knots, self._xy_anchors
-        draw_points(p, knots, self._knots, self.knot_pen, grid=3.0)
-        draw_points(p, knots, self._knots, self.hole_pen, grid=3.0)
-        draw_points(p, anchors, self._anchors, self.anchor_pen, grid=3.0)
+        lines, knots, anchors = self._lines, self._xy_knots, self._xy_anchors
+        kpoly, apoly = self._knots, self._anchors
+        self.last_drawn = "full"
+        coarse = getattr(self, "_coarse", None)
+        if coarse is not None:
+            t = p.transform()
+            px = 1.0 / max(math.hypot(t.m11(), t.m12()), 1e-300)
+            if coarse[0] <= 0.5 * px:
+                lines, anchors, knots = coarse[1], coarse[2], coarse[3]
+                kpoly = apoly = None
+                self.last_drawn = "coarse"
+        p.drawPath(lines)
+        draw_points(p, knots, kpoly, self.knot_pen, grid=3.0)
+        draw_points(p, knots, kpoly, self.hole_pen, grid=3.0)
+        draw_points(p, anchors, apoly, self.anchor_pen, grid=3.0)
 
 
 class LinesItem(_FastItem):
@@ -427,25 +458,36 @@ class LinesItem(_FastItem):
         self.thin_pen = QPen(pen)
         self.thin_pen.setWidthF(1.0)
         self._path = QPainterPath()
+        self._coarse: tuple[float, QPainterPath] | None = None
         self._xy = np.empty((0, 2))
         self._n = 0
+        #: what the last paint drew: "full" or "coarse" (tests, benchmark)
+        self.last_drawn = ""
 
     @staticmethod
-    def prepare(xy: np.ndarray) -> tuple:
-        """(xy, path, rectangle, finite vertices) of NaN-separated polylines (any thread)."""
+    def prepare(xy: np.ndarray, lod: float | None = None) -> tuple:
+        """(xy, path, rectangle, finite vertices, coarse) of NaN-separated polylines (any
+        thread). With ``lod`` (item units) a big layer also gets a coarse path: vertices
+        merged on a grid of ``lod`` (:func:`decimate`), drawn while a device pixel is at
+        least twice ``lod`` (so it differs from the full path by under a pixel)."""
         xy = np.asarray(xy, dtype=np.float64).reshape(-1, 2)
         if not len(xy):
-            return xy, QPainterPath(), QRectF(), 0
+            return xy, QPainterPath(), QRectF(), 0, None
         finite = np.isfinite(xy).all(axis=1)
         n = int(finite.sum())
         if not n:
-            return xy, QPainterPath(), QRectF(), 0
+            return xy, QPainterPath(), QRectF(), 0, None
         path = pg.arrayToQPath(xy[:, 0], xy[:, 1], connect="finite")
-        return xy, path, _finite_rect(xy[finite]), n
+        coarse = None
+        if lod is not None and lod > 0 and n >= MAX_ANTIALIAS_POINTS:
+            c = decimate(xy, lod)
+            if len(c) < 0.7 * len(xy):
+                coarse = (float(lod), pg.arrayToQPath(c[:, 0], c[:, 1], connect="finite"))
+        return xy, path, _finite_rect(xy[finite]), n, coarse
 
     def setPrepared(self, prepared: tuple) -> None:  # noqa: N802
         self.prepareGeometryChange()
-        self._xy, self._path, self._rect, self._n = prepared
+        self._xy, self._path, self._rect, self._n, self._coarse = prepared
         self.update()
 
     def setData(self, xy: np.ndarray) -> None:  # noqa: N802 - like pyqtgraph
@@ -460,13 +502,54 @@ class LinesItem(_FastItem):
         small = self._n < MAX_ANTIALIAS_POINTS
         p.setRenderHint(p.RenderHint.Antialiasing, small)
         p.setPen(self.pen if small else self.thin_pen)
-        p.drawPath(self._path)
+        path = self._path
+        self.last_drawn = "full"
+        if self._coarse is not None:
+            t = p.transform()
+            px = 1.0 / max(math.hypot(t.m11(), t.m12()), 1e-300)  # item units per pixel
+            if self._coarse[0] <= 0.5 * px:
+                path = self._coarse[1]
+                self.last_drawn = "coarse"
+        p.drawPath(path)
 
 
-def prepare_layer(key: str, *arrays: np.ndarray) -> tuple:
+def _one_per_cell(pts: np.ndarray, cell: float) -> np.ndarray:
+    """One point per grid cell of side ``cell`` (the first of each), order kept."""
+    if len(pts) < 2:
+        return pts
+    c = np.floor((pts - pts.min(axis=0)) / cell).astype(np.int64)
+    key = c[:, 0] * (int(c[:, 1].max()) + 1) + c[:, 1]
+    _, first = np.unique(key, return_index=True)
+    return pts[np.sort(first)]
+
+
+def decimate(xy: np.ndarray, cell: float) -> np.ndarray:
+    """NaN-separated polylines with the vertices that stay in the grid cell (side
+    ``cell``) of the vertex before them dropped; the first and last vertex of every piece
+    and the NaN rows are kept. Every dropped vertex lies within ``cell * √2`` of the kept
+    polyline, so at a pixel of two cells or more the drawing is the same to a pixel."""
+    xy = np.asarray(xy, dtype=np.float64).reshape(-1, 2)
+    if len(xy) < 3:
+        return xy
+    with np.errstate(invalid="ignore"):
+        c = np.floor(xy / cell)
+    same = (c[1:] == c[:-1]).all(axis=1)  # NaN rows never equal: always kept
+    keep = np.ones(len(xy), dtype=bool)
+    keep[1:] = ~same
+    nan = ~np.isfinite(xy[:, 0])
+    keep[:-1] |= nan[1:]  # the last vertex of each piece
+    keep[-1] = True
+    return xy[keep]
+
+
+def prepare_layer(key: str, *arrays: np.ndarray, lod: float | None = None) -> tuple:
     """What the item of layer ``key`` needs from ``arrays`` (QPainterPaths, rectangles):
-    safe to call on a worker thread, then handed to :meth:`WorkView.set_layer`."""
-    return _LAYER_CLASS[key].prepare(*arrays)
+    safe to call on a worker thread, then handed to :meth:`WorkView.set_layer`. ``lod``:
+    the coarse grid of line layers, in the layer's units (see :meth:`LinesItem.prepare`)."""
+    cls = _LAYER_CLASS[key]
+    if cls in (LinesItem, ControlItem):
+        return cls.prepare(*arrays, lod=lod)
+    return cls.prepare(*arrays)
 
 
 class ColourBar(pg.GraphicsWidgetAnchor, pg.GraphicsWidget):

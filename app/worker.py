@@ -86,19 +86,21 @@ class PreparedCache:
 
     def __init__(self, size: int = 32) -> None:
         self.size = size
-        self._data: OrderedDict[tuple[str, int], tuple[tuple, tuple]] = OrderedDict()
+        self._data: OrderedDict[tuple[str, int, float | None], tuple[tuple, tuple]] = \
+            OrderedDict()
         self._lock = threading.Lock()
 
-    def get(self, key: str, arrays: tuple[np.ndarray, ...]) -> tuple:
+    def get(self, key: str, arrays: tuple[np.ndarray, ...], lod: float | None = None
+            ) -> tuple:
         from .views import prepare_layer
 
-        k = (key, id(arrays[0]))
+        k = (key, id(arrays[0]), lod)
         with self._lock:
             hit = self._data.get(k)
             if hit is not None and hit[0][0] is arrays[0]:
                 self._data.move_to_end(k)
                 return hit[1]
-        value = prepare_layer(key, *arrays)
+        value = prepare_layer(key, *arrays, lod=lod)
         with self._lock:
             self._data[k] = (arrays, value)
             while len(self._data) > self.size:
@@ -112,11 +114,21 @@ def with_prepared(result: RunResult, prepared: PreparedCache | None,
     arrays = layer_arrays(result.preview)
     if prepared is None:
         return replace(result, arrays=arrays)
+    pv = result.preview
+    lod_units = lod_bits = None
+    if pv.bounds is not None:
+        # coarse paths for the whole-drawing view: a grid of 1/4000 of the drawing's size
+        # (a quarter of a pixel or less on views up to 2000 pixels)
+        span_mm = max(pv.bounds[2] - pv.bounds[0], pv.bounds[3] - pv.bounds[1])
+        if span_mm > 0:
+            g = float(f"{span_mm / 4000.0:.3g}")  # rounded: the same grid run after run
+            lod_units, lod_bits = g / pv.units_scale, g / pv.mm_per_bit
     out = {}
     for key, arr in arrays.items():
         if cancel():
             raise Cancelled()
-        out[key] = prepared.get(key, arr)
+        lod = lod_bits if key in ("jumps", "hatch") else lod_units
+        out[key] = prepared.get(key, arr, lod)
     return replace(result, arrays=arrays, prepared=out)
 
 

@@ -279,3 +279,34 @@ def test_export_kinds_can_be_extended(win, qtbot, tmp_path):
     win.rebuild_export_menu()
     assert "txt" in win.export_actions and win.export_actions["txt"].isEnabled()
     assert win.export("txt", tmp_path / "a.txt") and written == ["circle.plt"]
+
+
+def test_big_job_files_are_written_and_read_the_same_way(tmp_path, monkeypatch):
+    """The stroke-by-stroke JSON of app.offload is byte for byte write_job's, and a job
+    read in the helper process equals the one read directly."""
+    from app import offload
+    from galvo_core.hpgl import read_file
+    from galvo_core.job import write_job
+    from galvo_core.params import Params
+    from galvo_core.pipeline import Pipeline
+
+    job = Pipeline().run(read_file(SEAL), Params(fit_field=True))
+    a = tmp_path / "a.json"
+    write_job(job, a)
+    assert offload.job_json_bytes(job) == a.read_bytes()
+    monkeypatch.setattr(offload, "BIG_JOB_ITEMS", 0)
+    b = tmp_path / "b.json"
+    offload.write_job_file(write_job, job, b)
+    assert b.read_bytes() == a.read_bytes()
+    monkeypatch.setattr(offload, "BIG_JOB_BYTES", 0)
+    monkeypatch.setattr(offload, "CHUNK_SEGMENTS", 50)
+    back = offload.load_job_file(a, lambda p: pytest.fail("read in the helper process"))
+    direct = load_job(a)
+    assert len(back.strokes) == len(direct.strokes) > 1
+    for s, t in zip(back.strokes, direct.strokes, strict=True):
+        assert np.array_equal(s.marks, t.marks) and len(s.segments) == len(t.segments)
+    assert back.stats == direct.stats and back.source_sha256 == direct.source_sha256
+    bad = tmp_path / "bad.json"
+    bad.write_text("{not json")
+    with pytest.raises(Exception, match="bad.json"):
+        offload.load_job_file(bad, load_job)
