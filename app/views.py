@@ -50,8 +50,10 @@ FIELD = "#9aa5b1"
 SELECTION = "#ffc400"  # amber underlay
 TITLE_SIZE = "11pt"
 
-#: Deviation colours, from "well inside the tolerance" to "at the tolerance".
-DEVIATION_STOPS = ("#1a9850", "#a6d96a", "#fee08b", "#f46d43", "#a50026")
+#: Deviation colours, from "well inside the tolerance" to "at the tolerance": pale yellow to
+#: dark brown, a hue none of the other layers uses (the marks are red, the fitted curve
+#: green, control points blue, hatch purple, kerf magenta).
+DEVIATION_STOPS = ("#f3e08a", "#eab84a", "#c98a1c", "#8c510a", "#3d2300")
 DEVIATION_BINS = 16
 
 #: Point markers of the original drawing are drawn only below this many points.
@@ -638,7 +640,7 @@ class WorkView(pg.PlotWidget):
                                      name="field")
         self.field.setZValue(-10)
         pi.addItem(self.field)
-        self.field_label = pg.TextItem("", color=FIELD, anchor=(0, 1))
+        self.field_label = pg.TextItem("", color=FIELD, anchor=(1, 0))
         self.field_label.setZValue(-10)
         pi.addItem(self.field_label, ignoreBounds=True)
 
@@ -711,7 +713,8 @@ class WorkView(pg.PlotWidget):
             return
         self.field.setData(outline_mm[:, 0], outline_mm[:, 1])
         self.field_label.setText(label)
-        self.field_label.setPos(float(outline_mm[:, 0].min()), float(outline_mm[:, 1].max()))
+        # under the field's lower right corner: the legend covers the top left
+        self.field_label.setPos(float(outline_mm[:, 0].max()), float(outline_mm[:, 1].min()))
 
     def set_layer_visible(self, key: str, visible: bool) -> None:
         if key in self.layers:

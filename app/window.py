@@ -10,6 +10,7 @@ geometry: :mod:`galvo_core.preview` does.
 from __future__ import annotations
 
 import json
+import math
 import os
 import re
 import time
@@ -45,13 +46,16 @@ from PySide6.QtWidgets import (
     QApplication,
     QCheckBox,
     QDockWidget,
+    QDoubleSpinBox,
     QFileDialog,
-    QHBoxLayout,
+    QFormLayout,
+    QGroupBox,
     QLabel,
     QMainWindow,
     QMessageBox,
     QProgressBar,
     QScrollArea,
+    QSpinBox,
     QSplitter,
     QToolButton,
     QVBoxLayout,
@@ -67,6 +71,7 @@ from galvo_core.preview import PreviewCache
 
 from . import views as views_mod
 from .controls import ControlsPanel, LaserDialog
+from .flow import flow_container
 from .stats import StatsPanel, WarningsPanel
 from .views import LAYERS, WorkView, scale_transform, units_transform
 from .worker import (
@@ -336,11 +341,9 @@ class MainWindow(QMainWindow):
         self.splitter = splitter
 
         self.layer_boxes: dict[str, QCheckBox] = {}
-        layer_bar = QWidget()
+        layer_bar, bar = flow_container()  # wraps to a second row in a narrow window
         layer_bar.setObjectName("layer_bar")
-        bar = QHBoxLayout(layer_bar)
         bar.setContentsMargins(6, 2, 6, 2)
-        bar.setSpacing(10)
         title = QLabel("Layers:")
         title.setStyleSheet("font-weight: bold; color: #3d4853;")
         bar.addWidget(title)
@@ -353,7 +356,6 @@ class MainWindow(QMainWindow):
             cb.toggled.connect(lambda on, k=spec.key: self.set_layer_visible(k, on))
             self.layer_boxes[spec.key] = cb
             bar.addWidget(cb)
-        bar.addStretch(1)
         self.layer_bar = layer_bar
 
         self.banner = QLabel("")
@@ -388,6 +390,7 @@ class MainWindow(QMainWindow):
         self.controls.changed.connect(self._on_controls_changed)
         self.controls.laser_requested.connect(self.open_laser_dialog)
         self.controls.defaults_button.clicked.connect(self.restore_defaults)
+        self._add_hatch_pass_controls()
         scroll = QScrollArea()
         scroll.setWidget(self.controls)
         scroll.setWidgetResizable(True)
@@ -404,6 +407,7 @@ class MainWindow(QMainWindow):
         self.stats_panel = StatsPanel()
         self.warnings_panel = WarningsPanel()
         self.warnings_panel.activated.connect(self.zoom_to_warning)
+        self.warnings_panel.translate = self.gui_message
         job_split = QSplitter(Qt.Orientation.Horizontal)
         job_split.addWidget(self.stats_panel)
         job_split.addWidget(self.warnings_panel)
@@ -545,7 +549,7 @@ class MainWindow(QMainWindow):
         self.status_label = QLabel()
         self.warnings_label = QLabel()
         self.cursor_label = QLabel()
-        self.cursor_label.setMinimumWidth(420)
+        self.cursor_label.setMinimumWidth(0)
         self.cursor_label.setTextFormat(Qt.TextFormat.PlainText)
         self.cursor_label.setStyleSheet("font-family: monospace;")
         self.run_label = QLabel()
@@ -567,6 +571,54 @@ class MainWindow(QMainWindow):
         sb.addPermanentWidget(self.run_label)
         sb.addPermanentWidget(self.warnings_label)
         sb.addPermanentWidget(self.cursor_label)
+
+    def _add_hatch_pass_controls(self) -> None:
+        """Hatch passes and the angle step between them, in the Fill group (when the panel
+        does not have them already: the core has them, the generated panel may not)."""
+        self.hatch_passes_spin: QSpinBox | None = None
+        self.hatch_step_spin: QDoubleSpinBox | None = None
+        names = {f.name for f in fields(Params)}
+        c = self.controls
+        if "hatch_passes" not in names or "hatch_passes" in c.sliders or \
+                "hatch_passes" in c.combos:
+            return
+        box = next((b for b in c.findChildren(QGroupBox) if b.title() == "Fill"), None)
+        if box is None or box.layout() is None:
+            return
+        passes = QSpinBox()
+        passes.setObjectName("spin_hatch_passes")
+        passes.setRange(1, 16)
+        passes.setValue(self.params.hatch_passes)
+        passes.setToolTip("how many times the fill is hatched, each pass turned by the "
+                          "angle step (hatch_passes)")
+        step = QDoubleSpinBox()
+        step.setObjectName("spin_hatch_angle_step_deg")
+        step.setRange(-180.0, 180.0)
+        step.setDecimals(1)
+        step.setSuffix(" °")
+        step.setKeyboardTracking(False)
+        step.setValue(self.params.hatch_angle_step_deg)
+        step.setToolTip("angle between consecutive passes (hatch_angle_step_deg)")
+        row = QWidget()
+        form = QFormLayout(row)
+        form.setContentsMargins(0, 0, 0, 0)
+        form.addRow("Passes", passes)
+        form.addRow("Angle step", step)
+        box.layout().addWidget(row)
+        passes.valueChanged.connect(lambda v: self.apply_changes({"hatch_passes": int(v)}))
+        step.valueChanged.connect(
+            lambda v: self.apply_changes({"hatch_angle_step_deg": float(v)}))
+        self.hatch_passes_spin, self.hatch_step_spin = passes, step
+        real = c.set_params
+
+        def set_params(params: Params, fm=None) -> None:
+            real(params, fm)
+            for w, v in ((passes, params.hatch_passes), (step, params.hatch_angle_step_deg)):
+                w.blockSignals(True)
+                w.setValue(v)
+                w.blockSignals(False)
+
+        c.set_params = set_params  # type: ignore[method-assign]
 
     # --- params ---------------------------------------------------------------------------
     def _field_map_for(self, params: Params):
@@ -625,6 +677,23 @@ class MainWindow(QMainWindow):
             self.wanted_layers(), self.prepared_cache))
         self._update_stale()
         return gen
+
+    def gui_message(self, text: str) -> str:
+        """A core message in the window's words: command-line flags (``--fit-field``)
+        become the names of the controls that do the same."""
+        if not text or "--" not in text:
+            return text
+        labels: dict[str, str] = {"fit_field": "Fit field"}
+        for name, w in self.controls.sliders.items():
+            labels[name] = w.spec.label.split("  ")[0]
+        for name in self.controls.combos:
+            labels[name] = name.replace("_", " ")
+
+        def sub(m: re.Match[str]) -> str:
+            name = m.group(1).replace("-", "_")
+            return f"“{labels[name]}”" if name in labels else name.replace("_", " ")
+
+        return re.sub(r"--([a-z][a-z0-9-]*)", sub, text)
 
     # --- scripting surface (tests, benchmarks, scripts) -----------------------------------
     def busy(self) -> bool:
@@ -801,6 +870,7 @@ class MainWindow(QMainWindow):
         self.result_shown.emit(gen)
 
     def _on_failed(self, gen: int, message: str, user_facing: bool) -> None:
+        message = self.gui_message(message)
         self.run_error = message
         self.warnings_panel.set_warnings(self.result.job.warnings if self.result else (),
                                          error=message)
@@ -815,7 +885,8 @@ class MainWindow(QMainWindow):
     def apply_result(self, result: RunResult) -> None:
         """Show a finished run: layers, field, stats, warnings, conversions."""
         self.result = result
-        self.run_error = getattr(result, "error", None)
+        err = getattr(result, "error", None)
+        self.run_error = self.gui_message(err) if err else None
         pv = result.preview
         ut = units_transform(pv.units_scale, pv.units_offset)
         bt = scale_transform(pv.mm_per_bit)
@@ -851,8 +922,15 @@ class MainWindow(QMainWindow):
         if result.drawing is self.drawing and bb is not None:
             size_units = (bb[2] - bb[0], bb[3] - bb[1])
         self.controls.set_field_map(fm, size_units)
-        if self.params.fit_field:
-            self.controls.sliders["magnification"].set_value(fm.magnification)
+        mag = self.controls.sliders.get("magnification")
+        if mag is not None:
+            # the box must be able to show (and take) what Fit field computes, e.g. 0.09
+            step = 10.0 ** -mag.spin.decimals()
+            low = max(step, math.floor(fm.magnification / step) * step)
+            if low < mag.spin.minimum():
+                mag.spin.setMinimum(low)
+            if self.params.fit_field:
+                mag.set_value(fm.magnification)
         stats = dict(result.job.stats) if result.job is not None else {}
         extra = {}
         if len(pv.deviation_err):

@@ -121,8 +121,10 @@ def with_prepared(result: RunResult, prepared: PreparedCache | None,
         # (a quarter of a pixel or less on views up to 2000 pixels)
         span_mm = max(pv.bounds[2] - pv.bounds[0], pv.bounds[3] - pv.bounds[1])
         if span_mm > 0:
-            g = float(f"{span_mm / 4000.0:.3g}")  # rounded: the same grid run after run
-            lod_units, lod_bits = g / pv.units_scale, g / pv.mm_per_bit
+            # rounded in the layers' own units: a new magnification keeps the grid of the
+            # layers in input units (their cached paths stay valid)
+            lod_units = float(f"{span_mm / pv.units_scale / 4000.0:.2g}")
+            lod_bits = float(f"{span_mm / pv.mm_per_bit / 4000.0:.2g}")
     out = {}
     for key, arr in arrays.items():
         if cancel():
