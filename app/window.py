@@ -101,6 +101,9 @@ SAMPLES_DIR = RESOURCES_DIR / "samples"
 THROTTLE_MS = 60
 #: Show the progress bar only for runs longer than this (ms).
 BUSY_DELAY_MS = 200
+#: Dim the views as out of date when a run of new parameters takes longer than this (ms);
+#: a result of another file is marked at once.
+STALE_DELAY_MS = 400
 MAX_RECENT = 8
 
 _EXTS = ("plt", "hpgl", "hpg", "hp", "pgl", "pcl", "spl")
@@ -381,9 +384,13 @@ class MainWindow(QMainWindow):
         cl.setSpacing(0)
         cl.addWidget(layer_bar)
         cl.addWidget(self.banner)
-        cl.addWidget(self.stale_bar)
         cl.addWidget(splitter, 1)
         self.setCentralWidget(central)
+        # the stale bar floats over the top of the views: showing it must not resize them
+        # (a resize re-rasterises every cached layer)
+        self.stale_bar.setParent(central)
+        self.stale_bar.setAttribute(Qt.WidgetAttribute.WA_TransparentForMouseEvents)
+        self._central = central
 
         # --- docks ---------------------------------------------------------------------
         self.controls = ControlsPanel(self.params)
@@ -750,7 +757,7 @@ class MainWindow(QMainWindow):
     def is_stale(self) -> bool:
         """True while the views do not show the result of the current file and parameters
         (a file is being read, a run is pending or running)."""
-        if self.io.busy or self.runner.busy or self._throttle.isActive():
+        if self.io.active or self.runner.active or self._throttle.isActive():
             return True
         res = self.result
         if res is None:
@@ -782,8 +789,8 @@ class MainWindow(QMainWindow):
         stale = self.is_stale() and self.result is not None
         other_file = stale and (self.loading_path is not None
                                 or self.pending_name() != self.shown_name())
-        long_run = self.runner.elapsed_ms() >= BUSY_DELAY_MS or self.io.busy
-        show = stale and (other_file or long_run or not self.runner.busy)
+        long_run = self.runner.elapsed_ms() >= STALE_DELAY_MS or self.io.active
+        show = stale and (other_file or long_run or not self.runner.active)
         if show:
             shown = self.shown_name() or "the previous drawing"
             if self.loading_path is not None:
@@ -797,15 +804,30 @@ class MainWindow(QMainWindow):
                 "Esc cancels and keeps the shown result; export waits for the new one.")
         if show != self._stale_shown:
             self._stale_shown = show
+            if show:
+                self._place_stale_bar()
+                self.stale_bar.raise_()
             self.stale_bar.setVisible(show)
             for v in (self.original, self.processed):
                 v.set_stale(show)
         self._update_title()
 
+    def _place_stale_bar(self) -> None:
+        g = self.splitter.geometry()
+        w = g.width()
+        self.stale_bar.setFixedWidth(w)
+        self.stale_bar.adjustSize()
+        self.stale_bar.move(g.x(), g.y())
+
+    def resizeEvent(self, ev) -> None:  # noqa: N802 - Qt API
+        super().resizeEvent(ev)
+        if self._stale_shown:
+            self._place_stale_bar()
+
     def cancel_processing(self) -> None:
         """Stop reading/processing; the shown result stays and becomes the truth again: the
         file, the parameters and the controls go back to those of the shown result."""
-        if not (self.runner.busy or self.io.busy or self._throttle.isActive()):
+        if not (self.runner.active or self.io.active or self._throttle.isActive()):
             return
         self._throttle.stop()
         self.runner.cancel()
@@ -843,20 +865,19 @@ class MainWindow(QMainWindow):
             self.progress.hide()
             self.cancel_button.hide()
             if self.run_label.text().startswith(("processing…", "opening", "exporting")):
-                self.run_label.setText("cancelled" if self.result is None else
-                                       self.run_label.text().replace("processing…", "done"))
+                self.run_label.setText("")  # ended without a result (a dialog said why)
         self._update_stale()
 
     def _update_busy(self) -> None:
         ms = max(self.runner.elapsed_ms(), self.io.elapsed_ms(), self.exporter.elapsed_ms())
-        busy = self.runner.busy or self.io.busy or self.exporter.busy
+        busy = self.runner.active or self.io.active or self.exporter.active
         long_run = busy and ms >= BUSY_DELAY_MS
         self.progress.setVisible(long_run)
-        self.cancel_button.setVisible(long_run and (self.runner.busy or self.io.busy))
+        self.cancel_button.setVisible(long_run and (self.runner.active or self.io.active))
         if long_run:
-            if self.exporter.busy and self._export_target is not None:
+            if self.exporter.active and self._export_target is not None:
                 what = f"exporting {self._export_target[1].name}…"
-            elif self.io.busy and self.loading_path is not None:
+            elif self.io.active and self.loading_path is not None:
                 what = f"opening {self.loading_path.name}…"
             else:
                 what = "processing…"
@@ -878,7 +899,7 @@ class MainWindow(QMainWindow):
         self.run_label.setText("processing failed")
 
     def _on_cancelled(self, gen: int) -> None:
-        if not (self.runner.busy or self.io.busy):
+        if not (self.runner.active or self.io.active):
             self.run_label.setText("cancelled")
         self._update_stale()
 

@@ -315,6 +315,7 @@ class LatestRunner(QObject):
     def __init__(self, parent: QObject | None = None) -> None:
         super().__init__(parent)
         self.generation = 0
+        self._cancelled_upto = 0
         self._pending: tuple[int, Task] | None = None
         self._thread: _RunThread | None = None
         self._clock = QElapsedTimer()
@@ -339,12 +340,20 @@ class LatestRunner(QObject):
     def cancel(self) -> None:
         """Drop the waiting request and stop the running one."""
         self._pending = None
+        self._cancelled_upto = self.generation  # never deliver these, even if they finish
         if self._thread is not None:
             self._thread.cancel_event.set()
 
     @property
     def busy(self) -> bool:
         return self._thread is not None or self._pending is not None
+
+    @property
+    def active(self) -> bool:
+        """A request waits or runs that was not cancelled (a cancelled run may still be
+        finishing on its thread: busy, but not active)."""
+        t = self._thread
+        return self._pending is not None or (t is not None and not t.cancel_event.is_set())
 
     def elapsed_ms(self) -> int:
         return int(self._clock.elapsed()) if self._thread is not None else 0
@@ -394,7 +403,7 @@ class LatestRunner(QObject):
         t.start()
 
     def _on_succeeded(self, gen: int, result: object) -> None:
-        if gen != self.generation:
+        if gen != self.generation or gen <= self._cancelled_upto:
             self.n_dropped += 1
             return
         self.n_delivered += 1
@@ -403,7 +412,7 @@ class LatestRunner(QObject):
         self.finished.emit(gen, result)
 
     def _on_failed(self, gen: int, message: str, user_facing: bool) -> None:
-        if gen != self.generation:
+        if gen != self.generation or gen <= self._cancelled_upto:
             self.n_dropped += 1
             return
         self.failed.emit(gen, message, user_facing)
