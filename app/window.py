@@ -10,7 +10,6 @@ geometry: :mod:`galvo_core.preview` does.
 from __future__ import annotations
 
 import json
-import math
 import os
 import re
 import time
@@ -398,6 +397,11 @@ class MainWindow(QMainWindow):
         self.controls.laser_requested.connect(self.open_laser_dialog)
         self.controls.defaults_button.clicked.connect(self.restore_defaults)
         self._add_hatch_pass_controls()
+        mag = self.controls.sliders.get("magnification")
+        if mag is not None:
+            # the box shows and takes any magnification down to its last decimal, e.g. the
+            # 0.09 Fit field computes for a big drawing (the slider keeps its range)
+            mag.spin.setMinimum(10.0 ** -mag.spin.decimals())
         scroll = QScrollArea()
         scroll.setWidget(self.controls)
         scroll.setWidgetResizable(True)
@@ -944,14 +948,8 @@ class MainWindow(QMainWindow):
             size_units = (bb[2] - bb[0], bb[3] - bb[1])
         self.controls.set_field_map(fm, size_units)
         mag = self.controls.sliders.get("magnification")
-        if mag is not None:
-            # the box must be able to show (and take) what Fit field computes, e.g. 0.09
-            step = 10.0 ** -mag.spin.decimals()
-            low = max(step, math.floor(fm.magnification / step) * step)
-            if low < mag.spin.minimum():
-                mag.spin.setMinimum(low)
-            if self.params.fit_field:
-                mag.set_value(fm.magnification)
+        if mag is not None and self.params.fit_field:
+            mag.set_value(fm.magnification)
         stats = dict(result.job.stats) if result.job is not None else {}
         extra = {}
         if len(pv.deviation_err):
