@@ -249,7 +249,8 @@ def _premultiplied(colour: QColor) -> np.uint32:
     return np.uint32((a << 24) | (r << 16) | (g << 8) | b)
 
 
-def draw_points(p, xy: np.ndarray, poly, pen: QPen, grid: float = 2.0) -> None:
+def draw_points(p, xy: np.ndarray, poly, pen: QPen, grid: float = 2.0,
+                cache: dict | None = None) -> None:
     """Draw markers at ``xy`` (item coordinates) with ``pen``. Small sets: antialiased, as
     they are. Large sets: culled to the device and thinned to one marker per ``grid``
     device pixels (what the eye can tell apart anyway), then rasterised here: each marker's
@@ -269,6 +270,14 @@ def draw_points(p, xy: np.ndarray, poly, pen: QPen, grid: float = 2.0) -> None:
     if w <= 0 or h <= 0:
         return
     t = p.transform()
+    key = (id(xy), len(xy), t.m11(), t.m12(), t.m21(), t.m22(), t.dx(), t.dy(), w, h, dpr,
+           pen.widthF(), pen.color().rgba(), grid)
+    if cache is not None and cache.get("key") == key:  # the same picture again (a repaint)
+        p.save()
+        p.resetTransform()
+        p.drawImage(QPointF(0.0, 0.0), cache["image"])
+        p.restore()
+        return
     dx = (xy[:, 0] * t.m11() + xy[:, 1] * t.m21() + t.dx()) * dpr
     dy = (xy[:, 0] * t.m12() + xy[:, 1] * t.m22() + t.dy()) * dpr
     g = max(1, int(round(grid * dpr)))
@@ -297,6 +306,8 @@ def draw_points(p, xy: np.ndarray, poly, pen: QPen, grid: float = 2.0) -> None:
         img[py[ok], px[ok]] = value
     qimg = QImage(img.data, w, h, 4 * w, QImage.Format.Format_ARGB32_Premultiplied)
     qimg.setDevicePixelRatio(dpr)
+    if cache is not None:
+        cache.update(key=key, image=qimg, buffer=img, data=xy)  # the buffer backs the image
     p.save()
     p.resetTransform()
     p.drawImage(QPointF(0.0, 0.0), qimg)
@@ -333,6 +344,7 @@ class PointsItem(_FastItem):
         self.pen.setCapStyle(Qt.PenCapStyle.SquareCap if square else Qt.PenCapStyle.RoundCap)
         self._xy = np.empty((0, 2))
         self._poly = _polygon(self._xy)
+        self._raster: dict = {}
 
     @staticmethod
     def prepare(xy: np.ndarray) -> tuple:
@@ -355,7 +367,7 @@ class PointsItem(_FastItem):
 
     def paint(self, p, *args) -> None:
         if len(self._xy):
-            draw_points(p, self._xy, self._poly, self.pen)
+            draw_points(p, self._xy, self._poly, self.pen, cache=self._raster)
 
 
 class ControlItem(_FastItem):
@@ -785,14 +797,29 @@ class WorkView(pg.PlotWidget):
     def data_items(self) -> list[pg.GraphicsObject]:
         return [self.layers[k] for k in self.layers]
 
-    #: opacity of the layers while the view shows an out-of-date result
-    STALE_OPACITY = 0.3
+    #: how much of the background covers the layers while the result is out of date
+    STALE_VEIL_ALPHA = 180
 
     def set_stale(self, stale: bool) -> None:
-        """Dim every layer (the result shown is out of date) or show it normally."""
+        """Dim the plot (the result shown is out of date) or show it normally: a veil of
+        the background colour over the plot area, so the layers' cached pixmaps stay valid
+        (changing their opacity would rasterise them all again, twice per change)."""
         self.stale = stale
-        for item in self.data_items():
-            item.setOpacity(self.STALE_OPACITY if stale else 1.0)
+        veil = getattr(self, "_veil", None)
+        if veil is None:
+            from PySide6.QtWidgets import QGraphicsRectItem
+
+            veil = QGraphicsRectItem()
+            c = pg.mkColor(BACKGROUND)
+            c.setAlpha(self.STALE_VEIL_ALPHA)
+            veil.setBrush(pg.mkBrush(c))
+            veil.setPen(pg.mkPen(None))
+            veil.setZValue(1e6)
+            self.scene().addItem(veil)
+            self._veil = veil
+        if stale:
+            veil.setRect(self.getPlotItem().getViewBox().sceneBoundingRect())
+        veil.setVisible(stale)
 
     # --- range ---------------------------------------------------------------------------
     def legend_height(self) -> float:
