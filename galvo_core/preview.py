@@ -390,27 +390,44 @@ def stroke_curves(job: Job, tol: float, kinds: Iterable[str] = ("contour",)) -> 
                     (s.source_index for s in strokes))
 
 
+def _all_marks(strokes: Sequence[Any]) -> tuple[np.ndarray, np.ndarray]:
+    """Every mark of ``strokes`` in order as one (M, 2) int64 array, and each stroke's mark
+    count (one concatenation, no Python work per mark)."""
+    if not strokes:
+        return np.empty((0, 2), dtype=np.int64), np.empty(0, dtype=np.int64)
+    lens = np.fromiter((len(s.marks) for s in strokes), dtype=np.int64, count=len(strokes))
+    if not lens.sum():
+        return np.empty((0, 2), dtype=np.int64), lens
+    allm = np.concatenate([s.marks for s in strokes if len(s.marks)])
+    return np.asarray(allm, dtype=np.int64).reshape(-1, 2), lens
+
+
 def mark_points(job: Job, kinds: Iterable[str] | None = None) -> tuple[np.ndarray, np.ndarray]:
     """Every mark of the job's strokes (of ``kinds``; all when None) in marking order:
     ``(bits (M, 2) int64, ids (M,) source_index)``."""
-    strokes = [s for s in job.strokes if kinds is None or s.kind in set(kinds)]
+    want = None if kinds is None else set(kinds)
+    strokes = [s for s in job.strokes if want is None or s.kind in want]
     if not strokes:
         return np.empty((0, 2), dtype=np.int64), _NO_IDS
-    marks = [np.asarray(s.marks, dtype=np.int64).reshape(-1, 2) for s in strokes]
-    ids = np.repeat(np.fromiter((s.source_index for s in strokes), dtype=np.int64,
-                                count=len(strokes)),
-                    [len(m) for m in marks])
-    return np.concatenate(marks), ids
+    marks, lens = _all_marks(strokes)
+    src = np.fromiter((s.source_index for s in strokes), dtype=np.int64, count=len(strokes))
+    return marks, np.repeat(src, lens)
 
 
 def jump_segments(job: Job) -> np.ndarray:
     """The laser-off moves between consecutive strokes (last mark -> next first mark) as
     NaN-separated pairs, galvo bits (float)."""
-    ends = [(s.marks[0], s.marks[-1]) for s in job.strokes if len(s.marks)]
-    if len(ends) < 2:
+    return _jumps_from(*_all_marks(job.strokes))
+
+
+def _jumps_from(marks: np.ndarray, lens: np.ndarray) -> np.ndarray:
+    lens = lens[lens > 0]
+    if len(lens) < 2:
         return EMPTY
-    starts = np.array([e[0] for e in ends[1:]], dtype=np.float64)
-    stops = np.array([e[1] for e in ends[:-1]], dtype=np.float64)
+    ends = np.cumsum(lens)
+    firsts = marks[ends - lens].astype(np.float64)
+    lasts = marks[ends - 1].astype(np.float64)
+    starts, stops = firsts[1:], lasts[:-1]
     moving = (starts != stops).any(axis=1)
     starts, stops = starts[moving], stops[moving]
     out = np.full((3 * len(starts), 2), np.nan)
@@ -745,9 +762,12 @@ def build_preview(
     kerf_on = float(job.params.get("kerf_mm", 0.0) or 0.0) > 0.0
     kerf = stroke_curves(job, tol_units) if kerf_on else Polylines()
 
-    marks_bits, mark_ids = mark_points(job)
+    marks_bits, lens = _all_marks(job.strokes)  # once for the marks and the jumps
+    src = np.fromiter((s.source_index for s in job.strokes), dtype=np.int64,
+                      count=len(job.strokes))
+    mark_ids = np.repeat(src, lens)
     marks = marks_bits.astype(np.float64)
-    jumps = jump_segments(job)
+    jumps = _jumps_from(marks_bits, lens)
     hatch = hatch_polylines(job)
 
     bounds = _union(_affine_box(_union(o_box, c_box, bbox(kerf.xy)), scale, offset),
