@@ -249,24 +249,27 @@ def _piece_indices(first: int, last: int, n: int, closed: bool) -> np.ndarray:
 
 
 @njit(cache=True, nogil=True)
-def _deviation_kernel(src: np.ndarray, closed: bool, ctrl: np.ndarray, first: np.ndarray,
-                      last: np.ndarray, ks: np.ndarray, starts: np.ndarray, a_out: np.ndarray,
-                      b_out: np.ndarray, e_out: np.ndarray) -> None:  # pragma: no cover - jit
-    """One path's segments: ``ks[j]`` samples of segment ``j`` (Bernstein form, uniform
-    parameters), each sample's distance to the source points ``first .. last`` (indices
-    modulo ``n`` when ``closed``); chords ``starts[j] ..`` of the outputs."""
-    n = src.shape[0]
+def _deviation_kernel(src: np.ndarray, off: np.ndarray, npts: np.ndarray, closed: np.ndarray,
+                      ctrl: np.ndarray, first: np.ndarray, last: np.ndarray, ks: np.ndarray,
+                      starts: np.ndarray, a_out: np.ndarray, b_out: np.ndarray,
+                      e_out: np.ndarray) -> None:  # pragma: no cover - jit
+    """Segment ``j``: ``ks[j]`` samples (Bernstein form, uniform parameters), each sample's
+    distance to the source points ``first .. last`` of its path (the path's points are
+    ``src[off[j] : off[j] + npts[j]]``; indices modulo ``npts`` when ``closed``); chords
+    ``starts[j] ..`` of the outputs."""
     for j in range(ctrl.shape[0]):
         k = ks[j]
         if k == 0:
             continue
+        n = npts[j]
+        o = off[j]
         p0x, p0y = ctrl[j, 0, 0], ctrl[j, 0, 1]
         p1x, p1y = ctrl[j, 1, 0], ctrl[j, 1, 1]
         p2x, p2y = ctrl[j, 2, 0], ctrl[j, 2, 1]
         p3x, p3y = ctrl[j, 3, 0], ctrl[j, 3, 1]
         lo = first[j]
         hi = last[j]
-        if not closed:
+        if not closed[j]:
             lo = max(lo, 0)
             hi = min(hi, n - 1)
         prev_x = 0.0
@@ -278,13 +281,13 @@ def _deviation_kernel(src: np.ndarray, closed: bool, ctrl: np.ndarray, first: np
             x = u * u * u * p0x + 3.0 * u * u * t * p1x + 3.0 * u * t * t * p2x + t * t * t * p3x
             y = u * u * u * p0y + 3.0 * u * u * t * p1y + 3.0 * u * t * t * p2y + t * t * t * p3y
             best = np.inf
-            qx = src[lo % n, 0]
-            qy = src[lo % n, 1]
+            qx = src[o + lo % n, 0]
+            qy = src[o + lo % n, 1]
             if hi == lo:
                 best = (x - qx) ** 2 + (y - qy) ** 2
             for m in range(lo + 1, hi + 1):
-                rx = src[m % n, 0]
-                ry = src[m % n, 1]
+                rx = src[o + m % n, 0]
+                ry = src[o + m % n, 1]
                 vx = rx - qx
                 vy = ry - qy
                 den = vx * vx + vy * vy
@@ -331,52 +334,53 @@ def deviation_samples(
     points ``b`` (K, 2) in input units, and ``err`` (K,) the larger error of the chord's two
     ends, in input units. Segments whose source points are unknown are skipped.
 
-    Compiled (numba): a loop over samples and the source points each segment replaces, so
-    the work is about ``max_samples`` × the input points at most, with no Python per segment.
+    Compiled (numba), one call for the whole drawing: a loop over samples and the source
+    points each segment replaces, so the work is about ``max_samples`` × the input points
+    at most; Python only gathers each segment's control points once.
     """
-    jobs: list[tuple[np.ndarray, bool, np.ndarray, np.ndarray, np.ndarray, np.ndarray]] = []
-    total = 0
-    for j, fp in enumerate(fitted):
-        if cancel is not None and j % 64 == 0 and cancel():
-            raise Cancelled()
-        if not 0 <= fp.source_index < len(drawing.paths) or not fp.segments:
-            continue
-        src = np.ascontiguousarray(drawing.paths[fp.source_index].points, dtype=np.float64)
-        n = len(src)
-        if not n:
-            continue
-        segs = fp.segments
-        first = np.fromiter((sg.first for sg in segs), dtype=np.int64, count=len(segs))
-        last = np.fromiter((sg.last for sg in segs), dtype=np.int64, count=len(segs))
-        ctrl = np.empty((len(segs), 4, 2))
-        for i, sg in enumerate(segs):
-            pts = sg.points
-            if len(pts) == 4:
-                ctrl[i] = pts
-            else:  # a line as a cubic with its inner points at thirds: B(t) = P0 + t (P3 - P0)
-                d = pts[-1] - pts[0]
-                ctrl[i, 0], ctrl[i, 3] = pts[0], pts[-1]
-                ctrl[i, 1], ctrl[i, 2] = pts[0] + d / 3.0, pts[0] + 2.0 * d / 3.0
-        if fp.closed:
-            count = np.maximum(last - first + 1, 0)
-        else:
-            count = np.maximum(np.minimum(last, n - 1) - np.maximum(first, 0) + 1, 0)
-        ks = np.where(count > 0, np.clip(2 * count, min_samples, max_samples), 0)
-        jobs.append((src, bool(fp.closed), ctrl, first, last, ks))
-        total += int(np.maximum(ks - 1, 0).sum())
+    fps = [fp for fp in fitted if 0 <= fp.source_index < len(drawing.paths) and fp.segments
+           and len(drawing.paths[fp.source_index].points)]
+    if not fps:
+        return EMPTY, EMPTY, np.empty(0)
+    if cancel is not None and cancel():
+        raise Cancelled()
+    srcs = [drawing.paths[fp.source_index].points for fp in fps]
+    plen = np.fromiter((len(p) for p in srcs), dtype=np.int64, count=len(srcs))
+    poff = np.concatenate(([0], np.cumsum(plen)[:-1]))
+    src = np.ascontiguousarray(np.concatenate(srcs), dtype=np.float64)
+    nseg = np.fromiter((len(fp.segments) for fp in fps), dtype=np.int64, count=len(fps))
+    segs = [sg for fp in fps for sg in fp.segments]
+    first = np.fromiter((sg.first for sg in segs), dtype=np.int64, count=len(segs))
+    last = np.fromiter((sg.last for sg in segs), dtype=np.int64, count=len(segs))
+    pts = [sg.points for sg in segs]
+    if cancel is not None and cancel():
+        raise Cancelled()
+    is_cubic = np.fromiter((len(q) == 4 for q in pts), dtype=bool, count=len(pts))
+    ctrl = np.empty((len(segs), 4, 2))
+    if is_cubic.any():
+        ctrl[is_cubic] = np.stack([q for q, c in zip(pts, is_cubic, strict=True) if c])
+    if not is_cubic.all():
+        # a line as a cubic with its inner points at thirds: B(t) = P0 + t (P3 - P0)
+        ends = np.stack([(q[0], q[-1]) for q, c in zip(pts, is_cubic, strict=True) if not c])
+        d = ends[:, 1] - ends[:, 0]
+        ctrl[~is_cubic] = np.stack((ends[:, 0], ends[:, 0] + d / 3.0,
+                                    ends[:, 0] + 2.0 * d / 3.0, ends[:, 1]), axis=1)
+    off = np.repeat(poff, nseg)
+    npts = np.repeat(plen, nseg)
+    closed = np.repeat(np.fromiter((bool(fp.closed) for fp in fps), dtype=bool,
+                                   count=len(fps)), nseg)
+    count = np.where(closed, np.maximum(last - first + 1, 0),
+                     np.maximum(np.minimum(last, npts - 1) - np.maximum(first, 0) + 1, 0))
+    ks = np.where(count > 0, np.clip(2 * count, min_samples, max_samples), 0)
+    chords = np.maximum(ks - 1, 0)
+    total = int(chords.sum())
     if not total:
         return EMPTY, EMPTY, np.empty(0)
+    starts = np.concatenate(([0], np.cumsum(chords)[:-1]))
     a = np.empty((total, 2))
     b = np.empty((total, 2))
     e = np.empty(total)
-    row = 0
-    for j, (src, closed, ctrl, first, last, ks) in enumerate(jobs):
-        if cancel is not None and j % 64 == 0 and cancel():
-            raise Cancelled()
-        chords = np.maximum(ks - 1, 0)
-        starts = row + np.concatenate(([0], np.cumsum(chords)[:-1]))
-        _deviation_kernel(src, closed, ctrl, first, last, ks, starts, a, b, e)
-        row += int(chords.sum())
+    _deviation_kernel(src, off, npts, closed, ctrl, first, last, ks, starts, a, b, e)
     return a, b, e
 
 
