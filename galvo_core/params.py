@@ -378,7 +378,8 @@ class FillParams(ParamGroup):
         decimals=0, control=True)
     hatch_angle_step_deg: float = param(
         90.0, unit="deg", label="Hatch angle step", lo=-360.0, hi=360.0,
-        help="turn between hatch passes")
+        help="turn between hatch passes", slider=(-180.0, 180.0), log=False, decimals=1,
+        control=True)
     hatch_inset_mm: float = param(
         0.0, unit="mm", label="Hatch inset", lo=0.0, hi=1000.0,
         help="distance kept between the fill lines and the outline")
