@@ -135,7 +135,7 @@ def main() -> None:
     for f in files:
         try:
             d = read_file(f)
-            job = pipe.run(d, Params(fit_field=True))
+            job = pipe.run(d, Params(fit_field=True)).job
         except GalvoError:
             continue
         if not job.strokes:

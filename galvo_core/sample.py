@@ -96,7 +96,7 @@ from typing import Any
 
 import numpy as np
 
-from galvo_core.errors import ParamError
+from galvo_core.errors import Cancelled, ParamError
 from galvo_core.field import FieldMap
 from galvo_core.fit import FittedPath
 from galvo_core.geometry import power_coeffs_many
@@ -553,8 +553,6 @@ def _search_h(curves: _Curves, ids0: np.ndarray, t0: np.ndarray,
     while len(k):
         rounds += 1
         if cancel is not None and rounds % 64 == 0 and cancel():
-            from galvo_core.pipeline import Cancelled
-
             raise Cancelled()
         ids = ids0[k]
         te = t1[k]
