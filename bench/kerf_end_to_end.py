@@ -89,8 +89,9 @@ def main() -> None:
     a = ap.parse_args()
     corpus = sorted((f for f in CORPUS.glob("*") if f.suffix.lower() in (".plt", ".hpgl")),
                     key=lambda f: -f.stat().st_size)[: a.files] if CORPUS.is_dir() else []
-    print(f"# {time.strftime('%Y-%m-%d %H:%M UTC', time.gmtime())}, {platform.processor() or platform.machine()}, "
-          f"CPU time best of {a.repeat}")
+    when = time.strftime("%Y-%m-%d %H:%M UTC", time.gmtime())
+    cpu = platform.processor() or platform.machine()
+    print(f"# {when}, {cpu}, CPU time best of {a.repeat}")
     print("| file | side | marks current | marks plain | x | gap (bits) | CPU current (s) | "
           "CPU plain (s) | x |")
     print("|---|---|---:|---:|---:|---:|---:|---:|---:|")

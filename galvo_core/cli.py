@@ -16,12 +16,8 @@ from typing import Any, NoReturn
 
 from galvo_core import __version__, cli_lmc
 from galvo_core.errors import GalvoError, ParamError
-from galvo_core.export import write_plt, write_svg
-from galvo_core.fit import fit_report
 from galvo_core.hpgl import read_file
-from galvo_core.job import write_job
 from galvo_core.params import GROUPS, Params, Spec, all_specs
-from galvo_core.pipeline import Pipeline
 
 
 class _Parser(argparse.ArgumentParser):
@@ -87,6 +83,11 @@ def cmd_info(a: argparse.Namespace) -> int:
 
 
 def cmd_process(a: argparse.Namespace) -> int:
+    # imported here: info and --help need none of the pipeline (numba, scipy, shapely)
+    from galvo_core.export import write_plt, write_svg
+    from galvo_core.job import write_job
+    from galvo_core.pipeline import Pipeline
+
     params = _params_from_args(a)
     d = read_file(a.file)
     job = Pipeline().run(d, params).job
@@ -109,6 +110,9 @@ def cmd_process(a: argparse.Namespace) -> int:
 
 
 def cmd_report(a: argparse.Namespace) -> int:
+    from galvo_core.fit import fit_report
+    from galvo_core.pipeline import Pipeline
+
     params = _params_from_args(a)
     d = read_file(a.file)
     row = fit_report(d, eps_line=params.eps_line, e_per=params.e_per, eps_sum=params.eps_sum)

@@ -97,14 +97,6 @@ def add_controller_options(p: argparse.ArgumentParser) -> None:
                         f"{DEFAULT_FRAME_LOOPS})")
 
 
-def controller_dests() -> frozenset[str]:
-    """The ``process`` options :func:`add_controller_options` adds (argparse dests): files
-    and controller settings, not processing parameters."""
-    p = argparse.ArgumentParser(add_help=False)
-    add_controller_options(p)
-    return frozenset(a.dest for a in p._actions)
-
-
 def _orientation(a: argparse.Namespace) -> Orientation:
     return Orientation(bool(a.swap_xy), bool(a.flip_x), bool(a.flip_y))
 

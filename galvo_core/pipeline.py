@@ -33,7 +33,7 @@ from galvo_core.errors import Cancelled
 from galvo_core.field import FieldMap, check_in_field, make_field
 from galvo_core.fill import HatchStroke, hatch
 from galvo_core.fit import FitCancelled, FittedPath, control_points, fit_drawing
-from galvo_core.job import Job, Stroke
+from galvo_core.job import Job, Segments, Stroke
 from galvo_core.kerf import compensate_indexed
 from galvo_core.order import order_job_strokes
 from galvo_core.params import UNITS_PER_MM, Params
@@ -301,7 +301,7 @@ class Pipeline:
             return c
 
         segs = self._fact(fitted, "segments", lambda: [
-            tuple((s.kind, s.points) for s in fp.segments) for fp in fitted])
+            Segments(fp.is_cubic, fp.points) for fp in fitted])
         strokes = [Stroke("contour", origin[fp.source_index], fp.closed, clamp(m), sg, fp.pen)
                    for fp, m, sg in zip(fitted, sampled.marks, segs, strict=True) if len(m)]
         strokes += [Stroke("hatch", origin[h.source_index], False, clamp(hm), (),
@@ -320,8 +320,8 @@ class Pipeline:
         fit_err, n_control, n_lines, n_cubics = self._fact(fitted, "counts", lambda: (
             max((f.max_error for f in fitted), default=0.0),
             sum(control_points(f) for f in fitted),
-            sum(1 for f in fitted for s in f.segments if s.kind == "line"),
-            sum(1 for f in fitted for s in f.segments if s.kind == "cubic")))
+            sum(f.n_lines for f in fitted),
+            sum(f.n_cubics for f in fitted)))
         out: dict[str, Any] = {
             "input_points": n_input,
             "control_points": n_control,

@@ -86,8 +86,8 @@ def test_two_pen_export_replays_exactly(files):
 
 
 @pytest.mark.parametrize("text, reason", [
-    ("[pen.1]\nmark_speed_mm_s = -100\n", "pen.1: mark_speed_mm_s must be "),
-    ("[pen.2]\npower_percent = 101\n", "pen.2: power_percent must be "),
+    ("[pen.1]\nmark_speed_mm_s = -100\n", "mark_speed_mm_s must be > 0"),
+    ("[pen.2]\npower_percent = 101\n", "power_percent must be >= 0 and <= 100"),
     ("[pen.1\n", "not valid TOML"),
     ("[pen.1]\nspeed = 3\n", "unknown key"),
 ])
