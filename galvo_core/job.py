@@ -695,7 +695,3 @@ def _strokes_from_arrays(arr: dict[str, np.ndarray], n: int, fm: FieldMap,
         strokes.append(Stroke(kinds[i], src[i], closed[i], marks[ms[i]:ms[i + 1]], segs,
                               pen[i]))
     return _finish(doc, fm, strokes, name)
-
-
-def strokes_marks(strokes: Sequence[Stroke]) -> list[np.ndarray]:
-    return [s.marks for s in strokes]
