@@ -100,7 +100,7 @@ from galvo_core.errors import Cancelled, ParamError
 from galvo_core.field import FieldMap
 from galvo_core.fit import FittedPath
 from galvo_core.geometry import power_coeffs_into
-from galvo_core.timing import CORNER_DEG
+from galvo_core.turns import CORNER_DEG, turn_deg
 
 __all__ = [
     "E_MIN_RATIO",
@@ -978,10 +978,8 @@ class _Geometry:
         corner = np.zeros(g, dtype=bool)
         if g > 1:
             a, b = te[:-1], ts[1:]
-            ax_, ay_, bx_, by_ = a[:, 0], a[:, 1], b[:, 0], b[:, 1]
-            cr = ax_ * by_ - ay_ * bx_
-            ang = np.degrees(np.abs(np.arctan2(cr, ax_ * bx_ + ay_ * by_)))
-            deg = ~(((ax_ != 0) | (ay_ != 0)) & ((bx_ != 0) | (by_ != 0)))
+            ang = turn_deg(a, b)
+            deg = ~((a != 0).any(axis=1) & (b != 0).any(axis=1))
             corner[:-1] = ((ang > CORNER_DEG) | deg) & (self.seg_path[:-1] ==
                                                          self.seg_path[1:])
         cf = tuple(block[i, j] for i in range(4) for j in range(2))
@@ -1351,7 +1349,6 @@ def polyline_marks(points: np.ndarray, fm: FieldMap, *, min_step_bits: float,
     if n >= 3:
         a = pts[1:-1] - pts[:-2]
         b = pts[2:] - pts[1:-1]
-        ang = np.degrees(np.abs(np.arctan2(_cross(a, b), _dot(a, b))))
-        prot[1:-1] = ang > corner_deg
+        prot[1:-1] = turn_deg(a, b) > corner_deg
     keep = _min_step_filter(pts, prot, min_step_bits)
     return _dedup(_round(pts[keep]))

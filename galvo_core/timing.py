@@ -28,8 +28,7 @@ from collections.abc import Sequence
 import numpy as np
 
 from galvo_core.params import LaserParams
-
-CORNER_DEG = 15.0
+from galvo_core.turns import CORNER_DEG, consecutive_turns_deg
 
 
 def stroke_lengths_mm(marks: np.ndarray, mm_per_bit: float) -> np.ndarray:
@@ -39,23 +38,13 @@ def stroke_lengths_mm(marks: np.ndarray, mm_per_bit: float) -> np.ndarray:
     return np.hypot(d[:, 0], d[:, 1]) * mm_per_bit
 
 
-def _turns_deg(d: np.ndarray) -> np.ndarray:
-    """Direction change (degrees) between consecutive non-zero vectors ``d`` (K, 2)."""
-    if len(d) < 2:
-        return np.zeros(0)
-    a, b = d[:-1], d[1:]
-    cross = a[:, 0] * b[:, 1] - a[:, 1] * b[:, 0]
-    dot = (a * b).sum(axis=1)
-    return np.degrees(np.abs(np.arctan2(cross, dot)))
-
-
 def corners(marks: np.ndarray, corner_deg: float = CORNER_DEG) -> int:
     """Interior vertices where the direction turns by more than ``corner_deg``."""
     if len(marks) < 3:
         return 0
     d = np.diff(marks.astype(np.float64), axis=0)
     d = d[(d != 0).any(axis=1)]
-    return int((_turns_deg(d) > corner_deg).sum())
+    return int((consecutive_turns_deg(d) > corner_deg).sum())
 
 
 def _periods(length_mm: np.ndarray, speed_mm_s: float, period_s: float) -> np.ndarray:
@@ -111,9 +100,8 @@ def estimate_with_dwell(
     vx, vy, vsid = vx[nz], vy[nz], vsid[nz]
     n_corners = 0
     if len(vx) >= 2:
-        cross = vx[:-1] * vy[1:] - vy[:-1] * vx[1:]
-        dot = vx[:-1] * vx[1:] + vy[:-1] * vy[1:]
-        turn = np.degrees(np.abs(np.arctan2(cross, dot)))
+        v = np.stack([vx, vy], axis=1)
+        turn = consecutive_turns_deg(v)
         n_corners = int(np.count_nonzero((turn > CORNER_DEG) & (vsid[1:] == vsid[:-1])))
     # jumps
     jv = allm[starts[1:]] - allm[ends[:-1]]
