@@ -91,7 +91,7 @@ import math
 import threading
 from collections import OrderedDict
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, fields
 from typing import Any
 
 import numpy as np
@@ -1034,92 +1034,144 @@ def sample_paths(
 
     All cubics of all paths are searched together, so the cost per mark stays low however
     many paths there are. ``raw_points[i]`` are the input points of ``fitted[i]`` (needed for
-    ``raw``).
+    ``raw``). The steps: the marks' curve parameters (cubics by the search or paper 001's
+    fixed step, lines by their ends), merged in path order; the minimum step; rounding to
+    whole bits; every chord measured against the true curve; one stroke per path.
     """
     if interpolation not in ("adaptive", "fixed", "raw"):
         raise ParamError(f"interpolation must be adaptive, fixed or raw; got {interpolation!r}")
     tol = float(chord_tol_bits)
     report = SampleReport(interpolation, tol)
     res = SampleResult([], report)
-    mx = fm.max_bit
     if interpolation == "raw":
-        for i, _fp in enumerate(fitted):
-            pts = raw_points[i] if raw_points is not None else np.empty((0, 2))
-            m = _dedup(fm.to_bits(np.asarray(pts, dtype=np.float64).reshape(-1, 2)))
-            res.marks.append(m)
-            report.outside_points += int(((m < 0) | (m > mx)).any(axis=1).sum()) if len(m) else 0
+        res.marks = _raw_marks(fitted, fm, raw_points, report)
         return res
     ms_max = math.inf if max_step_bits is None else float(max_step_bits)
     min_step = float(min_step_bits)
-    # ---- every segment of every path, in bits, in power form
+    # every segment of every path, in bits, in power form (a line's: a = b = 0)
     geo = _geometry(fitted)
-    path_first, path_n, is_cubic = geo.path_first, geo.path_n, geo.is_cubic
-    if not len(is_cubic):
+    if not len(geo.is_cubic):
         res.marks = [np.empty((0, 2), dtype=np.int64) for _ in fitted]
         return res
-    ends, coef, corner, cf = geo.fielded(fm)  # a line's power form: a = b = 0
+    ends, coef, corner, cf = geo.fielded(fm)
     cs = _CubicSet(coef, cf=cf)
     res.coef = coef
-    # ---- marks (segment id, t) per segment, t in (0, 1], last at 1
-    seg_ids: list[np.ndarray] = []
-    seg_ts: list[np.ndarray] = []
-    # the search's own measurement of the chord ending at each mark, and that chord's start
-    # parameter (NaN where there is none): reused below where the chord is still that one
-    seg_h: list[np.ndarray] = []
-    seg_a: list[np.ndarray] = []
-    cub = np.flatnonzero(is_cubic)
-    if len(cub):
-        if interpolation == "adaptive":
-            # cubics meeting smoothly are searched as one curve: no mark is forced at
-            # their joint, and no partial chord is left at the end of each cubic
-            first, n = _smooth_chains(cf, is_cubic, corner, geo.seg_path, tol)
-            chains = _ChainSet(cs, first, n)
-            ck = np.arange(len(first))
-            s0 = np.zeros(len(first))
-            kk, ss, oo, trials, hh, aa = _search_h(
-                chains, ck, s0, n.astype(np.float64), e_min=E_MIN_RATIO * tol, e_max=tol,
-                min_step=min_step, max_step=ms_max, cancel=cancel)
-            _fix_short_ends(chains, ck, s0, kk, ss, e_max=tol, min_step=min_step, h=hh, a=aa)
-            report.min_step_overrides = int(oo.sum())
-            report.trials = trials
-            gid, tt = chains.locate(kk, ss, ending=True)
-            # the search's measurement is reused for chords within one cubic only
-            aa = aa - (gid - first[kk])
-            within = aa >= 0.0  # NaN compares False
-            seg_ids.append(gid)
-            seg_ts.append(tt)
-            seg_h.append(np.where(within, hh, np.nan))
-            seg_a.append(np.where(within, aa, np.nan))
-        else:
-            for g in cub.tolist():
-                tf = _fixed_params(cs, g, float(fixed_step_bits), float(fixed_slope_tol))
-                seg_ids.append(np.full(len(tf), g))
-                seg_ts.append(tf)
-    lines = np.flatnonzero(~is_cubic)
-    if len(lines):
-        if math.isfinite(ms_max):
-            ln = np.hypot(*(ends[lines, 1] - ends[lines, 0]).T)
-            nseg = np.maximum(1, np.ceil(ln / ms_max - 1e-9)).astype(np.int64)
-            rep = np.repeat(lines, nseg)
-            start = np.cumsum(nseg) - nseg
-            idx = np.arange(len(rep)) - np.repeat(start, nseg) + 1
-            seg_ids.append(rep)
-            seg_ts.append(idx / np.repeat(nseg, nseg))
-        else:
-            seg_ids.append(lines)
-            seg_ts.append(np.ones(len(lines)))
-    # the start mark of every non-empty path: (first segment, t = 0); every other mark has
-    # t > 0
-    seg_path = geo.seg_path
-    firsts = path_first[path_n > 0]
-    sid = np.concatenate([firsts] + seg_ids).astype(np.int64)
-    st = np.concatenate([np.zeros(len(firsts))] + seg_ts)
-    n_known = sum(len(x) for x in seg_h)
-    hm = np.full(len(sid), np.nan)
-    am = np.full(len(sid), np.nan)
-    if n_known:  # the search's block comes right after the starts
-        hm[len(firsts):len(firsts) + n_known] = np.concatenate(seg_h)
-        am[len(firsts):len(firsts) + n_known] = np.concatenate(seg_a)
+    blocks = _cubic_params(cs, cf, geo, corner, interpolation, tol, min_step, ms_max,
+                           float(fixed_step_bits), float(fixed_slope_tol), report, cancel)
+    blocks.append(_line_params(np.flatnonzero(~geo.is_cubic), ends, ms_max))
+    mk = _merged_marks(cs, geo, ends, corner, blocks)
+    if min_step > 0.0:
+        mk = _min_step_pass(mk, cs, tol, min_step, report)
+    r, mk = _rounded(mk)
+    report.outside_points = int(((r < 0) | (r > fm.max_bit)).any(axis=1).sum())
+    _measure_into(report, mk, r, cs, geo.is_cubic, tol)
+    # one stroke per path
+    cuts = np.searchsorted(mk.pid, np.arange(len(fitted) + 1)).tolist()
+    cuts[-1] = len(mk.pid)
+    spans = list(zip(cuts[:-1], cuts[1:], strict=True))
+    res.marks = [r[a:b] for a, b in spans]
+    res.float_marks = [mk.pos[a:b] for a, b in spans]
+    res.params = [(mk.sid[a:b], mk.st[a:b]) for a, b in spans]
+    return res
+
+
+def _raw_marks(fitted: Sequence[FittedPath], fm: FieldMap,
+               raw_points: Sequence[np.ndarray] | None, report: SampleReport
+               ) -> list[np.ndarray]:
+    """``raw``: the input points themselves, rounded, consecutive repeats dropped."""
+    out = []
+    for i, _fp in enumerate(fitted):
+        pts = raw_points[i] if raw_points is not None else np.empty((0, 2))
+        m = _dedup(fm.to_bits(np.asarray(pts, dtype=np.float64).reshape(-1, 2)))
+        out.append(m)
+        report.outside_points += (int(((m < 0) | (m > fm.max_bit)).any(axis=1).sum())
+                                  if len(m) else 0)
+    return out
+
+
+@dataclass
+class _ParamBlock:
+    """Marks as (segment id, t) with t in (0, 1], and, where the search measured it, the
+    chord ending at each mark (height ``h`` and its start parameter ``a``; NaN: unknown)."""
+
+    ids: np.ndarray
+    ts: np.ndarray
+    h: np.ndarray | None = None
+    a: np.ndarray | None = None
+
+
+def _cubic_params(cs: _CubicSet, cf: CF, geo: _Geometry, corner: np.ndarray,
+                  interpolation: str, tol: float, min_step: float, ms_max: float,
+                  fixed_step: float, fixed_slope_tol: float, report: SampleReport,
+                  cancel: Callable[[], bool] | None) -> list[_ParamBlock]:
+    """The marks on the cubics: the adaptive search (paper 000 §4, 004) over chains of
+    cubics that meet smoothly (no mark forced at their joints, no partial chord left at the
+    end of each cubic), or paper 001's fixed step cubic by cubic."""
+    cub = np.flatnonzero(geo.is_cubic)
+    if not len(cub):
+        return []
+    if interpolation != "adaptive":
+        return [_ParamBlock(np.full(len(tf), g), tf) for g in cub.tolist()
+                for tf in (_fixed_params(cs, g, fixed_step, fixed_slope_tol),)]
+    first, n = _smooth_chains(cf, geo.is_cubic, corner, geo.seg_path, tol)
+    chains = _ChainSet(cs, first, n)
+    ck = np.arange(len(first))
+    s0 = np.zeros(len(first))
+    kk, ss, oo, trials, hh, aa = _search_h(
+        chains, ck, s0, n.astype(np.float64), e_min=E_MIN_RATIO * tol, e_max=tol,
+        min_step=min_step, max_step=ms_max, cancel=cancel)
+    _fix_short_ends(chains, ck, s0, kk, ss, e_max=tol, min_step=min_step, h=hh, a=aa)
+    report.min_step_overrides = int(oo.sum())
+    report.trials = trials
+    gid, tt = chains.locate(kk, ss, ending=True)
+    # the search's measurement is reused for chords within one cubic only
+    aa = aa - (gid - first[kk])
+    within = aa >= 0.0  # NaN compares False
+    return [_ParamBlock(gid, tt, np.where(within, hh, np.nan), np.where(within, aa, np.nan))]
+
+
+def _line_params(lines: np.ndarray, ends: np.ndarray, ms_max: float) -> _ParamBlock:
+    """The marks on the lines: their ends, and steps of at most ``ms_max`` between."""
+    if not math.isfinite(ms_max) or not len(lines):
+        return _ParamBlock(lines, np.ones(len(lines)))
+    ln = np.hypot(*(ends[lines, 1] - ends[lines, 0]).T)
+    nseg = np.maximum(1, np.ceil(ln / ms_max - 1e-9)).astype(np.int64)
+    start = np.cumsum(nseg) - nseg
+    idx = np.arange(int(nseg.sum())) - np.repeat(start, nseg) + 1
+    return _ParamBlock(np.repeat(lines, nseg), idx / np.repeat(nseg, nseg))
+
+
+@dataclass
+class _MarkRows:
+    """Every mark of every path in path order: segment id, parameter, float position
+    (bits), path, the search's chord height and start (NaN: unknown), first/last of a
+    stroke, protected (stroke ends and corner joints: never merged)."""
+
+    sid: np.ndarray
+    st: np.ndarray
+    pos: np.ndarray
+    pid: np.ndarray
+    hm: np.ndarray
+    am: np.ndarray
+    first_of: np.ndarray
+    last_of: np.ndarray
+    prot: np.ndarray
+
+    def keep(self, keep: np.ndarray) -> _MarkRows:
+        return _MarkRows(*(getattr(self, f.name)[keep] for f in fields(self)))
+
+
+def _merged_marks(cs: _CubicSet, geo: _Geometry, ends: np.ndarray, corner: np.ndarray,
+                  blocks: list[_ParamBlock]) -> _MarkRows:
+    """The blocks and the start mark of every non-empty path (first segment, t = 0; every
+    other mark has t > 0), in path order, with their positions."""
+    firsts = geo.path_first[geo.path_n > 0]
+    sid = np.concatenate([firsts] + [b.ids for b in blocks]).astype(np.int64)
+    st = np.concatenate([np.zeros(len(firsts))] + [b.ts for b in blocks])
+    hm = np.concatenate([np.full(len(firsts), np.nan)] + [
+        b.h if b.h is not None else np.full(len(b.ids), np.nan) for b in blocks])
+    am = np.concatenate([np.full(len(firsts), np.nan)] + [
+        b.a if b.a is not None else np.full(len(b.ids), np.nan) for b in blocks])
     # each block is sorted by (segment, t) and starts come first: a stable sort by segment
     # merges the runs (timsort, about linear here)
     order = np.argsort(sid, kind="stable")
@@ -1129,66 +1181,75 @@ def sample_paths(
     pos[at1] = ends[sid[at1], 1]  # segment ends exactly (continuity)
     at0 = st <= 0.0
     pos[at0] = ends[sid[at0], 0]
-    pid = seg_path[sid]
-    # ---- protected marks: stroke ends and corner joints
+    pid = geo.seg_path[sid]
     first_of = np.r_[True, pid[1:] != pid[:-1]]
     last_of = np.r_[pid[1:] != pid[:-1], True]
     prot = first_of | last_of | (at1 & corner[sid])
-    # ---- the minimum step between consecutive marks (rarely needed after the search)
-    if min_step > 0.0 and len(pid) > 2:
-        dd = np.hypot(pos[1:, 0] - pos[:-1, 0], pos[1:, 1] - pos[:-1, 1])
-        short = (dd < min_step) & ~last_of[:-1]
-        if short.any():  # every stroke at once; the loop runs only near short chords
-            keep = np.zeros(len(pid), dtype=bool)
-            forced: list[int] = []
+    return _MarkRows(sid, st, pos, pid, hm, am, first_of, last_of, prot)
 
-            def merge_ok(a: int, b: int) -> bool:
-                """The chord from mark a to mark b keeps within the tolerance."""
-                h = _chords_heights(cs, sid[[a]], st[[a]], sid[[b]], st[[b]], pos[[a]],
-                                    pos[[b]])
-                return bool(h[0] <= tol)
 
-            keep[_min_step_filter(pos, prot, min_step, first=first_of, d=dd,
-                                  merge_ok=merge_ok, forced=forced)] = True
-            report.min_step_overrides += len(forced)
-            sid, st, pos, pid, hm, am = (x[keep] for x in (sid, st, pos, pid, hm, am))
-            first_of, last_of = first_of[keep], last_of[keep]
-    # ---- rounding to whole bits; consecutive repeats dropped (the stroke's end kept)
-    r = _round(pos)
+def _min_step_pass(mk: _MarkRows, cs: _CubicSet, tol: float, min_step: float,
+                   report: SampleReport) -> _MarkRows:
+    """Marks closer than ``min_step`` merged (rarely needed after the search), every stroke
+    at once; a merge that would leave a chord above the tolerance is refused (counted)."""
+    if len(mk.pid) <= 2:
+        return mk
+    pos = mk.pos
+    dd = np.hypot(pos[1:, 0] - pos[:-1, 0], pos[1:, 1] - pos[:-1, 1])
+    short = (dd < min_step) & ~mk.last_of[:-1]
+    if not short.any():
+        return mk
+    sid, st = mk.sid, mk.st
+
+    def merge_ok(a: int, b: int) -> bool:
+        """The chord from mark a to mark b keeps within the tolerance."""
+        h = _chords_heights(cs, sid[[a]], st[[a]], sid[[b]], st[[b]], pos[[a]], pos[[b]])
+        return bool(h[0] <= tol)
+
+    keep = np.zeros(len(mk.pid), dtype=bool)
+    forced: list[int] = []
+    keep[_min_step_filter(pos, mk.prot, min_step, first=mk.first_of, d=dd,
+                          merge_ok=merge_ok, forced=forced)] = True
+    report.min_step_overrides += len(forced)
+    return mk.keep(keep)
+
+
+def _rounded(mk: _MarkRows) -> tuple[np.ndarray, _MarkRows]:
+    """Marks rounded to whole bits, consecutive repeats dropped (a stroke's true end is
+    kept: its twin before it goes instead, unless that twin is the start)."""
+    r = _round(mk.pos)
+    first_of, last_of = mk.first_of, mk.last_of
     same = np.r_[False, (r[1:, 0] == r[:-1, 0]) & (r[1:, 1] == r[:-1, 1]) & ~first_of[1:]]
-    if same.any():
-        drop = same.copy()
-        for e in np.flatnonzero(same & last_of).tolist():
-            j = e - 1  # keep the true end, drop its twin before it unless that is the start
-            while same[j]:
-                j -= 1
-            if not first_of[j]:
-                drop[e] = False
-                drop[j] = True
-        keep = ~drop
-        sid, st, pos, pid, r = sid[keep], st[keep], pos[keep], pid[keep], r[keep]
-        hm, am = hm[keep], am[keep]
-        last_of = last_of[keep] | np.r_[pid[1:] != pid[:-1], True]
-    report.outside_points = int(((r < 0) | (r > mx)).any(axis=1).sum())
-    # ---- measurement of every chord against the true curve
-    pair = ~last_of[:-1] if len(pid) > 1 else np.zeros(0, dtype=bool)
-    if pair.any():
-        hf, hi_max = _measure_marks(cs, sid, st, pos, r, hm, am, pair, is_cubic)
-        report.chords = int(np.count_nonzero(pair))
-        report.max_chord_height_bits = float(hf.max())
-        report.max_chord_height_int_bits = hi_max
-        report.chord_violations = int(np.count_nonzero(hf > tol * (1.0 + 1e-9)))
-    else:
+    if not same.any():
+        return r, mk
+    drop = same.copy()
+    for e in np.flatnonzero(same & last_of).tolist():
+        j = e - 1
+        while same[j]:
+            j -= 1
+        if not first_of[j]:
+            drop[e] = False
+            drop[j] = True
+    keep = ~drop
+    out = mk.keep(keep)
+    out.last_of = out.last_of | np.r_[out.pid[1:] != out.pid[:-1], True]
+    return r[keep], out
+
+
+def _measure_into(report: SampleReport, mk: _MarkRows, r: np.ndarray, cs: _CubicSet,
+                  is_cubic: np.ndarray, tol: float) -> None:
+    """Every chord between consecutive marks of a stroke measured against the true curve
+    (float and rounded marks), into ``report``."""
+    pair = ~mk.last_of[:-1] if len(mk.pid) > 1 else np.zeros(0, dtype=bool)
+    if not pair.any():
         report.max_chord_height_bits = 0.0
         report.max_chord_height_int_bits = 0.0
-    # ---- one stroke per path
-    cuts = np.searchsorted(pid, np.arange(len(fitted) + 1)).tolist()
-    cuts[-1] = len(pid)
-    spans = list(zip(cuts[:-1], cuts[1:], strict=True))
-    res.marks = [r[a:b] for a, b in spans]
-    res.float_marks = [pos[a:b] for a, b in spans]
-    res.params = [(sid[a:b], st[a:b]) for a, b in spans]
-    return res
+        return
+    hf, hi_max = _measure_marks(cs, mk.sid, mk.st, mk.pos, r, mk.hm, mk.am, pair, is_cubic)
+    report.chords = int(np.count_nonzero(pair))
+    report.max_chord_height_bits = float(hf.max())
+    report.max_chord_height_int_bits = hi_max
+    report.chord_violations = int(np.count_nonzero(hf > tol * (1.0 + 1e-9)))
 
 
 def _first_nonzero(legs: tuple[np.ndarray, ...]) -> np.ndarray:
