@@ -119,7 +119,23 @@ __all__ = [
 E_MIN_RATIO = 0.97
 #: the most that rounding a mark to whole bits adds to a chord height
 ROUNDING_BOUND_BITS = math.sqrt(2.0) / 2.0
+#: trials of one chord's step before the search takes the longest chord found to pass
 _MAX_TRIALS = 60
+#: a chord this close to ``max_step`` (as a share of it) is long enough to be accepted even
+#: below E_min: asking for more would only shave the last few percent of the step
+_MAX_STEP_ACCEPT = 0.98
+#: when the step would break ``max_step``, the next trial aims this far below it
+_MAX_STEP_AIM = 0.99
+#: the bracket [lo, hi] of a chord's step is collapsed when narrower than this share of hi
+_BRACKET_REL = 1e-9
+#: the height grows as step**p between two trials; p is kept in this range (2: a smooth
+#: curve's chord height, 1: a corner's, up to 4 near an inflection) and is 2 until measured
+_GROWTH_MIN, _GROWTH_MAX, _GROWTH_DEFAULT = 1.0, 4.0, 2.0
+#: a chord stretched to the minimum step: corrections of its length (the length is not
+#: linear in the parameter) and the largest stretch per correction
+_MIN_STEP_FIXES, _MIN_STEP_GROWTH = 3, 4.0
+#: the search looks at ``cancel`` every this many rounds
+_CANCEL_EVERY = 64
 _OVER_SAMPLES = 64
 #: about how many marks a chain of smoothly joined cubics gathers before it is cut
 _CHAIN_MARKS = 64
@@ -557,7 +573,7 @@ def _search_h(curves: _Curves, ids0: np.ndarray, t0: np.ndarray,
     rounds = 0
     while len(k):
         rounds += 1
-        if cancel is not None and rounds % 64 == 0 and cancel():
+        if cancel is not None and rounds % _CANCEL_EVERY == 0 and cancel():
             raise Cancelled()
         ids = ids0[k]
         te = t1[k]
@@ -568,14 +584,14 @@ def _search_h(curves: _Curves, ids0: np.ndarray, t0: np.ndarray,
         H, L = curves.height(ids, ta, tb)
         trials += len(k)
         ok = (H <= e_max) & (L <= max_step)
-        acc = ok & (end | (H >= e_min) | (L >= 0.98 * max_step))
+        acc = ok & (end | (H >= e_min) | (L >= _MAX_STEP_ACCEPT * max_step))
         it += 1
         lo = np.where(ok, np.maximum(lo, trial), lo)
         hi = np.where(ok, hi, np.minimum(hi, trial))
         # the minimum step: a chord shorter than it is only taken at the curve's end
         short_fail = ~ok & (L < min_step)
         short_acc = acc & ~end & (L < min_step)
-        stuck = ~acc & ~short_fail & ((np.isfinite(hi) & ((hi - lo) <= 1e-9 * hi))
+        stuck = ~acc & ~short_fail & ((np.isfinite(hi) & ((hi - lo) <= _BRACKET_REL * hi))
                                        | (it >= _MAX_TRIALS))
         ovr = short_fail | short_acc | (stuck & (lo <= 0.0))
         take_lo = stuck & (lo > 0.0)
@@ -584,20 +600,10 @@ def _search_h(curves: _Curves, ids0: np.ndarray, t0: np.ndarray,
         stretch = np.where(np.isfinite(stretch), stretch, rem)
         t_new = tb.copy()
         t_new[take_lo] = (ta + lo)[take_lo]
-        if ovr.any():  # a chord of min_step length: L(Δt) is not linear, correct twice
+        if ovr.any():
             io = np.flatnonzero(ovr)
-            dto = np.maximum(stretch, trial)[io]
-            for _ in range(3):
-                t_try = np.minimum(ta[io] + dto, te[io])
-                d = curves.point(ids[io], t_try) - curves.point(ids[io], ta[io])
-                lo_len = np.sqrt((d * d).sum(axis=1))
-                with np.errstate(divide="ignore", invalid="ignore"):
-                    f = min_step / lo_len
-                grow = np.isfinite(f) & (f > 1.0) & (t_try < te[io])
-                if not grow.any():
-                    break
-                dto = np.where(grow, dto * np.minimum(f, 4.0), dto)
-            t_new[io] = np.minimum(ta[io] + dto, te[io])
+            t_new[io] = _min_step_end(curves, ids[io], ta[io], te[io],
+                                      np.maximum(stretch, trial)[io], min_step)
         done = acc | ovr | take_lo
         if done.any():
             out_k.append(k[done])
@@ -606,16 +612,7 @@ def _search_h(curves: _Curves, ids0: np.ndarray, t0: np.ndarray,
             # the measured height belongs to the chord ta -> tb: only where t_new is tb
             out_h.append(np.where(ovr | take_lo, np.nan, H)[done])
             out_a.append(np.where(ovr | take_lo, np.nan, ta)[done])
-        # next trial for the rest: rescale by the measured growth law, inside the bracket
-        with np.errstate(divide="ignore", invalid="ignore"):
-            p = np.log(H / pH) / np.log(trial / pdt)
-        p = np.where(np.isfinite(p), np.clip(p, 1.0, 4.0), 2.0)
-        with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
-            nxt = trial * (hp / np.maximum(H, _TINY)) ** (1.0 / p)
-            nxt = np.where(L > max_step, np.minimum(nxt, trial * 0.99 * max_step / L), nxt)
-        inside = (nxt > lo) & (nxt < hi) & np.isfinite(nxt)
-        mid = np.where(np.isfinite(hi), np.where(lo > 0.0, 0.5 * (lo + hi), 0.5 * hi), 2.0 * lo)
-        nxt = np.where(inside, nxt, mid)
+        nxt = _next_trial(trial, H, L, pdt, pH, lo, hi, hp, max_step)
         pdt, pH, dt = trial, H, nxt
         # accepted: move on (curves that reached their end leave)
         ta = np.where(done, t_new, ta)
@@ -639,6 +636,44 @@ def _search_h(curves: _Curves, ids0: np.ndarray, t0: np.ndarray,
     aa = np.concatenate(out_a)
     order = np.argsort(kk, kind="stable")  # rounds emit increasing t per curve
     return kk[order], tt[order], oo[order], trials, hh[order], aa[order]
+
+
+def _min_step_end(curves: _Curves, ids: np.ndarray, ta: np.ndarray, te: np.ndarray,
+                  dto: np.ndarray, min_step: float) -> np.ndarray:
+    """The end parameter of a chord from ``ta`` stretched to ``min_step`` long (not past
+    ``te``), from the first guess ``ta + dto``: the chord's length is not linear in the
+    parameter, so the guess is corrected a few times."""
+    for _ in range(_MIN_STEP_FIXES):
+        t_try = np.minimum(ta + dto, te)
+        d = curves.point(ids, t_try) - curves.point(ids, ta)
+        length = np.sqrt((d * d).sum(axis=1))
+        with np.errstate(divide="ignore", invalid="ignore"):
+            f = min_step / length
+        grow = np.isfinite(f) & (f > 1.0) & (t_try < te)
+        if not grow.any():
+            break
+        dto = np.where(grow, dto * np.minimum(f, _MIN_STEP_GROWTH), dto)
+    return np.minimum(ta + dto, te)
+
+
+def _next_trial(trial: np.ndarray, H: np.ndarray, L: np.ndarray, pdt: np.ndarray,
+                pH: np.ndarray, lo: np.ndarray, hi: np.ndarray, hp: float,
+                max_step: float) -> np.ndarray:
+    """The next step to try for the chords not yet accepted: the last step rescaled by the
+    growth law measured between the last two trials (height ~ step**p) to hit the middle
+    of the window ``hp``, kept under ``max_step`` and inside the bracket [lo, hi] of steps
+    known to pass and to fail (else the bracket's middle, or twice ``lo`` when nothing has
+    failed yet)."""
+    with np.errstate(divide="ignore", invalid="ignore"):
+        p = np.log(H / pH) / np.log(trial / pdt)
+    p = np.where(np.isfinite(p), np.clip(p, _GROWTH_MIN, _GROWTH_MAX), _GROWTH_DEFAULT)
+    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
+        nxt = trial * (hp / np.maximum(H, _TINY)) ** (1.0 / p)
+        nxt = np.where(L > max_step, np.minimum(nxt, trial * _MAX_STEP_AIM * max_step / L),
+                       nxt)
+    inside = (nxt > lo) & (nxt < hi) & np.isfinite(nxt)
+    mid = np.where(np.isfinite(hi), np.where(lo > 0.0, 0.5 * (lo + hi), 0.5 * hi), 2.0 * lo)
+    return np.where(inside, nxt, mid)
 
 
 def _fix_short_ends(curves: _Curves, ids0: np.ndarray, t0: np.ndarray,
