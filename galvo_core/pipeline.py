@@ -37,7 +37,13 @@ from galvo_core.job import Job, Segments, Stroke
 from galvo_core.kerf import compensate_indexed
 from galvo_core.order import order_job_strokes
 from galvo_core.params import UNITS_PER_MM, Params
-from galvo_core.sample import ROUNDING_BOUND_BITS, SampleReport, polyline_marks, sample_paths
+from galvo_core.sample import (
+    ROUNDING_BOUND_BITS,
+    SampleReport,
+    polyline_marks,
+    sample_geometry,
+    sample_paths,
+)
 from galvo_core.timing import estimate_with_dwell
 
 __all__ = ["Cancelled", "Pipeline", "RunResult", "coordinate_quantum", "process"]
@@ -211,6 +217,7 @@ class Pipeline:
                 fixed_slope_tol=params.fixed_slope_tol,
                 raw_points=[work.paths[fp.source_index].points for fp in fitted],
                 cancel=run.cancel,
+                geometry=self._fact(fitted, "sample_geometry", lambda: sample_geometry(fitted)),
             )
             return _Marks(tuple(res.marks), res.report)
 

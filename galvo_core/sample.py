@@ -1028,27 +1028,12 @@ class _Geometry:
         return out
 
 
-_GEO_CACHE: OrderedDict[int, tuple[Sequence[FittedPath], _Geometry]] = OrderedDict()
-_GEO_LOCK = threading.Lock()
-
-
-def _geometry(fitted: Sequence[FittedPath]) -> _Geometry:
-    """:class:`_Geometry` of ``fitted``, cached by identity for tuples (the pipeline's
-    cached fit): a re-sample at another magnification or tolerance gathers nothing again.
-    Each entry holds its tuple, so an id cannot be reused while cached."""
-    if not isinstance(fitted, tuple):
-        return _Geometry(fitted)
-    with _GEO_LOCK:
-        hit = _GEO_CACHE.get(id(fitted))
-        if hit is not None and hit[0] is fitted:
-            _GEO_CACHE.move_to_end(id(fitted))
-            return hit[1]
-    geo = _Geometry(fitted)
-    with _GEO_LOCK:
-        _GEO_CACHE[id(fitted)] = (fitted, geo)
-        while len(_GEO_CACHE) > 2:
-            _GEO_CACHE.popitem(last=False)
-    return geo
+def sample_geometry(fitted: Sequence[FittedPath]) -> _Geometry:
+    """Every segment of ``fitted`` gathered for the sampler (paths, kinds, control points):
+    made once per fit and passed to :func:`sample_paths` again (``geometry=``) when the same
+    fit is re-sampled at another magnification or tolerance (the pipeline keeps it with
+    its cached fit)."""
+    return _Geometry(fitted)
 
 
 def sample_paths(
@@ -1063,6 +1048,7 @@ def sample_paths(
     fixed_slope_tol: float = 0.05,
     raw_points: Sequence[np.ndarray] | None = None,
     cancel: Callable[[], bool] | None = None,
+    geometry: _Geometry | None = None,
 ) -> SampleResult:
     """Marks of many fitted paths at once (one stroke each, (M, 2) int64 bits, in the
     direction of the segments; empty for a path without segments), and what was measured.
@@ -1084,7 +1070,7 @@ def sample_paths(
     ms_max = math.inf if max_step_bits is None else float(max_step_bits)
     min_step = float(min_step_bits)
     # every segment of every path, in bits, in power form (a line's: a = b = 0)
-    geo = _geometry(fitted)
+    geo = geometry if geometry is not None else sample_geometry(fitted)
     if not len(geo.is_cubic):
         res.marks = [np.empty((0, 2), dtype=np.int64) for _ in fitted]
         return res
