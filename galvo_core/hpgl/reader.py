@@ -201,6 +201,7 @@ _VENDOR_RE = re.compile(rb"!([A-Za-z]{2})([^;\x1b\n]*);?")
 _PCL_START_RE = re.compile(rb"[\x00-\x20]*(?:\x1bE|\x1b%-12345X|@PJL|\x1b[&*(]|\x1b%-?\d*A)")
 
 _POW10 = 10.0 ** np.arange(0, 23)
+_EMPTY_I32 = np.empty(0, dtype=np.int32)
 _WARN_CAP = 20  # warnings of one kind kept verbatim; the rest are counted
 
 
@@ -914,9 +915,9 @@ class _Reader:
 
     # ------------------------------------------------------------------ compiled runs
     def _new_chunk(self, need: int, at: int = 0) -> _Chunk:
-        # about one point per 8 bytes still to read (a pair is rarely shorter), at most
-        # _CHUNK_POINTS: a small file does not get a large chunk; more chunks come as needed
-        cap = max(need + 2, min(_CHUNK_POINTS, (self.n - at) // 8 + 64))
+        # about one point per 16 bytes still to read (real files: 10-50 bytes per point), at
+        # most _CHUNK_POINTS: a small file does not get a large chunk; more come as needed
+        cap = max(need + 2, min(_CHUNK_POINTS, (self.n - at) // 16 + 64))
         ch = _Chunk(cap)
         self._chunk = ch
         self.chunks.append(ch)
@@ -1772,6 +1773,7 @@ def _read(data: bytes, name: str) -> Drawing:
     lines_l = lines.tolist()
     cols_l = cols.tolist()
     for ch in rd.chunks:
+        ch.seg_start = ch.seg_off = ch.seg_pen = ch.seg_line = ch.seg_col = _EMPTY_I32
         if len(ch.pts) - ch.npts > max(ch.npts // 4, 4096):
             ch.pts = ch.pts[: ch.npts].copy()  # the drawing keeps only what was used
         ch.pts.setflags(write=False)
