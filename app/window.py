@@ -12,7 +12,6 @@ from __future__ import annotations
 import json
 import os
 import time
-from dataclasses import fields
 from pathlib import Path as FsPath
 from typing import Any
 
@@ -58,7 +57,7 @@ from PySide6.QtWidgets import (
 from galvo_core.drawing import Drawing
 from galvo_core.errors import GalvoError, ParamError
 from galvo_core.job import Job, atomic_write_bytes, load_job, write_job
-from galvo_core.params import LaserParams, Params
+from galvo_core.params import Params
 from galvo_core.pipeline import Pipeline
 from galvo_core.preview import PreviewCache
 
@@ -147,24 +146,18 @@ def _fmt_int(n: int) -> str:
 
 
 def params_to_json(p: Params) -> str:
-    d = p.processing_dict()
-    d["laser"] = p.laser.as_dict()
-    return json.dumps(d)
+    return json.dumps(p.as_dict())
 
 
 def params_from_json(text: str, base: Params | None = None) -> Params:
-    """Params from :func:`params_to_json` text; unknown keys are ignored, invalid -> base."""
+    """Params from :func:`params_to_json` text (or the older layout with a ``laser``
+    table); unknown keys are ignored, an invalid value gives ``base``."""
     base = base or Params()
     try:
         d = json.loads(text)
-        names = {f.name for f in fields(Params)}
-        changes: dict[str, Any] = {k: v for k, v in d.items() if k in names and k != "laser"}
-        if isinstance(changes.get("offset_bits"), list):
-            changes["offset_bits"] = tuple(changes["offset_bits"])
         if isinstance(d.get("laser"), dict):
-            lnames = {f.name for f in fields(LaserParams)}
-            changes["laser"] = LaserParams(**{k: v for k, v in d["laser"].items() if k in lnames})
-        return base.replace(**changes)
+            d = {**d.pop("laser"), **d}
+        return Params.from_mapping(d, base=base, ignore_unknown=True)
     except (ValueError, TypeError, AttributeError):
         return base
 

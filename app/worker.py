@@ -51,9 +51,8 @@ def pipeline_task(pipeline: Pipeline, cache: PreviewCache, drawing: Drawing,
 
     def task(cancel: Callable[[], bool]) -> RunResult:
         t0 = time.perf_counter()
-        job = pipeline.run(drawing, params, cancel=cancel)
-        stages = tuple(pipeline.last_info.stages_run)
-        fitted = pipeline.fitted(drawing, params, cancel)  # cached by the run
+        res = pipeline.run(drawing, params, cancel=cancel)
+        job, stages, fitted = res.job, res.stages_run, res.fitted
         if cancel():
             raise Cancelled()
         preview = build_preview(job, drawing, fitted, cache=cache, cancel=cancel)
@@ -79,7 +78,7 @@ def pipeline_task_safe(pipeline: Pipeline, cache: PreviewCache, drawing: Drawing
                       params.laser.as_dict(), (), {}, tuple(drawing.warnings))
             preview = build_preview(job, drawing, None, cache=cache, cancel=cancel)
             return RunResult(drawing, params, job, None, preview, time.perf_counter() - t0,
-                             tuple(pipeline.last_info.stages_run), error=str(exc))
+                             (), error=str(exc))
 
     return task
 

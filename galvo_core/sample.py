@@ -96,10 +96,10 @@ from typing import Any
 
 import numpy as np
 
-from galvo_core.errors import ParamError
+from galvo_core.errors import Cancelled, ParamError
 from galvo_core.field import FieldMap
 from galvo_core.fit import FittedPath
-from galvo_core.geometry import power_coeffs_many
+from galvo_core.geometry import power_coeffs_into
 from galvo_core.timing import CORNER_DEG
 
 __all__ = [
@@ -398,12 +398,17 @@ def _smooth_chains(cf: CF, is_cubic: np.ndarray, corner: np.ndarray, seg_path: n
                        & (seg_path[:-1] == seg_path[1:]))
     if joined.any():
         x, w = np.polynomial.legendre.leggauss(4)
-        est = np.zeros(g)
+        # a line (a = b = 0) has curvature 0: its estimate is exactly 1, only the cubics
+        # are evaluated
+        cub = np.flatnonzero(is_cubic)
+        cfc = tuple(x[cub] for x in cf)
+        ec = np.zeros(len(cub))
         for xi, wi in zip(0.5 * (x + 1.0), 0.5 * w, strict=True):
-            sp, k = _speed_curvature(cf, float(xi))
+            sp, k = _speed_curvature(cfc, float(xi))  # type: ignore[arg-type]
             with np.errstate(invalid="ignore"):
-                est += wi * np.nan_to_num(np.sqrt(k) * sp, posinf=0.0)  # sqrt(κ)·|B'|
-        est = est / math.sqrt(8.0 * tol) + 1.0
+                ec += wi * np.nan_to_num(np.sqrt(k) * sp, posinf=0.0)  # sqrt(κ)·|B'|
+        est = np.ones(g)
+        est[cub] = ec / math.sqrt(8.0 * tol) + 1.0
         # marks gathered before each cubic since the start of its run; cut at multiples
         start = ~np.r_[False, joined[:-1]]
         cum = np.cumsum(est) - est
@@ -553,8 +558,6 @@ def _search_h(curves: _Curves, ids0: np.ndarray, t0: np.ndarray,
     while len(k):
         rounds += 1
         if cancel is not None and rounds % 64 == 0 and cancel():
-            from galvo_core.pipeline import Cancelled
-
             raise Cancelled()
         ids = ids0[k]
         te = t1[k]
@@ -901,37 +904,34 @@ class _Geometry:
     latest mapping: a re-sample at another tolerance maps nothing again."""
 
     def __init__(self, fitted: Sequence[FittedPath]) -> None:
-        segs = [s for fp in fitted for s in fp.segments]
-        self.path_n = np.fromiter((len(fp.segments) for fp in fitted), dtype=np.int64,
+        # the paths' own arrays (FittedPath: kinds and shared control points), concatenated
+        self.path_n = np.fromiter((len(fp.is_cubic) for fp in fitted), dtype=np.int64,
                                   count=len(fitted))
         self.path_first = np.cumsum(self.path_n) - self.path_n
-        g = len(segs)
-        self.is_cubic = np.fromiter((s.kind == "cubic" for s in segs), dtype=bool, count=g)
+        g = int(self.path_n.sum())
         self.seg_path = np.repeat(np.arange(len(fitted)), self.path_n)
-        # (G, 4, 2): a cubic's four control points; a line's P0 and P1 in rows 0 and 3
-        self.ctrl_units = np.zeros((g, 4, 2))
+        # the shared control points of every path (input units) and the row of each
+        # segment's P0 among them (a line: P0, P1 in rows row, row + 1; a cubic: P0..P3 in
+        # rows row..row + 3): 16 bytes per point and 8 per segment, not a (G, 4, 2) copy
         if g:
-            lens = np.fromiter((len(s.points) for s in segs), dtype=np.int64, count=g)
-            pts = np.concatenate([s.points for s in segs]).astype(np.float64, copy=False)
-            row = np.cumsum(lens) - lens  # first row of each segment
-            rc = row[self.is_cubic]
-            for j in range(4):
-                self.ctrl_units[self.is_cubic, j] = pts[rc + j]
-            rl = row[~self.is_cubic]
-            self.ctrl_units[~self.is_cubic, 0] = pts[rl]
-            self.ctrl_units[~self.is_cubic, 3] = pts[rl + 1]
+            self.is_cubic = np.concatenate([fp.is_cubic for fp in fitted])
+            self.points = np.concatenate([fp.points for fp in fitted]).astype(np.float64,
+                                                                              copy=False)
+            npts = np.fromiter((len(fp.points) for fp in fitted), dtype=np.int64,
+                               count=len(fitted))
+            step = np.where(self.is_cubic, 3, 1)
+            # row of each segment's P0: its path's first row + the steps before it in the path
+            cs = np.cumsum(step)
+            row = cs - step
+            base = (np.cumsum(npts) - npts) - np.r_[row, cs[-1:]][self.path_first]
+            row += np.repeat(base, self.path_n)
+            self.row = row
+        else:
+            self.is_cubic = np.zeros(0, dtype=bool)
+            self.points = np.zeros((0, 2))
+            self.row = np.zeros(0, dtype=np.int64)
         self._fielded: OrderedDict[tuple[float, ...], tuple[Any, ...]] = OrderedDict()
         self._lock = threading.Lock()
-
-    def ctrl_bits(self, fm: FieldMap) -> np.ndarray:
-        """(G, 4, 2) control points in float bits; a line P0→P1 as the cubic with its inner
-        control points at 1/3 and 2/3 (computed in bits)."""
-        out = fm.to_bits_float(self.ctrl_units.reshape(-1, 2)).reshape(-1, 4, 2)
-        ln = ~self.is_cubic
-        c0, c1 = out[ln, 0], out[ln, 3]
-        out[ln, 1] = c0 + (c1 - c0) / 3.0
-        out[ln, 2] = c0 + 2.0 * (c1 - c0) / 3.0
-        return out
 
     def fielded(self, fm: FieldMap) -> tuple[Any, ...]:
         """``(ends, coef, corner, cf)`` for ``fm`` (read-only arrays): the end points in
@@ -944,16 +944,39 @@ class _Geometry:
             if hit is not None:
                 self._fielded.move_to_end(key)
                 return hit
-        ctrl_all = self.ctrl_bits(fm)
-        is_cubic = self.is_cubic
-        coef = power_coeffs_many(ctrl_all)
-        coef[~is_cubic, 0] = 0.0
-        coef[~is_cubic, 1] = 0.0
-        coef[~is_cubic, 2] = ctrl_all[~is_cubic, 3] - ctrl_all[~is_cubic, 0]
-        g = len(ctrl_all)
+        # control points in float bits, gathered from the shared points: P0 and P3 of every
+        # segment, P1 and P2 of the cubics; a line P0→P1 is the cubic with its inner control
+        # points at 1/3 and 2/3 (computed in bits; used for its end tangents)
+        pb = fm.to_bits_float(self.points)
+        row, is_cubic = self.row, self.is_cubic
+        g = len(row)
+        p0 = pb[row]
+        p3 = pb[row + np.where(is_cubic, 3, 1)]
+        ic = np.flatnonzero(is_cubic)
+        il = np.flatnonzero(~is_cubic)
+        # power coefficients laid out (4, 2, G): each of a, b, d, e in x and y is one
+        # contiguous row, so the eight flat arrays the kernels want are views, not copies;
+        # a line exactly a = b = 0, d = P3 − P0, e = P0
+        block = np.empty((4, 2, g))
+        block[0] = 0.0
+        block[1] = 0.0
+        np.subtract(p3.T, p0.T, out=block[2])
+        block[3] = p0.T
+        ts = np.empty((g, 2))
+        te = np.empty((g, 2))
+        if len(ic):
+            c0, c1, c2, c3 = p0[ic], pb[row[ic] + 1], pb[row[ic] + 2], p3[ic]
+            sub = np.empty((4, 2, len(ic)))
+            power_coeffs_into(sub, c0.T, c1.T, c2.T, c3.T)
+            block[:, :, ic] = sub
+            ts[ic], te[ic] = _tangents(c0, c1, c2, c3)
+        if len(il):
+            c0, c3 = p0[il], p3[il]
+            d = c3 - c0
+            ts[il], te[il] = _tangents(c0, c0 + d / 3.0, c0 + 2.0 * d / 3.0, c3)
+        coef = block.transpose(2, 0, 1)  # (G, 4, 2) view
         corner = np.zeros(g, dtype=bool)
         if g > 1:
-            ts, te = _tangents_all(ctrl_all)
             a, b = te[:-1], ts[1:]
             ax_, ay_, bx_, by_ = a[:, 0], a[:, 1], b[:, 0], b[:, 1]
             cr = ax_ * by_ - ay_ * bx_
@@ -961,8 +984,8 @@ class _Geometry:
             deg = ~(((ax_ != 0) | (ay_ != 0)) & ((bx_ != 0) | (by_ != 0)))
             corner[:-1] = ((ang > CORNER_DEG) | deg) & (self.seg_path[:-1] ==
                                                          self.seg_path[1:])
-        cf = _cf(coef)
-        ends = np.ascontiguousarray(ctrl_all[:, ::3])  # P0, P3
+        cf = tuple(block[i, j] for i in range(4) for j in range(2))
+        ends = np.stack((p0, p3), axis=1)  # (G, 2, 2): P0, P3
         for x in (ends, coef, corner, *cf):
             x.setflags(write=False)
         out = (ends, coef, corner, cf)
@@ -1170,22 +1193,22 @@ def sample_paths(
     return res
 
 
-def _tangents_all(ctrl: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Start and end tangent directions of every segment (first non-zero control leg)."""
-    p0, p1, p2, p3 = ctrl[:, 0], ctrl[:, 1], ctrl[:, 2], ctrl[:, 3]
+def _first_nonzero(legs: tuple[np.ndarray, ...]) -> np.ndarray:
+    out = legs[0]
+    for alt in legs[1:]:
+        zero = (out[:, 0] == 0) & (out[:, 1] == 0)
+        if zero.any():
+            out = out.copy()
+            out[zero] = alt[zero]
+    return out
 
-    def first_nonzero(legs: tuple[np.ndarray, ...]) -> np.ndarray:
-        out = legs[0]
-        for alt in legs[1:]:
-            zero = (out[:, 0] == 0) & (out[:, 1] == 0)
-            if zero.any():
-                out = out.copy()
-                out[zero] = alt[zero]
-        return out
 
-    s = first_nonzero((p1 - p0, p2 - p0, p3 - p0))
-    e = first_nonzero((p3 - p2, p3 - p1, p3 - p0))
-    return s, e
+def _tangents(p0: np.ndarray, p1: np.ndarray, p2: np.ndarray, p3: np.ndarray
+              ) -> tuple[np.ndarray, np.ndarray]:
+    """Start and end tangent directions of cubics given by their control points (N, 2)
+    each (first non-zero control leg)."""
+    return (_first_nonzero((p1 - p0, p2 - p0, p3 - p0)),
+            _first_nonzero((p3 - p2, p3 - p1, p3 - p0)))
 
 
 def _measure_marks(cs: _CubicSet, sid: np.ndarray, st: np.ndarray, pos: np.ndarray,
