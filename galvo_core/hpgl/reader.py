@@ -8,16 +8,22 @@ What it reads
   flattened by the HP-GL chord rule (:mod:`.arcs`), CT chord-tolerance mode honoured;
   Béziers BZ BR (and BA, the name paper 001 uses for BZ) flattened within 0.1 unit; XT/YT
   tick marks.
-* Polygon mode: PM0/PM1/PM2 fill a polygon buffer; the first EP or FP after it emits each
-  sub-polygon once as a closed ring (geometry, not paint: an edged *and* filled polygon is
-  one region, not two).
+* Polygon mode: PM0/PM1/PM2 fill a polygon buffer, each edge with its pen state; PM1/PM2
+  close a sub-polygon with the pen state of the moment, the point after PM1 starts the next
+  one with a pen-up move. EP gives the runs of pen-down edges (an open polyline stays open),
+  FP each sub-polygon as a closed ring; a buffer edged *and* filled is one region (FP after
+  EP replaces EP's edges). A pen-up move inside PM0 also ends a sub-polygon (its ring is
+  its own region), where the reference would join the pieces by pen-up edges into one
+  ring; files use it for separate pieces.
 * Geometry state: IN DF IP IR SC (types 0, 1, 2) RO IW PS SP; user units are converted to
   plotter units, RO rotates about the plotter origin (x, y) -> (-y, x) for 90 degrees,
   IW clips pen-down lines to the window (one warning says how many paths were clipped).
   IR with two numbers moves P1 and keeps the P1-P2 distance (P2 moves along).
 * Recorded, not drawn: LT VS FS PW LA PT FT and the like; labels LB/BL/WD (skipped to their
-  terminator, DT honoured), CO comments, SM symbols, vendor ``!XX`` commands.
-* Wrappers: PCL (ESC E, ESC%#A / ESC%#B, parameterised escapes with binary data), PJL
+  terminator, DT honoured; LB moves the pen over the text: SI/SR/default cell, CR/LF/BS,
+  DI/DR; LO is not applied), CO comments, SM symbols, vendor ``!XX`` commands.
+* Wrappers: PCL (ESC E, ESC%#A / ESC%#B, parameterised escapes with binary data: ESC...#W
+  and ESC&p#X; ESC*p#X is cursor positioning, no data), PJL
   (``@PJL ENTER LANGUAGE=HPGL2``), UEL, HP 7475A device control ESC.( ESC.I…: (also with
   the ESC byte lost), NUL padding.
 
@@ -37,8 +43,12 @@ Syntax decisions (where the standard is ambiguous or files break it)
 * An unquoted CO comment ends at ``;``, at the label terminator or at the end of the line.
 * Default P1/P2 (for SC without IP, and IR) are those of an HP 7475A on ANSI A paper:
   (250, 596) and (10250, 7796); after PS w,h they are (0, 0) and (w, h).
-* SP and IN lift the pen; RO and IW end the current path (the pen stays down, the next
-  pen-down move starts a new path); IP and SC only change later coordinates.
+* IN lifts the pen. SP ends the current path; it keeps the pen down in HP-GL/2 ("the pen
+  remains down ... until a PU or IN") and lifts it in HP-GL/1 (a plotter stores the pen):
+  a file is HP-GL/2 once it shows it (PCL/PJL entry, BP PS PE PW BZ ... see HPGL2_ONLY).
+  Without any SP the paths are drawn with pen 1 and one warning says so. RO and IW end the
+  current path (the pen stays down, the next pen-down move starts a new path); IP and SC
+  only change later coordinates. PS with a length <= 0 is ignored.
 * IW without numbers is the hard-clip window: the page PS gave, (0, 0)-(w, h), when RO is
   0; without PS (a galvo has no paper) or under RO there is no window.
 * PE: a pair without ``<`` puts the pen down; a PE that ends with a pen-up move leaves the
@@ -56,6 +66,14 @@ HP-GL/2 -- escapes alone do not count as HP-GL --, mostly unreadable) raises
 :class:`~galvo_core.errors.InputError`. A malformed or unknown command inside a good file is
 skipped with a warning naming line and column. Time and memory are linear in the file size
 (also for ``PEPEPE...``: see :mod:`.pe`).
+
+Speed
+-----
+Large inputs (from ``_COMPILED_MIN_BYTES``), or any input once numba is loaded, are read by
+the compiled scanner (:mod:`.scan`) wherever a PU/PD/PA/PR/SP command starts, and PE by its
+compiled decoder; the general reader takes every other command. Smaller inputs in a fresh
+process use the numpy runs of :mod:`.fastrun`. All three read the same geometry bit for bit
+(tests/test_hpgl_scan.py, tests/test_hpgl_fuzz.py).
 """
 
 from __future__ import annotations
@@ -183,6 +201,7 @@ _VENDOR_RE = re.compile(rb"!([A-Za-z]{2})([^;\x1b\n]*);?")
 _PCL_START_RE = re.compile(rb"[\x00-\x20]*(?:\x1bE|\x1b%-12345X|@PJL|\x1b[&*(]|\x1b%-?\d*A)")
 
 _POW10 = 10.0 ** np.arange(0, 23)
+_EMPTY_I32 = np.empty(0, dtype=np.int32)
 _WARN_CAP = 20  # warnings of one kind kept verbatim; the rest are counted
 
 
@@ -896,9 +915,9 @@ class _Reader:
 
     # ------------------------------------------------------------------ compiled runs
     def _new_chunk(self, need: int, at: int = 0) -> _Chunk:
-        # about one point per 8 bytes still to read (a pair is rarely shorter), at most
-        # _CHUNK_POINTS: a small file does not get a large chunk; more chunks come as needed
-        cap = max(need + 2, min(_CHUNK_POINTS, (self.n - at) // 8 + 64))
+        # about one point per 16 bytes still to read (real files: 10-50 bytes per point), at
+        # most _CHUNK_POINTS: a small file does not get a large chunk; more come as needed
+        cap = max(need + 2, min(_CHUNK_POINTS, (self.n - at) // 16 + 64))
         ch = _Chunk(cap)
         self._chunk = ch
         self.chunks.append(ch)
@@ -1754,6 +1773,7 @@ def _read(data: bytes, name: str) -> Drawing:
     lines_l = lines.tolist()
     cols_l = cols.tolist()
     for ch in rd.chunks:
+        ch.seg_start = ch.seg_off = ch.seg_pen = ch.seg_line = ch.seg_col = _EMPTY_I32
         if len(ch.pts) - ch.npts > max(ch.npts // 4, 4096):
             ch.pts = ch.pts[: ch.npts].copy()  # the drawing keeps only what was used
         ch.pts.setflags(write=False)
