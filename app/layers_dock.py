@@ -172,6 +172,14 @@ class LayersDock:
             win.request_run()
         self.panel.set_table(self.effective())
 
+    def restore(self, result: Any) -> None:
+        """Processing was cancelled: the pen table goes back to the one ``result`` (the
+        shown one) was made with."""
+        pens = getattr(result, "pens", None)
+        if isinstance(pens, PenTable) and pens != self.table:
+            self.table = pens
+            self.panel.set_table(self.effective())
+
     def _on_edited(self, table: PenTable) -> None:
         self.table = table
         self.win.request_run()

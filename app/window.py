@@ -788,6 +788,7 @@ class MainWindow(QMainWindow):
             if res.params is not None:
                 self.params = res.params
                 self.controls.set_params(res.params, res.preview.field_map)
+            self.layers.restore(res)  # and the pen table
             self._watch(self.file_path)
         self.run_label.setText("cancelled")
         self.statusBar().showMessage(
