@@ -87,6 +87,23 @@ def pens_task(inner: Task, pens: PenTable) -> Task:
     return task
 
 
+def repens_task(shown: Any, pens: PenTable) -> Task:
+    """The shown result (a ``RunResult`` of the current drawing and parameters) with another
+    pen table: only ``apply_pens`` runs (it redoes the layers table and the time from the
+    strokes, so the job is the one a fresh run with ``pens`` gives); the views keep their
+    geometry."""
+
+    def task(cancel: Callable[[], bool]) -> Any:
+        t0 = time.perf_counter()
+        job = apply_pens(shown.job, pens)
+        if cancel():
+            raise Cancelled()
+        return dataclasses.replace(shown, job=job, pens=pens, stages_run=("layers",),
+                                   seconds=time.perf_counter() - t0)
+
+    return task
+
+
 class LayersDock:
     """The pen layers of one :class:`~app.window.MainWindow` (see the module docstring)."""
 
@@ -182,7 +199,17 @@ class LayersDock:
 
     def _on_edited(self, table: PenTable) -> None:
         self.table = table
-        self.win.request_run()
+        win = self.win
+        res = win.result
+        if (res is not None and res.job_path is None and win.job_path is None
+                and res.drawing is win.drawing and res.params == win.params
+                and res.error is None and isinstance(res.pens, PenTable)
+                and not (win.runner.active or win.io.active or win._throttle.isActive())):
+            # only the pens changed: re-make the shown job, not the pipeline and the views
+            win.runner.request(repens_task(res, self.effective()))
+            win._update_stale()  # noqa: SLF001 - the window's own bookkeeping
+        else:
+            win.request_run()
 
     def _on_result_shown(self, _gen: int) -> None:
         res = self.win.result

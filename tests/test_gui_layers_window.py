@@ -263,3 +263,26 @@ def test_esc_goes_back_to_the_pen_table_of_the_shown_result(win, tmp_path):
     assert {la["power_percent"] for la in win.current_job().layers} == \
         {LaserParams().power_percent}
     replay(out.read_bytes(), shown)
+
+
+def test_a_pen_edit_gives_the_job_of_a_fresh_run(win):
+    from galvo_core.layers import apply_pens
+    from galvo_core.pipeline import Pipeline
+
+    preview = win.result.preview
+    win.layers.panel.editor(2, "mark_speed_mm_s").setValue(333.0)
+    assert win.wait_idle(60)
+    win.layers.panel.editor(1, "passes").setValue(2)
+    assert win.wait_idle(60)
+    # only the pens changed: the shown geometry is kept, only the job is re-made
+    assert win.result.stages_run == ("layers",) and win.result.preview is preview
+    job = win.current_job()
+    fresh = apply_pens(Pipeline().run(win.drawing, win.params).job, win.layers.effective())
+    assert job.layers == fresh.layers
+    rest = {k: v for k, v in job.stats.items() if k != "layers"}
+    assert rest == pytest.approx({k: v for k, v in fresh.stats.items() if k != "layers"})
+    assert len(job.stats["layers"]) == len(fresh.stats["layers"]) == 2
+    for a, b in zip(job.stats["layers"], fresh.stats["layers"], strict=True):
+        assert a == pytest.approx(b)
+    assert job.stats["layers"][0]["passes"] == 2
+    assert [s.marks.tolist() for s in job.strokes] == [s.marks.tolist() for s in fresh.strokes]
