@@ -139,7 +139,7 @@ class LayersDock:
                               | QDockWidget.DockWidgetFeature.DockWidgetFloatable)
         win.addDockWidget(Qt.DockWidgetArea.RightDockWidgetArea, self.dock)
         win.splitDockWidget(win.controls_dock, self.dock, Qt.Orientation.Vertical)
-        win.resizeDocks([win.controls_dock, self.dock], [560, 170], Qt.Orientation.Vertical)
+        win.resizeDocks([win.controls_dock, self.dock], [500, 240], Qt.Orientation.Vertical)
 
         # File ▸ Open/Save Pen Table… (before Export), View ▸ Layers
         self.open_action = QAction("Open &Pen Table…", win)
