@@ -161,7 +161,7 @@ class LayersDock:
             "Export &LMC List (.lmc)…", "BJJCZ list (*.lmc)", ".lmc", write_lmc_list,
             "BJJCZ list commands, layers by pen number with their settings")
         win.export_kinds["lmc_text"] = ExportKind(
-            "Export LMC &Text…", "Text files (*.txt)", ".txt", write_lmc_text,
+            "Export LMC &Text…", "Text files (*.txt)", ".lmc.txt", write_lmc_text,
             "the BJJCZ list as readable text, one command per line")
         win.rebuild_export_menu()
         win.result_shown.connect(self._on_result_shown)
