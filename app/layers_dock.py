@@ -19,7 +19,10 @@ File ▸ Export ▸ LMC list / LMC text.
   the file and the place, and nothing changes;
 * the export kinds ``lmc`` (BJJCZ list records) and ``lmc_text`` (MeerK40t's readable dump),
   written by :func:`galvo_core.lmc.write_lmc` from the job's own layers table, on the
-  export worker like every other kind.
+  export worker like every other kind, with the field orientation (swap x/y, flip x, flip y)
+  checked in the dock when the export was asked for;
+* a window that restores its settings keeps the pen table and the orientation for the next
+  session.
 """
 
 from __future__ import annotations
@@ -27,18 +30,34 @@ from __future__ import annotations
 import dataclasses
 import os
 import time
+import tomllib
 from collections.abc import Callable
+from dataclasses import dataclass
 from pathlib import Path as FsPath
 from typing import TYPE_CHECKING, Any
 
 from PySide6.QtCore import Qt
 from PySide6.QtGui import QAction
-from PySide6.QtWidgets import QDockWidget, QFileDialog, QLabel, QVBoxLayout, QWidget
+from PySide6.QtWidgets import (
+    QCheckBox,
+    QDockWidget,
+    QFileDialog,
+    QHBoxLayout,
+    QLabel,
+    QVBoxLayout,
+    QWidget,
+)
 
 from galvo_core.errors import GalvoError
 from galvo_core.job import Job, atomic_write_bytes
-from galvo_core.layers import PenTable, apply_pens, dump_pen_table, load_pen_table
-from galvo_core.lmc import job_pen_table, write_lmc
+from galvo_core.layers import (
+    PenTable,
+    apply_pens,
+    dump_pen_table,
+    load_pen_table,
+    pen_table_from_dict,
+)
+from galvo_core.lmc import AS_IS, Orientation, job_pen_table, write_lmc
 from galvo_core.params import Params
 from galvo_core.pipeline import Cancelled
 
@@ -49,16 +68,23 @@ if TYPE_CHECKING:
 
 Task = Callable[[Callable[[], bool]], Any]
 PEN_FILTER = "Pen tables (*.toml);;All files (*)"
+#: settings keys: the pen table (TOML) and the export orientation, kept between sessions
+PENS_KEY = "layers/pen_table"
+ORIENT_KEY = "layers/orientation"
+ORIENT_NAMES = ("swap_xy", "flip_x", "flip_y")
 
 
-def write_lmc_list(job: Job, path: FsPath) -> None:
-    """File ▸ Export ▸ LMC list: the job's BJJCZ list records (its own layers table)."""
-    write_lmc(job, os.fspath(path))
+@dataclass(frozen=True)
+class LmcWriter:
+    """File ▸ Export ▸ LMC list (``text`` False: the job's BJJCZ list records, from its own
+    layers table) or LMC text (MeerK40t's readable dump of the same list), with the field
+    orientation chosen in the Layers dock when the export was asked for."""
 
+    text: bool = False
+    orientation: Orientation = AS_IS
 
-def write_lmc_text(job: Job, path: FsPath) -> None:
-    """File ▸ Export ▸ LMC text: the same list as MeerK40t's readable dump."""
-    write_lmc(job, os.fspath(path), text=True)
+    def __call__(self, job: Job, path: FsPath) -> None:
+        write_lmc(job, os.fspath(path), orientation=self.orientation, text=self.text)
 
 
 def with_profile(table: PenTable, params: Params) -> PenTable:
@@ -127,10 +153,28 @@ class LayersDock:
         self.note.setObjectName("layers_note")
         self.note.setWordWrap(True)
         self.note.setStyleSheet("color: #5f6b7a;")
+        # the field's orientation at LMC export (how the job's X/Y reach the galvos)
+        self.orient_boxes: dict[str, QCheckBox] = {}
+        orient = QWidget()
+        ol = QHBoxLayout(orient)
+        ol.setContentsMargins(0, 0, 0, 0)
+        ol.addWidget(QLabel("LMC export:"))
+        for name, label, tip in (
+                ("swap_xy", "swap x/y", "exchange the galvos' X and Y (applied first)"),
+                ("flip_x", "flip x", "mirror X across the field"),
+                ("flip_y", "flip y", "mirror Y across the field")):
+            cb = QCheckBox(label)
+            cb.setObjectName(f"lmc_{name}")
+            cb.setToolTip(tip)
+            cb.toggled.connect(self._on_orientation)
+            self.orient_boxes[name] = cb
+            ol.addWidget(cb)
+        ol.addStretch(1)
         box = QWidget()
         lay = QVBoxLayout(box)
         lay.setContentsMargins(4, 2, 4, 2)
         lay.addWidget(self.panel, 1)
+        lay.addWidget(orient)
         lay.addWidget(self.note)
         self.dock = QDockWidget("Layers", win)
         self.dock.setObjectName("dock_layers")
@@ -157,14 +201,63 @@ class LayersDock:
         if "View" in menus:
             menus["View"].addAction(self.dock.toggleViewAction())
 
-        win.export_kinds["lmc"] = ExportKind(
-            "Export &LMC List (.lmc)…", "BJJCZ list (*.lmc)", ".lmc", write_lmc_list,
-            "BJJCZ list commands, layers by pen number with their settings")
-        win.export_kinds["lmc_text"] = ExportKind(
-            "Export LMC &Text…", "Text files (*.txt)", ".lmc.txt", write_lmc_text,
-            "the BJJCZ list as readable text, one command per line")
+        self._export_kind = ExportKind
+        self._set_export_kinds()
         win.rebuild_export_menu()
         win.result_shown.connect(self._on_result_shown)
+        if win._restore_settings:  # noqa: SLF001 - the window's own choice
+            self._restore_settings()
+
+    # ------------------------------------------------------------------ export
+    def orientation(self) -> Orientation:
+        """The field orientation the LMC export applies (the dock's check boxes)."""
+        return Orientation(*(self.orient_boxes[n].isChecked() for n in ORIENT_NAMES))
+
+    def set_orientation(self, orientation: Orientation) -> None:
+        for n in ORIENT_NAMES:
+            self.orient_boxes[n].setChecked(bool(getattr(orientation, n)))
+
+    def _set_export_kinds(self) -> None:
+        # a writer holds the orientation: the one of the moment the export is asked for
+        o = self.orientation()
+        where = "" if o.is_identity else " (" + ", ".join(
+            n.replace("_", " ") for n in ORIENT_NAMES if getattr(o, n)) + ")"
+        self.win.export_kinds["lmc"] = self._export_kind(
+            "Export &LMC List (.lmc)…", "BJJCZ list (*.lmc)", ".lmc", LmcWriter(False, o),
+            "BJJCZ list commands, layers by pen number with their settings" + where)
+        self.win.export_kinds["lmc_text"] = self._export_kind(
+            "Export LMC &Text…", "Text files (*.txt)", ".lmc.txt", LmcWriter(True, o),
+            "the BJJCZ list as readable text, one command per line" + where)
+
+    def _on_orientation(self, _on: bool = False) -> None:
+        self._set_export_kinds()
+        self._remember()
+
+    # ------------------------------------------------------------------ settings
+    def _remember(self) -> None:
+        """Keep the pen table and the orientation for the next session (a window that
+        restores its settings only)."""
+        if not self.win._restore_settings:  # noqa: SLF001
+            return
+        s = self.win.settings
+        s.setValue(PENS_KEY, dump_pen_table(self.table))
+        o = self.orientation()
+        s.setValue(ORIENT_KEY, ",".join(n for n in ORIENT_NAMES if getattr(o, n)))
+
+    def _restore_settings(self) -> None:
+        s = self.win.settings
+        text = s.value(PENS_KEY)
+        if isinstance(text, str) and text:
+            try:
+                self.table = pen_table_from_dict(tomllib.loads(text), "settings",
+                                                 self.win.params.laser)
+            except (GalvoError, tomllib.TOMLDecodeError):
+                pass  # a table of an older version: start from the laser parameters
+            else:
+                self.panel.set_table(self.effective())
+        names = s.value(ORIENT_KEY)
+        if isinstance(names, str):
+            self.set_orientation(Orientation(*(n in names.split(",") for n in ORIENT_NAMES)))
 
     # ------------------------------------------------------------------ the run
     def effective(self, params: Params | None = None) -> PenTable:
@@ -182,6 +275,7 @@ class LayersDock:
     def set_table(self, table: PenTable) -> None:
         """Use ``table`` (its profile becomes the laser parameters) and process again."""
         self.table = table
+        self._remember()
         win = self.win
         if table.default.laser != win.params.laser:
             win.apply_changes({"laser": table.default.laser})  # runs again
@@ -195,10 +289,12 @@ class LayersDock:
         pens = getattr(result, "pens", None)
         if isinstance(pens, PenTable) and pens != self.table:
             self.table = pens
+            self._remember()
             self.panel.set_table(self.effective())
 
     def _on_edited(self, table: PenTable) -> None:
         self.table = table
+        self._remember()
         win = self.win
         res = win.result
         if (res is not None and res.job_path is None and win.job_path is None

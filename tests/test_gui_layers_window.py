@@ -286,3 +286,42 @@ def test_a_pen_edit_gives_the_job_of_a_fresh_run(win):
         assert a == pytest.approx(b)
     assert job.stats["layers"][0]["passes"] == 2
     assert [s.marks.tolist() for s in job.strokes] == [s.marks.tolist() for s in fresh.strokes]
+
+
+def test_lmc_export_applies_the_orientation_checked_in_the_dock(win, tmp_path):
+    from galvo_core.lmc import Orientation
+
+    job = win.current_job()
+    win.layers.orient_boxes["flip_y"].setChecked(True)
+    win.layers.orient_boxes["swap_xy"].setChecked(True)
+    out = tmp_path / "flipped.lmc"
+    assert win.export("lmc", out)
+    o = Orientation(swap_xy=True, flip_y=True)
+    d = decode(out.read_bytes())
+    want = expected_strokes(job, orientation=o)
+    assert [s.marks.tolist() for s in d.strokes] == [m.tolist() for _, m in want]
+    plain = expected_strokes(job)
+    assert [s.marks.tolist() for s in d.strokes] != [m.tolist() for _, m in plain]
+    text = tmp_path / "flipped.txt"
+    assert win.export("lmc_text", text)
+    assert text.read_text() == to_text(encode_job(job, orientation=o))
+
+
+def test_pen_table_and_orientation_kept_between_sessions(qtbot, two, tmp_path):
+    from PySide6.QtCore import QSettings
+
+    ini = str(tmp_path / "s.ini")
+    a = MainWindow(settings=QSettings(ini, QSettings.Format.IniFormat))
+    qtbot.addWidget(a)
+    assert a.load_file(two, wait=True)
+    a.layers.panel.editor(2, "power_percent").setValue(77.0)
+    a.layers.orient_boxes["flip_x"].setChecked(True)
+    assert a.wait_idle(60)
+    a.close()
+    b = MainWindow(settings=QSettings(ini, QSettings.Format.IniFormat))
+    qtbot.addWidget(b)
+    assert b.layers.table.settings(2).laser.power_percent == 77.0
+    assert b.layers.orientation().flip_x and not b.layers.orientation().flip_y
+    assert b.load_file(two, wait=True)
+    assert {la["pen"]: la for la in b.current_job().layers}[2]["power_percent"] == 77.0
+    b.close()
