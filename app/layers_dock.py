@@ -44,6 +44,7 @@ from PySide6.QtWidgets import (
     QFileDialog,
     QHBoxLayout,
     QLabel,
+    QMenu,
     QVBoxLayout,
     QWidget,
 )
@@ -191,8 +192,8 @@ class LayersDock:
         self.open_action.triggered.connect(self.open_dialog)
         self.save_action = QAction("Save Pen &Table…", win)
         self.save_action.triggered.connect(self.save_dialog)
-        menus = {a.text().replace("&", ""): a.menu() for a in win.menuBar().actions()
-                 if a.menu() is not None}
+        menus = {a.text().replace("&", ""): m for a in win.menuBar().actions()
+                 if isinstance(m := a.menu(), QMenu)}
         if "File" in menus:
             before = win.export_menu.menuAction()
             menus["File"].insertAction(before, self.open_action)
