@@ -721,8 +721,10 @@ class _Hatch:
             r = self._oriented(self._rungs_of(c, extra), e == 1)  # type: ignore[arg-type]
             y, xs, pcs = r
 
-            def pt(j: int, sd: int, y: np.ndarray = y, xs: np.ndarray = xs) -> np.ndarray:
-                return np.array([[xs[j, sd], y[j]]])
+            ends = (np.column_stack([xs[:, 0], y]), np.column_stack([xs[:, 1], y]))
+
+            def pt(j: int, sd: int, ends: tuple = ends) -> np.ndarray:
+                return ends[sd][j:j + 1]
 
             if not ut:
                 sd = s
