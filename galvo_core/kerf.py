@@ -118,7 +118,7 @@ ASSIGN_STRIDE = 4
 #: scan spacing of the rectangle method as a fraction of d
 RECT_SPACING = 0.25
 #: the even-odd ray test cuts the plane into columns of about this many edge ends each
-CROSS_COLUMN_EDGES = 128
+CROSS_COLUMN_EDGES = 512
 #: ... unless the plain ray count pairs at most this many times (points + edges)
 CROSS_PLAIN_PAIRS = 8
 
