@@ -804,6 +804,9 @@ def hatch(
     ``inset_units`` are input units; pass ``p`` uses ``angle_deg + p * angle_step_deg``.
     Strokes come region by region (file order of the outer rings), pass by pass, bottom to
     top of the rotated frame; order them for the job with :func:`galvo_core.order`.
+    ``max_effort``: zig-zag search steps per monotone cell of a region piece (plus
+    :data:`EFFORT_BASE`), after which greedy walks cover the cells left (see
+    :meth:`_Hatch.walk`; 0: greedy walks only).
     """
     if fill == "none":
         return []
