@@ -892,9 +892,9 @@ def _odd_crossings(pts: np.ndarray, a: np.ndarray, b: np.ndarray) -> np.ndarray:
                                    side="right"))
         stop = max(stop, start + 1)
         rows = sel[start:stop]
-        c = cnt[rows]
-        row = np.repeat(rows, c)
-        k = lo[row] + (np.arange(len(row)) - np.repeat(np.cumsum(c) - c, c))
+        rc = cnt[rows]
+        row = np.repeat(rows, rc)
+        k = lo[row] + (np.arange(len(row)) - np.repeat(np.cumsum(rc) - rc, rc))
         pi = porder[k]
         e = e_id[row]
         x = ax[e] + (py[pi] - ay[e]) * (bx[e] - ax[e]) / (by[e] - ay[e])
