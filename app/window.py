@@ -311,6 +311,9 @@ class MainWindow(QMainWindow):
         #: True/False: how the last export ended; None while it runs
         self.last_export_ok: bool | None = None
         self._keep_selection: int | None = None
+        self._undo: list[Params] = []
+        self._redo: list[Params] = []
+        self._committed: Params | None = None
         self._reloading = False
         self._fit_banner = False
         self._stale_shown = False
@@ -483,6 +486,7 @@ class MainWindow(QMainWindow):
             for v in (self.original, self.processed):
                 v.set_layer_visible(spec.key, self.layer_boxes[spec.key].isChecked())
         self.controls.set_params(self.params, self._field_map_for(self.params))
+        self._committed = self.params
         if drawing is not None:
             self.set_drawing(drawing)
         else:
@@ -538,6 +542,18 @@ class MainWindow(QMainWindow):
         view_menu.addSeparator()
         view_menu.addAction(self.controls_dock.toggleViewAction())
         view_menu.addAction(self.job_dock.toggleViewAction())
+
+        edit = self.menuBar().addMenu("&Edit")
+        self.undo_action = QAction("&Undo Parameter Change", self)
+        self.undo_action.setShortcut(QKeySequence.StandardKey.Undo)
+        self.undo_action.triggered.connect(self.undo)
+        self.redo_action = QAction("&Redo Parameter Change", self)
+        self.redo_action.setShortcuts([QKeySequence.StandardKey.Redo,
+                                       QKeySequence("Ctrl+Shift+Z")])
+        self.redo_action.triggered.connect(self.redo)
+        edit.addAction(self.undo_action)
+        edit.addAction(self.redo_action)
+        self._update_undo_actions()
 
         proc = self.menuBar().addMenu("&Process")
         self.laser_action = QAction("&Laser Parameters…", self)
@@ -638,12 +654,56 @@ class MainWindow(QMainWindow):
         except (GalvoError, ValueError):
             return None
 
-    def set_params(self, params: Params, *, run: bool = True) -> None:
-        """Use ``params`` (controls follow) and process again."""
+    def set_params(self, params: Params, *, run: bool = True, record: bool = False) -> None:
+        """Use ``params`` (controls follow) and process again; ``record``: as an operator's
+        change that Undo takes back."""
+        if record:
+            self._record(params)
+        else:
+            self._committed = params
         self.params = params
         self.controls.set_params(params, self._field_map_for(params))
         if run:
             self.request_run()
+
+    # --- undo / redo of parameter changes -------------------------------------------------
+    #: how many parameter changes Undo remembers
+    UNDO_DEPTH = 200
+
+    def _record(self, params: Params) -> None:
+        """A committed change to ``params``: the previous committed set goes on the undo
+        stack (drags are not recorded, only their release)."""
+        prev = getattr(self, "_committed", None)
+        if prev is not None and prev != params:
+            self._undo.append(prev)
+            del self._undo[:-self.UNDO_DEPTH]
+            self._redo.clear()
+        self._committed = params
+        self._update_undo_actions()
+
+    def undo(self) -> bool:
+        """Back to the parameters before the last change (False when there is none)."""
+        if not self._undo:
+            return False
+        self._redo.append(self._committed)
+        self.set_params(self._undo.pop())
+        self._update_undo_actions()
+        self.statusBar().showMessage("undone: parameters as before the last change", 4000)
+        return True
+
+    def redo(self) -> bool:
+        """Again the change that Undo took back (False when there is none)."""
+        if not self._redo:
+            return False
+        self._undo.append(self._committed)
+        self.set_params(self._redo.pop())
+        self._update_undo_actions()
+        return True
+
+    def _update_undo_actions(self) -> None:
+        if hasattr(self, "undo_action"):
+            self.undo_action.setEnabled(bool(self._undo))
+            self.redo_action.setEnabled(bool(self._redo))
 
     def apply_changes(self, changes: dict[str, Any], final: bool = True) -> bool:
         """Change some Params fields (validated); returns False (and says why) when refused."""
@@ -655,6 +715,7 @@ class MainWindow(QMainWindow):
             return False
         self.params = params
         if final:
+            self._record(params)
             self._throttle.stop()
             self.request_run()
         elif not self._throttle.isActive():
@@ -665,7 +726,7 @@ class MainWindow(QMainWindow):
         self.apply_changes(dict(changes), final)
 
     def restore_defaults(self) -> None:
-        self.set_params(Params(laser=self.params.laser))
+        self.set_params(Params(laser=self.params.laser), record=True)
 
     def open_laser_dialog(self) -> None:
         dlg = LaserDialog(self.params.laser, self)
@@ -850,6 +911,7 @@ class MainWindow(QMainWindow):
             self._drawing_bbox = self.pipeline.bbox(res.drawing) if res.drawing else None
             if res.params is not None:
                 self.params = res.params
+                self._committed = res.params
                 self.controls.set_params(res.params, res.preview.field_map)
             self._watch(self.file_path)
         self.run_label.setText("cancelled")

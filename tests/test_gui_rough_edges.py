@@ -132,3 +132,29 @@ def test_plt_export_says_it_is_in_galvo_bits(qtbot, tmp_path):
     assert win.export("plt", out) and out.exists()
     assert "galvo bits" in win.statusBar().currentMessage()
     assert FsPath(out).stat().st_size > 0
+
+
+def test_undo_and_redo_of_parameter_changes(qtbot, tmp_path):
+    src = tmp_path / "circle.plt"
+    src.write_bytes(circle_plt())
+    win = make(qtbot)
+    assert win.load_file(src, wait=True)
+    assert not win.undo_action.isEnabled()
+    e0 = win.params.e_per
+    s = win.controls.sliders["e_per"]
+    s.set_position(s.to_position(0.3), final=False)  # a drag is not a change of its own
+    s.set_position(s.to_position(0.5), final=False)
+    s.set_position(s.to_position(0.5), final=True)  # the release
+    assert win.wait_idle(60) and win.params.e_per == pytest.approx(0.5, rel=0.01)
+    assert win.set_param("chord_tol_bits", 2.0) and win.wait_idle(60)
+    assert win.undo() and win.wait_idle(60)
+    assert win.params.chord_tol_bits != 2.0 and win.params.e_per == pytest.approx(0.5, rel=0.01)
+    assert win.current_job().params["chord_tol_bits"] == win.params.chord_tol_bits
+    assert win.undo() and win.wait_idle(60)
+    assert win.params.e_per == e0 and s.value() == pytest.approx(e0)
+    assert win.undo() is False
+    assert win.redo() and win.redo() and win.wait_idle(60)
+    assert win.params.chord_tol_bits == 2.0 and win.redo() is False
+    win.undo()
+    assert win.set_param("e_per", 0.7)  # a new change forgets what was undone
+    assert win.redo() is False
