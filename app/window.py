@@ -376,7 +376,7 @@ class MainWindow(QMainWindow):
         self.stale_bar.setObjectName("stale_bar")
         self.stale_bar.setWordWrap(True)
         self.stale_bar.setStyleSheet(
-            "background: #e8eef7; color: #1d3557; padding: 3px 8px; border-bottom: 1px solid "
+            "background: #e8eef7; color: #1d3557; padding: 3px 8px; border-top: 1px solid "
             "#a8bcd8;")
         self.stale_bar.hide()
 
@@ -882,7 +882,8 @@ class MainWindow(QMainWindow):
         w = g.width()
         self.stale_bar.setFixedWidth(w)
         self.stale_bar.adjustSize()
-        self.stale_bar.move(g.x(), g.y())
+        # along the bottom of the views (their titles stay readable)
+        self.stale_bar.move(g.x(), g.y() + g.height() - self.stale_bar.height())
 
     def resizeEvent(self, ev) -> None:  # noqa: N802 - Qt API
         super().resizeEvent(ev)
