@@ -529,6 +529,10 @@ class MainWindow(QMainWindow):
         self.field_action = QAction("Zoom to the &Field", self)
         self.field_action.triggered.connect(self.fit_field_view)
         view_menu.addAction(self.field_action)
+        self.ruler_action = QAction("&Ruler (click two points)", self, checkable=True)
+        self.ruler_action.setShortcut(QKeySequence("R"))
+        self.ruler_action.toggled.connect(self.set_ruler)
+        view_menu.addAction(self.ruler_action)
         view_menu.addSeparator()
         self.layer_actions: dict[str, QAction] = {}
         for i, spec in enumerate(LAYERS):
@@ -1536,7 +1540,65 @@ class MainWindow(QMainWindow):
         if not vb.sceneBoundingRect().contains(ev.scenePos()):
             return
         p = vb.mapSceneToView(ev.scenePos())
+        if self.ruler_action.isChecked():
+            self.ruler_click(p.x(), p.y())
+            return
         self.select_at(p.x(), p.y(), view)
+
+    # --- ruler ----------------------------------------------------------------------------
+    def set_ruler(self, on: bool) -> None:
+        """Ruler mode: clicks in either view measure instead of selecting."""
+        if self.ruler_action.isChecked() != on:
+            self.ruler_action.setChecked(on)
+            return
+        self._ruler_pts: list[tuple[float, float]] = []
+        self._draw_ruler()
+        self.statusBar().showMessage(
+            "Ruler: click two points (R again to leave)" if on else "", 6000 if on else 1)
+
+    def ruler_click(self, x_mm: float, y_mm: float) -> str | None:
+        """One ruler click (mm in the field); the second one measures and says so."""
+        pts = getattr(self, "_ruler_pts", [])
+        if len(pts) >= 2:
+            pts = []
+        pts.append((x_mm, y_mm))
+        self._ruler_pts = pts
+        self._draw_ruler()
+        if len(pts) < 2:
+            self.statusBar().showMessage("Ruler: click the second point", 6000)
+            return None
+        text = self.measure(pts[0], pts[1])
+        self.statusBar().showMessage(text, 30_000)
+        return text
+
+    def measure(self, a_mm: tuple[float, float], b_mm: tuple[float, float]) -> str:
+        """The distance between two points of the field in mm and galvo bits (and its
+        components), at the shown result's field."""
+        dx, dy = b_mm[0] - a_mm[0], b_mm[1] - a_mm[1]
+        d = float(np.hypot(dx, dy))
+        text = f"Ruler: {d:.3f} mm  (Δx {dx:.3f}, Δy {dy:.3f} mm)"
+        if self.result is not None:
+            mpb = self.result.preview.mm_per_bit
+            text += f" = {d / mpb:,.1f} bits (Δx {dx / mpb:,.0f}, Δy {dy / mpb:,.0f})".replace(
+                ",", "\u2009")
+        return text
+
+    def _draw_ruler(self) -> None:
+        pts = getattr(self, "_ruler_pts", [])
+        for view in (self.original, self.processed):
+            item = getattr(view, "_ruler_item", None)
+            if item is None:
+                import pyqtgraph as pg
+
+                item = pg.PlotDataItem([], [], pen=pg.mkPen("#222222", width=1.5),
+                                       symbol="+", symbolSize=12, symbolPen="#222222")
+                item.setZValue(1e5)
+                view.getPlotItem().addItem(item, ignoreBounds=True)
+                view._ruler_item = item
+            if pts:
+                item.setData([p[0] for p in pts], [p[1] for p in pts])
+            else:
+                item.setData([], [])
 
     def select_at(self, x_mm: float, y_mm: float, view: WorkView | None = None) -> int | None:
         """Select the path nearest to (x, y) mm (within ~8 pixels); None clears."""

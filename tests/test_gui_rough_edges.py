@@ -158,3 +158,22 @@ def test_undo_and_redo_of_parameter_changes(qtbot, tmp_path):
     win.undo()
     assert win.set_param("e_per", 0.7)  # a new change forgets what was undone
     assert win.redo() is False
+
+
+def test_ruler_measures_in_mm_and_bits(qtbot, tmp_path):
+    src = tmp_path / "circle.plt"
+    src.write_bytes(circle_plt())
+    win = make(qtbot)
+    assert win.load_file(src, wait=True)
+    win.ruler_action.setChecked(True)
+    assert win.ruler_click(10.0, 20.0) is None
+    text = win.ruler_click(13.0, 24.0)  # a 3-4-5 triangle: 5 mm
+    mpb = win.result.preview.mm_per_bit
+    assert text is not None and "5.000 mm" in text
+    bits = float(text.split("=")[1].split("bits")[0].replace("\u2009", ""))
+    assert bits == pytest.approx(5.0 / mpb, abs=0.1)
+    x, _ = win.processed._ruler_item.getData()
+    assert list(x) == [10.0, 13.0]
+    win.ruler_action.setChecked(False)
+    x, _ = win.processed._ruler_item.getData()
+    assert x is None or len(x) == 0
