@@ -49,6 +49,7 @@ from PySide6.QtWidgets import (
     QFileDialog,
     QFormLayout,
     QGroupBox,
+    QHBoxLayout,
     QLabel,
     QMainWindow,
     QMessageBox,
@@ -387,6 +388,8 @@ class MainWindow(QMainWindow):
         cl.addWidget(layer_bar)
         cl.addWidget(self.banner)
         cl.addWidget(splitter, 1)
+        self._build_simulation_bar()
+        cl.addWidget(self.sim_bar)
         self.setCentralWidget(central)
         # the stale bar floats over the top of the views: showing it must not resize them
         # (a resize re-rasterises every cached layer)
@@ -529,6 +532,10 @@ class MainWindow(QMainWindow):
         self.field_action = QAction("Zoom to the &Field", self)
         self.field_action.triggered.connect(self.fit_field_view)
         view_menu.addAction(self.field_action)
+        self.sim_action = QAction("Marking &Simulation", self, checkable=True)
+        self.sim_action.setShortcut(QKeySequence("Ctrl+M"))
+        self.sim_action.toggled.connect(self.set_simulation)
+        view_menu.addAction(self.sim_action)
         self.ruler_action = QAction("&Ruler (click two points)", self, checkable=True)
         self.ruler_action.setShortcut(QKeySequence("R"))
         self.ruler_action.toggled.connect(self.set_ruler)
@@ -1033,6 +1040,9 @@ class MainWindow(QMainWindow):
         self.last_result_time = time.perf_counter()
         self._update_status()
         self._update_stale()
+        if self.sim_bar.isVisible():
+            self._sim = None
+            self.simulate_at(self.sim_slider.value() / self.SIM_STEPS)
         missing = [k for k in self.wanted_layers() if not pv.has_layer(k)]
         if missing and result.job_path is None and result.fitted is not None:
             self.request_run()  # a layer turned on while this result was computed
@@ -1544,6 +1554,119 @@ class MainWindow(QMainWindow):
             self.ruler_click(p.x(), p.y())
             return
         self.select_at(p.x(), p.y(), view)
+
+    # --- marking simulation ---------------------------------------------------------------
+    SIM_STEPS = 1000
+
+    def _build_simulation_bar(self) -> None:
+        from PySide6.QtWidgets import QSlider
+
+        bar = QWidget()
+        bar.setObjectName("simulation_bar")
+        lay = QHBoxLayout(bar)
+        lay.setContentsMargins(6, 2, 6, 2)
+        self.sim_play = QToolButton()
+        self.sim_play.setText("▶")
+        self.sim_play.setCheckable(True)
+        self.sim_play.setToolTip("play the job in its marking order")
+        self.sim_play.toggled.connect(self._sim_toggle_play)
+        self.sim_slider = QSlider(Qt.Orientation.Horizontal)
+        self.sim_slider.setRange(0, self.SIM_STEPS)
+        self.sim_slider.valueChanged.connect(lambda v: self.simulate_at(v / self.SIM_STEPS))
+        self.sim_label = QLabel("")
+        self.sim_label.setMinimumWidth(260)
+        lay.addWidget(QLabel("Simulation:"))
+        lay.addWidget(self.sim_play)
+        lay.addWidget(self.sim_slider, 1)
+        lay.addWidget(self.sim_label)
+        bar.hide()
+        self.sim_bar = bar
+        self._sim_timer = QTimer(self)
+        self._sim_timer.setInterval(40)
+        self._sim_timer.timeout.connect(self._sim_tick)
+        self._sim: tuple[Any, ...] | None = None
+
+    def set_simulation(self, on: bool) -> None:
+        """Show the marking simulation bar (the beam and what it has marked so far)."""
+        if self.sim_action.isChecked() != on:
+            self.sim_action.setChecked(on)
+            return
+        self.sim_bar.setVisible(on)
+        if not on:
+            self.sim_play.setChecked(False)
+        self._sim = None
+        self.simulate_at(self.sim_slider.value() / self.SIM_STEPS if on else None)
+
+    def _sim_data(self) -> tuple[Any, ...] | None:
+        from galvo_core.preview import beam_timeline
+
+        res = self.result
+        if res is None:
+            return None
+        if self._sim is None or self._sim[0] is not res.job:
+            xy, t, on = beam_timeline(res.job)
+            self._sim = (res.job, xy, t, on)
+        return self._sim
+
+    def simulate_at(self, fraction: float | None) -> dict[str, Any] | None:
+        """Put the simulated beam at ``fraction`` (0..1) of the job's estimated time: the
+        beam marker, the marked trail so far, and the time read-out. None hides them.
+        Returns the state shown (time, total, index, position in bits, laser on)."""
+        import pyqtgraph as pg
+
+        view = self.processed
+        if not hasattr(view, "_sim_items"):
+            trail = pg.PlotDataItem([], [], pen=pg.mkPen("#111111", width=2))
+            beam = pg.ScatterPlotItem([], [], size=14, pen=pg.mkPen("#111111", width=2),
+                                      brush=pg.mkBrush(255, 255, 255, 0))
+            for it in (trail, beam):
+                it.setZValue(2e5)
+                view.getPlotItem().addItem(it, ignoreBounds=True)
+            view._sim_items = (trail, beam)
+        trail, beam = view._sim_items
+        data = self._sim_data() if fraction is not None else None
+        if data is None or not len(data[2]):
+            trail.setData([], [])
+            beam.setData([], [])
+            self.sim_label.setText("")
+            return None
+        _, xy, t, on = data
+        total = float(t[-1])
+        now = min(max(fraction, 0.0), 1.0) * total
+        k = int(np.searchsorted(t, now, side="right")) - 1
+        k = max(0, min(k, len(t) - 1))
+        pos = xy[k].copy()
+        lit = False
+        if k + 1 < len(t) and t[k + 1] > t[k]:
+            f = (now - t[k]) / (t[k + 1] - t[k])
+            pos = xy[k] + f * (xy[k + 1] - xy[k])
+            lit = bool(on[k + 1])
+        mpb = self.result.preview.mm_per_bit if self.result else 1.0
+        seg = np.vstack((xy[: k + 1], pos[None, :])) * mpb
+        conn = np.zeros(len(seg), dtype=bool)
+        conn[:-1] = np.append(on[1 : k + 1], lit)  # draw a step only where the laser was on
+        trail.setData(seg[:, 0], seg[:, 1], connect=conn)
+        beam.setData([pos[0] * mpb], [pos[1] * mpb],
+                     pen=pg.mkPen("#d7191c" if lit else "#111111", width=2))
+        self.sim_label.setText(f"t = {now:.3f} s / {total:.3f} s · laser "
+                               f"{'on' if lit else 'off'}")
+        return {"time_s": now, "total_s": total, "index": k, "bits": pos, "laser_on": lit}
+
+    def _sim_toggle_play(self, on: bool) -> None:
+        self.sim_play.setText("⏸" if on else "▶")
+        if on:
+            if self.sim_slider.value() >= self.SIM_STEPS:
+                self.sim_slider.setValue(0)
+            self._sim_timer.start()
+        else:
+            self._sim_timer.stop()
+
+    def _sim_tick(self) -> None:
+        v = self.sim_slider.value() + 2
+        if v >= self.SIM_STEPS:
+            v = self.SIM_STEPS
+            self.sim_play.setChecked(False)
+        self.sim_slider.setValue(v)
 
     # --- ruler ----------------------------------------------------------------------------
     def set_ruler(self, on: bool) -> None:

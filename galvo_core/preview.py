@@ -840,3 +840,45 @@ def warning_path(drawing: Drawing | None, warning: Warning) -> int | None:
     if drawing is None or not warning.line:
         return None
     return path_for_position(drawing, warning.line, warning.col)
+
+
+def beam_timeline(job: Job) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The beam's path through the job in marking order, for a marking simulation.
+
+    Returns ``(xy, t, on)``: ``xy`` (K, 2) the beam positions in galvo bits (the first mark
+    of each stroke is reached by a jump, the others by marking moves), ``t`` (K,) the time
+    in seconds at which the beam reaches each position, ``on`` (K,) True when the move *to*
+    that position is marked (laser on). Moves take distance / speed (the mark and jump
+    speeds of ``job.laser``), at least one point period, jumps add their delay and each
+    stroke its laser on/off delays; the whole timeline is then scaled so that it ends at
+    the job's ``estimated_time_s`` (when the job has one), the figure the window shows.
+    """
+    marks, lens = _all_marks(job.strokes)
+    if not len(marks):
+        return EMPTY, np.empty(0), np.empty(0, dtype=bool)
+    lens = lens[lens > 0]
+    laser = job.laser
+    mpb = job.field_map.mm_per_bit
+    xy = marks.astype(np.float64)
+    step = np.zeros(len(xy))
+    step[1:] = np.hypot(*np.diff(xy, axis=0).T) * mpb
+    starts = np.concatenate(([0], np.cumsum(lens)[:-1]))
+    on = np.ones(len(xy), dtype=bool)
+    on[starts] = False  # each stroke's first mark is reached by a jump
+    on[0] = False
+    period = float(laser.get("point_period_us", 10.0)) * 1e-6
+    mark_v = float(laser.get("mark_speed_mm_s", 100.0))
+    jump_v = float(laser.get("jump_speed_mm_s", 2000.0))
+    dt = np.where(on, np.maximum(step / mark_v, period), step / jump_v)
+    long_mm = float(laser.get("long_jump_mm", 10.0))
+    jd = np.where(step > long_mm, float(laser.get("jump_delay_long_us", 200.0)),
+                  float(laser.get("jump_delay_us", 8.0))) * 1e-6
+    dt = np.where(on, dt, dt + jd)
+    dt[starts[1:]] += (float(laser.get("laser_off_delay_us", 100.0))
+                       + float(laser.get("laser_on_delay_us", 100.0))) * 1e-6
+    dt[0] = 0.0
+    t = np.cumsum(dt)
+    total = float(job.stats.get("estimated_time_s") or 0.0)
+    if total > 0 and t[-1] > 0:
+        t *= total / t[-1]
+    return xy, t, on

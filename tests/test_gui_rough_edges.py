@@ -177,3 +177,34 @@ def test_ruler_measures_in_mm_and_bits(qtbot, tmp_path):
     win.ruler_action.setChecked(False)
     x, _ = win.processed._ruler_item.getData()
     assert x is None or len(x) == 0
+
+
+def test_marking_simulation_plays_the_job_in_order(qtbot, tmp_path):
+    from galvo_core.preview import beam_timeline
+
+    win = make(qtbot)
+    assert win.load_file(SAMPLES / "seal.plt", wait=True)
+    job = win.current_job()
+    xy, t, on = beam_timeline(job)
+    assert len(xy) == sum(len(s.marks) for s in job.strokes)
+    assert t[-1] == pytest.approx(job.stats["estimated_time_s"])
+    assert (t[1:] >= t[:-1]).all()
+    assert on.sum() == len(xy) - len(job.strokes)  # each stroke starts with a jump
+    win.sim_action.setChecked(True)
+    assert win.sim_bar.isVisible()
+    start = win.simulate_at(0.0)
+    assert start["time_s"] == 0 and start["index"] == 0
+    np_first = job.strokes[0].marks[0]
+    assert tuple(start["bits"]) == pytest.approx(tuple(np_first))
+    end = win.simulate_at(1.0)
+    assert end["time_s"] == pytest.approx(job.stats["estimated_time_s"])
+    assert tuple(end["bits"]) == pytest.approx(tuple(job.strokes[-1].marks[-1]))
+    mid = win.simulate_at(0.5)
+    assert 0 < mid["index"] < len(xy) - 1
+    assert "s /" in win.sim_label.text()
+    # scrubbing with the slider moves the beam
+    win.sim_slider.setValue(250)
+    x, _ = win.processed._sim_items[0].getData()
+    assert x is not None and 1 < len(x) <= mid["index"] + 2
+    win.sim_action.setChecked(False)
+    assert not win.sim_bar.isVisible()
