@@ -1171,6 +1171,14 @@ class MainWindow(QMainWindow):
             self._show_job(loaded)
         self.last_load_ok = True
 
+    def open_drawing(self, drawing: Drawing, path: str | os.PathLike | None = None) -> None:
+        """Open a drawing read elsewhere (the --screenshot command) as :meth:`load_file`
+        opens a file: a drawing bigger than the field at true size gets Fit field."""
+        p = FsPath(path) if path is not None else FsPath(drawing.name or "untitled")
+        loaded = Loaded(p, drawing, self.pipeline.bbox(drawing), drawing.size_mm())
+        self._open_fitting_field(loaded)
+        self.set_drawing(drawing, path, bbox=loaded.bbox, size_mm=loaded.size_mm)
+
     def _on_load_failed(self, gen: int, message: str, user_facing: bool) -> None:
         path = self.loading_path
         self.loading_path = None

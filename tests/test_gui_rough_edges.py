@@ -208,3 +208,15 @@ def test_marking_simulation_plays_the_job_in_order(qtbot, tmp_path):
     assert x is not None and 1 < len(x) <= mid["index"] + 2
     win.sim_action.setChecked(False)
     assert not win.sim_bar.isVisible()
+
+
+def test_screenshot_of_a_drawing_bigger_than_the_field_uses_fit_field(qtbot, dialogs):
+    """--screenshot opens its drawing with open_drawing: the same Fit field rule."""
+    from galvo_core.hpgl import read_bytes
+
+    big = read_bytes(b"IN;SP1;PU0,0;PD16000,0,16000,16000,0,16000,0,0;PU;", "big.plt")
+    win = make(qtbot)
+    win.open_drawing(big, "big.plt")
+    assert win.wait_idle(60)
+    assert win.params.fit_field and win.run_error is None and win.banner.isVisible()
+    assert win.current_job().strokes and not dialogs
