@@ -985,10 +985,6 @@ def scale_transform(scale: float) -> QTransform:
     return QTransform(scale, 0.0, 0.0, scale, 0.0, 0.0)
 
 
-def colour_of(name: str) -> QColor:
-    return pg.mkColor(name)
-
-
 __all__ = [
     "LAYERS",
     "LAYER_KEYS",

@@ -14,7 +14,7 @@ import os
 import re
 import time
 from collections.abc import Callable
-from dataclasses import dataclass, fields
+from dataclasses import dataclass
 from pathlib import Path as FsPath
 from typing import Any
 
@@ -45,27 +45,24 @@ from PySide6.QtWidgets import (
     QApplication,
     QCheckBox,
     QDockWidget,
-    QDoubleSpinBox,
     QFileDialog,
-    QFormLayout,
-    QGroupBox,
     QHBoxLayout,
     QLabel,
     QMainWindow,
     QMessageBox,
     QProgressBar,
     QScrollArea,
-    QSpinBox,
     QSplitter,
     QToolButton,
     QVBoxLayout,
     QWidget,
 )
 
+from galvo_core import params as params_mod
 from galvo_core.drawing import Drawing
 from galvo_core.errors import GalvoError, ParamError
 from galvo_core.job import Job, atomic_write_bytes, load_job, write_job
-from galvo_core.params import LaserParams, Params
+from galvo_core.params import Params
 from galvo_core.pipeline import Pipeline
 from galvo_core.preview import PreviewCache
 
@@ -218,24 +215,18 @@ def _fmt_int(n: int) -> str:
 
 
 def params_to_json(p: Params) -> str:
-    d = p.processing_dict()
-    d["laser"] = p.laser.as_dict()
-    return json.dumps(d)
+    return json.dumps(p.as_dict())
 
 
 def params_from_json(text: str, base: Params | None = None) -> Params:
-    """Params from :func:`params_to_json` text; unknown keys are ignored, invalid -> base."""
+    """Params from :func:`params_to_json` text (or the older layout with a ``laser``
+    table); unknown keys are ignored, an invalid value gives ``base``."""
     base = base or Params()
     try:
         d = json.loads(text)
-        names = {f.name for f in fields(Params)}
-        changes: dict[str, Any] = {k: v for k, v in d.items() if k in names and k != "laser"}
-        if isinstance(changes.get("offset_bits"), list):
-            changes["offset_bits"] = tuple(changes["offset_bits"])
         if isinstance(d.get("laser"), dict):
-            lnames = {f.name for f in fields(LaserParams)}
-            changes["laser"] = LaserParams(**{k: v for k, v in d["laser"].items() if k in lnames})
-        return base.replace(**changes)
+            d = {**d.pop("laser"), **d}
+        return Params.from_mapping(d, base=base, ignore_unknown=True)
     except (ValueError, TypeError, AttributeError):
         return base
 
@@ -402,7 +393,6 @@ class MainWindow(QMainWindow):
         self.controls.changed.connect(self._on_controls_changed)
         self.controls.laser_requested.connect(self.open_laser_dialog)
         self.controls.defaults_button.clicked.connect(self.restore_defaults)
-        self._add_hatch_pass_controls()
         mag = self.controls.sliders.get("magnification")
         if mag is not None:
             # the box shows and takes any magnification down to its last decimal, e.g. the
@@ -475,6 +465,8 @@ class MainWindow(QMainWindow):
 
         self._build_menus()
         self._build_status_bar()
+        from .layers_dock import LayersDock
+        self.layers = LayersDock(self)  # the layer table, pen table files, LMC export
         for view in (self.original, self.processed):
             view.scene().sigMouseMoved.connect(lambda pos, v=view: self._on_mouse_moved(v, pos))
             view.scene().sigMouseClicked.connect(lambda ev, v=view: self._on_mouse_clicked(v, ev))
@@ -610,54 +602,6 @@ class MainWindow(QMainWindow):
         sb.addPermanentWidget(self.warnings_label)
         sb.addPermanentWidget(self.cursor_label)
 
-    def _add_hatch_pass_controls(self) -> None:
-        """Hatch passes and the angle step between them, in the Fill group (when the panel
-        does not have them already: the core has them, the generated panel may not)."""
-        self.hatch_passes_spin: QSpinBox | None = None
-        self.hatch_step_spin: QDoubleSpinBox | None = None
-        names = {f.name for f in fields(Params)}
-        c = self.controls
-        if "hatch_passes" not in names or "hatch_passes" in c.sliders or \
-                "hatch_passes" in c.combos:
-            return
-        box = next((b for b in c.findChildren(QGroupBox) if b.title() == "Fill"), None)
-        if box is None or box.layout() is None:
-            return
-        passes = QSpinBox()
-        passes.setObjectName("spin_hatch_passes")
-        passes.setRange(1, 16)
-        passes.setValue(self.params.hatch_passes)
-        passes.setToolTip("how many times the fill is hatched, each pass turned by the "
-                          "angle step (hatch_passes)")
-        step = QDoubleSpinBox()
-        step.setObjectName("spin_hatch_angle_step_deg")
-        step.setRange(-180.0, 180.0)
-        step.setDecimals(1)
-        step.setSuffix(" °")
-        step.setKeyboardTracking(False)
-        step.setValue(self.params.hatch_angle_step_deg)
-        step.setToolTip("angle between consecutive passes (hatch_angle_step_deg)")
-        row = QWidget()
-        form = QFormLayout(row)
-        form.setContentsMargins(0, 0, 0, 0)
-        form.addRow("Passes", passes)
-        form.addRow("Angle step", step)
-        box.layout().addWidget(row)
-        passes.valueChanged.connect(lambda v: self.apply_changes({"hatch_passes": int(v)}))
-        step.valueChanged.connect(
-            lambda v: self.apply_changes({"hatch_angle_step_deg": float(v)}))
-        self.hatch_passes_spin, self.hatch_step_spin = passes, step
-        real = c.set_params
-
-        def set_params(params: Params, fm=None) -> None:
-            real(params, fm)
-            for w, v in ((passes, params.hatch_passes), (step, params.hatch_angle_step_deg)):
-                w.blockSignals(True)
-                w.setValue(v)
-                w.blockSignals(False)
-
-        c.set_params = set_params  # type: ignore[method-assign]
-
     # --- params ---------------------------------------------------------------------------
     def _field_map_for(self, params: Params):
         try:
@@ -755,9 +699,9 @@ class MainWindow(QMainWindow):
             return None
         from .worker import pipeline_task_safe
 
-        gen = self.runner.request(pipeline_task_safe(
+        gen = self.runner.request(self.layers.wrap(pipeline_task_safe(
             self.pipeline, self.preview_cache, self.drawing, self.params, self.file_path,
-            self.wanted_layers(), self.prepared_cache))
+            self.wanted_layers(), self.prepared_cache)))
         self._update_stale()
         return gen
 
@@ -807,18 +751,10 @@ class MainWindow(QMainWindow):
         optional) as the controls would, and process again; False (and the status bar says
         why) when refused."""
         name = name.removeprefix("laser.")
-        if name in {f.name for f in fields(Params)} and name != "laser":
-            ok = self.apply_changes({name: value})
-        elif name in {f.name for f in fields(LaserParams)}:
-            try:
-                laser = LaserParams(**{**self.params.laser.as_dict(), name: value})
-            except (ParamError, TypeError, ValueError) as exc:
-                self.statusBar().showMessage(f"refused: {exc}", 8000)
-                return False
-            ok = self.apply_changes({"laser": laser})
-        else:
+        if name not in params_mod.WHERE:
             self.statusBar().showMessage(f"refused: no parameter named {name!r}", 8000)
             return False
+        ok = self.apply_changes({name: value})
         if ok:
             self.controls.set_params(self.params, self._field_map_for(self.params))
         return ok
@@ -840,7 +776,8 @@ class MainWindow(QMainWindow):
             return self.drawing is not None
         if res.job_path is not None or self.job_path is not None:
             return res.job_path != self.job_path
-        return res.drawing is not self.drawing or res.params != self.params
+        return (res.drawing is not self.drawing or res.params != self.params
+                or not self.layers.is_current(res))
 
     def shown_name(self) -> str:
         """The name of the file whose result the views show ('' when none)."""
@@ -925,6 +862,7 @@ class MainWindow(QMainWindow):
                 self.params = res.params
                 self._committed = res.params
                 self.controls.set_params(res.params, res.preview.field_map)
+            self.layers.restore(res)  # and the pen table
             self._watch(self.file_path)
         self.run_label.setText("cancelled")
         self.statusBar().showMessage(

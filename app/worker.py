@@ -56,6 +56,8 @@ class RunResult:
     #: worker (QPainterPaths, rectangles: :func:`app.views.prepare_layer`)
     arrays: dict[str, tuple[np.ndarray, ...]] | None = None
     prepared: dict[str, tuple] | None = None
+    #: the pen table applied to ``job`` (app.layers_dock: part of what the result was made of)
+    pens: Any = None
 
 
 _NO_POINTS = np.empty((0, 2))
@@ -143,9 +145,8 @@ def pipeline_task(pipeline: Pipeline, cache: PreviewCache, drawing: Drawing,
 
     def task(cancel: Callable[[], bool]) -> RunResult:
         t0 = time.perf_counter()
-        job = pipeline.run(drawing, params, cancel=cancel)
-        stages = tuple(pipeline.last_info.stages_run)
-        fitted = pipeline.fitted(drawing, params, cancel)  # cached by the run
+        res = pipeline.run(drawing, params, cancel=cancel)
+        job, stages, fitted = res.job, res.stages_run, res.fitted
         if cancel():
             raise Cancelled()
         preview = build_preview(job, drawing, fitted, cache=cache, cancel=cancel, layers=layers)
@@ -177,8 +178,7 @@ def pipeline_task_safe(pipeline: Pipeline, cache: PreviewCache, drawing: Drawing
             preview = build_preview(job, drawing, None, cache=cache, cancel=cancel,
                                     layers=layers)
             res = RunResult(drawing, params, job, None, preview, time.perf_counter() - t0,
-                            tuple(pipeline.last_info.stages_run), error=str(exc), path=path,
-                            layers=layers)
+                            (), error=str(exc), path=path, layers=layers)
             return with_prepared(res, prepared, cancel)
 
     return task

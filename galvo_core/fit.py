@@ -57,7 +57,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from galvo_core.drawing import Drawing
-from galvo_core.errors import ParamError
+from galvo_core.errors import Cancelled, ParamError
 from galvo_core.geometry import (
     cubic_eval,
     cubic_length,
@@ -121,44 +121,146 @@ class Segment:
         return self.points[-1]
 
 
-@dataclass(frozen=True, eq=False)
-class FittedPath:
-    """The fitted form of one :class:`~galvo_core.drawing.Path`.
+def _read_only(a: np.ndarray) -> np.ndarray:
+    a.setflags(write=False)
+    return a
 
-    ``segments`` are continuous (each starts exactly where the previous ended; a closed
-    path's last ends exactly at the first's start). ``max_error`` is the largest true
-    distance from an input point to its segment (input units). ``n_thinned`` is the number of
-    points left by the line thinning.
+
+_EMPTY_POINTS = _read_only(np.zeros((0, 2)))
+_EMPTY_BOOL = _read_only(np.zeros(0, dtype=bool))
+_EMPTY_INT = _read_only(np.zeros(0, dtype=np.int64))
+
+
+def segment_point_offsets(is_cubic: np.ndarray) -> np.ndarray:
+    """Row of each segment's first control point in a path's shared ``points`` array: the
+    start point is row 0, a line adds one row (its end), a cubic three (P1, P2, P3)."""
+    step = np.where(is_cubic, 3, 1)
+    return np.cumsum(step) - step
+
+
+@dataclass(frozen=True, slots=True, eq=False, init=False)
+class FittedPath:
+    """The fitted form of one :class:`~galvo_core.drawing.Path`, stored as arrays.
+
+    ``is_cubic`` (S,) bool: the segment kinds in order (False: a line). ``points`` (C, 2)
+    float64 input units, read-only: the control points shared between segments, the start
+    point then per segment its points after the start (a line: its end; a cubic: P1, P2,
+    P3), so C = 1 + lines + 3·cubics (0 without segments); segment k spans
+    ``points[o_k : o_k + 2]`` (line) or ``points[o_k : o_k + 4]`` (cubic), o_k from
+    :func:`segment_point_offsets`. ``first``/``last`` (S,) int64: the input point indices
+    each segment replaces (see :class:`Segment`).
+
+    The segments are continuous by construction (each starts exactly where the previous
+    ended; a closed path's last ends exactly at the first's start). ``max_error`` is the
+    largest true distance from an input point to its segment (input units). ``n_thinned``
+    is the number of points left by the line thinning.
+
+    ``segments``: the same geometry as a tuple of :class:`Segment` objects (views of
+    ``points``), built on first use, for code that wants one object per segment (the
+    GUI's selected path, tests). ``FittedPath(source_index, pen, closed, segments, ...)``
+    still accepts such a tuple (continuous segments; else ValueError).
     """
 
     source_index: int
     pen: int
     closed: bool
-    segments: tuple[Segment, ...]
+    is_cubic: np.ndarray
+    points: np.ndarray
+    first: np.ndarray
+    last: np.ndarray
     max_error: float
     n_input: int
-    n_thinned: int = 0
+    n_thinned: int
+    _segments: tuple[Segment, ...] | None
+
+    def __init__(self, source_index: int, pen: int, closed: bool,
+                 segments: Sequence[Segment] = (), max_error: float = 0.0, n_input: int = 0,
+                 n_thinned: int = 0) -> None:
+        segs = tuple(segments)
+        if segs:
+            kinds = np.array([s.kind == "cubic" for s in segs], dtype=bool)
+            parts = [np.asarray(segs[0].points, dtype=np.float64)[:1]]
+            prev = parts[0][0]
+            for k, s in enumerate(segs):
+                p = np.asarray(s.points, dtype=np.float64)
+                if p.shape != ((4, 2) if kinds[k] else (2, 2)):
+                    raise ValueError(f"segment {k}: a line has 2 points, a cubic 4")
+                if not np.array_equal(p[0], prev):
+                    raise ValueError(f"segment {k} does not start where segment {k - 1} ended")
+                parts.append(p[1:])
+                prev = p[-1]
+            pts = np.concatenate(parts)
+            first = np.array([s.first for s in segs], dtype=np.int64)
+            last = np.array([s.last for s in segs], dtype=np.int64)
+            _init_fitted(self, int(source_index), int(pen), bool(closed), _read_only(kinds),
+                         _read_only(pts), _read_only(first), _read_only(last),
+                         float(max_error), int(n_input), int(n_thinned))
+        else:
+            _init_fitted(self, int(source_index), int(pen), bool(closed), _EMPTY_BOOL,
+                         _EMPTY_POINTS, _EMPTY_INT, _EMPTY_INT, float(max_error), int(n_input),
+                         int(n_thinned))
+
+    @classmethod
+    def from_arrays(cls, source_index: int, pen: int, closed: bool, is_cubic: np.ndarray,
+                    points: np.ndarray, first: np.ndarray, last: np.ndarray,
+                    max_error: float, n_input: int, n_thinned: int) -> FittedPath:
+        """A fitted path from its arrays as they are (read-only, of the documented shapes and
+        types: not checked, not copied): the fitter's fast path, one object per path."""
+        fp = _new(cls)
+        _init_fitted(fp, source_index, pen, closed, is_cubic, points, first, last, max_error,
+                     n_input, n_thinned)
+        return fp
+
+    @property
+    def n_segments(self) -> int:
+        return len(self.is_cubic)
 
     @property
     def n_lines(self) -> int:
-        return sum(1 for s in self.segments if s.kind == "line")
+        return len(self.is_cubic) - int(np.count_nonzero(self.is_cubic))
 
     @property
     def n_cubics(self) -> int:
-        return sum(1 for s in self.segments if s.kind == "cubic")
+        return int(np.count_nonzero(self.is_cubic))
+
+    @property
+    def segments(self) -> tuple[Segment, ...]:
+        segs = self._segments
+        if segs is None:
+            cub = self.is_cubic.tolist()
+            off = segment_point_offsets(self.is_cubic).tolist()
+            pts = self.points
+            segs = tuple(map(_make_segment, [_KINDS[c] for c in cub],
+                             [pts[o:o + (4 if c else 2)] for o, c in zip(off, cub, strict=True)],
+                             self.first.tolist(), self.last.tolist()))
+            _set_fp_segments(self, segs)
+        return segs
+
+
+_KINDS = ("line", "cubic")
+_DOT_KIND = _read_only(np.zeros(1, dtype=bool))
+_ZERO_FIRST = _read_only(np.zeros(1, dtype=np.int64))
+_fp_setters = [FittedPath.__dict__[f].__set__ for f in (
+    "source_index", "pen", "closed", "is_cubic", "points", "first", "last", "max_error",
+    "n_input", "n_thinned", "_segments")]
+_set_fp_segments = _fp_setters[-1]
+
+
+def _init_fitted(fp: FittedPath, *values: object) -> None:
+    for setter, v in zip(_fp_setters, (*values, None), strict=True):
+        setter(fp, v)
 
 
 def control_points(fp: FittedPath) -> int:
     """Control points of a fitted path, counted as stored: the start point plus, per segment,
     its points minus the shared start (1 per line, 3 per cubic); a closed path's closing
     point counts again (as in paper 000: a circle of 13 cubics = 40 points). A dot is 1."""
-    if not fp.segments:
+    n = len(fp.is_cubic)
+    if n == 0:
         return 0
-    if len(fp.segments) == 1 and fp.segments[0].kind == "line":
-        s = fp.segments[0]
-        if np.array_equal(s.points[0], s.points[1]):
-            return 1
-    return 1 + sum(len(s.points) - 1 for s in fp.segments)
+    if n == 1 and not fp.is_cubic[0] and np.array_equal(fp.points[0], fp.points[1]):
+        return 1
+    return len(fp.points)
 
 
 def _check_params(eps_line: object, e_per: object, eps_sum: object) -> tuple[float, float, float]:
@@ -178,20 +280,14 @@ _set_kind, _set_points, _set_first, _set_last = (
 def _make_segment(kind: str, points: np.ndarray, first: int, last: int) -> Segment:
     """``Segment(kind, points, first, last)`` for arguments already of the right types
     (``points`` a read-only float64 array), about 1.6x faster than the frozen dataclass's
-    ``__init__`` (it sets the slots directly): fit_paths builds one per segment, tens of
-    thousands per drawing."""
+    ``__init__`` (it sets the slots directly): :attr:`FittedPath.segments` builds one per
+    segment when asked."""
     s = _new(Segment)
     _set_kind(s, kind)
     _set_points(s, points)
     _set_first(s, first)
     _set_last(s, last)
     return s
-
-
-def _seg(kind: str, pts: np.ndarray, first: int, last: int) -> Segment:
-    arr = np.array(pts, dtype=np.float64)
-    arr.setflags(write=False)
-    return Segment(kind, arr, int(first), int(last))
 
 
 #: pairs measured at once by :func:`_curve_to_polyline_bound_many` (its candidates x pairs
@@ -598,17 +694,21 @@ def fit_paths(
     wlen = np.array([len(w) for w in works], dtype=np.intp)
     klen = np.array([len(k) for k in kept_all], dtype=np.intp)
     out: list[FittedPath | None] = [None] * npth
+    mk = FittedPath.from_arrays
     for k in np.flatnonzero(klen == 1).tolist():  # a dot: all points equal
-        seg = _seg("line", works[k][[0, 0]], 0, len(works[k]) - 1)
-        out[k] = FittedPath(src[k], pen[k], cl[k], (seg,), 0.0, ns[k], 1)
+        out[k] = mk(src[k], pen[k], cl[k], _DOT_KIND, _read_only(works[k][[0, 0]]),
+                    _ZERO_FIRST, _read_only(np.array([len(works[k]) - 1], dtype=np.int64)),
+                    0.0, ns[k], 1)
     for k in np.flatnonzero(wlen == 0).tolist():
         out[k] = FittedPath(src[k], pen[k], cl[k], (), 0.0, 0, 0)
     todo = np.flatnonzero((wlen > 0) & (klen != 1))
     if len(todo):
-        fitted = _fit_concatenated(works, kept_all, todo, cl, e_per, eps_sum)
+        is_cubic, points, first, last, seg_cut, pt_cut, worst = _fit_concatenated(
+            works, kept_all, todo, cl, e_per, eps_sum)
         for t, k in enumerate(todo.tolist()):
-            segs, worst = fitted[t]
-            out[k] = FittedPath(src[k], pen[k], cl[k], segs, worst, ns[k], int(klen[k]))
+            a, b = seg_cut[t], seg_cut[t + 1]
+            out[k] = mk(src[k], pen[k], cl[k], is_cubic[a:b], points[pt_cut[t]:pt_cut[t + 1]],
+                        first[a:b], last[a:b], worst[t], ns[k], int(klen[k]))
     return out  # type: ignore[return-value]
 
 
@@ -640,9 +740,13 @@ def _fit_concatenated(
     closed: list[bool],
     e_per: float,
     eps_sum: float,
-) -> list[tuple[tuple[Segment, ...], float]]:
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, list[int], list[int],
+           list[float]]:
     """Segments and max_error of the paths ``todo`` (>= 2 thinned points each), all at once
-    on the concatenation of every path's points (global indices below)."""
+    on the concatenation of every path's points (global indices below). Returns, over all
+    those paths in order, the segment kinds (is_cubic), the shared control points, the
+    first/last input indices (each path's own), the cuts of each path's segments and
+    points in those arrays (len(todo) + 1 each) and each path's max_error."""
     wlen = np.array([len(w) for w in works], dtype=np.intp)
     woff = np.cumsum(wlen) - wlen
     klen = np.array([len(k) for k in kept_all], dtype=np.intp)
@@ -681,19 +785,35 @@ def _fit_concatenated(
     clast = np.where(is_kend[cb], end_w[owner[cb]], K[cb])
     if len(ca):
         worst = _cubic_worst(W, ctrl, cfirst, clast, bound, owner[ca], worst)
-    # all segments in path order
+    # all segments in path order, as arrays: kinds, shared control points (each path's
+    # start, then per segment its points after the start), replaced input point ranges
     seg_a = np.concatenate([la, ca])
     order = np.argsort(seg_a, kind="stable")
     nl = len(la)
-    kinds = np.array(["line", "cubic"])[(order >= nl).astype(np.intp)].tolist()
-    pts = list(lpts) + list(ctrl)
+    is_cubic = order >= nl
     seg_owner = owner[seg_a[order]]
-    first = (np.concatenate([lfirst, cfirst])[order] - o_w[seg_owner]).tolist()
-    last = (np.concatenate([llast, clast])[order] - o_w[seg_owner]).tolist()
-    segs = list(map(_make_segment, kinds, [pts[i] for i in order.tolist()], first, last))
-    bounds = np.searchsorted(seg_owner, np.arange(len(todo) + 1)).tolist()
-    wl = worst.tolist()
-    return [(tuple(segs[bounds[t] : bounds[t + 1]]), wl[t]) for t in range(len(todo))]
+    first = np.concatenate([lfirst, cfirst])[order] - o_w[seg_owner]
+    last = np.concatenate([llast, clast])[order] - o_w[seg_owner]
+    seg_cut = np.searchsorted(seg_owner, np.arange(len(todo) + 1))
+    step = np.where(is_cubic, 3, 1)
+    tail = np.cumsum(step) - step + seg_owner + 1  # row of each segment's point after P0
+    points = np.empty((int(step.sum()) + len(todo), 2))
+    fs = seg_cut[:-1]  # each path's first segment (every path here has one)
+    fl = fs[~is_cubic[fs]]
+    points[tail[fl] - 1] = lpts[order[fl], 0]
+    fc = fs[is_cubic[fs]]
+    points[tail[fc] - 1] = ctrl[order[fc] - nl, 0]
+    lrow = np.flatnonzero(~is_cubic)
+    points[tail[lrow]] = lpts[order[lrow], 1]
+    crow = np.flatnonzero(is_cubic)
+    cidx = order[crow] - nl
+    for j in range(3):
+        points[tail[crow] + j] = ctrl[cidx, j + 1]
+    pt_cut = np.r_[0, np.cumsum(np.bincount(seg_owner, weights=step, minlength=len(todo))
+                                .astype(np.int64) + 1)]
+    for x in (is_cubic, points, first, last):
+        x.setflags(write=False)
+    return is_cubic, points, first, last, seg_cut.tolist(), pt_cut.tolist(), worst.tolist()
 
 
 def _arc_per_path(W: np.ndarray, wlen: np.ndarray) -> np.ndarray:
@@ -802,8 +922,8 @@ def fit_drawing(
     return tuple(out)
 
 
-class FitCancelled(Exception):
-    """Raised by :func:`fit_drawing` when its ``cancel`` callback says stop."""
+#: what :func:`fit_drawing` raises when its ``cancel`` callback says stop
+FitCancelled = Cancelled
 
 
 def warm_up() -> None:

@@ -338,8 +338,8 @@ def deviation_samples(
     points each segment replaces, so the work is about ``max_samples`` × the input points
     at most; Python only gathers each segment's control points once.
     """
-    fps = [fp for fp in fitted if 0 <= fp.source_index < len(drawing.paths) and fp.segments
-           and len(drawing.paths[fp.source_index].points)]
+    fps = [fp for fp in fitted if 0 <= fp.source_index < len(drawing.paths)
+           and len(fp.is_cubic) and len(drawing.paths[fp.source_index].points)]
     if not fps:
         return EMPTY, EMPTY, np.empty(0)
     if cancel is not None and cancel():
@@ -348,23 +348,32 @@ def deviation_samples(
     plen = np.fromiter((len(p) for p in srcs), dtype=np.int64, count=len(srcs))
     poff = np.concatenate(([0], np.cumsum(plen)[:-1]))
     src = np.ascontiguousarray(np.concatenate(srcs), dtype=np.float64)
-    nseg = np.fromiter((len(fp.segments) for fp in fps), dtype=np.int64, count=len(fps))
-    segs = [sg for fp in fps for sg in fp.segments]
-    first = np.fromiter((sg.first for sg in segs), dtype=np.int64, count=len(segs))
-    last = np.fromiter((sg.last for sg in segs), dtype=np.int64, count=len(segs))
-    pts = [sg.points for sg in segs]
+    # the fits' arrays, joined: segment kinds, input ranges, shared control points
+    nseg = np.fromiter((len(fp.is_cubic) for fp in fps), dtype=np.int64, count=len(fps))
+    is_cubic = np.concatenate([fp.is_cubic for fp in fps]).astype(bool)
+    first = np.concatenate([fp.first for fp in fps]).astype(np.int64)
+    last = np.concatenate([fp.last for fp in fps]).astype(np.int64)
+    cpts = [np.asarray(fp.points, dtype=np.float64).reshape(-1, 2) for fp in fps]
+    clen = np.fromiter((len(c) for c in cpts), dtype=np.int64, count=len(cpts))
+    allc = np.concatenate(cpts)
+    step = np.where(is_cubic, 3, 1)
+    seg_start = np.cumsum(step) - step  # row within its path's points, per segment
+    path_first_seg = np.concatenate(([0], np.cumsum(nseg)[:-1]))
+    seg_start -= np.repeat(seg_start[path_first_seg], nseg)  # restart at each path
+    o = seg_start + np.repeat(np.concatenate(([0], np.cumsum(clen)[:-1])), nseg)
     if cancel is not None and cancel():
         raise Cancelled()
-    is_cubic = np.fromiter((len(q) == 4 for q in pts), dtype=bool, count=len(pts))
-    ctrl = np.empty((len(segs), 4, 2))
-    if is_cubic.any():
-        ctrl[is_cubic] = np.stack([q for q, c in zip(pts, is_cubic, strict=True) if c])
-    if not is_cubic.all():
+    ctrl = np.empty((len(is_cubic), 4, 2))
+    c = is_cubic
+    if c.any():
+        oc = o[c]
+        ctrl[c] = np.stack([allc[oc], allc[oc + 1], allc[oc + 2], allc[oc + 3]], axis=1)
+    if not c.all():
         # a line as a cubic with its inner points at thirds: B(t) = P0 + t (P3 - P0)
-        ends = np.stack([(q[0], q[-1]) for q, c in zip(pts, is_cubic, strict=True) if not c])
-        d = ends[:, 1] - ends[:, 0]
-        ctrl[~is_cubic] = np.stack((ends[:, 0], ends[:, 0] + d / 3.0,
-                                    ends[:, 0] + 2.0 * d / 3.0, ends[:, 1]), axis=1)
+        ol = o[~c]
+        p0, p3 = allc[ol], allc[ol + 1]
+        d = p3 - p0
+        ctrl[~c] = np.stack((p0, p0 + d / 3.0, p0 + 2.0 * d / 3.0, p3), axis=1)
     off = np.repeat(poff, nseg)
     npts = np.repeat(plen, nseg)
     closed = np.repeat(np.fromiter((bool(fp.closed) for fp in fps), dtype=bool,

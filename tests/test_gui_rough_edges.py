@@ -112,14 +112,14 @@ def test_hatch_passes_control(qtbot, tmp_path):
     assert win.load_file(src, wait=True)
     assert win.set_param("fill", "scanline") and win.wait_idle(60)
     one = sum(len(s.marks) for s in win.current_job().strokes if s.kind == "hatch")
-    assert win.hatch_passes_spin is not None
-    win.hatch_passes_spin.setValue(2)
+    passes = win.controls.sliders["hatch_passes"]
+    passes.spin.setValue(2)
     assert win.wait_idle(60)
     assert win.params.hatch_passes == 2
     two = sum(len(s.marks) for s in win.current_job().strokes if s.kind == "hatch")
     assert two > 1.5 * one
     win.restore_defaults()
-    assert win.hatch_passes_spin.value() == 1
+    assert passes.value() == 1
 
 
 def test_plt_export_says_it_is_in_galvo_bits(qtbot, tmp_path):

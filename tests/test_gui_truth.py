@@ -290,7 +290,7 @@ def test_big_job_files_are_written_and_read_the_same_way(tmp_path, monkeypatch):
     from galvo_core.params import Params
     from galvo_core.pipeline import Pipeline
 
-    job = Pipeline().run(read_file(SEAL), Params(fit_field=True))
+    job = Pipeline().run(read_file(SEAL), Params(fit_field=True)).job
     a = tmp_path / "a.json"
     write_job(job, a)
     assert offload.job_json_bytes(job) == a.read_bytes()
