@@ -182,7 +182,7 @@ def _screenshot(args: argparse.Namespace, size: tuple[int, int]) -> int:
     window = MainWindow(restore=False)
     window.set_params(params, run=False)
     if drawing is not None:
-        window.set_drawing(drawing, path)
+        window.open_drawing(drawing, path)  # as the window opens a file (Fit field rule)
     try:
         render_screenshot(window, out, size)
     except OSError as exc:

@@ -115,7 +115,7 @@ class StatsPanel(QWidget):
     """A two-column table of the job's stats, and the selected path's counts."""
 
     #: width (pixels) one quantity/value pair needs; fewer pairs side by side when narrower
-    PAIR_WIDTH = 250
+    PAIR_WIDTH = 220
 
     def __init__(self, parent: QWidget | None = None) -> None:
         super().__init__(parent)

@@ -250,14 +250,16 @@ def _premultiplied(colour: QColor) -> np.uint32:
 
 
 def draw_points(p, xy: np.ndarray, poly, pen: QPen, grid: float = 2.0,
-                cache: dict | None = None) -> None:
+                cache: dict | None = None, small: bool | None = None) -> None:
     """Draw markers at ``xy`` (item coordinates) with ``pen``. Small sets: antialiased, as
     they are. Large sets: culled to the device and thinned to one marker per ``grid``
     device pixels (what the eye can tell apart anyway), then rasterised here: each marker's
     footprint (the pen's disk or square, no antialiasing) is written into one ARGB image
     with numpy and the image is drawn once. The raster engine would stroke every wide point
     as a path; this keeps a 100,000-point layer at a few milliseconds."""
-    if len(xy) < MAX_ANTIALIAS_POINTS:
+    if small is None:  # the caller may decide by its whole layer (a coarse level is small)
+        small = len(xy) < MAX_ANTIALIAS_POINTS
+    if small:
         p.setRenderHint(p.RenderHint.Antialiasing, True)
         p.setPen(pen)
         p.drawPoints(poly if poly is not None else _polygon(xy))
@@ -347,16 +349,21 @@ class PointsItem(_FastItem):
         self._raster: dict = {}
 
     @staticmethod
-    def prepare(xy: np.ndarray) -> tuple:
-        """Finite points, their polygon (small sets) and rectangle (any thread)."""
+    def prepare(xy: np.ndarray, lod: float | None = None) -> tuple:
+        """Finite points, their polygon (small sets) and rectangle (any thread); with
+        ``lod`` a big set also gets one point per grid cell at the coarse levels (drawn
+        while a cell is at most half a pixel: the same markers on screen)."""
         xy = np.asarray(xy, dtype=np.float64).reshape(-1, 2)
         if not np.isfinite(xy).all():
             xy = xy[np.isfinite(xy).all(axis=1)]
-        return xy, _small_polygon(xy), _finite_rect(xy)
+        levels = None
+        if lod is not None and lod > 0 and len(xy) >= MAX_ANTIALIAS_POINTS:
+            levels = [(float(lod * f), _one_per_cell(xy, lod * f)) for f in LOD_FACTORS]
+        return xy, _small_polygon(xy), _finite_rect(xy), levels
 
     def setPrepared(self, prepared: tuple) -> None:  # noqa: N802
         self.prepareGeometryChange()
-        self._xy, self._poly, self._rect = prepared
+        self._xy, self._poly, self._rect, self._levels = prepared
         self.update()
 
     def setData(self, xy: np.ndarray) -> None:  # noqa: N802 - like pyqtgraph
@@ -367,7 +374,10 @@ class PointsItem(_FastItem):
 
     def paint(self, p, *args) -> None:
         if len(self._xy):
-            draw_points(p, self._xy, self._poly, self.pen, cache=self._raster)
+            level = _pick_level(getattr(self, "_levels", None), p)
+            xy = level[1] if level is not None else self._xy
+            draw_points(p, xy, self._poly if level is None else None, self.pen,
+                        cache=self._raster, small=len(self._xy) < MAX_ANTIALIAS_POINTS)
 
 
 class ControlItem(_FastItem):
@@ -413,15 +423,18 @@ class ControlItem(_FastItem):
             h = handles & np.isfinite(xy[:, 0])
             start = np.flatnonzero(h[:-1] & h[1:])
             d = np.hypot(*(xy[start + 1] - xy[start]).T)
-            long_ = start[d >= lod]
-            if len(long_):
-                px = np.full((3 * len(long_), 2), np.nan)
-                px[0::3], px[1::3] = xy[long_], xy[long_ + 1]
-                c_lines = pg.arrayToQPath(px[:-1, 0], px[:-1, 1], connect="finite")
-            else:
-                c_lines = QPainterPath()
-            coarse = (float(lod), c_lines, _one_per_cell(anchors, lod),
-                      _one_per_cell(knots, lod))
+            coarse = []
+            for f in LOD_FACTORS:
+                g = lod * f
+                long_ = start[d >= g]
+                if len(long_):
+                    px = np.full((3 * len(long_), 2), np.nan)
+                    px[0::3], px[1::3] = xy[long_], xy[long_ + 1]
+                    c_lines = pg.arrayToQPath(px[:-1, 0], px[:-1, 1], connect="finite")
+                else:
+                    c_lines = QPainterPath()
+                coarse.append((float(g), c_lines, _one_per_cell(anchors, g),
+                               _one_per_cell(knots, g)))
         return (xy, role, lines, anchors, knots, _small_polygon(anchors), _small_polygon(knots),
                 _finite_rect(xy[role >= 0]), coarse)
 
@@ -447,18 +460,15 @@ class ControlItem(_FastItem):
         lines, knots, anchors = self._lines, self._xy_knots, self._xy_anchors
         kpoly, apoly = self._knots, self._anchors
         self.last_drawn = "full"
-        coarse = getattr(self, "_coarse", None)
-        if coarse is not None:
-            t = p.transform()
-            px = 1.0 / max(math.hypot(t.m11(), t.m12()), 1e-300)
-            if coarse[0] <= 0.5 * px:
-                lines, anchors, knots = coarse[1], coarse[2], coarse[3]
-                kpoly = apoly = None
-                self.last_drawn = "coarse"
+        level = _pick_level(getattr(self, "_coarse", None), p)
+        if level is not None:
+            lines, anchors, knots = level[1], level[2], level[3]
+            kpoly = apoly = None
+            self.last_drawn = "coarse"
         p.drawPath(lines)
-        draw_points(p, knots, kpoly, self.knot_pen, grid=3.0)
-        draw_points(p, knots, kpoly, self.hole_pen, grid=3.0)
-        draw_points(p, anchors, apoly, self.anchor_pen, grid=3.0)
+        draw_points(p, knots, kpoly, self.knot_pen, grid=3.0, small=small)
+        draw_points(p, knots, kpoly, self.hole_pen, grid=3.0, small=small)
+        draw_points(p, anchors, apoly, self.anchor_pen, grid=3.0, small=small)
 
 
 class LinesItem(_FastItem):
@@ -472,7 +482,7 @@ class LinesItem(_FastItem):
         self.thin_pen = QPen(pen)
         self.thin_pen.setWidthF(1.0)
         self._path = QPainterPath()
-        self._coarse: tuple[float, QPainterPath] | None = None
+        self._coarse: list[tuple[float, QPainterPath]] | None = None
         self._xy = np.empty((0, 2))
         self._n = 0
         #: what the last paint drew: "full" or "coarse" (tests, benchmark)
@@ -492,12 +502,16 @@ class LinesItem(_FastItem):
         if not n:
             return xy, QPainterPath(), QRectF(), 0, None
         path = pg.arrayToQPath(xy[:, 0], xy[:, 1], connect="finite")
-        coarse = None
+        levels: list[tuple[float, QPainterPath]] = []
         if lod is not None and lod > 0 and n >= MAX_ANTIALIAS_POINTS:
-            c = decimate(xy, lod)
-            if len(c) < 0.7 * len(xy):
-                coarse = (float(lod), pg.arrayToQPath(c[:, 0], c[:, 1], connect="finite"))
-        return xy, path, _finite_rect(xy[finite]), n, coarse
+            prev = len(xy)
+            for f in LOD_FACTORS[::-1]:  # finest first: each level from the full data
+                c = decimate(xy, lod * f)
+                if len(c) < 0.7 * prev:
+                    levels.append((float(lod * f), pg.arrayToQPath(c[:, 0], c[:, 1],
+                                                                   connect="finite")))
+                    prev = len(c)
+        return xy, path, _finite_rect(xy[finite]), n, levels[::-1] or None
 
     def setPrepared(self, prepared: tuple) -> None:  # noqa: N802
         self.prepareGeometryChange()
@@ -518,13 +532,28 @@ class LinesItem(_FastItem):
         p.setPen(self.pen if small else self.thin_pen)
         path = self._path
         self.last_drawn = "full"
-        if self._coarse is not None:
-            t = p.transform()
-            px = 1.0 / max(math.hypot(t.m11(), t.m12()), 1e-300)  # item units per pixel
-            if self._coarse[0] <= 0.5 * px:
-                path = self._coarse[1]
-                self.last_drawn = "coarse"
+        level = _pick_level(self._coarse, p)
+        if level is not None:
+            path = level[1]
+            self.last_drawn = "coarse"
         p.drawPath(path)
+
+
+#: coarse levels of big layers, as multiples of the finest grid (coarsest first)
+LOD_FACTORS = (4.0, 2.0, 1.0)
+
+
+def _pick_level(levels, p):
+    """The coarsest level whose grid is at most half a device pixel under the painter's
+    transform (None: draw the full data)."""
+    if not levels:
+        return None
+    t = p.transform()
+    px = 1.0 / max(math.hypot(t.m11(), t.m12()), 1e-300)  # item units per device pixel
+    for level in levels:  # coarsest first
+        if level[0] <= 0.5 * px:
+            return level
+    return None
 
 
 def _one_per_cell(pts: np.ndarray, cell: float) -> np.ndarray:
@@ -561,7 +590,7 @@ def prepare_layer(key: str, *arrays: np.ndarray, lod: float | None = None) -> tu
     safe to call on a worker thread, then handed to :meth:`WorkView.set_layer`. ``lod``:
     the coarse grid of line layers, in the layer's units (see :meth:`LinesItem.prepare`)."""
     cls = _LAYER_CLASS[key]
-    if cls in (LinesItem, ControlItem):
+    if cls in (LinesItem, ControlItem, PointsItem):
         return cls.prepare(*arrays, lod=lod)
     return cls.prepare(*arrays)
 

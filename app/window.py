@@ -46,6 +46,7 @@ from PySide6.QtWidgets import (
     QCheckBox,
     QDockWidget,
     QFileDialog,
+    QHBoxLayout,
     QLabel,
     QMainWindow,
     QMessageBox,
@@ -302,6 +303,9 @@ class MainWindow(QMainWindow):
         #: True/False: how the last export ended; None while it runs
         self.last_export_ok: bool | None = None
         self._keep_selection: int | None = None
+        self._undo: list[Params] = []
+        self._redo: list[Params] = []
+        self._committed: Params | None = None
         self._reloading = False
         self._fit_banner = False
         self._stale_shown = False
@@ -364,7 +368,7 @@ class MainWindow(QMainWindow):
         self.stale_bar.setObjectName("stale_bar")
         self.stale_bar.setWordWrap(True)
         self.stale_bar.setStyleSheet(
-            "background: #e8eef7; color: #1d3557; padding: 3px 8px; border-bottom: 1px solid "
+            "background: #e8eef7; color: #1d3557; padding: 3px 8px; border-top: 1px solid "
             "#a8bcd8;")
         self.stale_bar.hide()
 
@@ -375,6 +379,8 @@ class MainWindow(QMainWindow):
         cl.addWidget(layer_bar)
         cl.addWidget(self.banner)
         cl.addWidget(splitter, 1)
+        self._build_simulation_bar()
+        cl.addWidget(self.sim_bar)
         self.setCentralWidget(central)
         # the stale bar floats over the top of the views: showing it must not resize them
         # (a resize re-rasterises every cached layer)
@@ -475,6 +481,7 @@ class MainWindow(QMainWindow):
             for v in (self.original, self.processed):
                 v.set_layer_visible(spec.key, self.layer_boxes[spec.key].isChecked())
         self.controls.set_params(self.params, self._field_map_for(self.params))
+        self._committed = self.params
         if drawing is not None:
             self.set_drawing(drawing)
         else:
@@ -517,6 +524,14 @@ class MainWindow(QMainWindow):
         self.field_action = QAction("Zoom to the &Field", self)
         self.field_action.triggered.connect(self.fit_field_view)
         view_menu.addAction(self.field_action)
+        self.sim_action = QAction("Marking &Simulation", self, checkable=True)
+        self.sim_action.setShortcut(QKeySequence("Ctrl+M"))
+        self.sim_action.toggled.connect(self.set_simulation)
+        view_menu.addAction(self.sim_action)
+        self.ruler_action = QAction("&Ruler (click two points)", self, checkable=True)
+        self.ruler_action.setShortcut(QKeySequence("R"))
+        self.ruler_action.toggled.connect(self.set_ruler)
+        view_menu.addAction(self.ruler_action)
         view_menu.addSeparator()
         self.layer_actions: dict[str, QAction] = {}
         for i, spec in enumerate(LAYERS):
@@ -530,6 +545,18 @@ class MainWindow(QMainWindow):
         view_menu.addSeparator()
         view_menu.addAction(self.controls_dock.toggleViewAction())
         view_menu.addAction(self.job_dock.toggleViewAction())
+
+        edit = self.menuBar().addMenu("&Edit")
+        self.undo_action = QAction("&Undo Parameter Change", self)
+        self.undo_action.setShortcut(QKeySequence.StandardKey.Undo)
+        self.undo_action.triggered.connect(self.undo)
+        self.redo_action = QAction("&Redo Parameter Change", self)
+        self.redo_action.setShortcuts([QKeySequence.StandardKey.Redo,
+                                       QKeySequence("Ctrl+Shift+Z")])
+        self.redo_action.triggered.connect(self.redo)
+        edit.addAction(self.undo_action)
+        edit.addAction(self.redo_action)
+        self._update_undo_actions()
 
         proc = self.menuBar().addMenu("&Process")
         self.laser_action = QAction("&Laser Parameters…", self)
@@ -582,12 +609,56 @@ class MainWindow(QMainWindow):
         except (GalvoError, ValueError):
             return None
 
-    def set_params(self, params: Params, *, run: bool = True) -> None:
-        """Use ``params`` (controls follow) and process again."""
+    def set_params(self, params: Params, *, run: bool = True, record: bool = False) -> None:
+        """Use ``params`` (controls follow) and process again; ``record``: as an operator's
+        change that Undo takes back."""
+        if record:
+            self._record(params)
+        else:
+            self._committed = params
         self.params = params
         self.controls.set_params(params, self._field_map_for(params))
         if run:
             self.request_run()
+
+    # --- undo / redo of parameter changes -------------------------------------------------
+    #: how many parameter changes Undo remembers
+    UNDO_DEPTH = 200
+
+    def _record(self, params: Params) -> None:
+        """A committed change to ``params``: the previous committed set goes on the undo
+        stack (drags are not recorded, only their release)."""
+        prev = getattr(self, "_committed", None)
+        if prev is not None and prev != params:
+            self._undo.append(prev)
+            del self._undo[:-self.UNDO_DEPTH]
+            self._redo.clear()
+        self._committed = params
+        self._update_undo_actions()
+
+    def undo(self) -> bool:
+        """Back to the parameters before the last change (False when there is none)."""
+        if not self._undo:
+            return False
+        self._redo.append(self._committed)
+        self.set_params(self._undo.pop())
+        self._update_undo_actions()
+        self.statusBar().showMessage("undone: parameters as before the last change", 4000)
+        return True
+
+    def redo(self) -> bool:
+        """Again the change that Undo took back (False when there is none)."""
+        if not self._redo:
+            return False
+        self._undo.append(self._committed)
+        self.set_params(self._redo.pop())
+        self._update_undo_actions()
+        return True
+
+    def _update_undo_actions(self) -> None:
+        if hasattr(self, "undo_action"):
+            self.undo_action.setEnabled(bool(self._undo))
+            self.redo_action.setEnabled(bool(self._redo))
 
     def apply_changes(self, changes: dict[str, Any], final: bool = True) -> bool:
         """Change some Params fields (validated); returns False (and says why) when refused."""
@@ -599,6 +670,7 @@ class MainWindow(QMainWindow):
             return False
         self.params = params
         if final:
+            self._record(params)
             self._throttle.stop()
             self.request_run()
         elif not self._throttle.isActive():
@@ -609,7 +681,7 @@ class MainWindow(QMainWindow):
         self.apply_changes(dict(changes), final)
 
     def restore_defaults(self) -> None:
-        self.set_params(Params(laser=self.params.laser))
+        self.set_params(Params(laser=self.params.laser), record=True)
 
     def open_laser_dialog(self) -> None:
         dlg = LaserDialog(self.params.laser, self)
@@ -758,7 +830,8 @@ class MainWindow(QMainWindow):
         w = g.width()
         self.stale_bar.setFixedWidth(w)
         self.stale_bar.adjustSize()
-        self.stale_bar.move(g.x(), g.y())
+        # along the bottom of the views (their titles stay readable)
+        self.stale_bar.move(g.x(), g.y() + g.height() - self.stale_bar.height())
 
     def resizeEvent(self, ev) -> None:  # noqa: N802 - Qt API
         super().resizeEvent(ev)
@@ -787,6 +860,7 @@ class MainWindow(QMainWindow):
             self._drawing_bbox = self.pipeline.bbox(res.drawing) if res.drawing else None
             if res.params is not None:
                 self.params = res.params
+                self._committed = res.params
                 self.controls.set_params(res.params, res.preview.field_map)
             self.layers.restore(res)  # and the pen table
             self._watch(self.file_path)
@@ -904,6 +978,9 @@ class MainWindow(QMainWindow):
         self.last_result_time = time.perf_counter()
         self._update_status()
         self._update_stale()
+        if self.sim_bar.isVisible():
+            self._sim = None
+            self.simulate_at(self.sim_slider.value() / self.SIM_STEPS)
         missing = [k for k in self.wanted_layers() if not pv.has_layer(k)]
         if missing and result.job_path is None and result.fitted is not None:
             self.request_run()  # a layer turned on while this result was computed
@@ -1031,6 +1108,14 @@ class MainWindow(QMainWindow):
         elif isinstance(loaded, LoadedJob):
             self._show_job(loaded)
         self.last_load_ok = True
+
+    def open_drawing(self, drawing: Drawing, path: str | os.PathLike | None = None) -> None:
+        """Open a drawing read elsewhere (the --screenshot command) as :meth:`load_file`
+        opens a file: a drawing bigger than the field at true size gets Fit field."""
+        p = FsPath(path) if path is not None else FsPath(drawing.name or "untitled")
+        loaded = Loaded(p, drawing, self.pipeline.bbox(drawing), drawing.size_mm())
+        self._open_fitting_field(loaded)
+        self.set_drawing(drawing, path, bbox=loaded.bbox, size_mm=loaded.size_mm)
 
     def _on_load_failed(self, gen: int, message: str, user_facing: bool) -> None:
         path = self.loading_path
@@ -1411,7 +1496,178 @@ class MainWindow(QMainWindow):
         if not vb.sceneBoundingRect().contains(ev.scenePos()):
             return
         p = vb.mapSceneToView(ev.scenePos())
+        if self.ruler_action.isChecked():
+            self.ruler_click(p.x(), p.y())
+            return
         self.select_at(p.x(), p.y(), view)
+
+    # --- marking simulation ---------------------------------------------------------------
+    SIM_STEPS = 1000
+
+    def _build_simulation_bar(self) -> None:
+        from PySide6.QtWidgets import QSlider
+
+        bar = QWidget()
+        bar.setObjectName("simulation_bar")
+        lay = QHBoxLayout(bar)
+        lay.setContentsMargins(6, 2, 6, 2)
+        self.sim_play = QToolButton()
+        self.sim_play.setText("▶")
+        self.sim_play.setCheckable(True)
+        self.sim_play.setToolTip("play the job in its marking order")
+        self.sim_play.toggled.connect(self._sim_toggle_play)
+        self.sim_slider = QSlider(Qt.Orientation.Horizontal)
+        self.sim_slider.setRange(0, self.SIM_STEPS)
+        self.sim_slider.valueChanged.connect(lambda v: self.simulate_at(v / self.SIM_STEPS))
+        self.sim_label = QLabel("")
+        self.sim_label.setMinimumWidth(260)
+        lay.addWidget(QLabel("Simulation:"))
+        lay.addWidget(self.sim_play)
+        lay.addWidget(self.sim_slider, 1)
+        lay.addWidget(self.sim_label)
+        bar.hide()
+        self.sim_bar = bar
+        self._sim_timer = QTimer(self)
+        self._sim_timer.setInterval(40)
+        self._sim_timer.timeout.connect(self._sim_tick)
+        self._sim: tuple[Any, ...] | None = None
+
+    def set_simulation(self, on: bool) -> None:
+        """Show the marking simulation bar (the beam and what it has marked so far)."""
+        if self.sim_action.isChecked() != on:
+            self.sim_action.setChecked(on)
+            return
+        self.sim_bar.setVisible(on)
+        if not on:
+            self.sim_play.setChecked(False)
+        self._sim = None
+        self.simulate_at(self.sim_slider.value() / self.SIM_STEPS if on else None)
+
+    def _sim_data(self) -> tuple[Any, ...] | None:
+        from galvo_core.preview import beam_timeline
+
+        res = self.result
+        if res is None:
+            return None
+        if self._sim is None or self._sim[0] is not res.job:
+            xy, t, on = beam_timeline(res.job)
+            self._sim = (res.job, xy, t, on)
+        return self._sim
+
+    def simulate_at(self, fraction: float | None) -> dict[str, Any] | None:
+        """Put the simulated beam at ``fraction`` (0..1) of the job's estimated time: the
+        beam marker, the marked trail so far, and the time read-out. None hides them.
+        Returns the state shown (time, total, index, position in bits, laser on)."""
+        import pyqtgraph as pg
+
+        view = self.processed
+        if not hasattr(view, "_sim_items"):
+            trail = pg.PlotDataItem([], [], pen=pg.mkPen("#111111", width=2))
+            beam = pg.ScatterPlotItem([], [], size=14, pen=pg.mkPen("#111111", width=2),
+                                      brush=pg.mkBrush(255, 255, 255, 0))
+            for it in (trail, beam):
+                it.setZValue(2e5)
+                view.getPlotItem().addItem(it, ignoreBounds=True)
+            view._sim_items = (trail, beam)
+        trail, beam = view._sim_items
+        data = self._sim_data() if fraction is not None else None
+        if data is None or not len(data[2]):
+            trail.setData([], [])
+            beam.setData([], [])
+            self.sim_label.setText("")
+            return None
+        _, xy, t, on = data
+        total = float(t[-1])
+        now = min(max(fraction, 0.0), 1.0) * total
+        k = int(np.searchsorted(t, now, side="right")) - 1
+        k = max(0, min(k, len(t) - 1))
+        pos = xy[k].copy()
+        lit = False
+        if k + 1 < len(t) and t[k + 1] > t[k]:
+            f = (now - t[k]) / (t[k + 1] - t[k])
+            pos = xy[k] + f * (xy[k + 1] - xy[k])
+            lit = bool(on[k + 1])
+        mpb = self.result.preview.mm_per_bit if self.result else 1.0
+        seg = np.vstack((xy[: k + 1], pos[None, :])) * mpb
+        conn = np.zeros(len(seg), dtype=bool)
+        conn[:-1] = np.append(on[1 : k + 1], lit)  # draw a step only where the laser was on
+        trail.setData(seg[:, 0], seg[:, 1], connect=conn)
+        beam.setData([pos[0] * mpb], [pos[1] * mpb],
+                     pen=pg.mkPen("#d7191c" if lit else "#111111", width=2))
+        self.sim_label.setText(f"t = {now:.3f} s / {total:.3f} s · laser "
+                               f"{'on' if lit else 'off'}")
+        return {"time_s": now, "total_s": total, "index": k, "bits": pos, "laser_on": lit}
+
+    def _sim_toggle_play(self, on: bool) -> None:
+        self.sim_play.setText("⏸" if on else "▶")
+        if on:
+            if self.sim_slider.value() >= self.SIM_STEPS:
+                self.sim_slider.setValue(0)
+            self._sim_timer.start()
+        else:
+            self._sim_timer.stop()
+
+    def _sim_tick(self) -> None:
+        v = self.sim_slider.value() + 2
+        if v >= self.SIM_STEPS:
+            v = self.SIM_STEPS
+            self.sim_play.setChecked(False)
+        self.sim_slider.setValue(v)
+
+    # --- ruler ----------------------------------------------------------------------------
+    def set_ruler(self, on: bool) -> None:
+        """Ruler mode: clicks in either view measure instead of selecting."""
+        if self.ruler_action.isChecked() != on:
+            self.ruler_action.setChecked(on)
+            return
+        self._ruler_pts: list[tuple[float, float]] = []
+        self._draw_ruler()
+        self.statusBar().showMessage(
+            "Ruler: click two points (R again to leave)" if on else "", 6000 if on else 1)
+
+    def ruler_click(self, x_mm: float, y_mm: float) -> str | None:
+        """One ruler click (mm in the field); the second one measures and says so."""
+        pts = getattr(self, "_ruler_pts", [])
+        if len(pts) >= 2:
+            pts = []
+        pts.append((x_mm, y_mm))
+        self._ruler_pts = pts
+        self._draw_ruler()
+        if len(pts) < 2:
+            self.statusBar().showMessage("Ruler: click the second point", 6000)
+            return None
+        text = self.measure(pts[0], pts[1])
+        self.statusBar().showMessage(text, 30_000)
+        return text
+
+    def measure(self, a_mm: tuple[float, float], b_mm: tuple[float, float]) -> str:
+        """The distance between two points of the field in mm and galvo bits (and its
+        components), at the shown result's field."""
+        dx, dy = b_mm[0] - a_mm[0], b_mm[1] - a_mm[1]
+        d = float(np.hypot(dx, dy))
+        text = f"Ruler: {d:.3f} mm  (Δx {dx:.3f}, Δy {dy:.3f} mm)"
+        if self.result is not None:
+            mpb = self.result.preview.mm_per_bit
+            text += f" = {d / mpb:,.1f} bits (Δx {dx / mpb:,.0f}, Δy {dy / mpb:,.0f})".replace(
+                ",", "\u2009")
+        return text
+
+    def _draw_ruler(self) -> None:
+        pts = getattr(self, "_ruler_pts", [])
+        for view in (self.original, self.processed):
+            item = getattr(view, "_ruler_item", None)
+            if item is None:
+                import pyqtgraph as pg
+
+                item = pg.PlotDataItem([], [], pen=pg.mkPen("#222222", width=1.5),
+                                       symbol="+", symbolSize=12, symbolPen="#222222")
+                item.setZValue(1e5)
+                view.getPlotItem().addItem(item, ignoreBounds=True)
+                view._ruler_item = item
+            if pts:
+                item.setData([p[0] for p in pts], [p[1] for p in pts])
+            else:
+                item.setData([], [])
 
     def select_at(self, x_mm: float, y_mm: float, view: WorkView | None = None) -> int | None:
         """Select the path nearest to (x, y) mm (within ~8 pixels); None clears."""

@@ -131,7 +131,7 @@ def with_prepared(result: RunResult, prepared: PreparedCache | None,
     for key, arr in arrays.items():
         if cancel():
             raise Cancelled()
-        lod = lod_bits if key in ("jumps", "hatch") else lod_units
+        lod = lod_bits if key in ("jumps", "hatch", "marks") else lod_units
         out[key] = prepared.get(key, arr, lod)
     return replace(result, arrays=arrays, prepared=out)
 

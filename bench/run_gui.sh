@@ -1,6 +1,19 @@
 #!/usr/bin/env bash
-# GUI latency benchmark (issue 8): slider release -> redrawn views on a 100,000-point file.
+# GUI benchmark (issue 18): control change -> redrawn views on a generated 150k-point file and
+# the three largest corpus files; GUI-thread stalls while a 1M-point file opens, processes,
+# exports and loads back. Prints the tables of bench/RESULTS.md, "GUI (issue 18)".
 set -euo pipefail
 cd "$(dirname "$0")/.."
 export QT_QPA_PLATFORM=offscreen
-exec .venv/bin/python bench/bench_gui.py "$@"
+C=../shared/corpus/plt
+FILES=()
+for f in schwittlick__hpgl-viewer__composition100_mutoh_xp500_a1.hpgl \
+         straight-coding__gcode-hpgl-viewer__s_fabric_nesting.plt \
+         straight-coding__gcode-hpgl-viewer__b_fabric_nesting.plt; do
+  [ -f "$C/$f" ] && FILES+=("$C/$f")
+done
+TMP=$(mktemp -d)
+.venv/bin/python bench/gen_plt.py 150000 "$TMP/gen_150k.plt"
+.venv/bin/python bench/bench_gui.py latency "$TMP/gen_150k.plt" "${FILES[@]}" "$@"
+.venv/bin/python bench/bench_gui.py stalls --points 1000000
+rm -rf "$TMP"

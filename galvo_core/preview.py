@@ -338,8 +338,8 @@ def deviation_samples(
     points each segment replaces, so the work is about ``max_samples`` × the input points
     at most; Python only gathers each segment's control points once.
     """
-    fps = [fp for fp in fitted if 0 <= fp.source_index < len(drawing.paths) and fp.segments
-           and len(drawing.paths[fp.source_index].points)]
+    fps = [fp for fp in fitted if 0 <= fp.source_index < len(drawing.paths)
+           and len(fp.is_cubic) and len(drawing.paths[fp.source_index].points)]
     if not fps:
         return EMPTY, EMPTY, np.empty(0)
     if cancel is not None and cancel():
@@ -348,23 +348,32 @@ def deviation_samples(
     plen = np.fromiter((len(p) for p in srcs), dtype=np.int64, count=len(srcs))
     poff = np.concatenate(([0], np.cumsum(plen)[:-1]))
     src = np.ascontiguousarray(np.concatenate(srcs), dtype=np.float64)
-    nseg = np.fromiter((len(fp.segments) for fp in fps), dtype=np.int64, count=len(fps))
-    segs = [sg for fp in fps for sg in fp.segments]
-    first = np.fromiter((sg.first for sg in segs), dtype=np.int64, count=len(segs))
-    last = np.fromiter((sg.last for sg in segs), dtype=np.int64, count=len(segs))
-    pts = [sg.points for sg in segs]
+    # the fits' arrays, joined: segment kinds, input ranges, shared control points
+    nseg = np.fromiter((len(fp.is_cubic) for fp in fps), dtype=np.int64, count=len(fps))
+    is_cubic = np.concatenate([fp.is_cubic for fp in fps]).astype(bool)
+    first = np.concatenate([fp.first for fp in fps]).astype(np.int64)
+    last = np.concatenate([fp.last for fp in fps]).astype(np.int64)
+    cpts = [np.asarray(fp.points, dtype=np.float64).reshape(-1, 2) for fp in fps]
+    clen = np.fromiter((len(c) for c in cpts), dtype=np.int64, count=len(cpts))
+    allc = np.concatenate(cpts)
+    step = np.where(is_cubic, 3, 1)
+    seg_start = np.cumsum(step) - step  # row within its path's points, per segment
+    path_first_seg = np.concatenate(([0], np.cumsum(nseg)[:-1]))
+    seg_start -= np.repeat(seg_start[path_first_seg], nseg)  # restart at each path
+    o = seg_start + np.repeat(np.concatenate(([0], np.cumsum(clen)[:-1])), nseg)
     if cancel is not None and cancel():
         raise Cancelled()
-    is_cubic = np.fromiter((len(q) == 4 for q in pts), dtype=bool, count=len(pts))
-    ctrl = np.empty((len(segs), 4, 2))
-    if is_cubic.any():
-        ctrl[is_cubic] = np.stack([q for q, c in zip(pts, is_cubic, strict=True) if c])
-    if not is_cubic.all():
+    ctrl = np.empty((len(is_cubic), 4, 2))
+    c = is_cubic
+    if c.any():
+        oc = o[c]
+        ctrl[c] = np.stack([allc[oc], allc[oc + 1], allc[oc + 2], allc[oc + 3]], axis=1)
+    if not c.all():
         # a line as a cubic with its inner points at thirds: B(t) = P0 + t (P3 - P0)
-        ends = np.stack([(q[0], q[-1]) for q, c in zip(pts, is_cubic, strict=True) if not c])
-        d = ends[:, 1] - ends[:, 0]
-        ctrl[~is_cubic] = np.stack((ends[:, 0], ends[:, 0] + d / 3.0,
-                                    ends[:, 0] + 2.0 * d / 3.0, ends[:, 1]), axis=1)
+        ol = o[~c]
+        p0, p3 = allc[ol], allc[ol + 1]
+        d = p3 - p0
+        ctrl[~c] = np.stack((p0, p0 + d / 3.0, p0 + 2.0 * d / 3.0, p3), axis=1)
     off = np.repeat(poff, nseg)
     npts = np.repeat(plen, nseg)
     closed = np.repeat(np.fromiter((bool(fp.closed) for fp in fps), dtype=bool,
@@ -840,3 +849,45 @@ def warning_path(drawing: Drawing | None, warning: Warning) -> int | None:
     if drawing is None or not warning.line:
         return None
     return path_for_position(drawing, warning.line, warning.col)
+
+
+def beam_timeline(job: Job) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The beam's path through the job in marking order, for a marking simulation.
+
+    Returns ``(xy, t, on)``: ``xy`` (K, 2) the beam positions in galvo bits (the first mark
+    of each stroke is reached by a jump, the others by marking moves), ``t`` (K,) the time
+    in seconds at which the beam reaches each position, ``on`` (K,) True when the move *to*
+    that position is marked (laser on). Moves take distance / speed (the mark and jump
+    speeds of ``job.laser``), at least one point period, jumps add their delay and each
+    stroke its laser on/off delays; the whole timeline is then scaled so that it ends at
+    the job's ``estimated_time_s`` (when the job has one), the figure the window shows.
+    """
+    marks, lens = _all_marks(job.strokes)
+    if not len(marks):
+        return EMPTY, np.empty(0), np.empty(0, dtype=bool)
+    lens = lens[lens > 0]
+    laser = job.laser
+    mpb = job.field_map.mm_per_bit
+    xy = marks.astype(np.float64)
+    step = np.zeros(len(xy))
+    step[1:] = np.hypot(*np.diff(xy, axis=0).T) * mpb
+    starts = np.concatenate(([0], np.cumsum(lens)[:-1]))
+    on = np.ones(len(xy), dtype=bool)
+    on[starts] = False  # each stroke's first mark is reached by a jump
+    on[0] = False
+    period = float(laser.get("point_period_us", 10.0)) * 1e-6
+    mark_v = float(laser.get("mark_speed_mm_s", 100.0))
+    jump_v = float(laser.get("jump_speed_mm_s", 2000.0))
+    dt = np.where(on, np.maximum(step / mark_v, period), step / jump_v)
+    long_mm = float(laser.get("long_jump_mm", 10.0))
+    jd = np.where(step > long_mm, float(laser.get("jump_delay_long_us", 200.0)),
+                  float(laser.get("jump_delay_us", 8.0))) * 1e-6
+    dt = np.where(on, dt, dt + jd)
+    dt[starts[1:]] += (float(laser.get("laser_off_delay_us", 100.0))
+                       + float(laser.get("laser_on_delay_us", 100.0))) * 1e-6
+    dt[0] = 0.0
+    t = np.cumsum(dt)
+    total = float(job.stats.get("estimated_time_s") or 0.0)
+    if total > 0 and t[-1] > 0:
+        t *= total / t[-1]
+    return xy, t, on

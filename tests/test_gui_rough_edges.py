@@ -132,3 +132,91 @@ def test_plt_export_says_it_is_in_galvo_bits(qtbot, tmp_path):
     assert win.export("plt", out) and out.exists()
     assert "galvo bits" in win.statusBar().currentMessage()
     assert FsPath(out).stat().st_size > 0
+
+
+def test_undo_and_redo_of_parameter_changes(qtbot, tmp_path):
+    src = tmp_path / "circle.plt"
+    src.write_bytes(circle_plt())
+    win = make(qtbot)
+    assert win.load_file(src, wait=True)
+    assert not win.undo_action.isEnabled()
+    e0 = win.params.e_per
+    s = win.controls.sliders["e_per"]
+    s.set_position(s.to_position(0.3), final=False)  # a drag is not a change of its own
+    s.set_position(s.to_position(0.5), final=False)
+    s.set_position(s.to_position(0.5), final=True)  # the release
+    assert win.wait_idle(60) and win.params.e_per == pytest.approx(0.5, rel=0.01)
+    assert win.set_param("chord_tol_bits", 2.0) and win.wait_idle(60)
+    assert win.undo() and win.wait_idle(60)
+    assert win.params.chord_tol_bits != 2.0 and win.params.e_per == pytest.approx(0.5, rel=0.01)
+    assert win.current_job().params["chord_tol_bits"] == win.params.chord_tol_bits
+    assert win.undo() and win.wait_idle(60)
+    assert win.params.e_per == e0 and s.value() == pytest.approx(e0)
+    assert win.undo() is False
+    assert win.redo() and win.redo() and win.wait_idle(60)
+    assert win.params.chord_tol_bits == 2.0 and win.redo() is False
+    win.undo()
+    assert win.set_param("e_per", 0.7)  # a new change forgets what was undone
+    assert win.redo() is False
+
+
+def test_ruler_measures_in_mm_and_bits(qtbot, tmp_path):
+    src = tmp_path / "circle.plt"
+    src.write_bytes(circle_plt())
+    win = make(qtbot)
+    assert win.load_file(src, wait=True)
+    win.ruler_action.setChecked(True)
+    assert win.ruler_click(10.0, 20.0) is None
+    text = win.ruler_click(13.0, 24.0)  # a 3-4-5 triangle: 5 mm
+    mpb = win.result.preview.mm_per_bit
+    assert text is not None and "5.000 mm" in text
+    bits = float(text.split("=")[1].split("bits")[0].replace("\u2009", ""))
+    assert bits == pytest.approx(5.0 / mpb, abs=0.1)
+    x, _ = win.processed._ruler_item.getData()
+    assert list(x) == [10.0, 13.0]
+    win.ruler_action.setChecked(False)
+    x, _ = win.processed._ruler_item.getData()
+    assert x is None or len(x) == 0
+
+
+def test_marking_simulation_plays_the_job_in_order(qtbot, tmp_path):
+    from galvo_core.preview import beam_timeline
+
+    win = make(qtbot)
+    assert win.load_file(SAMPLES / "seal.plt", wait=True)
+    job = win.current_job()
+    xy, t, on = beam_timeline(job)
+    assert len(xy) == sum(len(s.marks) for s in job.strokes)
+    assert t[-1] == pytest.approx(job.stats["estimated_time_s"])
+    assert (t[1:] >= t[:-1]).all()
+    assert on.sum() == len(xy) - len(job.strokes)  # each stroke starts with a jump
+    win.sim_action.setChecked(True)
+    assert win.sim_bar.isVisible()
+    start = win.simulate_at(0.0)
+    assert start["time_s"] == 0 and start["index"] == 0
+    np_first = job.strokes[0].marks[0]
+    assert tuple(start["bits"]) == pytest.approx(tuple(np_first))
+    end = win.simulate_at(1.0)
+    assert end["time_s"] == pytest.approx(job.stats["estimated_time_s"])
+    assert tuple(end["bits"]) == pytest.approx(tuple(job.strokes[-1].marks[-1]))
+    mid = win.simulate_at(0.5)
+    assert 0 < mid["index"] < len(xy) - 1
+    assert "s /" in win.sim_label.text()
+    # scrubbing with the slider moves the beam
+    win.sim_slider.setValue(250)
+    x, _ = win.processed._sim_items[0].getData()
+    assert x is not None and 1 < len(x) <= mid["index"] + 2
+    win.sim_action.setChecked(False)
+    assert not win.sim_bar.isVisible()
+
+
+def test_screenshot_of_a_drawing_bigger_than_the_field_uses_fit_field(qtbot, dialogs):
+    """--screenshot opens its drawing with open_drawing: the same Fit field rule."""
+    from galvo_core.hpgl import read_bytes
+
+    big = read_bytes(b"IN;SP1;PU0,0;PD16000,0,16000,16000,0,16000,0,0;PU;", "big.plt")
+    win = make(qtbot)
+    win.open_drawing(big, "big.plt")
+    assert win.wait_idle(60)
+    assert win.params.fit_field and win.run_error is None and win.banner.isVisible()
+    assert win.current_job().strokes and not dialogs

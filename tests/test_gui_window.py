@@ -238,7 +238,7 @@ def test_markers_drawn_only_below_the_limit(qtbot, monkeypatch):
 
 
 def test_processed_view_shows_fit_controls_and_marks(qtbot):
-    win = shown(qtbot, MainWindow(square_drawing()))
+    win = shown(qtbot, MainWindow(square_drawing(), restore=False))  # every layer on
     c = win.processed.counts
     assert c["fitted"] >= 5 and c["marks"] >= 5 and c["control"] >= 5
     assert c["hatch"] == 0 and c["kerf"] == 0  # features off: the layers are simply empty

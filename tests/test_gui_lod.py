@@ -1,0 +1,53 @@
+"""Coarse display levels of big layers (app.views): what the whole-drawing zoom draws
+instead of every vertex must look the same to a pixel."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+pytest.importorskip("pytestqt")
+
+from app.views import LOD_FACTORS, LinesItem, _one_per_cell, decimate  # noqa: E402
+from galvo_core.geometry import point_polyline_distance  # noqa: E402
+
+pytestmark = pytest.mark.gui
+
+
+def dense_walk(n: int, seed: int = 0) -> np.ndarray:
+    rng = np.random.default_rng(seed)
+    ang = np.cumsum(rng.normal(0, 0.05, n))
+    return np.cumsum(np.c_[np.cos(ang), np.sin(ang)] * 0.01, axis=0)
+
+
+@pytest.mark.parametrize("cell", [0.02, 0.1, 0.5])
+def test_decimate_keeps_every_vertex_within_a_cell_diagonal(cell):
+    pieces = [dense_walk(4000, s) + 10 * s for s in range(3)]
+    xy = np.concatenate([np.vstack((p, [[np.nan, np.nan]])) for p in pieces])[:-1]
+    out = decimate(xy, cell)
+    assert len(out) < len(xy)
+    # pieces stay pieces, with their ends
+    assert np.isnan(out[:, 0]).sum() == 2
+    kept = np.split(out, np.flatnonzero(np.isnan(out[:, 0])))
+    for p, k in zip(pieces, kept, strict=True):
+        k = k[np.isfinite(k[:, 0])]
+        assert np.array_equal(k[0], p[0]) and np.array_equal(k[-1], p[-1])
+        d = point_polyline_distance(p, k)
+        assert d.max() <= cell * np.sqrt(2) + 1e-12
+
+
+def test_one_point_per_cell():
+    pts = np.random.default_rng(1).uniform(0, 10, (50_000, 2))
+    out = _one_per_cell(pts, 1.0)
+    cells = {(int(x), int(y)) for x, y in np.floor(out)}
+    assert len(out) == len(cells) == 100  # every occupied cell once
+
+
+def test_big_lines_get_coarse_levels_coarsest_first(qtbot):
+    xy = dense_walk(60_000)
+    prepared = LinesItem.prepare(xy, lod=0.01)
+    levels = prepared[-1]
+    assert levels and [lv for lv, _ in levels] == sorted((lv for lv, _ in levels),
+                                                          reverse=True)
+    assert levels[0][0] == pytest.approx(0.01 * LOD_FACTORS[0])
+    assert LinesItem.prepare(xy[:100], lod=0.01)[-1] is None  # small layers: full only
