@@ -61,6 +61,7 @@ from PySide6.QtWidgets import (
 from galvo_core import params as params_mod
 from galvo_core.drawing import Drawing
 from galvo_core.errors import GalvoError, ParamError
+from galvo_core.export import write_plt, write_svg
 from galvo_core.job import Job, atomic_write_bytes, load_job, write_job
 from galvo_core.params import Params
 from galvo_core.pipeline import Pipeline
@@ -158,28 +159,17 @@ def bundled_sample() -> FsPath | None:
     return found[0] if found else None
 
 
-def exporters() -> dict[str, Any]:
-    """The optional PLT/SVG writers of ``galvo_core.export`` (imported lazily): name ->
-    function; missing ones are absent."""
-    try:
-        from galvo_core import export  # type: ignore[attr-defined]
-    except Exception:  # noqa: BLE001 - not there yet, or broken: grey the actions out
-        return {}
-    return {n: getattr(export, n) for n in ("write_plt", "write_svg")
-            if callable(getattr(export, n, None))}
-
-
 @dataclass(frozen=True)
 class ExportKind:
     """One kind of File ▸ Export: the menu text, the save dialog's filter and suffix, the
-    writer ``write(job, path)`` (atomic) or the name of a ``galvo_core.export`` function, and
-    what the status bar says about the file after writing it. Other modules add kinds to
-    :attr:`MainWindow.export_kinds` (then call :meth:`MainWindow.rebuild_export_menu`)."""
+    writer ``write(job, path)`` (atomic), and what the status bar says about the file after
+    writing it. Other modules add kinds to :attr:`MainWindow.export_kinds` (then call
+    :meth:`MainWindow.rebuild_export_menu`)."""
 
     label: str
     file_filter: str
     suffix: str
-    write: Callable[[Job, FsPath], None] | str
+    write: Callable[[Job, FsPath], None]
     note: str = ""
 
 
@@ -188,9 +178,9 @@ def default_export_kinds() -> dict[str, ExportKind]:
         "job": ExportKind("Export &Job (JSON)…", "Job files (*.json)", ".json", write_job,
                           "job file"),
         "plt": ExportKind("Export &PLT (galvo bits)…", "HP-GL files (*.plt)", ".plt",
-                          "write_plt", "HP-GL of the marks in galvo bits (1 plotter unit = "
+                          write_plt, "HP-GL of the marks in galvo bits (1 plotter unit = "
                           "1 bit, not 40 units per mm)"),
-        "svg": ExportKind("Export &SVG (mm)…", "SVG files (*.svg)", ".svg", "write_svg",
+        "svg": ExportKind("Export &SVG (mm)…", "SVG files (*.svg)", ".svg", write_svg,
                           "SVG of the fitted geometry in mm on the workpiece"),
     }
 
@@ -1291,17 +1281,11 @@ class MainWindow(QMainWindow):
 
     def _writer(self, kind: str) -> Callable[[Job, FsPath], None] | None:
         spec = self.export_kinds.get(kind)
-        if spec is None:
-            return None
-        if isinstance(spec.write, str):
-            return exporters().get(spec.write)
-        return spec.write
+        return None if spec is None else spec.write
 
     def _refresh_export_actions(self) -> None:
         for kind, a in self.export_actions.items():
-            ok = self._writer(kind) is not None
-            a.setEnabled(ok)
-            a.setToolTip("" if ok else "galvo_core.export is not available")
+            a.setEnabled(self._writer(kind) is not None)
 
     def export_dialog(self, kind: str) -> None:
         """Ask where, then export (on the worker). Refused at once, with a dialog, while the
