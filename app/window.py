@@ -310,7 +310,40 @@ class MainWindow(QMainWindow):
         self.setDockOptions(QMainWindow.DockOption.AnimatedDocks
                             | QMainWindow.DockOption.AllowTabbedDocks)
 
-        # --- views ---------------------------------------------------------------------
+        self._build_views()
+        self._build_layer_bar()
+        self._build_central()
+        self._build_controls_dock()
+        self._build_job_dock()
+        self._build_workers()
+        self._build_menus()
+        self._build_status_bar()
+        from .layers_dock import LayersDock
+        self.layers = LayersDock(self)  # the layer table, pen table files, LMC export
+        for view in (self.original, self.processed):
+            view.scene().sigMouseMoved.connect(lambda pos, v=view: self._on_mouse_moved(v, pos))
+            view.scene().sigMouseClicked.connect(lambda ev, v=view: self._on_mouse_clicked(v, ev))
+            view.update_legend()
+            view.on_legend_toggle = lambda k: self.layer_boxes[k].toggle()
+        self.warnings_panel.set_warnings(())
+        self.stats_panel.set_stats({})
+
+        if restore:
+            self._restore_state()
+        for spec in LAYERS:  # items follow the boxes (also those left at their default)
+            for v in (self.original, self.processed):
+                v.set_layer_visible(spec.key, self.layer_boxes[spec.key].isChecked())
+        self.controls.set_params(self.params, self._field_map_for(self.params))
+        self._committed = self.params
+        if drawing is not None:
+            self.set_drawing(drawing)
+        else:
+            self._update_title()
+            self._update_status()
+
+    # --- UI construction ------------------------------------------------------------------
+    def _build_views(self) -> None:
+        """The two views (original, processed), linked, side by side in a splitter."""
         self.original = WorkView("Original", tuple(s.key for s in LAYERS
                                                    if s.view == "original"))
         self.processed = WorkView("Processed", tuple(s.key for s in LAYERS
@@ -327,6 +360,8 @@ class MainWindow(QMainWindow):
         splitter.setStretchFactor(1, 1)
         self.splitter = splitter
 
+    def _build_layer_bar(self) -> None:
+        """The layer check boxes above the views (they wrap in a narrow window)."""
         self.layer_boxes: dict[str, QCheckBox] = {}
         layer_bar, bar = flow_container()  # wraps to a second row in a narrow window
         layer_bar.setObjectName("layer_bar")
@@ -345,6 +380,8 @@ class MainWindow(QMainWindow):
             bar.addWidget(cb)
         self.layer_bar = layer_bar
 
+    def _build_central(self) -> None:
+        """The banner, the views, the stale bar over them and the simulation bar."""
         self.banner = QLabel("")
         self.banner.setObjectName("banner")
         self.banner.setWordWrap(True)
@@ -366,9 +403,9 @@ class MainWindow(QMainWindow):
         cl = QVBoxLayout(central)
         cl.setContentsMargins(0, 0, 0, 0)
         cl.setSpacing(0)
-        cl.addWidget(layer_bar)
+        cl.addWidget(self.layer_bar)
         cl.addWidget(self.banner)
-        cl.addWidget(splitter, 1)
+        cl.addWidget(self.splitter, 1)
         self._build_simulation_bar()
         cl.addWidget(self.sim_bar)
         self.setCentralWidget(central)
@@ -378,7 +415,8 @@ class MainWindow(QMainWindow):
         self.stale_bar.setAttribute(Qt.WidgetAttribute.WA_TransparentForMouseEvents)
         self._central = central
 
-        # --- docks ---------------------------------------------------------------------
+    def _build_controls_dock(self) -> None:
+        """The Processing dock: the controls generated from the parameter model."""
         self.controls = ControlsPanel(self.params)
         self.controls.changed.connect(self._on_controls_changed)
         self.controls.laser_requested.connect(self.open_laser_dialog)
@@ -401,6 +439,8 @@ class MainWindow(QMainWindow):
                                        | QDockWidget.DockWidgetFeature.DockWidgetFloatable)
         self.addDockWidget(Qt.DockWidgetArea.RightDockWidgetArea, self.controls_dock)
 
+    def _build_job_dock(self) -> None:
+        """The Job dock: stats and warnings."""
         self.stats_panel = StatsPanel()
         self.warnings_panel = WarningsPanel()
         self.warnings_panel.activated.connect(self.zoom_to_warning)
@@ -422,7 +462,8 @@ class MainWindow(QMainWindow):
         self.resizeDocks([self.controls_dock], [self.controls_dock.minimumSizeHint().width()],
                          Qt.Orientation.Horizontal)
 
-        # --- worker, timers, watcher ---------------------------------------------------
+    def _build_workers(self) -> None:
+        """The workers (runs, file reads, exports), the throttle and the file watcher."""
         self.runner = LatestRunner(self)
         self.runner.finished.connect(self._on_result)
         self.runner.failed.connect(self._on_failed)
@@ -453,32 +494,6 @@ class MainWindow(QMainWindow):
         self._reload_timer.setInterval(300)
         self._reload_timer.timeout.connect(self._reload_changed)
 
-        self._build_menus()
-        self._build_status_bar()
-        from .layers_dock import LayersDock
-        self.layers = LayersDock(self)  # the layer table, pen table files, LMC export
-        for view in (self.original, self.processed):
-            view.scene().sigMouseMoved.connect(lambda pos, v=view: self._on_mouse_moved(v, pos))
-            view.scene().sigMouseClicked.connect(lambda ev, v=view: self._on_mouse_clicked(v, ev))
-            view.update_legend()
-            view.on_legend_toggle = lambda k: self.layer_boxes[k].toggle()
-        self.warnings_panel.set_warnings(())
-        self.stats_panel.set_stats({})
-
-        if restore:
-            self._restore_state()
-        for spec in LAYERS:  # items follow the boxes (also those left at their default)
-            for v in (self.original, self.processed):
-                v.set_layer_visible(spec.key, self.layer_boxes[spec.key].isChecked())
-        self.controls.set_params(self.params, self._field_map_for(self.params))
-        self._committed = self.params
-        if drawing is not None:
-            self.set_drawing(drawing)
-        else:
-            self._update_title()
-            self._update_status()
-
-    # --- UI construction ------------------------------------------------------------------
     def _build_menus(self) -> None:
         file_menu = self.menuBar().addMenu("&File")
         self.open_action = QAction("&Open…", self)
