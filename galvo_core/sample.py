@@ -1146,8 +1146,28 @@ def sample_paths(
             keep = np.zeros(len(pid), dtype=bool)
             forced: list[int] = []
 
+            # the filter asks, around the short chords q -> q + 1, whether a chord that
+            # would replace a few marks holds (q -> q + 2 mostly, q -> q + 3 after a drop,
+            # q - 1 -> q + 1, q - 1 -> q + 2 when the mark before is dropped instead):
+            # measured here for all of them at once (a chord's height does not depend on
+            # the others measured with it), any other question one by one
+            q = np.flatnonzero(short)
+            npid = len(pid)
+            qa = np.concatenate([q, q, q - 1, q - 1])
+            qb = np.concatenate([q + 2, q + 3, q + 1, q + 2])
+            ok = (qa >= 0) & (qb < npid)
+            qa, qb = qa[ok], qb[ok]
+            ok = pid[qa] == pid[qb]
+            qa, qb = qa[ok], qb[ok]
+            hq = _chords_heights(cs, sid[qa], st[qa], sid[qb], st[qb], pos[qa], pos[qb])
+            known = dict(zip(zip(qa.tolist(), qb.tolist(), strict=True),
+                             (hq <= tol).tolist(), strict=True))
+
             def merge_ok(a: int, b: int) -> bool:
                 """The chord from mark a to mark b keeps within the tolerance."""
+                hit = known.get((a, b))
+                if hit is not None:
+                    return hit
                 h = _chords_heights(cs, sid[[a]], st[[a]], sid[[b]], st[[b]], pos[[a]],
                                     pos[[b]])
                 return bool(h[0] <= tol)
