@@ -10,8 +10,7 @@ typed value and on combo/checkbox changes.
 from __future__ import annotations
 
 import math
-from collections.abc import Callable
-from dataclasses import dataclass, fields
+from dataclasses import dataclass
 from typing import Any
 
 from PySide6.QtCore import Qt, Signal
@@ -35,7 +34,7 @@ from PySide6.QtWidgets import (
 
 from galvo_core import params as params_mod
 from galvo_core.field import FieldMap
-from galvo_core.params import LaserParams, Params
+from galvo_core.params import LaserParams, Params, Spec
 
 SLIDER_STEPS = 1000
 
@@ -60,7 +59,7 @@ class SliderSpec:
     tip: str = ""
 
 
-SUFFIX = {"units": " u", "bits": " bits", "mm": " mm", "deg": " °", "mag": " bits/u"}
+SUFFIX = {"units": " u", "bits": " bits", "mm": " mm", "deg": " °", "mag": " bits/u", "": ""}
 
 
 class ParamSlider(QWidget):
@@ -218,53 +217,34 @@ def conversion_text(unit: str, value: float, fm: FieldMap, drawing_size_units: t
     return ""
 
 
-#: The sliders, in panel order, grouped. Ranges are the panel's, validity is Params'.
-GROUPS: tuple[tuple[str, tuple[SliderSpec | str, ...]], ...] = (
-    ("Fit (paper 000)", (
-        SliderSpec("eps_line", "ε_line  (line thinning)", "units", 0.001, 10.0,
-                   tip="largest distance of a dropped point from the line that replaces it"),
-        SliderSpec("e_per", "e_per  (curve tolerance)", "units", 0.001, 10.0,
-                   tip="largest distance of an input point from the fitted cubic"),
-    )),
-    ("Field", (
-        SliderSpec("magnification", "Magnification", "mag", 0.2, 2000.0, decimals=4,
-                   tip="galvo bits per input unit (true size ≈ 14.9)"),
-        "fit_field",
-    )),
-    ("Marking points", (
-        "interpolation",
-        SliderSpec("chord_tol_bits", "Chord tolerance", "bits", 0.02, 512.0,
-                   tip="largest chord height between marks on a curve"),
-        SliderSpec("min_step_bits", "Minimum step", "bits", 0.1, 512.0, zero=True,
-                   tip="marks closer than this are merged (0: keep all)"),
-    )),
-    ("Kerf compensation", (
-        SliderSpec("kerf_mm", "Kerf width", "mm", 0.001, 5.0, zero=True,
-                   tip="beam / cut width on the workpiece (0: off)"),
-        "kerf_side",
-        "kerf_method",
-    )),
-    ("Fill", (
-        "fill",
-        SliderSpec("hatch_spacing_mm", "Hatch spacing", "mm", 0.005, 10.0,
-                   tip="distance between fill lines on the workpiece"),
-        SliderSpec("hatch_angle_deg", "Hatch angle", "deg", -90.0, 90.0, log=False,
-                   decimals=1, tip="direction of the fill lines"),
-    )),
-    ("Order", ("scan_order",)),
-)
+#: how a parameter's unit (galvo_core.params.Spec.unit) shows its conversions in the panel
+GUI_UNIT = {"units": "units", "bits": "bits", "mm": "mm", "deg": "deg", "bits/unit": "mag"}
+
+
+def slider_spec(spec: Spec) -> SliderSpec:
+    """The slider of a numeric parameter, from its Spec (label, unit, range, tooltip)."""
+    assert spec.slider is not None, spec.name
+    lo, hi = spec.slider
+    return SliderSpec(spec.name, spec.label, GUI_UNIT.get(spec.unit, ""), lo, hi, log=spec.log,
+                      zero=spec.zero, decimals=spec.decimals, tip=spec.describe())
+
+
+def _control(spec: Spec) -> SliderSpec | str:
+    return slider_spec(spec) if spec.slider is not None else spec.name
+
+
+#: The controls, in panel order, grouped: every parameter whose Spec says ``control``;
+#: sliders for numbers, combo boxes for choices, check boxes for switches.
+GROUPS: tuple[tuple[str, tuple[SliderSpec | str, ...]], ...] = tuple(
+    (g.TITLE, tuple(_control(s) for s in g.specs() if s.control))
+    for g in params_mod.GROUPS if any(s.control for s in g.specs()))
 
 CHOICES: dict[str, tuple[str, tuple[str, ...]]] = {
-    "interpolation": ("Method", getattr(params_mod, "INTERPOLATIONS", ())),
-    "kerf_side": ("Side", getattr(params_mod, "KERF_SIDES", ())),
-    "kerf_method": ("Method", getattr(params_mod, "KERF_METHODS", ())),
-    "fill": ("Fill", getattr(params_mod, "FILLS", ())),
-    "scan_order": ("Scan order", getattr(params_mod, "SCAN_ORDERS", ())),
-}
+    s.name: (s.label, s.choices) for s in params_mod.all_specs() if s.kind == "choice"}
 
 
 def _param_names() -> set[str]:
-    return {f.name for f in fields(Params)}
+    return {s.name for s in params_mod.all_specs()}
 
 
 class ControlsPanel(QWidget):
@@ -304,7 +284,8 @@ class ControlsPanel(QWidget):
                     self.sliders[item.name] = w
                     lay.addWidget(w)
                 elif item == "fit_field":
-                    cb = QCheckBox("Fit field (largest size that fits)")
+                    cb = QCheckBox(params_mod.spec("fit_field").label)
+                    cb.setToolTip(params_mod.spec("fit_field").describe())
                     cb.setObjectName("check_fit_field")
                     cb.setChecked(bool(params.fit_field))
                     cb.toggled.connect(self._on_fit_field)
@@ -394,22 +375,13 @@ class ControlsPanel(QWidget):
         self.changed.emit(changes, True)
 
     def _emit(self, name: str, value: Any, final: bool) -> None:
+        if params_mod.spec(name).kind == "int":
+            value = int(round(value))
         if name in self.sliders:
             fm = self._fm
             if fm is not None:
                 self.refresh_info()
         self.changed.emit({name: value}, final)
-
-
-LASER_UNITS = (("_mm_s", "mm/s"), ("_khz", "kHz"), ("_us", "µs"), ("_percent", "%"),
-               ("_mm", "mm"))
-
-
-def laser_label(name: str) -> tuple[str, str]:
-    for suffix, unit in LASER_UNITS:
-        if name.endswith(suffix):
-            return name[: -len(suffix)].replace("_", " ").capitalize(), unit
-    return name.replace("_", " ").capitalize(), ""
 
 
 class LaserDialog(QDialog):
@@ -420,17 +392,16 @@ class LaserDialog(QDialog):
         self.setWindowTitle("Laser parameters")
         self.spins: dict[str, QDoubleSpinBox] = {}
         form = QFormLayout()
-        for f in fields(LaserParams):
-            label, unit = laser_label(f.name)
+        for spec in LaserParams.specs():
             spin = QDoubleSpinBox()
-            spin.setObjectName(f"laser_{f.name}")
+            spin.setObjectName(f"laser_{spec.name}")
             spin.setDecimals(2)
-            spin.setRange(0.0, 1e7 if unit != "%" else 100.0)
-            spin.setSuffix(f" {unit}" if unit else "")
-            spin.setValue(float(getattr(laser, f.name)))
-            spin.setToolTip(f.name)
-            self.spins[f.name] = spin
-            form.addRow(label, spin)
+            spin.setRange(spec.lo or 0.0, spec.hi if spec.hi is not None else 1e7)
+            spin.setSuffix(f" {spec.unit}" if spec.unit else "")
+            spin.setValue(float(getattr(laser, spec.name)))
+            spin.setToolTip(f"{spec.describe()}\n({spec.name})")
+            self.spins[spec.name] = spin
+            form.addRow(spec.label, spin)
         self.error = QLabel("")
         self.error.setStyleSheet("color: #b00020;")
         self.error.setWordWrap(True)
@@ -462,10 +433,6 @@ class LaserDialog(QDialog):
             self.error.setText(str(exc))
             return
         self.accept()
-
-
-def effective_magnification(params: Params, fm_of: Callable[[Params], FieldMap]) -> float:
-    return fm_of(params).magnification
 
 
 __all__ = ["ControlsPanel", "GROUPS", "LaserDialog", "ParamSlider", "SliderSpec",

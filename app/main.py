@@ -51,66 +51,25 @@ def parse_size(text: str) -> tuple[int, int]:
     return w, h
 
 
-def _convert(name: str, text: str, current: object, annotation: str) -> object:
-    t = text.strip()
-    low = t.lower()
-    if low in ("none", "null", "auto") and "None" in annotation:
-        return None
-    if "bool" in annotation:
-        if low in ("1", "true", "yes", "on"):
-            return True
-        if low in ("0", "false", "no", "off"):
-            return False
-        raise UsageError(f"--set {name}: expected true or false, got {text!r}")
-    if "tuple" in annotation:
-        parts = [p for p in re.split(r"[,\s]+", t) if p]
-        try:
-            return tuple(float(p) for p in parts)
-        except ValueError:
-            raise UsageError(f"--set {name}: expected two numbers X,Y, got {text!r}") from None
-    if annotation.startswith("int") or isinstance(current, int) and not isinstance(current, bool):
-        try:
-            return int(t)
-        except ValueError:
-            raise UsageError(f"--set {name}: expected an integer, got {text!r}") from None
-    if annotation.startswith("str"):
-        return t
-    try:
-        return float(t)
-    except ValueError:
-        raise UsageError(f"--set {name}: expected a number, got {text!r}") from None
-
-
 def params_from_sets(sets: Sequence[str]):
-    """Params() with ``NAME=VALUE`` changes, validated by Params; UsageError otherwise."""
-    from dataclasses import fields
-
+    """Params() with ``NAME=VALUE`` changes, each parsed and checked by its parameter's Spec
+    (:mod:`galvo_core.params`); UsageError otherwise."""
     from galvo_core.errors import ParamError
-    from galvo_core.params import LaserParams, Params
+    from galvo_core.params import Params, spec
 
-    pfields = {f.name: f for f in fields(Params) if f.name != "laser"}
-    lfields = {f.name: f for f in fields(LaserParams)}
-    base = Params()
     changes: dict[str, object] = {}
-    laser: dict[str, object] = {}
     for item in sets:
         if "=" not in item:
             raise UsageError(f"--set needs NAME=VALUE, got {item!r}")
         name, value = (x.strip() for x in item.split("=", 1))
         name = name.removeprefix("laser.")
-        if name in pfields:
-            f = pfields[name]
-            changes[name] = _convert(name, value, getattr(base, name), str(f.type))
-        elif name in lfields:
-            f = lfields[name]
-            laser[name] = _convert(name, value, getattr(base.laser, name), str(f.type))
-        else:
-            raise UsageError(f"--set: unknown parameter {name!r} (see galvo_core.params.Params)")
+        try:
+            changes[name] = spec(name).parse(value)
+        except ParamError as exc:
+            raise UsageError(f"--set: {exc}") from None
     try:
-        if laser:
-            changes["laser"] = LaserParams(**{**base.laser.as_dict(), **laser})
-        return base.replace(**changes)
-    except (ParamError, TypeError, ValueError) as exc:
+        return Params(**changes)
+    except ParamError as exc:
         raise UsageError(f"--set: {exc}") from None
 
 

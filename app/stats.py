@@ -55,8 +55,10 @@ def _int(n: int) -> str:
 
 def format_stat(key: str, value: Any) -> str:
     """A stats value with its unit, from the key's suffix."""
-    if isinstance(value, bool) or value is None:
-        return str(value)
+    if value is None:
+        return "—"  # not measured (e.g. raw marks have no chord height)
+    if isinstance(value, bool):
+        return "yes" if value else "no"
     if isinstance(value, int):
         return _int(value)
     if isinstance(value, float):
@@ -70,13 +72,19 @@ def format_stat(key: str, value: Any) -> str:
         if key.endswith("_mm"):
             return f"{value:,.2f} mm".replace(",", "\u2009")
         if key.endswith("_um"):
+            if abs(value) < 5e-4:  # rounding noise of an exact fit (8.9e-14 µm): zero
+                return "0 µm"
             return f"{value:.3g} µm" if value < 1000 else f"{value / 1000:.3f} mm"
         if key.endswith("_bits"):
+            if abs(value) < 5e-7:
+                return "0 bits"
             return f"{value:.3g} bits"
         if key.endswith("_deg"):
             return f"{value:.1f}°"
         if value.is_integer() and abs(value) < 1e15:
             return _int(int(value))
+        if abs(value) < 1e-9:
+            return "0 u" if "error" in key else "0"
         return f"{value:.4g} u" if "error" in key else f"{value:.4g}"
     if isinstance(value, (list, tuple)):
         return ", ".join(format_stat(key, v) for v in value)
@@ -104,16 +112,16 @@ def ordered_stats(stats: dict[str, Any]) -> list[tuple[str, Any]]:
 class StatsPanel(QWidget):
     """A two-column table of the job's stats, and the selected path's counts."""
 
+    #: width (pixels) one quantity/value pair needs; fewer pairs side by side when narrower
+    PAIR_WIDTH = 250
+
     def __init__(self, parent: QWidget | None = None) -> None:
         super().__init__(parent)
+        self.columns = STAT_COLUMNS
         self.table = QTableWidget(0, 2 * STAT_COLUMNS)
         self.table.setObjectName("stats_table")
         self.table.verticalHeader().setVisible(False)
-        for c in range(STAT_COLUMNS):
-            self.table.horizontalHeader().setSectionResizeMode(
-                2 * c, QHeaderView.ResizeMode.Stretch)
-            self.table.horizontalHeader().setSectionResizeMode(
-                2 * c + 1, QHeaderView.ResizeMode.ResizeToContents)
+        self._set_columns(STAT_COLUMNS)
         self.table.horizontalHeader().setVisible(False)
         self.table.setEditTriggers(QAbstractItemView.EditTrigger.NoEditTriggers)
         self.table.setSelectionMode(QAbstractItemView.SelectionMode.NoSelection)
@@ -135,11 +143,31 @@ class StatsPanel(QWidget):
         self.shown: dict[str, str] = {}
         self.values: dict[str, Any] = {}
 
+    def _set_columns(self, n: int) -> None:
+        self.columns = n
+        self.table.setColumnCount(2 * n)
+        for c in range(n):
+            self.table.horizontalHeader().setSectionResizeMode(
+                2 * c, QHeaderView.ResizeMode.Stretch)
+            self.table.horizontalHeader().setSectionResizeMode(
+                2 * c + 1, QHeaderView.ResizeMode.ResizeToContents)
+
+    def resizeEvent(self, ev) -> None:  # noqa: N802 - Qt API
+        super().resizeEvent(ev)
+        n = max(1, min(STAT_COLUMNS, self.width() // self.PAIR_WIDTH))
+        if n != self.columns:
+            self._set_columns(n)
+            self.set_stats(self._last_stats, self._last_extra)
+
+    _last_stats: dict[str, Any] | None = None
+    _last_extra: dict[str, Any] | None = None
+
     def set_stats(self, stats: dict[str, Any] | None, extra: dict[str, Any] | None = None
                   ) -> None:
+        self._last_stats, self._last_extra = stats, extra
         rows = ordered_stats(dict(stats or {}))
         rows += list((extra or {}).items())
-        per_col = (len(rows) + STAT_COLUMNS - 1) // STAT_COLUMNS
+        per_col = (len(rows) + self.columns - 1) // self.columns
         self.table.clearContents()
         self.table.setRowCount(per_col)
         self.shown = {}
@@ -192,9 +220,14 @@ class WarningsPanel(QWidget):
         self.warnings: tuple[Warning, ...] = ()
         self.error: str | None = None
 
+    #: turns a core message into the window's words (e.g. CLI flags into control names)
+    translate: staticmethod = staticmethod(lambda text: text)
+
     def set_warnings(self, warnings: tuple[Warning, ...] | list[Warning],
                      error: str | None = None) -> None:
         self.warnings = tuple(warnings)
+        tr = self.translate
+        error = tr(error) if error else error
         self.error = error
         self.list.clear()
         if error:
@@ -205,10 +238,10 @@ class WarningsPanel(QWidget):
             self.list.addItem(item)
         for i, w in enumerate(self.warnings):
             where = f"line {w.line}, col {w.col}: " if w.line else ""
-            item = QListWidgetItem(f"⚠ {where}{w.message}")
+            item = QListWidgetItem(f"⚠ {where}{tr(w.message)}")
             item.setForeground(QBrush(QColor("#8a4b00")))
             item.setData(Qt.ItemDataRole.UserRole, i)
-            item.setToolTip(str(w))
+            item.setToolTip(tr(str(w)))
             self.list.addItem(item)
         if not error and not self.warnings:
             item = QListWidgetItem("✓ no warnings")

@@ -50,8 +50,10 @@ FIELD = "#9aa5b1"
 SELECTION = "#ffc400"  # amber underlay
 TITLE_SIZE = "11pt"
 
-#: Deviation colours, from "well inside the tolerance" to "at the tolerance".
-DEVIATION_STOPS = ("#1a9850", "#a6d96a", "#fee08b", "#f46d43", "#a50026")
+#: Deviation colours, from "well inside the tolerance" to "at the tolerance": pale yellow to
+#: dark brown, a hue none of the other layers uses (the marks are red, the fitted curve
+#: green, control points blue, hatch purple, kerf magenta).
+DEVIATION_STOPS = ("#f3e08a", "#eab84a", "#c98a1c", "#8c510a", "#3d2300")
 DEVIATION_BINS = 16
 
 #: Point markers of the original drawing are drawn only below this many points.
@@ -149,27 +151,38 @@ class DeviationItem(pg.GraphicsObject):
             self._pens.append(pen)
         self.n_chords = 0
 
-    def setData(self, a: np.ndarray, b: np.ndarray, level: np.ndarray) -> None:  # noqa: N802
-        self.prepareGeometryChange()
-        self._paths = []
-        self.n_chords = len(level)
+    @staticmethod
+    def prepare(a: np.ndarray, b: np.ndarray, level: np.ndarray) -> tuple:
+        """The paths per colour bin and the rectangle (any thread: no item touched)."""
         if not len(level):
-            self._rect = QRectF()
-            self.update()
-            return
+            return [], QRectF(), 0
         bins = np.minimum((level * DEVIATION_BINS).astype(np.int64), DEVIATION_BINS - 1)
-        for k in np.unique(bins):
-            sel = bins == k
-            n = int(sel.sum())
+        order = np.argsort(bins, kind="stable")
+        sb = bins[order]
+        cuts = np.flatnonzero(np.diff(sb)) + 1
+        paths = []
+        for idx in np.split(order, cuts):
+            k = int(bins[idx[0]])
+            n = len(idx)
             x = np.empty(2 * n)
             y = np.empty(2 * n)
-            x[0::2], x[1::2] = a[sel, 0], b[sel, 0]
-            y[0::2], y[1::2] = a[sel, 1], b[sel, 1]
-            self._paths.append((self._pens[int(k)], pg.arrayToQPath(x, y, connect="pairs")))
+            x[0::2], x[1::2] = a[idx, 0], b[idx, 0]
+            y[0::2], y[1::2] = a[idx, 1], b[idx, 1]
+            paths.append((k, pg.arrayToQPath(x, y, connect="pairs")))
         lo = np.minimum(a.min(axis=0), b.min(axis=0))
         hi = np.maximum(a.max(axis=0), b.max(axis=0))
-        self._rect = QRectF(QPointF(lo[0], lo[1]), QPointF(hi[0], hi[1]))
+        return paths, QRectF(QPointF(lo[0], lo[1]), QPointF(hi[0], hi[1])), len(level)
+
+    def setPrepared(self, prepared: tuple) -> None:  # noqa: N802
+        paths, rect, n = prepared
+        self.prepareGeometryChange()
+        self._paths = [(self._pens[k], path) for k, path in paths]
+        self._rect = rect
+        self.n_chords = n
         self.update()
+
+    def setData(self, a: np.ndarray, b: np.ndarray, level: np.ndarray) -> None:  # noqa: N802
+        self.setPrepared(self.prepare(a, b, level))
 
     def boundingRect(self) -> QRectF:  # noqa: N802 - Qt API
         return self._rect
@@ -236,7 +249,8 @@ def _premultiplied(colour: QColor) -> np.uint32:
     return np.uint32((a << 24) | (r << 16) | (g << 8) | b)
 
 
-def draw_points(p, xy: np.ndarray, poly, pen: QPen, grid: float = 2.0) -> None:
+def draw_points(p, xy: np.ndarray, poly, pen: QPen, grid: float = 2.0,
+                cache: dict | None = None) -> None:
     """Draw markers at ``xy`` (item coordinates) with ``pen``. Small sets: antialiased, as
     they are. Large sets: culled to the device and thinned to one marker per ``grid``
     device pixels (what the eye can tell apart anyway), then rasterised here: each marker's
@@ -256,6 +270,14 @@ def draw_points(p, xy: np.ndarray, poly, pen: QPen, grid: float = 2.0) -> None:
     if w <= 0 or h <= 0:
         return
     t = p.transform()
+    key = (id(xy), len(xy), t.m11(), t.m12(), t.m21(), t.m22(), t.dx(), t.dy(), w, h, dpr,
+           pen.widthF(), pen.color().rgba(), grid)
+    if cache is not None and cache.get("key") == key:  # the same picture again (a repaint)
+        p.save()
+        p.resetTransform()
+        p.drawImage(QPointF(0.0, 0.0), cache["image"])
+        p.restore()
+        return
     dx = (xy[:, 0] * t.m11() + xy[:, 1] * t.m21() + t.dx()) * dpr
     dy = (xy[:, 0] * t.m12() + xy[:, 1] * t.m22() + t.dy()) * dpr
     g = max(1, int(round(grid * dpr)))
@@ -284,6 +306,8 @@ def draw_points(p, xy: np.ndarray, poly, pen: QPen, grid: float = 2.0) -> None:
         img[py[ok], px[ok]] = value
     qimg = QImage(img.data, w, h, 4 * w, QImage.Format.Format_ARGB32_Premultiplied)
     qimg.setDevicePixelRatio(dpr)
+    if cache is not None:
+        cache.update(key=key, image=qimg, buffer=img, data=xy)  # the buffer backs the image
     p.save()
     p.resetTransform()
     p.drawImage(QPointF(0.0, 0.0), qimg)
@@ -320,23 +344,30 @@ class PointsItem(_FastItem):
         self.pen.setCapStyle(Qt.PenCapStyle.SquareCap if square else Qt.PenCapStyle.RoundCap)
         self._xy = np.empty((0, 2))
         self._poly = _polygon(self._xy)
+        self._raster: dict = {}
 
-    def setData(self, xy: np.ndarray) -> None:  # noqa: N802 - like pyqtgraph
+    @staticmethod
+    def prepare(xy: np.ndarray) -> tuple:
+        """Finite points, their polygon (small sets) and rectangle (any thread)."""
         xy = np.asarray(xy, dtype=np.float64).reshape(-1, 2)
         if not np.isfinite(xy).all():
             xy = xy[np.isfinite(xy).all(axis=1)]
+        return xy, _small_polygon(xy), _finite_rect(xy)
+
+    def setPrepared(self, prepared: tuple) -> None:  # noqa: N802
         self.prepareGeometryChange()
-        self._xy = xy
-        self._poly = _small_polygon(xy)
-        self._rect = _finite_rect(xy)
+        self._xy, self._poly, self._rect = prepared
         self.update()
+
+    def setData(self, xy: np.ndarray) -> None:  # noqa: N802 - like pyqtgraph
+        self.setPrepared(self.prepare(xy))
 
     def getData(self) -> tuple[np.ndarray, np.ndarray]:  # noqa: N802 - like pyqtgraph
         return self._xy[:, 0], self._xy[:, 1]
 
     def paint(self, p, *args) -> None:
         if len(self._xy):
-            draw_points(p, self._xy, self._poly, self.pen)
+            draw_points(p, self._xy, self._poly, self.pen, cache=self._raster)
 
 
 class ControlItem(_FastItem):
@@ -358,24 +389,50 @@ class ControlItem(_FastItem):
         self._knots = _polygon(self._xy_knots)
         self._xy = np.empty((0, 2))
         self._role = np.empty(0, dtype=np.int8)
+        self._coarse: tuple | None = None
+        self.last_drawn = ""
 
-    def setData(self, xy: np.ndarray, role: np.ndarray) -> None:  # noqa: N802
-        self.prepareGeometryChange()
-        self._xy = xy = np.asarray(xy, dtype=np.float64).reshape(-1, 2)
-        self._role = role = np.asarray(role)
+    @staticmethod
+    def prepare(xy: np.ndarray, role: np.ndarray, lod: float | None = None) -> tuple:
+        """Handle lines as a path, anchors, knots and the rectangle (any thread). With
+        ``lod`` a big layer also gets a coarse version for the whole-drawing view: handle
+        lines shorter than ``lod`` left out (under half a pixel: the markers cover them)
+        and one anchor and one knot per ``lod`` grid cell."""
+        xy = np.asarray(xy, dtype=np.float64).reshape(-1, 2)
+        role = np.asarray(role)
         handles = role[: len(xy)] != 1
         hx = xy.copy()
         hx[~handles] = np.nan
-        if len(xy):
-            self._lines = pg.arrayToQPath(hx[:, 0], hx[:, 1], connect="finite")
-        else:
-            self._lines = QPainterPath()
-        self._xy_anchors = xy[role == 1]
-        self._xy_knots = xy[role == 2]
-        self._anchors = _small_polygon(self._xy_anchors)
-        self._knots = _small_polygon(self._xy_knots)
-        self._rect = _finite_rect(xy[role >= 0])
+        lines = pg.arrayToQPath(hx[:, 0], hx[:, 1], connect="finite") if len(xy) \
+            else QPainterPath()
+        anchors, knots = xy[role == 1], xy[role == 2]
+        coarse = None
+        if lod is not None and lod > 0 and len(xy) >= MAX_ANTIALIAS_POINTS:
+            # rows are P0, P1, NaN, P2, P3, NaN, ... then the anchors: pairs start where a
+            # handle row follows a NaN (or the start) and is followed by a handle row
+            h = handles & np.isfinite(xy[:, 0])
+            start = np.flatnonzero(h[:-1] & h[1:])
+            d = np.hypot(*(xy[start + 1] - xy[start]).T)
+            long_ = start[d >= lod]
+            if len(long_):
+                px = np.full((3 * len(long_), 2), np.nan)
+                px[0::3], px[1::3] = xy[long_], xy[long_ + 1]
+                c_lines = pg.arrayToQPath(px[:-1, 0], px[:-1, 1], connect="finite")
+            else:
+                c_lines = QPainterPath()
+            coarse = (float(lod), c_lines, _one_per_cell(anchors, lod),
+                      _one_per_cell(knots, lod))
+        return (xy, role, lines, anchors, knots, _small_polygon(anchors), _small_polygon(knots),
+                _finite_rect(xy[role >= 0]), coarse)
+
+    def setPrepared(self, prepared: tuple) -> None:  # noqa: N802
+        self.prepareGeometryChange()
+        (self._xy, self._role, self._lines, self._xy_anchors, self._xy_knots, self._anchors,
+         self._knots, self._rect, self._coarse) = prepared
         self.update()
+
+    def setData(self, xy: np.ndarray, role: np.ndarray) -> None:  # noqa: N802
+        self.setPrepared(self.prepare(xy, role))
 
     def getData(self) -> tuple[np.ndarray, np.ndarray]:  # noqa: N802
         pts = self._xy[self._role > 0]
@@ -387,11 +444,126 @@ class ControlItem(_FastItem):
         small = len(self._xy) < MAX_ANTIALIAS_POINTS
         p.setRenderHint(p.RenderHint.Antialiasing, small)
         p.setPen(self.line_pen)
-        p.drawPath(self._lines)
-        knots, anchors = self._xy_knots, self._xy_anchors
-        draw_points(p, knots, self._knots, self.knot_pen, grid=3.0)
-        draw_points(p, knots, self._knots, self.hole_pen, grid=3.0)
-        draw_points(p, anchors, self._anchors, self.anchor_pen, grid=3.0)
+        lines, knots, anchors = self._lines, self._xy_knots, self._xy_anchors
+        kpoly, apoly = self._knots, self._anchors
+        self.last_drawn = "full"
+        coarse = getattr(self, "_coarse", None)
+        if coarse is not None:
+            t = p.transform()
+            px = 1.0 / max(math.hypot(t.m11(), t.m12()), 1e-300)
+            if coarse[0] <= 0.5 * px:
+                lines, anchors, knots = coarse[1], coarse[2], coarse[3]
+                kpoly = apoly = None
+                self.last_drawn = "coarse"
+        p.drawPath(lines)
+        draw_points(p, knots, kpoly, self.knot_pen, grid=3.0)
+        draw_points(p, knots, kpoly, self.hole_pen, grid=3.0)
+        draw_points(p, anchors, apoly, self.anchor_pen, grid=3.0)
+
+
+class LinesItem(_FastItem):
+    """NaN-separated polylines as ONE QPainterPath, built by :meth:`prepare` (on the worker
+    thread: building the path of a million vertices takes a quarter of a second, which the
+    GUI thread must not spend). Big layers are drawn with 1-pixel lines, no antialiasing."""
+
+    def __init__(self, pen: QPen) -> None:
+        super().__init__()
+        self.pen = QPen(pen)
+        self.thin_pen = QPen(pen)
+        self.thin_pen.setWidthF(1.0)
+        self._path = QPainterPath()
+        self._coarse: tuple[float, QPainterPath] | None = None
+        self._xy = np.empty((0, 2))
+        self._n = 0
+        #: what the last paint drew: "full" or "coarse" (tests, benchmark)
+        self.last_drawn = ""
+
+    @staticmethod
+    def prepare(xy: np.ndarray, lod: float | None = None) -> tuple:
+        """(xy, path, rectangle, finite vertices, coarse) of NaN-separated polylines (any
+        thread). With ``lod`` (item units) a big layer also gets a coarse path: vertices
+        merged on a grid of ``lod`` (:func:`decimate`), drawn while a device pixel is at
+        least twice ``lod`` (so it differs from the full path by under a pixel)."""
+        xy = np.asarray(xy, dtype=np.float64).reshape(-1, 2)
+        if not len(xy):
+            return xy, QPainterPath(), QRectF(), 0, None
+        finite = np.isfinite(xy).all(axis=1)
+        n = int(finite.sum())
+        if not n:
+            return xy, QPainterPath(), QRectF(), 0, None
+        path = pg.arrayToQPath(xy[:, 0], xy[:, 1], connect="finite")
+        coarse = None
+        if lod is not None and lod > 0 and n >= MAX_ANTIALIAS_POINTS:
+            c = decimate(xy, lod)
+            if len(c) < 0.7 * len(xy):
+                coarse = (float(lod), pg.arrayToQPath(c[:, 0], c[:, 1], connect="finite"))
+        return xy, path, _finite_rect(xy[finite]), n, coarse
+
+    def setPrepared(self, prepared: tuple) -> None:  # noqa: N802
+        self.prepareGeometryChange()
+        self._xy, self._path, self._rect, self._n, self._coarse = prepared
+        self.update()
+
+    def setData(self, xy: np.ndarray) -> None:  # noqa: N802 - like pyqtgraph
+        self.setPrepared(self.prepare(xy))
+
+    def getData(self) -> tuple[np.ndarray, np.ndarray]:  # noqa: N802 - like pyqtgraph
+        return self._xy[:, 0], self._xy[:, 1]
+
+    def paint(self, p, *args) -> None:
+        if not self._n:
+            return
+        small = self._n < MAX_ANTIALIAS_POINTS
+        p.setRenderHint(p.RenderHint.Antialiasing, small)
+        p.setPen(self.pen if small else self.thin_pen)
+        path = self._path
+        self.last_drawn = "full"
+        if self._coarse is not None:
+            t = p.transform()
+            px = 1.0 / max(math.hypot(t.m11(), t.m12()), 1e-300)  # item units per pixel
+            if self._coarse[0] <= 0.5 * px:
+                path = self._coarse[1]
+                self.last_drawn = "coarse"
+        p.drawPath(path)
+
+
+def _one_per_cell(pts: np.ndarray, cell: float) -> np.ndarray:
+    """One point per grid cell of side ``cell`` (the first of each), order kept."""
+    if len(pts) < 2:
+        return pts
+    c = np.floor((pts - pts.min(axis=0)) / cell).astype(np.int64)
+    key = c[:, 0] * (int(c[:, 1].max()) + 1) + c[:, 1]
+    _, first = np.unique(key, return_index=True)
+    return pts[np.sort(first)]
+
+
+def decimate(xy: np.ndarray, cell: float) -> np.ndarray:
+    """NaN-separated polylines with the vertices that stay in the grid cell (side
+    ``cell``) of the vertex before them dropped; the first and last vertex of every piece
+    and the NaN rows are kept. Every dropped vertex lies within ``cell * √2`` of the kept
+    polyline, so at a pixel of two cells or more the drawing is the same to a pixel."""
+    xy = np.asarray(xy, dtype=np.float64).reshape(-1, 2)
+    if len(xy) < 3:
+        return xy
+    with np.errstate(invalid="ignore"):
+        c = np.floor(xy / cell)
+    same = (c[1:] == c[:-1]).all(axis=1)  # NaN rows never equal: always kept
+    keep = np.ones(len(xy), dtype=bool)
+    keep[1:] = ~same
+    nan = ~np.isfinite(xy[:, 0])
+    keep[:-1] |= nan[1:]  # the last vertex of each piece
+    keep[-1] = True
+    return xy[keep]
+
+
+def prepare_layer(key: str, *arrays: np.ndarray, lod: float | None = None) -> tuple:
+    """What the item of layer ``key`` needs from ``arrays`` (QPainterPaths, rectangles):
+    safe to call on a worker thread, then handed to :meth:`WorkView.set_layer`. ``lod``:
+    the coarse grid of line layers, in the layer's units (see :meth:`LinesItem.prepare`)."""
+    cls = _LAYER_CLASS[key]
+    if cls in (LinesItem, ControlItem):
+        return cls.prepare(*arrays, lod=lod)
+    return cls.prepare(*arrays)
 
 
 class ColourBar(pg.GraphicsWidgetAnchor, pg.GraphicsWidget):
@@ -480,7 +652,7 @@ class WorkView(pg.PlotWidget):
                                      name="field")
         self.field.setZValue(-10)
         pi.addItem(self.field)
-        self.field_label = pg.TextItem("", color=FIELD, anchor=(0, 1))
+        self.field_label = pg.TextItem("", color=FIELD, anchor=(1, 0))
         self.field_label.setZValue(-10)
         pi.addItem(self.field_label, ignoreBounds=True)
 
@@ -518,10 +690,11 @@ class WorkView(pg.PlotWidget):
 
     # --- data ----------------------------------------------------------------------------
     def set_layer(self, key: str, *arrays: np.ndarray, transform: QTransform,
-                  count: int | None = None, **extra) -> bool:
+                  count: int | None = None, prepared: tuple | None = None, **extra) -> bool:
         """Give a layer its data (native space) and the transform to mm. The data are only
-        re-sent when the first array is another object than last time. Returns True when
-        the data changed."""
+        re-sent when the first array is another object than last time. ``prepared``: the
+        item's data made by :func:`prepare_layer` on a worker (else made here). Returns True
+        when the data changed."""
         item = self.layers[key]
         if item.transform() != transform:  # an equal transform would still repaint
             item.setTransform(transform)
@@ -531,26 +704,11 @@ class WorkView(pg.PlotWidget):
         self._data_ids[key] = ident
         # keep the arrays alive so the id stays theirs
         item._galvo_data = arrays
+        item.setPrepared(prepared if prepared is not None else item.prepare(*arrays))
         if isinstance(item, DeviationItem):
-            item.setData(*arrays)
             self.counts[key] = item.n_chords
             return True
-        xy = arrays[0]
-        if isinstance(item, (PointsItem, ControlItem)):
-            item.setData(*arrays)
-        elif not len(xy):
-            item.setData([], [])
-        else:
-            big = len(xy) >= MAX_ANTIALIAS_POINTS
-            if not hasattr(item, "_galvo_pen"):
-                item._galvo_pen = item.opts["pen"]
-            # big layers: 1-pixel lines without antialiasing (a wide pen is stroked in
-            # software, many times slower); small ones keep their width
-            pen = QPen(item._galvo_pen)
-            if big:
-                pen.setWidthF(1.0)
-            item.setData(xy[:, 0], xy[:, 1], connect="finite", antialias=not big, pen=pen)
-        self.counts[key] = count if count is not None else len(xy)
+        self.counts[key] = count if count is not None else len(arrays[0])
         return True
 
     def set_highlight(self, xy: np.ndarray, transform: QTransform) -> None:
@@ -567,7 +725,8 @@ class WorkView(pg.PlotWidget):
             return
         self.field.setData(outline_mm[:, 0], outline_mm[:, 1])
         self.field_label.setText(label)
-        self.field_label.setPos(float(outline_mm[:, 0].min()), float(outline_mm[:, 1].max()))
+        # under the field's lower right corner: the legend covers the top left
+        self.field_label.setPos(float(outline_mm[:, 0].max()), float(outline_mm[:, 1].min()))
 
     def set_layer_visible(self, key: str, visible: bool) -> None:
         if key in self.layers:
@@ -637,6 +796,30 @@ class WorkView(pg.PlotWidget):
 
     def data_items(self) -> list[pg.GraphicsObject]:
         return [self.layers[k] for k in self.layers]
+
+    #: how much of the background covers the layers while the result is out of date
+    STALE_VEIL_ALPHA = 180
+
+    def set_stale(self, stale: bool) -> None:
+        """Dim the plot (the result shown is out of date) or show it normally: a veil of
+        the background colour over the plot area, so the layers' cached pixmaps stay valid
+        (changing their opacity would rasterise them all again, twice per change)."""
+        self.stale = stale
+        veil = getattr(self, "_veil", None)
+        if veil is None:
+            from PySide6.QtWidgets import QGraphicsRectItem
+
+            veil = QGraphicsRectItem()
+            c = pg.mkColor(BACKGROUND)
+            c.setAlpha(self.STALE_VEIL_ALPHA)
+            veil.setBrush(pg.mkBrush(c))
+            veil.setPen(pg.mkPen(None))
+            veil.setZValue(1e6)
+            self.scene().addItem(veil)
+            self._veil = veil
+        if stale:
+            veil.setRect(self.getPlotItem().getViewBox().sceneBoundingRect())
+        veil.setVisible(stale)
 
     # --- range ---------------------------------------------------------------------------
     def legend_height(self) -> float:
@@ -738,7 +921,7 @@ def _make_layer(key: str) -> tuple[pg.GraphicsObject, pg.PlotDataItem]:
     elif key == "control":
         item = ControlItem()
     else:
-        item = pg.PlotDataItem([], [], name=key, **kw)
+        item = LinesItem(kw["pen"])
     # samples get one point so that pyqtgraph hands their symbol style to the legend
     if key == "control":
         sample = pg.PlotDataItem([0.0], [0.0], pen=_pen(CONTROL, 1.0, alpha=170), symbol="s",
@@ -747,6 +930,13 @@ def _make_layer(key: str) -> tuple[pg.GraphicsObject, pg.PlotDataItem]:
     else:
         sample = pg.PlotDataItem([0.0], [0.0], **kw)
     return item, sample
+
+
+_LAYER_CLASS: dict[str, type] = {
+    "original": LinesItem, "fitted": LinesItem, "jumps": LinesItem, "hatch": LinesItem,
+    "kerf": LinesItem, "original_points": PointsItem, "marks": PointsItem,
+    "control": ControlItem, "deviation": DeviationItem,
+}
 
 
 def _painting_items(item: pg.GraphicsObject) -> list[pg.GraphicsObject]:
@@ -764,10 +954,6 @@ def units_transform(scale: float, offset: tuple[float, float]) -> QTransform:
 
 def scale_transform(scale: float) -> QTransform:
     return QTransform(scale, 0.0, 0.0, scale, 0.0, 0.0)
-
-
-def colour_of(name: str) -> QColor:
-    return pg.mkColor(name)
 
 
 __all__ = [

@@ -11,8 +11,10 @@ from __future__ import annotations
 
 import json
 import os
+import re
 import time
-from dataclasses import fields
+from collections.abc import Callable
+from dataclasses import dataclass
 from pathlib import Path as FsPath
 from typing import Any
 
@@ -40,10 +42,10 @@ from PySide6.QtGui import (
     QPixmap,
 )
 from PySide6.QtWidgets import (
+    QApplication,
     QCheckBox,
     QDockWidget,
     QFileDialog,
-    QHBoxLayout,
     QLabel,
     QMainWindow,
     QMessageBox,
@@ -55,18 +57,31 @@ from PySide6.QtWidgets import (
     QWidget,
 )
 
+from galvo_core import params as params_mod
 from galvo_core.drawing import Drawing
 from galvo_core.errors import GalvoError, ParamError
 from galvo_core.job import Job, atomic_write_bytes, load_job, write_job
-from galvo_core.params import LaserParams, Params
+from galvo_core.params import Params
 from galvo_core.pipeline import Pipeline
 from galvo_core.preview import PreviewCache
 
 from . import views as views_mod
 from .controls import ControlsPanel, LaserDialog
+from .flow import flow_container
 from .stats import StatsPanel, WarningsPanel
 from .views import LAYERS, WorkView, scale_transform, units_transform
-from .worker import LatestRunner, RunResult, job_task
+from .worker import (
+    LatestRunner,
+    Loaded,
+    LoadedJob,
+    PreparedCache,
+    RunResult,
+    export_task,
+    job_load_task,
+    job_task,
+    layer_arrays,
+    load_task,
+)
 
 APP_NAME = "Galvo Workstation"
 ORGANISATION = "galvo-workstation"
@@ -82,6 +97,9 @@ SAMPLES_DIR = RESOURCES_DIR / "samples"
 THROTTLE_MS = 60
 #: Show the progress bar only for runs longer than this (ms).
 BUSY_DELAY_MS = 200
+#: Dim the views as out of date when a run of new parameters takes longer than this (ms);
+#: a result of another file is marked at once.
+STALE_DELAY_MS = 400
 MAX_RECENT = 8
 
 _EXTS = ("plt", "hpgl", "hpg", "hp", "pgl", "pcl", "spl")
@@ -114,6 +132,23 @@ def describe_load_error(path: str | os.PathLike, exc: BaseException) -> str:
     return f"{name}: unexpected error while loading ({type(exc).__name__}: {detail})"
 
 
+def _read_for_gui(path: FsPath) -> Drawing:
+    """:func:`load_drawing` with any failure turned into one line for the user."""
+    try:
+        return load_drawing(path)
+    except Exception as exc:  # noqa: BLE001 - InputError, OSError or a bug: one line
+        raise GalvoError(describe_load_error(path, exc)) from None
+
+
+def _read_job_for_gui(path: FsPath) -> Job:
+    from .offload import load_job_file
+
+    try:
+        return load_job_file(path, load_job)
+    except Exception as exc:  # noqa: BLE001
+        raise GalvoError(describe_load_error(path, exc)) from None
+
+
 def bundled_sample() -> FsPath | None:
     """The first ``*.plt`` in ``resources/samples`` (sorted by name), or None."""
     if not SAMPLES_DIR.is_dir():
@@ -133,6 +168,38 @@ def exporters() -> dict[str, Any]:
             if callable(getattr(export, n, None))}
 
 
+@dataclass(frozen=True)
+class ExportKind:
+    """One kind of File ▸ Export: the menu text, the save dialog's filter and suffix, the
+    writer ``write(job, path)`` (atomic) or the name of a ``galvo_core.export`` function, and
+    what the status bar says about the file after writing it. Other modules add kinds to
+    :attr:`MainWindow.export_kinds` (then call :meth:`MainWindow.rebuild_export_menu`)."""
+
+    label: str
+    file_filter: str
+    suffix: str
+    write: Callable[[Job, FsPath], None] | str
+    note: str = ""
+
+
+def default_export_kinds() -> dict[str, ExportKind]:
+    return {
+        "job": ExportKind("Export &Job (JSON)…", "Job files (*.json)", ".json", write_job,
+                          "job file"),
+        "plt": ExportKind("Export &PLT (galvo bits)…", "HP-GL files (*.plt)", ".plt",
+                          "write_plt", "HP-GL of the marks in galvo bits (1 plotter unit = "
+                          "1 bit, not 40 units per mm)"),
+        "svg": ExportKind("Export &SVG (mm)…", "SVG files (*.svg)", ".svg", "write_svg",
+                          "SVG of the fitted geometry in mm on the workpiece"),
+    }
+
+
+def _user_path_message(text: str, path: FsPath) -> str:
+    """An error text that names the user's file, never the temporary file of an atomic
+    write (``.tmp-…`` beside it)."""
+    return re.sub(r"\S*\.tmp-[^\s:;,)]*", str(path), text)
+
+
 def app_settings() -> QSettings:
     """The settings store: the INI file named by $GALVO_WORKSTATION_SETTINGS, else the
     platform's default place for this organisation/application."""
@@ -147,24 +214,18 @@ def _fmt_int(n: int) -> str:
 
 
 def params_to_json(p: Params) -> str:
-    d = p.processing_dict()
-    d["laser"] = p.laser.as_dict()
-    return json.dumps(d)
+    return json.dumps(p.as_dict())
 
 
 def params_from_json(text: str, base: Params | None = None) -> Params:
-    """Params from :func:`params_to_json` text; unknown keys are ignored, invalid -> base."""
+    """Params from :func:`params_to_json` text (or the older layout with a ``laser``
+    table); unknown keys are ignored, an invalid value gives ``base``."""
     base = base or Params()
     try:
         d = json.loads(text)
-        names = {f.name for f in fields(Params)}
-        changes: dict[str, Any] = {k: v for k, v in d.items() if k in names and k != "laser"}
-        if isinstance(changes.get("offset_bits"), list):
-            changes["offset_bits"] = tuple(changes["offset_bits"])
         if isinstance(d.get("laser"), dict):
-            lnames = {f.name for f in fields(LaserParams)}
-            changes["laser"] = LaserParams(**{k: v for k, v in d["laser"].items() if k in lnames})
-        return base.replace(**changes)
+            d = {**d.pop("laser"), **d}
+        return Params.from_mapping(d, base=base, ignore_unknown=True)
     except (ValueError, TypeError, AttributeError):
         return base
 
@@ -224,6 +285,7 @@ class MainWindow(QMainWindow):
         self.params = Params()
         self.pipeline = Pipeline()
         self.preview_cache = PreviewCache()
+        self.prepared_cache = PreparedCache()
         self.result: RunResult | None = None
         self.run_error: str | None = None
         self.selected: int | None = None
@@ -233,6 +295,18 @@ class MainWindow(QMainWindow):
         #: The message of the last error dialog (kept for tests and logs).
         self.last_error: str | None = None
         self.last_result_time = 0.0
+        #: the file being read on the worker (None when none)
+        self.loading_path: FsPath | None = None
+        #: True/False: how the last load_file/load_job_file ended; None while it runs
+        self.last_load_ok: bool | None = None
+        #: True/False: how the last export ended; None while it runs
+        self.last_export_ok: bool | None = None
+        self._keep_selection: int | None = None
+        self._reloading = False
+        self._fit_banner = False
+        self._stale_shown = False
+        #: File ▸ Export kinds (other modules may add to it, then rebuild_export_menu())
+        self.export_kinds: dict[str, ExportKind] = default_export_kinds()
 
         self.setObjectName("MainWindow")
         if ICON_PATH.is_file():
@@ -260,11 +334,9 @@ class MainWindow(QMainWindow):
         self.splitter = splitter
 
         self.layer_boxes: dict[str, QCheckBox] = {}
-        layer_bar = QWidget()
+        layer_bar, bar = flow_container()  # wraps to a second row in a narrow window
         layer_bar.setObjectName("layer_bar")
-        bar = QHBoxLayout(layer_bar)
         bar.setContentsMargins(6, 2, 6, 2)
-        bar.setSpacing(10)
         title = QLabel("Layers:")
         title.setStyleSheet("font-weight: bold; color: #3d4853;")
         bar.addWidget(title)
@@ -277,7 +349,6 @@ class MainWindow(QMainWindow):
             cb.toggled.connect(lambda on, k=spec.key: self.set_layer_visible(k, on))
             self.layer_boxes[spec.key] = cb
             bar.addWidget(cb)
-        bar.addStretch(1)
         self.layer_bar = layer_bar
 
         self.banner = QLabel("")
@@ -288,6 +359,15 @@ class MainWindow(QMainWindow):
             "#f0c080;")
         self.banner.hide()
 
+        #: says that the views show an older result than the file/parameters asked for
+        self.stale_bar = QLabel("")
+        self.stale_bar.setObjectName("stale_bar")
+        self.stale_bar.setWordWrap(True)
+        self.stale_bar.setStyleSheet(
+            "background: #e8eef7; color: #1d3557; padding: 3px 8px; border-bottom: 1px solid "
+            "#a8bcd8;")
+        self.stale_bar.hide()
+
         central = QWidget()
         cl = QVBoxLayout(central)
         cl.setContentsMargins(0, 0, 0, 0)
@@ -296,12 +376,22 @@ class MainWindow(QMainWindow):
         cl.addWidget(self.banner)
         cl.addWidget(splitter, 1)
         self.setCentralWidget(central)
+        # the stale bar floats over the top of the views: showing it must not resize them
+        # (a resize re-rasterises every cached layer)
+        self.stale_bar.setParent(central)
+        self.stale_bar.setAttribute(Qt.WidgetAttribute.WA_TransparentForMouseEvents)
+        self._central = central
 
         # --- docks ---------------------------------------------------------------------
         self.controls = ControlsPanel(self.params)
         self.controls.changed.connect(self._on_controls_changed)
         self.controls.laser_requested.connect(self.open_laser_dialog)
         self.controls.defaults_button.clicked.connect(self.restore_defaults)
+        mag = self.controls.sliders.get("magnification")
+        if mag is not None:
+            # the box shows and takes any magnification down to its last decimal, e.g. the
+            # 0.09 Fit field computes for a big drawing (the slider keeps its range)
+            mag.spin.setMinimum(10.0 ** -mag.spin.decimals())
         scroll = QScrollArea()
         scroll.setWidget(self.controls)
         scroll.setWidgetResizable(True)
@@ -318,6 +408,7 @@ class MainWindow(QMainWindow):
         self.stats_panel = StatsPanel()
         self.warnings_panel = WarningsPanel()
         self.warnings_panel.activated.connect(self.zoom_to_warning)
+        self.warnings_panel.translate = self.gui_message
         job_split = QSplitter(Qt.Orientation.Horizontal)
         job_split.addWidget(self.stats_panel)
         job_split.addWidget(self.warnings_panel)
@@ -341,6 +432,17 @@ class MainWindow(QMainWindow):
         self.runner.failed.connect(self._on_failed)
         self.runner.cancelled.connect(self._on_cancelled)
         self.runner.busy_changed.connect(self._on_busy_changed)
+        # reading files (HP-GL, job files) and writing exports: each on its own worker
+        self.io = LatestRunner(self)
+        self.io.finished.connect(self._on_loaded)
+        self.io.failed.connect(self._on_load_failed)
+        self.io.cancelled.connect(lambda gen: self._on_cancelled(gen))
+        self.io.busy_changed.connect(self._on_busy_changed)
+        self.exporter = LatestRunner(self)
+        self.exporter.finished.connect(self._on_exported)
+        self.exporter.failed.connect(self._on_export_failed)
+        self.exporter.busy_changed.connect(self._on_busy_changed)
+        self._export_target: tuple[str, FsPath] | None = None
         self._throttle = QTimer(self)
         self._throttle.setSingleShot(True)
         self._throttle.setInterval(THROTTLE_MS)
@@ -393,18 +495,11 @@ class MainWindow(QMainWindow):
         self.open_job_action.triggered.connect(self.open_job_dialog)
         file_menu.addAction(self.open_job_action)
         file_menu.addSeparator()
-        self.export_job_action = QAction("Export &Job (JSON)…", self)
-        self.export_job_action.setShortcut(QKeySequence("Ctrl+E"))
-        self.export_job_action.triggered.connect(lambda: self.export_dialog("job"))
-        self.export_plt_action = QAction("Export &PLT…", self)
-        self.export_plt_action.triggered.connect(lambda: self.export_dialog("plt"))
-        self.export_svg_action = QAction("Export &SVG…", self)
-        self.export_svg_action.triggered.connect(lambda: self.export_dialog("svg"))
+        self.export_menu = file_menu.addMenu("&Export")
+        self.export_actions: dict[str, QAction] = {}
         self.export_png_action = QAction("Export P&NG of the Views…", self)
         self.export_png_action.triggered.connect(lambda: self.export_dialog("png"))
-        for a in (self.export_job_action, self.export_plt_action, self.export_svg_action,
-                  self.export_png_action):
-            file_menu.addAction(a)
+        self.rebuild_export_menu()
         file_menu.addSeparator()
         self.quit_action = QAction("&Quit", self)
         self.quit_action.setShortcut(QKeySequence.StandardKey.Quit)
@@ -455,7 +550,7 @@ class MainWindow(QMainWindow):
         self.status_label = QLabel()
         self.warnings_label = QLabel()
         self.cursor_label = QLabel()
-        self.cursor_label.setMinimumWidth(420)
+        self.cursor_label.setMinimumWidth(0)
         self.cursor_label.setTextFormat(Qt.TextFormat.PlainText)
         self.cursor_label.setStyleSheet("font-family: monospace;")
         self.run_label = QLabel()
@@ -519,47 +614,222 @@ class MainWindow(QMainWindow):
         if dlg.exec() and dlg.result_laser is not None:
             self.apply_changes({"laser": dlg.result_laser})
 
-    # --- running --------------------------------------------------------------------------
+    # --- running ------------------------------------------------------------------------
+    def wanted_layers(self) -> frozenset[str]:
+        """The layers shown (their geometry is computed; the optional ones only then)."""
+        return frozenset(k for k, cb in self.layer_boxes.items() if cb.isChecked())
+
     def request_run(self) -> int | None:
         """Process the current drawing with the current params on the worker thread."""
         if self.drawing is None or self.job_path is not None:
             return None
         from .worker import pipeline_task_safe
 
-        return self.runner.request(pipeline_task_safe(self.pipeline, self.preview_cache,
-                                                      self.drawing, self.params))
+        gen = self.runner.request(pipeline_task_safe(
+            self.pipeline, self.preview_cache, self.drawing, self.params, self.file_path,
+            self.wanted_layers(), self.prepared_cache))
+        self._update_stale()
+        return gen
+
+    def gui_message(self, text: str) -> str:
+        """A core message in the window's words: command-line flags (``--fit-field``)
+        become the names of the controls that do the same."""
+        if not text or "--" not in text:
+            return text
+        labels: dict[str, str] = {"fit_field": "Fit field"}
+        for name, w in self.controls.sliders.items():
+            labels[name] = w.spec.label.split("  ")[0]
+        for name in self.controls.combos:
+            labels[name] = name.replace("_", " ")
+
+        def sub(m: re.Match[str]) -> str:
+            name = m.group(1).replace("-", "_")
+            return f"“{labels[name]}”" if name in labels else name.replace("_", " ")
+
+        return re.sub(r"--([a-z][a-z0-9-]*)", sub, text)
+
+    # --- scripting surface (tests, benchmarks, scripts) -----------------------------------
+    def busy(self) -> bool:
+        """True while a file is read, a run is pending or running, or an export writes."""
+        return (self.io.busy or self.runner.busy or self.exporter.busy
+                or self._throttle.isActive())
+
+    def wait_idle(self, timeout_s: float = 60.0) -> bool:
+        """Process events until nothing is read, processed or written (True), or until
+        ``timeout_s`` passes (False)."""
+        deadline = time.monotonic() + timeout_s
+        app = QApplication.instance()
+        while self.busy() and time.monotonic() < deadline:
+            for r in (self.io, self.runner, self.exporter):
+                t = r._thread  # noqa: SLF001 - wait on the worker briefly, then pump events
+                if t is not None:
+                    t.wait(5)
+            if app is not None:
+                app.processEvents()
+        return not self.busy()
 
     def wait_for_result(self, timeout_s: float = 60.0) -> bool:
-        """Block (processing events) until the worker is idle (tests, --screenshot)."""
-        return self.runner.wait_idle(timeout_s)
+        """Block (processing events) until everything is idle (tests, --screenshot)."""
+        return self.wait_idle(timeout_s)
+
+    def set_param(self, name: str, value: Any) -> bool:
+        """Change one parameter (a Params field, or a LaserParams field, ``laser.`` prefix
+        optional) as the controls would, and process again; False (and the status bar says
+        why) when refused."""
+        name = name.removeprefix("laser.")
+        if name not in params_mod.WHERE:
+            self.statusBar().showMessage(f"refused: no parameter named {name!r}", 8000)
+            return False
+        ok = self.apply_changes({name: value})
+        if ok:
+            self.controls.set_params(self.params, self._field_map_for(self.params))
+        return ok
+
+    def current_job(self) -> Job | None:
+        """The job the views show when it is current (what Export writes), else None."""
+        if self.result is None or self.is_stale():
+            return None
+        return self.result.job
+
+    # --- one truth on screen --------------------------------------------------------------
+    def is_stale(self) -> bool:
+        """True while the views do not show the result of the current file and parameters
+        (a file is being read, a run is pending or running)."""
+        if self.io.active or self.runner.active or self._throttle.isActive():
+            return True
+        res = self.result
+        if res is None:
+            return self.drawing is not None
+        if res.job_path is not None or self.job_path is not None:
+            return res.job_path != self.job_path
+        return res.drawing is not self.drawing or res.params != self.params
+
+    def shown_name(self) -> str:
+        """The name of the file whose result the views show ('' when none)."""
+        res = self.result
+        if res is None:
+            return ""
+        for p in (res.job_path, res.path):
+            if p is not None:
+                return FsPath(p).name
+        return res.drawing.name if res.drawing is not None and res.drawing.name else ""
+
+    def pending_name(self) -> str:
+        """The file being read or processed ('' when it is the shown one or none)."""
+        if self.loading_path is not None:
+            return self.loading_path.name
+        return self.file_name()
+
+    def _update_stale(self) -> None:
+        """Mark the views stale (dimmed, with a bar saying what is pending) while they show
+        an older result than asked for; a short run of the same file (< BUSY_DELAY_MS) only
+        dims them when it lasts."""
+        stale = self.is_stale() and self.result is not None
+        other_file = stale and (self.loading_path is not None
+                                or self.pending_name() != self.shown_name())
+        long_run = self.runner.elapsed_ms() >= STALE_DELAY_MS or self.io.active
+        show = stale and (other_file or long_run or not self.runner.active)
+        if show:
+            shown = self.shown_name() or "the previous drawing"
+            if self.loading_path is not None:
+                what = f"opening {self.loading_path.name}…"
+            elif other_file:
+                what = f"processing {self.pending_name()}…"
+            else:
+                what = "processing the new parameters…"
+            self.stale_bar.setText(
+                f"⟳ Showing the last result of {shown} (out of date) — {what} "
+                "Esc cancels and keeps the shown result; export waits for the new one.")
+        if show != self._stale_shown:
+            self._stale_shown = show
+            if show:
+                self._place_stale_bar()
+                self.stale_bar.raise_()
+            self.stale_bar.setVisible(show)
+            for v in (self.original, self.processed):
+                v.set_stale(show)
+        self._update_title()
+
+    def _place_stale_bar(self) -> None:
+        g = self.splitter.geometry()
+        w = g.width()
+        self.stale_bar.setFixedWidth(w)
+        self.stale_bar.adjustSize()
+        self.stale_bar.move(g.x(), g.y())
+
+    def resizeEvent(self, ev) -> None:  # noqa: N802 - Qt API
+        super().resizeEvent(ev)
+        if self._stale_shown:
+            self._place_stale_bar()
 
     def cancel_processing(self) -> None:
-        if self.runner.busy:
-            self.runner.cancel()
-            self.statusBar().showMessage("Processing cancelled — the last result stays shown",
-                                         6000)
+        """Stop reading/processing; the shown result stays and becomes the truth again: the
+        file, the parameters and the controls go back to those of the shown result."""
+        if not (self.runner.active or self.io.active or self._throttle.isActive()):
+            return
+        self._throttle.stop()
+        self.runner.cancel()
+        self.io.cancel()
+        self.loading_path = None
+        self._keep_selection = None
+        if self.last_load_ok is None:
+            self.last_load_ok = False
+        res = self.result
+        if res is not None:
+            if res.job_path is None:
+                self._leave_job_mode()
+            self.drawing = res.drawing
+            self.file_path = FsPath(res.path) if res.path is not None else None
+            self.job_path = res.job_path
+            self._drawing_bbox = self.pipeline.bbox(res.drawing) if res.drawing else None
+            if res.params is not None:
+                self.params = res.params
+                self.controls.set_params(res.params, res.preview.field_map)
+            self._watch(self.file_path)
+        self.run_label.setText("cancelled")
+        self.statusBar().showMessage(
+            f"Processing cancelled — {self.shown_name() or 'nothing'} stays shown, with its "
+            "parameters", 6000)
+        self._update_title()
+        self._update_status()
+        self._update_stale()
 
     def _on_busy_changed(self, busy: bool) -> None:
-        if busy:
+        any_busy = self.runner.busy or self.io.busy or self.exporter.busy
+        if any_busy:
             self._busy_timer.start()
         else:
             self._busy_timer.stop()
             self.progress.hide()
             self.cancel_button.hide()
+            if self.run_label.text().startswith(("processing…", "opening", "exporting")):
+                self.run_label.setText("")  # ended without a result (a dialog said why)
+        self._update_stale()
 
     def _update_busy(self) -> None:
-        ms = self.runner.elapsed_ms()
-        long_run = self.runner.busy and ms >= BUSY_DELAY_MS
+        ms = max(self.runner.elapsed_ms(), self.io.elapsed_ms(), self.exporter.elapsed_ms())
+        busy = self.runner.active or self.io.active or self.exporter.active
+        long_run = busy and ms >= BUSY_DELAY_MS
         self.progress.setVisible(long_run)
-        self.cancel_button.setVisible(long_run)
+        self.cancel_button.setVisible(long_run and (self.runner.active or self.io.active))
         if long_run:
-            self.run_label.setText(f"processing… {ms / 1000:.1f} s")
+            if self.exporter.active and self._export_target is not None:
+                what = f"exporting {self._export_target[1].name}…"
+            elif self.io.active and self.loading_path is not None:
+                what = f"opening {self.loading_path.name}…"
+            else:
+                what = "processing…"
+            self.run_label.setText(f"{what} {ms / 1000:.1f} s")
+        self._update_stale()
 
     def _on_result(self, gen: int, result: RunResult) -> None:
+        if result.drawing is not self.drawing or result.job_path != self.job_path:
+            return  # of a file no longer asked for (never shown under another's name)
         self.apply_result(result)
         self.result_shown.emit(gen)
 
     def _on_failed(self, gen: int, message: str, user_facing: bool) -> None:
+        message = self.gui_message(message)
         self.run_error = message
         self.warnings_panel.set_warnings(self.result.job.warnings if self.result else (),
                                          error=message)
@@ -567,32 +837,36 @@ class MainWindow(QMainWindow):
         self.run_label.setText("processing failed")
 
     def _on_cancelled(self, gen: int) -> None:
-        if not self.runner.busy:
+        if not (self.runner.active or self.io.active):
             self.run_label.setText("cancelled")
+        self._update_stale()
 
     def apply_result(self, result: RunResult) -> None:
         """Show a finished run: layers, field, stats, warnings, conversions."""
         self.result = result
-        self.run_error = getattr(result, "error", None)
+        err = getattr(result, "error", None)
+        self.run_error = self.gui_message(err) if err else None
         pv = result.preview
         ut = units_transform(pv.units_scale, pv.units_offset)
         bt = scale_transform(pv.mm_per_bit)
         o, p = self.original, self.processed
+        arrays = result.arrays if result.arrays is not None else layer_arrays(pv)
+        prep = result.prepared or {}
         show_points = len(pv.original_points) < views_mod.MAX_MARKER_POINTS
-        o.set_layer("original", pv.original.xy, transform=ut, count=pv.original.n_vertices)
-        o.set_layer("original_points", pv.original_points if show_points else
-                    np.empty((0, 2)), transform=ut)
+        counts = {
+            "original": pv.original.n_vertices,
+            "fitted": pv.fitted.n_vertices,
+            "control": pv.n_control_points,
+            "jumps": len(pv.jumps) // 3 + (1 if len(pv.jumps) else 0),
+            "hatch": pv.hatch.n_vertices,
+            "kerf": pv.kerf.n_vertices,
+        }
+        for key, arr in arrays.items():
+            view = o if key in o.layers else p
+            tr = bt if key in ("marks", "jumps", "hatch") else ut
+            view.set_layer(key, *arr, transform=tr, count=counts.get(key),
+                           prepared=prep.get(key))
         self.markers_shown = show_points and len(pv.original_points) > 0
-        p.set_layer("fitted", pv.fitted.xy, transform=ut, count=pv.fitted.n_vertices)
-        p.set_layer("control", pv.control_xy, pv.control_role, transform=ut,
-                    count=pv.n_control_points)
-        p.set_layer("marks", pv.marks, transform=bt)
-        p.set_layer("jumps", pv.jumps, transform=bt, count=len(pv.jumps) // 3 + (
-            1 if len(pv.jumps) else 0))
-        p.set_layer("hatch", pv.hatch.xy, transform=bt, count=pv.hatch.n_vertices)
-        p.set_layer("kerf", pv.kerf.xy, transform=ut, count=pv.kerf.n_vertices)
-        p.set_layer("deviation", pv.deviation_a, pv.deviation_b, pv.deviation_level,
-                    transform=ut)
         fm = pv.field_map
         label = f"field {fm.field_size_mm:g} mm ({_fmt_int(fm.field_bits)} bits)"
         for v in (o, p):
@@ -607,8 +881,9 @@ class MainWindow(QMainWindow):
         if result.drawing is self.drawing and bb is not None:
             size_units = (bb[2] - bb[0], bb[3] - bb[1])
         self.controls.set_field_map(fm, size_units)
-        if self.params.fit_field:
-            self.controls.sliders["magnification"].set_value(fm.magnification)
+        mag = self.controls.sliders.get("magnification")
+        if mag is not None and self.params.fit_field:
+            mag.set_value(fm.magnification)
         stats = dict(result.job.stats) if result.job is not None else {}
         extra = {}
         if len(pv.deviation_err):
@@ -624,6 +899,10 @@ class MainWindow(QMainWindow):
             self.fit()
         self.last_result_time = time.perf_counter()
         self._update_status()
+        self._update_stale()
+        missing = [k for k in self.wanted_layers() if not pv.has_layer(k)]
+        if missing and result.job_path is None and result.fitted is not None:
+            self.request_run()  # a layer turned on while this result was computed
 
     # --- layers ---------------------------------------------------------------------------
     def set_layer_visible(self, key: str, visible: bool) -> None:
@@ -635,24 +914,38 @@ class MainWindow(QMainWindow):
             top = self.result.preview.tolerance_um if self.result is not None else 1.0
             self.processed.set_colorbar(visible, top)
         self.settings.setValue(f"layers/{key}", visible)
+        res = self.result
+        if (visible and res is not None and not res.preview.has_layer(key)
+                and self.job_path is None and not self.runner.busy):
+            self.request_run()  # its geometry was not computed while hidden: the cache hits
 
     def layer_visible(self, key: str) -> bool:
         return self.layer_boxes[key].isChecked()
 
     # --- data -----------------------------------------------------------------------------
-    def set_drawing(self, drawing: Drawing, path: str | os.PathLike | None = None) -> None:
-        """Show ``drawing`` and process it (on the worker)."""
+    def set_drawing(self, drawing: Drawing, path: str | os.PathLike | None = None, *,
+                    bbox: tuple[float, float, float, float] | None = None,
+                    size_mm: tuple[float, float] | None = None) -> None:
+        """Process ``drawing`` (on the worker) and show it when its result is ready; the
+        selection of the previous drawing is cleared at once. ``bbox``/``size_mm``: its
+        facts when already known (computed on the worker by :meth:`load_file`)."""
         self._leave_job_mode()
+        self._fit_banner = False
         self.drawing = drawing
-        self._drawing_bbox = drawing.bbox()
+        self._drawing_bbox = bbox if bbox is not None else self.pipeline.bbox(drawing)
+        if size_mm is not None:
+            self._size_mm_of = (drawing, size_mm)
         self.file_path = FsPath(path) if path is not None else None
         self.selected = None
+        self._show_selection(None)
         self._fit_pending = True
+        self._reloading = False
         self._watch(self.file_path)
-        self._update_title()
-        self._update_status()
         self.controls.set_params(self.params, self._field_map_for(self.params))
         self.request_run()
+        self._update_title()
+        self._update_status()
+        self._update_stale()
 
     def fit(self) -> None:
         """Zoom both (linked) views to what they show."""
@@ -685,45 +978,107 @@ class MainWindow(QMainWindow):
         if path:
             self.load_job_file(path)
 
-    def load_file(self, path: str | os.PathLike) -> bool:
-        """Read and show ``path`` (a job file when it ends in .json); on any failure show an
-        error dialog and keep the current drawing. Returns True when the file was loaded."""
+    def load_file(self, path: str | os.PathLike, *, wait: bool = False,
+                  timeout_s: float = 600.0) -> bool:
+        """Open ``path`` (a job file when it ends in .json): it is read on a worker thread
+        and processed; the views keep showing the current result (marked stale) until the
+        new one is ready. On any failure an error dialog says why and the current drawing
+        stays. Returns True when the read started; with ``wait``, once it is done, True
+        when the file was opened (its result shown)."""
         path = FsPath(path)
         self._last_dir = str(path.parent)
         self.settings.setValue("last_dir", self._last_dir)
         if path.suffix.lower() == ".json":
-            return self.load_job_file(path)
-        try:
-            drawing = load_drawing(path)
-        except Exception as exc:  # noqa: BLE001 - InputError, OSError or a bug: a dialog
-            self.show_error(describe_load_error(path, exc))
-            return False
-        previous, previous_path = self.drawing, self.file_path
-        try:
-            self.set_drawing(drawing, path)
-        except Exception as exc:  # noqa: BLE001
-            self._restore(previous, previous_path)
-            self.show_error(describe_load_error(path, exc))
-            return False
-        self._add_recent(path)
-        return True
+            return self.load_job_file(path, wait=wait, timeout_s=timeout_s)
+        self.loading_path = path
+        self.last_load_ok = None
+        self.io.request(load_task(path, _read_for_gui, self.pipeline))
+        self._update_stale()
+        if not wait:
+            return True
+        return self.wait_idle(timeout_s) and bool(self.last_load_ok)
 
-    def load_job_file(self, path: str | os.PathLike) -> bool:
+    def load_job_file(self, path: str | os.PathLike, *, wait: bool = False,
+                      timeout_s: float = 600.0) -> bool:
         """Show a job file's strokes and marks (no processing); the original view shows the
-        source drawing when a file of that name and checksum sits beside the job."""
+        source drawing when a file of that name and checksum sits beside the job. Read on a
+        worker thread, like :meth:`load_file` (same return value)."""
         path = FsPath(path)
+        self.loading_path = path
+        self.last_load_ok = None
+        self.io.request(job_load_task(path, _read_job_for_gui, self._find_source))
+        self._update_stale()
+        if not wait:
+            return True
+        return self.wait_idle(timeout_s) and bool(self.last_load_ok)
+
+    def _on_loaded(self, gen: int, loaded: object) -> None:
+        self.loading_path = None
+        if isinstance(loaded, Loaded):
+            keep = self._keep_selection
+            self._keep_selection = None
+            self._open_fitting_field(loaded)
+            self.set_drawing(loaded.drawing, loaded.path, bbox=loaded.bbox,
+                             size_mm=loaded.size_mm)
+            if keep is not None:
+                self._fit_pending = False
+                self.selected = keep
+            self._add_recent(loaded.path)
+        elif isinstance(loaded, LoadedJob):
+            self._show_job(loaded)
+        self.last_load_ok = True
+
+    def _on_load_failed(self, gen: int, message: str, user_facing: bool) -> None:
+        path = self.loading_path
+        self.loading_path = None
+        self._keep_selection = None
+        self.last_load_ok = False
+        self._update_stale()
+        if self._reloading:
+            self._reloading = False
+            self.statusBar().showMessage(f"not reloaded: {message}", 10_000)
+            self._watch(self.file_path)
+            return
+        title = "Cannot open job file" if path is not None and \
+            path.suffix.lower() == ".json" else "Cannot open file"
+        self.show_error(message, title)
+
+    def _open_fitting_field(self, loaded: Loaded) -> None:
+        """A drawing bigger than the field at the current (true-size) magnification opens
+        with Fit field on, and the banner says so (instead of an error state)."""
+        p = self.params
+        if p.fit_field or p.clamp or p.magnification is not None or loaded.bbox is None:
+            return
+        from galvo_core.field import check_in_field
+
         try:
-            job = load_job(path)
-        except Exception as exc:  # noqa: BLE001
-            self.show_error(describe_load_error(path, exc), "Cannot open job file")
-            return False
-        source = self._find_source(path, job)
+            fm = self.pipeline.field_map(loaded.drawing, p)
+            check_in_field(fm, loaded.bbox, clamp=False)
+            return
+        except (GalvoError, ValueError):
+            pass
+        try:
+            params = p.replace(fit_field=True)
+        except (GalvoError, ValueError):
+            return
+        self.set_params(params, run=False)
+        w, h = loaded.size_mm
+        self.banner.setText(
+            f"{loaded.path.name} is {w:.1f} × {h:.1f} mm, bigger than the "
+            f"{p.field_size_mm:g} mm field at true size: opened with Fit field on (scaled "
+            "to the field). Untick Fit field for a fixed magnification.")
+        self.banner.show()
+        self._fit_banner = True
+
+    def _show_job(self, loaded: LoadedJob) -> None:
+        source, path = loaded.source, loaded.path
         self.runner.cancel()
         self.drawing = source
-        self._drawing_bbox = source.bbox() if source is not None else None
+        self._drawing_bbox = loaded.bbox
         self.file_path = None
         self.job_path = path
         self.selected = None
+        self._show_selection(None)
         self._fit_pending = True
         self._watch(None)
         self.controls.setEnabled(False)
@@ -733,10 +1088,11 @@ class MainWindow(QMainWindow):
                             f"are inactive{where}). Open a PLT file to process again.")
         self.banner.show()
         self._add_recent(path)
+        self.runner.request(job_task(loaded.job, source, self.preview_cache, path,
+                                     self.prepared_cache))
         self._update_title()
         self._update_status()
-        self.runner.request(job_task(job, source, self.preview_cache))
-        return True
+        self._update_stale()
 
     def _find_source(self, job_path: FsPath, job: Job) -> Drawing | None:
         if not job.source_name:
@@ -757,6 +1113,8 @@ class MainWindow(QMainWindow):
             self.job_path = None
             self.controls.setEnabled(True)
             self.banner.hide()
+        elif not self._fit_banner:
+            self.banner.hide()
 
     def reload(self) -> bool:
         if self.job_path is not None:
@@ -764,18 +1122,6 @@ class MainWindow(QMainWindow):
         if self.file_path is None:
             return False
         return self.load_file(self.file_path)
-
-    def _restore(self, drawing: Drawing | None, path: FsPath | None) -> None:
-        try:
-            if drawing is not None:
-                self.set_drawing(drawing, path)
-            else:
-                self.drawing = None
-                self.file_path = None
-                self._update_title()
-                self._update_status()
-        except Exception:  # noqa: BLE001 - nothing more can be done; the dialog follows
-            pass
 
     # --- file watching --------------------------------------------------------------------
     def _watch(self, path: FsPath | None) -> None:
@@ -797,18 +1143,10 @@ class MainWindow(QMainWindow):
         if not path.is_file():  # replaced by rename: try again shortly
             self._reload_timer.start(500)
             return
-        try:
-            drawing = load_drawing(path)
-        except Exception as exc:  # noqa: BLE001
-            self.statusBar().showMessage(f"not reloaded: {describe_load_error(path, exc)}",
-                                         10_000)
-            self._watch(path)
-            return
-        keep = self.selected
-        self.set_drawing(drawing, path)
-        self._fit_pending = False
-        self.selected = keep
-        self.statusBar().showMessage(f"{path.name} changed on disk: reloaded", 5000)
+        self._reloading = True
+        self._keep_selection = self.selected
+        self.load_file(path)
+        self.statusBar().showMessage(f"{path.name} changed on disk: reloading", 5000)
 
     # --- recent files ---------------------------------------------------------------------
     def recent_files(self) -> list[str]:
@@ -834,49 +1172,152 @@ class MainWindow(QMainWindow):
         self.recent_menu.setEnabled(bool(items))
 
     # --- export ---------------------------------------------------------------------------
+    @property
+    def export_job_action(self) -> QAction:
+        return self.export_actions["job"]
+
+    @property
+    def export_plt_action(self) -> QAction:
+        return self.export_actions["plt"]
+
+    @property
+    def export_svg_action(self) -> QAction:
+        return self.export_actions["svg"]
+
+    def rebuild_export_menu(self) -> None:
+        """File ▸ Export from :attr:`export_kinds` (call after adding a kind)."""
+        self.export_menu.clear()
+        self.export_actions = {}
+        for kind, spec in self.export_kinds.items():
+            a = QAction(spec.label, self)
+            if kind == "job":
+                a.setShortcut(QKeySequence("Ctrl+E"))
+            a.setStatusTip(spec.note)
+            a.triggered.connect(lambda _=False, k=kind: self.export_dialog(k))
+            self.export_actions[kind] = a
+            self.export_menu.addAction(a)
+        self.export_menu.addSeparator()
+        self.export_menu.addAction(self.export_png_action)
+        self._refresh_export_actions()
+
+    def _writer(self, kind: str) -> Callable[[Job, FsPath], None] | None:
+        spec = self.export_kinds.get(kind)
+        if spec is None:
+            return None
+        if isinstance(spec.write, str):
+            return exporters().get(spec.write)
+        return spec.write
+
     def _refresh_export_actions(self) -> None:
-        ex = exporters()
-        self.export_plt_action.setEnabled("write_plt" in ex)
-        self.export_svg_action.setEnabled("write_svg" in ex)
-        for a, name in ((self.export_plt_action, "write_plt"),
-                        (self.export_svg_action, "write_svg")):
-            a.setToolTip("" if name in ex else "galvo_core.export is not available")
+        for kind, a in self.export_actions.items():
+            ok = self._writer(kind) is not None
+            a.setEnabled(ok)
+            a.setToolTip("" if ok else "galvo_core.export is not available")
 
     def export_dialog(self, kind: str) -> None:
-        filters = {"job": "Job files (*.json)", "plt": "HP-GL files (*.plt)",
-                   "svg": "SVG files (*.svg)", "png": "PNG images (*.png)"}
+        """Ask where, then export (on the worker). Refused at once, with a dialog, while the
+        views do not show the current result or when the job has an error."""
+        refusal = self.export_refusal(kind)
+        if refusal is not None:
+            self.show_error(refusal, "Not exported")
+            return
+        if kind == "png":
+            flt, suffix = "PNG images (*.png)", ".png"
+        else:
+            flt, suffix = self.export_kinds[kind].file_filter, self.export_kinds[kind].suffix
         stem = FsPath(self.file_name() or "untitled").stem
-        suggested = str(FsPath(self._last_dir) / f"{stem}.{'json' if kind == 'job' else kind}")
-        path, _ = QFileDialog.getSaveFileName(self, f"Export {kind.upper()}", suggested,
-                                              filters[kind])
+        suggested = str(FsPath(self._last_dir) / f"{stem}{suffix}")
+        path, _ = QFileDialog.getSaveFileName(self, f"Export {kind.upper()}", suggested, flt)
         if path:
-            self.export(kind, path)
+            self.export(kind, path, wait=False)
 
-    def export(self, kind: str, path: str | os.PathLike) -> bool:
-        """Write the current job (json/plt/svg) or a PNG of the views. Atomic: a failure
-        leaves no half-written file, and says why in a dialog."""
+    def export_refusal(self, kind: str) -> str | None:
+        """Why the current result cannot be exported now (None: it can). The views, the
+        title and the file written must belong to the same file and parameters: nothing is
+        exported while another result is pending, nor a job with an error or no strokes."""
+        if kind == "png":
+            return None
+        if kind not in self.export_kinds:
+            return f"unknown export kind {kind!r}"
+        if self._writer(kind) is None:
+            return f"{kind.upper()} export is not available"
+        res = self.result
+        if res is None:
+            return "nothing to export: open a file first"
+        shown = self.shown_name() or "the shown drawing"
+        if self.is_stale():
+            pending = self.pending_name()
+            what = f"{pending} is still being read or processed" if pending and \
+                pending != shown else "the parameters changed and the new result is not ready"
+            return (f"{shown}: not exported: {what}; the views show an older result. Export "
+                    "when the new result is shown (or press Esc to go back to the shown one).")
+        if res.error:
+            return f"{shown}: not exported: {res.error}"
+        if not res.job.strokes:
+            return (f"{shown}: not exported: the job has no strokes (nothing would be marked); "
+                    "see the warnings")
+        return None
+
+    def export(self, kind: str, path: str | os.PathLike, *, wait: bool = True,
+               timeout_s: float = 600.0) -> bool:
+        """Write the shown job (``kind`` one of :attr:`export_kinds`: job/plt/svg, …) or a
+        PNG of the views (``"png"``) to ``path``. The writing runs on a worker thread; with
+        ``wait`` this returns once it is done (True: written), else at once (True: started).
+        Refused with a dialog (False) while the shown result is stale, or when it has an
+        error or no strokes. Atomic: a failure leaves no half-written file, and says why in a
+        dialog naming ``path``."""
         path = FsPath(path)
-        try:
-            if kind == "png":
-                atomic_write_bytes(path, self.views_png())
-            else:
-                job = self.result.job if self.result is not None else None
-                if job is None:
-                    raise GalvoError("nothing to export: open a file first")
-                if kind == "job":
-                    write_job(job, path)
-                else:
-                    fn = exporters().get(f"write_{kind}")
-                    if fn is None:
-                        raise GalvoError(f"{kind.upper()} export is not available")
-                    fn(job, path)
-        except Exception as exc:  # noqa: BLE001 - GalvoError, OSError or a bug: a dialog
-            msg = str(exc) if isinstance(exc, GalvoError) else (
-                f"{path.name}: {type(exc).__name__}: {exc}")
-            self.show_error(msg, "Export failed")
+        refusal = self.export_refusal(kind)
+        if refusal is not None:
+            self.show_error(refusal, "Not exported")
             return False
-        self.statusBar().showMessage(f"exported {path}", 6000)
-        return True
+        if kind == "png":
+            try:
+                atomic_write_bytes(path, self.views_png())
+            except Exception as exc:  # noqa: BLE001 - a dialog
+                self._export_error(path, exc)
+                return False
+            self.statusBar().showMessage(f"exported {path}", 6000)
+            return True
+        assert self.result is not None
+        writer = self._writer(kind)
+        assert writer is not None
+        self._export_target = (kind, path)
+        self.last_export_ok = None
+        self.exporter.request(export_task(writer, self.result.job, path))
+        self.run_label.setText(f"exporting {path.name}…")
+        if not wait:
+            return True
+        if not self.exporter.wait_idle(timeout_s):
+            return False
+        return bool(self.last_export_ok)
+
+    def _export_error(self, path: FsPath, exc: BaseException | str) -> None:
+        if isinstance(exc, str):
+            msg = exc
+        elif isinstance(exc, GalvoError):
+            msg = str(exc)
+        elif isinstance(exc, OSError):
+            msg = f"{path}: cannot write ({exc.strerror or exc})"
+        else:
+            msg = f"{path}: {type(exc).__name__}: {exc}"
+        self.last_export_ok = False
+        self.show_error(_user_path_message(msg, path), "Export failed")
+
+    def _on_exported(self, gen: int, path: object) -> None:
+        self.last_export_ok = True
+        kind = self._export_target[0] if self._export_target else ""
+        note = self.export_kinds[kind].note if kind in self.export_kinds else ""
+        self.run_label.setText("")
+        self.statusBar().showMessage(f"exported {path}" + (f" ({note})" if note else ""),
+                                     8000)
+
+    def _on_export_failed(self, gen: int, message: str, user_facing: bool) -> None:
+        path = self._export_target[1] if self._export_target else FsPath("?")
+        self.run_label.setText("")
+        if not user_facing:
+            message = f"{path}: {message}"
+        self._export_error(path, message)
 
     def views_png(self) -> bytes:
         """Both views (as shown) as PNG bytes."""
@@ -1036,6 +1477,7 @@ class MainWindow(QMainWindow):
 
     # --- title and status -----------------------------------------------------------------
     def file_name(self) -> str:
+        """The name of the file asked for (the shown one once its result is ready)."""
         if self.job_path is not None:
             return self.job_path.name
         if self.file_path is not None:
@@ -1045,11 +1487,21 @@ class MainWindow(QMainWindow):
         return ""
 
     def _update_title(self) -> None:
-        name = self.file_name()
-        if self.drawing is None and self.job_path is None:
-            self.setWindowTitle(APP_NAME)
+        """The title names the file whose result the views show; a file being opened or
+        processed instead is named as pending."""
+        shown = self.shown_name() if self.result is not None else ""
+        pending = self.loading_path.name if self.loading_path is not None else (
+            self.file_name() if self.is_stale() else "")
+        if self.result is None and self.drawing is None and self.job_path is None:
+            title = APP_NAME if not pending else f"(opening {pending}…) — {APP_NAME}"
+        elif not shown:
+            title = f"{pending or self.file_name() or 'untitled'} — {APP_NAME}"
+        elif pending and pending != shown:
+            title = f"{shown} (opening {pending}…) — {APP_NAME}"
         else:
-            self.setWindowTitle(f"{name or 'untitled'} — {APP_NAME}")
+            title = f"{shown} — {APP_NAME}"
+        if self.windowTitle() != title:
+            self.setWindowTitle(title)
 
     def _size_mm(self, d: Drawing) -> tuple[float, float]:
         """``d.size_mm()``, kept per drawing (a bbox over every point: too slow per run)."""
@@ -1061,10 +1513,12 @@ class MainWindow(QMainWindow):
 
     def status_summary(self) -> str:
         """The counts shown in the status bar, as plain text."""
-        d = self.drawing
+        res = self.result
+        d = res.drawing if res is not None else self.drawing
+        job_path = res.job_path if res is not None else self.job_path
         if d is None:
-            if self.job_path is not None:
-                return f"job file {self.job_path.name}"
+            if job_path is not None:
+                return f"job file {job_path.name}"
             return "No file — File ▸ Open… or drop an HP-GL file onto the window"
         w, h = self._size_mm(d)
         return "   ·   ".join(
@@ -1073,20 +1527,23 @@ class MainWindow(QMainWindow):
                 f"{_fmt_int(d.n_points)} points",
                 f"{_fmt_int(d.n_closed)} closed",
                 f"{w:.2f} × {h:.2f} mm",
-                f"{_fmt_int(len(d.warnings))} warning{'s' if len(d.warnings) != 1 else ''}",
-                self.file_name() or "untitled",
+                (self.shown_name() if res is not None else self.file_name()) or "untitled",
             ]
         )
 
     def _update_status(self) -> None:
         self.status_label.setText(self.status_summary())
+        # one warning count: the job's (the file's own warnings are among them)
         n_warn = len(self.result.job.warnings) if self.result is not None else 0
         if self.run_error:
             self.warnings_label.setText("✖ error")
             self.warnings_label.setStyleSheet("color: #b00020; font-weight: bold;")
-        elif n_warn:
-            self.warnings_label.setText(f"⚠ {n_warn}")
-            self.warnings_label.setStyleSheet("color: #b35c00; font-weight: bold;")
+        elif self.result is not None:
+            self.warnings_label.setText(f"⚠ {_fmt_int(n_warn)} warning"
+                                        f"{'s' if n_warn != 1 else ''}" if n_warn else
+                                        "0 warnings")
+            self.warnings_label.setStyleSheet("color: #b35c00; font-weight: bold;" if n_warn
+                                              else "color: #5f6b7a;")
         else:
             self.warnings_label.setText("")
 
@@ -1119,5 +1576,6 @@ class MainWindow(QMainWindow):
     def closeEvent(self, event) -> None:  # noqa: N802 - Qt API
         if self._restore_settings:
             self.save_state()
-        self.runner.shutdown()
+        for r in (self.runner, self.io, self.exporter):
+            r.shutdown()
         super().closeEvent(event)

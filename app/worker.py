@@ -10,12 +10,16 @@ request the window sends: pipeline run + display geometry (:mod:`galvo_core.prev
 
 from __future__ import annotations
 
+import gc
 import threading
 import time
+from collections import OrderedDict
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
+from pathlib import Path as FsPath
 from typing import Any
 
+import numpy as np
 from PySide6.QtCore import QCoreApplication, QElapsedTimer, QObject, QThread, Signal
 
 from galvo_core.drawing import Drawing
@@ -43,31 +47,123 @@ class RunResult:
     generation: int = 0
     #: a ParamError of the run (e.g. the drawing leaves the field): only the original shows
     error: str | None = None
+    #: the file the drawing came from / the job file shown (the title and export name)
+    path: FsPath | None = None
+    job_path: FsPath | None = None
+    #: the layers whose geometry the preview holds (the others are empty until shown)
+    layers: frozenset[str] | None = None
+    #: per layer: the arrays handed to the view, and the item data made from them on the
+    #: worker (QPainterPaths, rectangles: :func:`app.views.prepare_layer`)
+    arrays: dict[str, tuple[np.ndarray, ...]] | None = None
+    prepared: dict[str, tuple] | None = None
+
+
+_NO_POINTS = np.empty((0, 2))
+
+
+def layer_arrays(pv: Preview) -> dict[str, tuple[np.ndarray, ...]]:
+    """The arrays each layer of the views shows (native space: units or bits)."""
+    from .views import MAX_MARKER_POINTS
+
+    show_points = len(pv.original_points) < MAX_MARKER_POINTS
+    return {
+        "original": (pv.original.xy,),
+        "original_points": (pv.original_points if show_points else _NO_POINTS,),
+        "fitted": (pv.fitted.xy,),
+        "control": (pv.control_xy, pv.control_role),
+        "marks": (pv.marks,),
+        "jumps": (pv.jumps,),
+        "hatch": (pv.hatch.xy,),
+        "kerf": (pv.kerf.xy,),
+        "deviation": (pv.deviation_a, pv.deviation_b, pv.deviation_level),
+    }
+
+
+class PreparedCache:
+    """Item data by layer and the identity of its first array (a small LRU that holds the
+    arrays, so an id is never reused while cached): a run that did not change a layer's
+    arrays does not rebuild its QPainterPath."""
+
+    def __init__(self, size: int = 32) -> None:
+        self.size = size
+        self._data: OrderedDict[tuple[str, int, float | None], tuple[tuple, tuple]] = \
+            OrderedDict()
+        self._lock = threading.Lock()
+
+    def get(self, key: str, arrays: tuple[np.ndarray, ...], lod: float | None = None
+            ) -> tuple:
+        from .views import prepare_layer
+
+        k = (key, id(arrays[0]), lod)
+        with self._lock:
+            hit = self._data.get(k)
+            if hit is not None and hit[0][0] is arrays[0]:
+                self._data.move_to_end(k)
+                return hit[1]
+        value = prepare_layer(key, *arrays, lod=lod)
+        with self._lock:
+            self._data[k] = (arrays, value)
+            while len(self._data) > self.size:
+                self._data.popitem(last=False)
+        return value
+
+
+def with_prepared(result: RunResult, prepared: PreparedCache | None,
+                  cancel: Callable[[], bool]) -> RunResult:
+    """``result`` with the layers' arrays and their item data made here (worker)."""
+    arrays = layer_arrays(result.preview)
+    if prepared is None:
+        return replace(result, arrays=arrays)
+    pv = result.preview
+    lod_units = lod_bits = None
+    if pv.bounds is not None:
+        # coarse paths for the whole-drawing view: a grid of 1/4000 of the drawing's size
+        # (a quarter of a pixel or less on views up to 2000 pixels)
+        span_mm = max(pv.bounds[2] - pv.bounds[0], pv.bounds[3] - pv.bounds[1])
+        if span_mm > 0:
+            # rounded in the layers' own units: a new magnification keeps the grid of the
+            # layers in input units (their cached paths stay valid)
+            lod_units = float(f"{span_mm / pv.units_scale / 4000.0:.2g}")
+            lod_bits = float(f"{span_mm / pv.mm_per_bit / 4000.0:.2g}")
+    out = {}
+    for key, arr in arrays.items():
+        if cancel():
+            raise Cancelled()
+        lod = lod_bits if key in ("jumps", "hatch") else lod_units
+        out[key] = prepared.get(key, arr, lod)
+    return replace(result, arrays=arrays, prepared=out)
 
 
 def pipeline_task(pipeline: Pipeline, cache: PreviewCache, drawing: Drawing,
-                  params: Params) -> Task:
-    """The work of one request: run the (cached) pipeline, then the display geometry."""
+                  params: Params, path: FsPath | None = None,
+                  layers: frozenset[str] | None = None,
+                  prepared: PreparedCache | None = None) -> Task:
+    """The work of one request: run the (cached) pipeline, then the display geometry of
+    ``layers`` (all when None)."""
 
     def task(cancel: Callable[[], bool]) -> RunResult:
         t0 = time.perf_counter()
-        job = pipeline.run(drawing, params, cancel=cancel)
-        stages = tuple(pipeline.last_info.stages_run)
-        fitted = pipeline.fitted(drawing, params, cancel)  # cached by the run
+        res = pipeline.run(drawing, params, cancel=cancel)
+        job, stages, fitted = res.job, res.stages_run, res.fitted
         if cancel():
             raise Cancelled()
-        preview = build_preview(job, drawing, fitted, cache=cache, cancel=cancel)
-        return RunResult(drawing, params, job, fitted, preview, time.perf_counter() - t0, stages)
+        preview = build_preview(job, drawing, fitted, cache=cache, cancel=cancel, layers=layers)
+        res = RunResult(drawing, params, job, fitted, preview, 0.0, stages, path=path,
+                        layers=layers)
+        res = with_prepared(res, prepared, cancel)
+        return replace(res, seconds=time.perf_counter() - t0)
 
     return task
 
 
 def pipeline_task_safe(pipeline: Pipeline, cache: PreviewCache, drawing: Drawing,
-                       params: Params) -> Task:
+                       params: Params, path: FsPath | None = None,
+                       layers: frozenset[str] | None = None,
+                       prepared: PreparedCache | None = None) -> Task:
     """Like :func:`pipeline_task`, but a ParamError of the run (a drawing that leaves the
     field, …) gives a result with ``error`` set that still shows the original drawing and the
     field (so the operator sees why), instead of failing."""
-    inner = pipeline_task(pipeline, cache, drawing, params)
+    inner = pipeline_task(pipeline, cache, drawing, params, path, layers, prepared)
 
     def task(cancel: Callable[[], bool]) -> RunResult:
         t0 = time.perf_counter()
@@ -77,20 +173,85 @@ def pipeline_task_safe(pipeline: Pipeline, cache: PreviewCache, drawing: Drawing
             fm = pipeline.field_map(drawing, params)
             job = Job(drawing.name, drawing.sha256, fm, params.processing_dict(),
                       params.laser.as_dict(), (), {}, tuple(drawing.warnings))
-            preview = build_preview(job, drawing, None, cache=cache, cancel=cancel)
-            return RunResult(drawing, params, job, None, preview, time.perf_counter() - t0,
-                             tuple(pipeline.last_info.stages_run), error=str(exc))
+            preview = build_preview(job, drawing, None, cache=cache, cancel=cancel,
+                                    layers=layers)
+            res = RunResult(drawing, params, job, None, preview, time.perf_counter() - t0,
+                            (), error=str(exc), path=path, layers=layers)
+            return with_prepared(res, prepared, cancel)
 
     return task
 
 
-def job_task(job: Job, drawing: Drawing | None, cache: PreviewCache) -> Task:
+def job_task(job: Job, drawing: Drawing | None, cache: PreviewCache,
+             job_path: FsPath | None = None, prepared: PreparedCache | None = None) -> Task:
     """The work of showing a loaded job file (no pipeline run)."""
 
     def task(cancel: Callable[[], bool]) -> RunResult:
         t0 = time.perf_counter()
         preview = build_preview(job, drawing, None, cache=cache, cancel=cancel)
-        return RunResult(drawing, None, job, None, preview, time.perf_counter() - t0, ())
+        res = RunResult(drawing, None, job, None, preview, 0.0, (), job_path=job_path)
+        res = with_prepared(res, prepared, cancel)
+        return replace(res, seconds=time.perf_counter() - t0)
+
+    return task
+
+
+@dataclass(frozen=True, eq=False)
+class Loaded:
+    """A file read on the worker: the drawing and the facts the GUI needs at once (so the
+    GUI thread never walks its points)."""
+
+    path: FsPath
+    drawing: Drawing
+    bbox: tuple[float, float, float, float] | None
+    size_mm: tuple[float, float]
+
+
+def load_task(path: FsPath, read: Callable[[FsPath], Drawing],
+              pipeline: Pipeline | None = None) -> Task:
+    """Read an HP-GL file on the worker (cancel drops the result: the reader itself runs to
+    its end)."""
+
+    def task(cancel: Callable[[], bool]) -> Loaded:
+        drawing = read(path)
+        if cancel():
+            raise Cancelled()
+        bb = pipeline.bbox(drawing) if pipeline is not None else drawing.bbox()
+        return Loaded(path, drawing, bb, drawing.size_mm())
+
+    return task
+
+
+@dataclass(frozen=True, eq=False)
+class LoadedJob:
+    path: FsPath
+    job: Job
+    source: Drawing | None
+    bbox: tuple[float, float, float, float] | None
+
+
+def job_load_task(path: FsPath, read_job: Callable[[FsPath], Job],
+                  find_source: Callable[[FsPath, Job], Drawing | None]) -> Task:
+    """Read a job file (and its source drawing when it sits beside it) on the worker."""
+
+    def task(cancel: Callable[[], bool]) -> LoadedJob:
+        job = read_job(path)
+        if cancel():
+            raise Cancelled()
+        source = find_source(path, job)
+        return LoadedJob(path, job, source, source.bbox() if source is not None else None)
+
+    return task
+
+
+def export_task(write: Callable[[Job, FsPath], None], job: Job, path: FsPath) -> Task:
+    """Write ``job`` to ``path`` on the worker (atomic writers: a failure leaves nothing);
+    a big job in a helper process (:mod:`app.offload`: JSON holds the GIL)."""
+    from .offload import write_job_file
+
+    def task(cancel: Callable[[], bool]) -> FsPath:
+        write_job_file(write, job, path)
+        return path
 
     return task
 
@@ -107,6 +268,21 @@ class _RunThread(QThread):
         self.cancel_event = threading.Event()
 
     def run(self) -> None:  # worker thread
+        # A run creates millions of small, long-lived objects (segments, arrays); a full
+        # garbage collection walking them holds the GIL for 0.3-0.7 s and freezes the GUI
+        # thread. So the collector is paused during the task, and what the task built is
+        # then frozen (gc.freeze: left out of later collections; acyclic objects are still
+        # freed by reference counting when dropped).
+        gc_on = gc.isenabled()
+        gc.disable()
+        try:
+            self._run_task()
+        finally:
+            if gc_on:
+                gc.freeze()
+                gc.enable()
+
+    def _run_task(self) -> None:
         try:
             result = self.task(self.cancel_event.is_set)
         except Cancelled:
@@ -137,6 +313,7 @@ class LatestRunner(QObject):
     def __init__(self, parent: QObject | None = None) -> None:
         super().__init__(parent)
         self.generation = 0
+        self._cancelled_upto = 0
         self._pending: tuple[int, Task] | None = None
         self._thread: _RunThread | None = None
         self._clock = QElapsedTimer()
@@ -161,12 +338,20 @@ class LatestRunner(QObject):
     def cancel(self) -> None:
         """Drop the waiting request and stop the running one."""
         self._pending = None
+        self._cancelled_upto = self.generation  # never deliver these, even if they finish
         if self._thread is not None:
             self._thread.cancel_event.set()
 
     @property
     def busy(self) -> bool:
         return self._thread is not None or self._pending is not None
+
+    @property
+    def active(self) -> bool:
+        """A request waits or runs that was not cancelled (a cancelled run may still be
+        finishing on its thread: busy, but not active)."""
+        t = self._thread
+        return self._pending is not None or (t is not None and not t.cancel_event.is_set())
 
     def elapsed_ms(self) -> int:
         return int(self._clock.elapsed()) if self._thread is not None else 0
@@ -216,7 +401,7 @@ class LatestRunner(QObject):
         t.start()
 
     def _on_succeeded(self, gen: int, result: object) -> None:
-        if gen != self.generation:
+        if gen != self.generation or gen <= self._cancelled_upto:
             self.n_dropped += 1
             return
         self.n_delivered += 1
@@ -225,7 +410,7 @@ class LatestRunner(QObject):
         self.finished.emit(gen, result)
 
     def _on_failed(self, gen: int, message: str, user_facing: bool) -> None:
-        if gen != self.generation:
+        if gen != self.generation or gen <= self._cancelled_upto:
             self.n_dropped += 1
             return
         self.failed.emit(gen, message, user_facing)

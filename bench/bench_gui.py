@@ -1,18 +1,23 @@
-"""GUI latency: slider release -> redrawn views, for changes that only re-sample the marks.
+"""GUI benchmark (issue 18): control change -> redrawn views at real file sizes, and the
+GUI thread's longest stall while files open, process, export and load back.
 
-A 100,000-point PLT (bench/gen_plt.py, 400 mm wide) is opened in the workstation (offscreen);
-after the first run (parse + fit) the chord tolerance and the magnification sliders are moved
-and released alternately between two values. Each sample times, on the GUI thread, from the
-release (``ParamSlider.set_position(..., final=True)``) to the moment both views have been
-repainted with the new result: the result is handed to the views (``result_shown``) and each
-view has painted once after that — in the event loop, as the running application does, or,
-for a view that has not painted by the time the result is shown, by a synchronous
-``repaint()``. ``--force-repaint`` repaints both views synchronously after the result even
-when the event loop already painted them (a second full paint per view: the method of the
-first version of this benchmark). The pipeline's own time (re-sample + display geometry on
-the worker) is reported apart.
+Driven through the window's scripting surface, offscreen (software rasteriser), 1400x800:
 
-    .venv/bin/python bench/bench_gui.py [--points 100000] [--repeats 15] [--force-repaint]
+* **latency**: for each file, each control is changed the way the operator does (a slider
+  released at a new value, a checkbox toggled) and the time is taken from the change to the
+  moment the new result has been handed to the views and both views have painted since (a
+  view that has not painted by then is repainted synchronously). Fresh values every time
+  (no cache hit), median of ``--repeats``. Wall time and process CPU time (both threads)
+  are recorded; the machine is shared, so wall time is the noisier of the two.
+* **stalls**: a 5 ms QTimer on the GUI thread records the largest gap between its ticks
+  while a file is opened and processed, exported as a job, and the job loaded back; peak
+  memory (ru_maxrss) after each phase.
+
+    .venv/bin/python bench/bench_gui.py latency [FILES...] [--points 150000] [--repeats 5]
+    .venv/bin/python bench/bench_gui.py stalls [--points 1000000]
+
+Without FILES, ``latency`` uses a generated ``--points`` file (bench/gen_plt.py); give the
+corpus files (``../shared/corpus/plt/...``) to measure them.
 """
 
 from __future__ import annotations
@@ -20,10 +25,12 @@ from __future__ import annotations
 import argparse
 import os
 import platform
+import resource
 import statistics
 import sys
 import tempfile
 import time
+from collections.abc import Callable
 from pathlib import Path
 
 HERE = Path(__file__).resolve().parent
@@ -33,108 +40,279 @@ os.environ.setdefault("QT_QPA_PLATFORM", "offscreen")
 os.environ.setdefault("GALVO_WORKSTATION_SETTINGS",
                       os.path.join(tempfile.mkdtemp(prefix="galvo-bench-"), "s.ini"))
 
+SIZE = (1400, 800)
 
-def main(argv: list[str] | None = None) -> int:
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--points", type=int, default=100_000)
-    ap.add_argument("--repeats", type=int, default=15)
-    ap.add_argument("--size", default="1400x800")
-    ap.add_argument("--force-repaint", action="store_true",
-                    help="always repaint both views after the result (paints them twice)")
-    a = ap.parse_args(argv)
 
-    from gen_plt import generate_plt
+class StallProbe:
+    """The largest gap between ticks of a 5 ms timer on the GUI thread (ms)."""
+
+    def __init__(self) -> None:
+        from PySide6.QtCore import Qt, QTimer
+
+        self.timer = QTimer()
+        self.timer.setTimerType(Qt.TimerType.PreciseTimer)
+        self.timer.setInterval(5)
+        self.timer.timeout.connect(self._tick)
+        self.last = time.perf_counter()
+        self.max_gap = 0.0
+        self.long: list[float] = []
+
+    def _tick(self) -> None:
+        now = time.perf_counter()
+        gap = (now - self.last) * 1000.0
+        self.last = now
+        self.max_gap = max(self.max_gap, gap)
+        if gap > 100.0:
+            self.long.append(gap)
+            if os.environ.get("GALVO_BENCH_WHERE"):  # what the other threads were doing
+                import threading
+                import traceback
+
+                main = threading.main_thread().ident
+                for ident, frame in sys._current_frames().items():  # noqa: SLF001
+                    if ident == main:
+                        continue
+                    st = traceback.extract_stack(frame)[-2:]
+                    where = " <- ".join(f"{x.filename.split('/')[-1]}:{x.lineno} {x.line}"
+                                        for x in reversed(st))
+                    print(f"    gap {gap:.0f} ms: {where}", file=sys.stderr)
+
+    def start(self) -> None:
+        self.last = time.perf_counter()
+        self.max_gap = 0.0
+        self.long = []
+        self.timer.start()
+
+    def stop(self) -> float:
+        self.timer.stop()
+        return self.max_gap
+
+
+def peak_mb() -> float:
+    return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0
+
+
+def machine() -> str:
+    date = time.strftime("%Y-%m-%d %H:%M UTC", time.gmtime())
+    return (f"machine: {platform.machine()} {os.cpu_count()} cores, Python "
+            f"{platform.python_version()}, {platform.system()} {platform.release()}; load "
+            f"average {os.getloadavg()[0]:.1f}; date {date}")
+
+
+class GuiWork:
+    """The longest single apply_result and view paint on the GUI thread (ms)."""
+
+    def __init__(self, win) -> None:
+        self.apply = 0.0
+        self.paint = 0.0
+        real_apply = win.apply_result
+
+        def apply(result) -> None:
+            t = time.perf_counter()
+            real_apply(result)
+            self.apply = max(self.apply, (time.perf_counter() - t) * 1000)
+
+        win.apply_result = apply
+        for v in (win.original, win.processed):
+            real_paint = v.paintEvent
+
+            def paint(ev, real=real_paint) -> None:
+                t = time.perf_counter()
+                real(ev)
+                self.paint = max(self.paint, (time.perf_counter() - t) * 1000)
+
+            v.paintEvent = paint
+
+    def take(self) -> tuple[float, float]:
+        out = (self.apply, self.paint)
+        self.apply = self.paint = 0.0
+        return out
+
+
+def make_window():
     from PySide6.QtWidgets import QApplication
 
     app = QApplication.instance() or QApplication([])
     from app.window import MainWindow
-    from galvo_core.params import Params
-
-    tmp = Path(tempfile.mkdtemp(prefix="galvo-bench-"))
-    f = tmp / f"bench_{a.points}.plt"
-    f.write_bytes(generate_plt(a.points, seed=0))
 
     win = MainWindow(restore=False)
-    w, h = (int(v) for v in a.size.split("x"))
-    win.resize(w, h)
+    win.gui_work = GuiWork(win)
+    win.resize(*SIZE)
     win.show()
-    # 400 mm drawing: magnification 4 bits/unit keeps it inside the 110 mm field
-    win.set_params(Params(magnification=4.0), run=False)
-    t0 = time.perf_counter()
-    assert win.load_file(f)
-    assert win.wait_for_result(600)
-    first = time.perf_counter() - t0
     for _ in range(3):
         app.processEvents()
-    win.fit()
-    stats = win.result.job.stats
+    return app, win
 
-    shown: list[int] = []
+
+def timed(app, win, action: Callable[[], object], timeout_s: float = 600.0
+          ) -> tuple[float, float]:
+    """(wall s, cpu s) from ``action()`` to the views painted with its result."""
     views = (win.original, win.processed)
-    painted_at_shown: list[tuple[int, int]] = []
+    shown: list[tuple[int, ...]] = []
 
     def on_shown(gen: int) -> None:
-        painted_at_shown.append(tuple(v.paint_count for v in views))  # type: ignore[arg-type]
-        shown.append(gen)
+        shown.append(tuple(v.paint_count for v in views))
 
     win.result_shown.connect(on_shown)
+    before = tuple(v.paint_count for v in views)
+    t0, c0 = time.perf_counter(), time.process_time()
+    action()
+    assert win.wait_idle(timeout_s)
+    app.processEvents()
+    ref = shown[-1] if shown else before
+    for v, n in zip(views, ref, strict=True):
+        if v.paint_count == n:
+            v.repaint_now()
+    t1, c1 = time.perf_counter(), time.process_time()
+    win.result_shown.disconnect(on_shown)
+    return t1 - t0, c1 - c0
 
-    def release(name: str, value: float) -> tuple[float, float, tuple[str, ...]]:
+
+def release(win, name: str, value: float) -> Callable[[], None]:
+    def act() -> None:
         s = win.controls.sliders[name]
-        n = len(shown)
-        t = time.perf_counter()
         s.set_position(s.to_position(value), final=True)
-        while len(shown) == n:
-            if win.runner._thread is not None:  # noqa: SLF001 - benchmark
-                win.runner._thread.wait(1)
-            app.processEvents()
-        for v, before in zip(views, painted_at_shown[-1], strict=True):
-            if a.force_repaint or v.paint_count == before:
-                v.repaint_now()  # not painted since the result arrived: paint it now
-        dt = time.perf_counter() - t
-        return dt, win.result.seconds, win.result.stages_run
 
-    results: dict[str, list[tuple[float, float]]] = {}
-    plans = {"chord_tol_bits": (0.5, 2.0), "magnification": (3.0, 4.0)}
-    for name, (v0, v1) in plans.items():
-        release(name, v0)  # warm the caches of both values
-        release(name, v1)
-        rows = []
-        for i in range(a.repeats):
-            dt, worker, stages = release(name, v0 if i % 2 == 0 else v1)
-            assert stages in (("sample",), ()), stages
-            rows.append((dt, worker))
-        results[name] = rows
-        # the cached value (same params twice) is not a re-sample: measure fresh values too
-    fresh = []
-    s = win.controls.sliders["chord_tol_bits"]
-    for i in range(a.repeats):
-        value = s.from_position(300 + 20 * i)
-        dt, worker, stages = release("chord_tol_bits", value)
-        fresh.append((dt, worker))
-    results["chord_tol_bits (new values)"] = fresh
-    fresh = []
-    for i in range(a.repeats):
-        dt, worker, stages = release("magnification", 2.5 + 0.1 * i)
-        fresh.append((dt, worker))
-    results["magnification (new values)"] = fresh
+    return act
 
-    print(f"machine: {platform.machine()} {platform.processor() or ''} "
-          f"{os.cpu_count()} cores, Python {platform.python_version()}, "
-          f"{platform.system()} {platform.release()}")
-    print(f"file: {a.points} points, {stats['input_points']} input points, "
-          f"{stats['control_points']} control points, {stats['mark_points']} marks, "
-          f"{stats['strokes']} strokes; window {a.size}")
-    print(f"first load (parse + fit + sample + geometry + draw): {first:.2f} s")
-    print(f"load average at the end: {os.getloadavg()[0]:.2f}; views repainted "
-          f"{'always (twice)' if a.force_repaint else 'once after the result'}")
-    print(f"{'change':32s} {'median ms':>10s} {'p90 ms':>8s} {'worker ms':>10s}")
-    for name, rows in results.items():
-        dts = sorted(r[0] * 1000 for r in rows)
-        wk = statistics.median(r[1] * 1000 for r in rows)
-        p90 = dts[int(0.9 * (len(dts) - 1))]
-        print(f"{name:32s} {statistics.median(dts):10.1f} {p90:8.1f} {wk:10.1f}")
+
+def toggle(win, key: str, on: bool) -> Callable[[], None]:
+    return lambda: win.layer_boxes[key].setChecked(on)
+
+
+def latency(files: list[Path], repeats: int) -> None:
+    app, win = make_window()
+    probe = StallProbe()
+    print(machine())
+    print(f"window {SIZE[0]}x{SIZE[1]}, offscreen; median of {repeats} (fresh values); "
+          "wall ms / CPU ms (both threads)")
+    for f in files:
+        win.layer_boxes["deviation"].setChecked(False)
+        from galvo_core.params import Params
+
+        win.set_params(Params(), run=False)
+        probe.start()
+        wall, cpu = timed(app, win, lambda f=f: win.load_file(f))
+        stall = probe.stop()
+        d = win.drawing
+        st = win.result.job.stats
+        print(f"\n{f.name}: {d.n_points} points, {len(d.paths)} paths, "
+              f"{st['control_points']} control points, {st['mark_points']} marks; "
+              f"fit field {win.params.fit_field}")
+        print(f"  open (read + fit + sample + display): {wall * 1000:.0f} ms wall, "
+              f"{cpu * 1000:.0f} ms CPU; GUI thread's longest stall {stall:.0f} ms")
+        mag = win.result.job.field_map.magnification
+        win.set_param("fit_field", False)
+        win.set_param("magnification", round(mag * 0.9, 4))
+        assert win.wait_idle(600) and win.run_error is None, win.run_error
+        rows: list[tuple[str, Callable[[int], Callable[[], None]]]] = [
+            ("e_per (fit)", lambda i: release(win, "e_per", 0.05 + 0.01 * i)),
+            ("eps_line (fit)", lambda i: release(win, "eps_line", 0.06 + 0.01 * i)),
+            ("kerf_mm (kerf + fit)", lambda i: release(win, "kerf_mm", 0.02 + 0.005 * i)),
+            ("magnification", lambda i, m=mag: release(win, "magnification",
+                                                       round(m * (0.85 - 0.01 * i), 4))),
+            ("chord_tol_bits", lambda i: release(win, "chord_tol_bits", 0.6 + 0.1 * i)),
+            ("layer: deviation on", lambda i: toggle(win, "deviation", True)),
+            ("layer: deviation off", lambda i: toggle(win, "deviation", False)),
+            ("layer: control off", lambda i: toggle(win, "control", False)),
+            ("layer: control on", lambda i: toggle(win, "control", True)),
+            ("layer: marks off", lambda i: toggle(win, "marks", False)),
+            ("layer: marks on", lambda i: toggle(win, "marks", True)),
+        ]
+        print(f"  {'change':26s} {'wall ms':>9s} {'CPU ms':>8s} {'stall ms':>9s}")
+        for name, make in rows:
+            walls, cpus, stalls = [], [], []
+            for i in range(repeats):
+                if name.startswith("layer: deviation on"):
+                    # a new fit each time, so the overlay is computed, not taken from the cache
+                    win.layer_boxes["deviation"].setChecked(False)
+                    win.set_param("e_per", 0.2 + 0.01 * i)
+                    assert win.wait_idle(600)
+                if name.startswith("layer: deviation off"):
+                    win.layer_boxes["deviation"].setChecked(True)
+                    assert win.wait_idle(600)
+                if name.startswith("layer: control on") or name.startswith("layer: marks on"):
+                    win.layer_boxes[name.split()[1]].setChecked(False)
+                    assert win.wait_idle(600)
+                if name.startswith("layer: control off") or name.startswith("layer: marks off"):
+                    win.layer_boxes[name.split()[1]].setChecked(True)
+                    assert win.wait_idle(600)
+                probe.start()
+                w, c = timed(app, win, make(i))
+                stalls.append(probe.stop())
+                walls.append(w * 1000)
+                cpus.append(c * 1000)
+            print(f"  {name:26s} {statistics.median(walls):9.0f} {statistics.median(cpus):8.0f}"
+                  f" {max(stalls):9.0f}")
+        win.set_param("kerf_mm", 0.0)
+        win.wait_idle(600)
     win.close()
+
+
+def stalls(points: int, big: Path | None) -> None:
+    from gen_plt import generate_plt
+
+    app, win = make_window()
+    probe = StallProbe()
+    tmp = Path(tempfile.mkdtemp(prefix="galvo-bench-"))
+    if big is None:
+        big = tmp / f"bench_{points}.plt"
+        big.write_bytes(generate_plt(points, seed=0))
+    print(machine())
+    print(f"file {big.name} ({big.stat().st_size / 1e6:.1f} MB); window {SIZE[0]}x{SIZE[1]}")
+    print(f"{'phase':34s} {'wall s':>7s} {'longest GUI stall ms':>21s} {'peak MB':>8s}"
+          "   (GUI thread's own longest apply_result / paint, ms)")
+
+    def phase(name: str, action: Callable[[], object]) -> None:
+        probe.start()
+        t0 = time.perf_counter()
+        action()
+        assert win.wait_idle(1200), name
+        for _ in range(3):
+            app.processEvents()
+        win.original.repaint_now()
+        win.processed.repaint_now()
+        dt = time.perf_counter() - t0
+        gap = probe.stop()
+        ap, pt = win.gui_work.take()
+        print(f"{name:34s} {dt:7.1f} {gap:21.0f} {peak_mb():8.0f}   "
+              f"(gaps > 100 ms: {len(probe.long)}; apply {ap:.0f}, paint {pt:.0f})")
+
+    win.gui_work.take()
+    phase("open + process", lambda: win.load_file(big))
+    d = win.drawing
+    print(f"  {d.n_points} points, {len(d.paths)} paths, "
+          f"{win.result.job.stats['mark_points']} marks, error: {win.run_error}")
+    job = tmp / "big.json"
+    phase("export job (JSON)", lambda: win.export("job", job, wait=False))
+    print(f"  job file {job.stat().st_size / 1e6:.0f} MB")
+    phase("e_per change (refit)", release(win, "e_per", 0.3))
+    phase("load the job back", lambda: win.load_file(job))
+    win.close()
+
+
+def main(argv: list[str] | None = None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    sub = ap.add_subparsers(dest="cmd", required=True)
+    a1 = sub.add_parser("latency")
+    a1.add_argument("files", nargs="*", type=Path)
+    a1.add_argument("--points", type=int, default=150_000)
+    a1.add_argument("--repeats", type=int, default=5)
+    a2 = sub.add_parser("stalls")
+    a2.add_argument("--points", type=int, default=1_000_000)
+    a2.add_argument("--file", type=Path, default=None)
+    a = ap.parse_args(argv)
+    if a.cmd == "latency":
+        files = list(a.files)
+        if not files:
+            from gen_plt import generate_plt
+
+            f = Path(tempfile.mkdtemp(prefix="galvo-bench-")) / f"gen_{a.points}.plt"
+            f.write_bytes(generate_plt(a.points, seed=0))
+            files = [f]
+        latency(files, a.repeats)
+    else:
+        stalls(a.points, a.file)
     return 0
 
 

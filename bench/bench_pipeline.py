@@ -193,7 +193,7 @@ def worker(src: str, out: str, fill: bool) -> None:
     params = Params(fit_field=True, **(FILL_PARAMS if fill else {}))
     d = timed("read", read_file)(src)
     w, c = time.perf_counter(), time.process_time()
-    job = pl.Pipeline().run(d, params)
+    job = pl.Pipeline().run(d, params).job
     run_w, run_c = time.perf_counter() - w, time.process_time() - c
     inner = [s for s in names]
     acc["glue"] = [run_w - sum(acc[s][0] for s in inner), run_c - sum(acc[s][1] for s in inner),

@@ -5,6 +5,8 @@
 #   bash bench/run_parse.sh                 # run everything, rewrite "## Import (issue 3)"
 #                                           # in bench/RESULTS.md
 #   bash bench/run_parse.sh --corpus-only --examples 3 --no-write   # look at differences
+#   bash bench/run_parse.sh --ratios        # issue 20: time and memory ratio to ezhpgl per
+#                                           # file, its own section of bench/RESULTS.md
 #
 # ezhpgl and numpy go into the bench's own environment bench/.venv-peers (gitignored), never
 # into the project's .venv; the project is imported from this checkout (sys.path), so both
@@ -24,11 +26,12 @@ if ! "$venv/bin/python" - "$spec" <<'EOF' 2>/dev/null
 import sys
 from importlib.metadata import version
 import numpy  # noqa: F401
+import numba  # noqa: F401  (the importer's compiled scanner)
 want = sys.argv[1].partition("==")[2]
 sys.exit(0 if (not want or version("ezhpgl") == want) else 1)
 EOF
 then
-    "$venv/bin/pip" install --quiet --disable-pip-version-check --pre "$spec" numpy
+    "$venv/bin/pip" install --quiet --disable-pip-version-check --pre "$spec" numpy numba
 fi
 
 write=(--write "$here/RESULTS.md")

@@ -11,26 +11,13 @@ import argparse
 import json
 import sys
 import time
-from collections.abc import Sequence
-from dataclasses import fields
+from collections.abc import Callable, Sequence
 from typing import Any, NoReturn
 
-from galvo_core import __version__
+from galvo_core import __version__, cli_lmc
 from galvo_core.errors import GalvoError, ParamError
-from galvo_core.export import write_plt, write_svg
-from galvo_core.fit import fit_report
 from galvo_core.hpgl import read_file
-from galvo_core.job import write_job
-from galvo_core.params import (
-    FILLS,
-    INTERPOLATIONS,
-    KERF_METHODS,
-    KERF_SIDES,
-    SCAN_ORDERS,
-    LaserParams,
-    Params,
-)
-from galvo_core.pipeline import Pipeline
+from galvo_core.params import GROUPS, Params, Spec, all_specs
 
 
 class _Parser(argparse.ArgumentParser):
@@ -39,97 +26,50 @@ class _Parser(argparse.ArgumentParser):
         sys.exit(2)
 
 
-def _finite(text: str) -> float:
-    try:
-        v = float(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"not a number: {text!r}") from None
-    if v != v or v in (float("inf"), float("-inf")):
-        raise argparse.ArgumentTypeError(f"not a finite number: {text!r}")
-    return v
+def _option_type(spec: Spec) -> Callable[[str], Any]:
+    """argparse ``type`` for one parameter: its Spec parses and checks the text."""
+
+    def convert(text: str) -> Any:
+        try:
+            return spec.parse(text)
+        except ParamError as exc:
+            raise argparse.ArgumentTypeError(str(exc)) from None
+
+    convert.__name__ = spec.kind  # argparse names the type in its messages
+    return convert
 
 
 def _add_processing_args(p: argparse.ArgumentParser, *, report: bool = False) -> None:
-    d = Params()
-    g = p.add_argument_group("thinning and fitting (input units, paper 000)")
-    g.add_argument("--eps-line", type=_finite, default=d.eps_line,
-                   help=f"line thinning tolerance (default {d.eps_line})")
-    g.add_argument("--e-per", type=_finite, default=d.e_per,
-                   help=f"largest distance of an input point to its cubic (default {d.e_per})")
-    g.add_argument("--eps-sum", type=_finite, default=d.eps_sum,
-                   help=f"dichotomy stop on the signed error sum (default {d.eps_sum})")
-    f = p.add_argument_group("field")
-    m = f.add_mutually_exclusive_group()
-    if report:
-        m.add_argument("--magnification", type=_finite, nargs="+", metavar="M",
-                       dest="magnifications",
-                       help="magnifications to compare raw and adaptive marks at (e.g. 36 72)")
-    else:
-        m.add_argument("--magnification", type=_finite,
-                       help="galvo bits per input unit (default: true size, "
-                            "field bits / field mm / 40)")
-    m.add_argument("--fit-field", action="store_true",
-                   help="the largest magnification that fits the field")
-    f.add_argument("--field-size-mm", type=_finite, default=d.field_size_mm)
-    f.add_argument("--field-bits", type=int, default=d.field_bits)
-    f.add_argument("--offset-bits", type=_finite, nargs=2, metavar=("OX", "OY"),
-                   help="offset added after scaling (default: drawing centred)")
-    f.add_argument("--clamp", action="store_true",
-                   help="clamp marks that leave the field (with a warning) instead of refusing")
-    s = p.add_argument_group("marking points")
-    s.add_argument("--interpolation", choices=INTERPOLATIONS, default=d.interpolation)
-    s.add_argument("--chord-tol-bits", type=_finite, default=d.chord_tol_bits)
-    s.add_argument("--min-step-bits", type=_finite, default=d.min_step_bits)
-    s.add_argument("--max-step-bits", type=_finite, default=None)
-    s.add_argument("--fixed-step-bits", type=_finite, default=d.fixed_step_bits,
-                   help="paper 001 baseline (--interpolation fixed): step along the curve's "
-                        "main axis")
-    s.add_argument("--fixed-slope-tol", type=_finite, default=d.fixed_slope_tol,
-                   help="paper 001 baseline: slope threshold k0")
-    k = p.add_argument_group("kerf compensation (paper 003)")
-    k.add_argument("--kerf-mm", type=_finite, default=d.kerf_mm,
-                   help="width of the laser trough on the workpiece; 0 = none (default)")
-    k.add_argument("--kerf-side", choices=KERF_SIDES, default=d.kerf_side,
-                   help="outside grows the design's regions, inside shrinks them")
-    k.add_argument("--kerf-method", choices=KERF_METHODS, default=d.kerf_method)
-    k.add_argument("--arc-tol-bits", type=_finite, default=d.arc_tol_bits,
-                   help="largest deviation of the round corners' arcs (galvo bits)")
-    h = p.add_argument_group("fill and order (paper 002)")
-    h.add_argument("--fill", choices=FILLS, default=d.fill)
-    h.add_argument("--hatch-spacing-mm", type=_finite, default=d.hatch_spacing_mm)
-    h.add_argument("--hatch-angle-deg", type=_finite, default=d.hatch_angle_deg)
-    h.add_argument("--hatch-passes", type=int, default=d.hatch_passes)
-    h.add_argument("--hatch-angle-step-deg", type=_finite, default=d.hatch_angle_step_deg)
-    h.add_argument("--hatch-inset-mm", type=_finite, default=d.hatch_inset_mm)
-    h.add_argument("--scan-order", choices=SCAN_ORDERS, default=d.scan_order)
-    h.add_argument("--order-time-budget-s", type=_finite, default=d.order_time_budget_s)
-    las = p.add_argument_group("laser")
-    for fld in fields(LaserParams):
-        las.add_argument("--" + fld.name.replace("_", "-"), type=_finite, default=None,
-                         dest="laser_" + fld.name, help=f"default {fld.default}")
+    """One option per parameter of :mod:`galvo_core.params`, from its Spec alone (name,
+    unit, range, default and help); only the options given end up in the namespace."""
+    for group in GROUPS:
+        g = p.add_argument_group(f"{group.TITLE.lower()} ({group.STAGE} stage)"
+                                 if group.STAGE != "laser" else "laser (time estimate, job)")
+        for spec in group.specs():
+            kw: dict[str, Any] = {"dest": spec.name, "default": argparse.SUPPRESS,
+                                  "help": spec.describe().replace("%", "%%")}
+            if spec.name == "magnification" and report:
+                g.add_argument(spec.option, type=_option_type(spec), nargs="+", metavar="M",
+                               dest="magnifications", default=None,
+                               help="magnifications to compare raw and adaptive marks at "
+                                    "(e.g. 36 72)")
+                continue
+            if spec.kind == "bool":
+                g.add_argument(spec.option, action=argparse.BooleanOptionalAction, **kw)
+            elif spec.kind == "pair":
+                g.add_argument(spec.option, type=float, nargs=2, metavar=("X", "Y"), **kw)
+            elif spec.kind == "choice":
+                g.add_argument(spec.option, choices=spec.choices, **kw)
+            else:
+                g.add_argument(spec.option, type=_option_type(spec), metavar=spec.kind.upper(),
+                               **kw)
 
 
 def _params_from_args(a: argparse.Namespace) -> Params:
-    laser_kw = {
-        fld.name: getattr(a, "laser_" + fld.name)
-        for fld in fields(LaserParams)
-        if getattr(a, "laser_" + fld.name) is not None
-    }
-    return Params(
-        eps_line=a.eps_line, e_per=a.e_per, eps_sum=a.eps_sum,
-        magnification=getattr(a, "magnification", None), fit_field=a.fit_field,
-        field_size_mm=a.field_size_mm, field_bits=a.field_bits,
-        offset_bits=tuple(a.offset_bits) if a.offset_bits else None, clamp=a.clamp,
-        interpolation=a.interpolation, chord_tol_bits=a.chord_tol_bits,
-        min_step_bits=a.min_step_bits, max_step_bits=a.max_step_bits,
-        fixed_step_bits=a.fixed_step_bits, fixed_slope_tol=a.fixed_slope_tol,
-        kerf_mm=a.kerf_mm, kerf_side=a.kerf_side, kerf_method=a.kerf_method,
-        arc_tol_bits=a.arc_tol_bits, fill=a.fill, hatch_spacing_mm=a.hatch_spacing_mm,
-        hatch_angle_deg=a.hatch_angle_deg, hatch_passes=a.hatch_passes,
-        hatch_angle_step_deg=a.hatch_angle_step_deg, hatch_inset_mm=a.hatch_inset_mm,
-        scan_order=a.scan_order, order_time_budget_s=a.order_time_budget_s,
-        laser=LaserParams(**laser_kw),
-    )
+    given = {s.name: getattr(a, s.name) for s in all_specs() if hasattr(a, s.name)}
+    if "offset_bits" in given:
+        given["offset_bits"] = tuple(given["offset_bits"])
+    return Params(**given)
 
 
 def _print_json(obj: Any) -> None:
@@ -143,25 +83,36 @@ def cmd_info(a: argparse.Namespace) -> int:
 
 
 def cmd_process(a: argparse.Namespace) -> int:
+    # imported here: info and --help need none of the pipeline (numba, scipy, shapely)
+    from galvo_core.export import write_plt, write_svg
+    from galvo_core.job import write_job
+    from galvo_core.pipeline import Pipeline
+
     params = _params_from_args(a)
     d = read_file(a.file)
-    job = Pipeline().run(d, params)
+    job = Pipeline().run(d, params).job
+    job = cli_lmc.prepare_job(job, a)  # pens, field correction; LMC files checked
     write_job(job, a.output)
     if a.plt:
         write_plt(job, a.plt, what=a.plt_what)
     if a.svg:
         write_svg(job, a.svg, marks=a.svg_marks)
+    controller = cli_lmc.write_controller_outputs(job, a)
     _print_json({
         "file": d.name,
         "output": a.output,
         "magnification": job.field_map.magnification,
         "stats": job.stats,
         "warnings": [w.as_dict() for w in job.warnings],
+        **controller,
     })
     return 0
 
 
 def cmd_report(a: argparse.Namespace) -> int:
+    from galvo_core.fit import fit_report
+    from galvo_core.pipeline import Pipeline
+
     params = _params_from_args(a)
     d = read_file(a.file)
     row = fit_report(d, eps_line=params.eps_line, e_per=params.e_per, eps_sum=params.eps_sum)
@@ -188,7 +139,7 @@ def cmd_report(a: argparse.Namespace) -> int:
             for interp in ("raw", "adaptive"):
                 p = params.replace(magnification=mag, fit_field=False, interpolation=interp)
                 t0 = time.perf_counter()
-                job = pipe.run(d, p)
+                job = pipe.run(d, p).job
                 r[interp] = {
                     "mark_points": job.stats["mark_points"],
                     "estimated_time_s": job.stats["estimated_time_s"],
@@ -242,6 +193,7 @@ def build_parser() -> argparse.ArgumentParser:
     ex.add_argument("--svg", metavar="OUT.svg", help="also write the fitted geometry as SVG (mm)")
     ex.add_argument("--svg-marks", action="store_true", help="draw the marks in the SVG too")
     _add_processing_args(pp)
+    cli_lmc.add_controller_options(pp)
     pp.set_defaults(func=cmd_process)
     pr = sub.add_parser("report", help="paper 000's Table 1 for a file",
                         description="Input points, points after thinning, control points, "
@@ -252,6 +204,7 @@ def build_parser() -> argparse.ArgumentParser:
     pr.add_argument("--json", action="store_true", help="print JSON instead of a table")
     _add_processing_args(pr, report=True)
     pr.set_defaults(func=cmd_report)
+    cli_lmc.add_send_parser(sub)
     return p
 
 

@@ -25,3 +25,7 @@ class InputError(GalvoError):
 
 class ParamError(GalvoError, ValueError):
     """A processing parameter is out of its allowed range (zero, negative, NaN, absurd)."""
+
+
+class Cancelled(Exception):
+    """Raised inside a run (fit, sampling, preview) when its ``cancel`` callback says stop."""

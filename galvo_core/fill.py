@@ -16,8 +16,10 @@ horizontal, ``spacing`` apart, centred in each region's height.
   the pieces are joined end to end by the region's boundary between them, alternating right
   and left side (the laser stays on). Cells are joined into one stroke along a path that
   visits each cell once (a semi-Hamiltonian path of the cell graph, searched depth-first with
-  Warnsdorff's rule within an effort bound); the join from one cell to the next is the piece
-  of boundary between the exit corner and the next cell's corner. Theorem 2 of the paper (a
+  Warnsdorff's rule, component by component, within a number of steps linear in the cells;
+  when they are spent, greedy walks cover the rest: strokes <= cells always); the join from
+  one cell to the next is the piece of boundary between the exit corner and the next cell's
+  corner. Theorem 2 of the paper (a
   convex cell can be covered from any boundary point to any other) makes the exit corner a
   free choice: a cell whose zig-zag would end on the wrong side gets one more hatch line
   half-way between two of its lines (in its narrowest strip), and a cell entered and left at
@@ -45,10 +47,15 @@ from shapely.geometry import LineString, MultiLineString, Polygon
 from shapely.geometry.base import BaseGeometry
 
 from galvo_core.drawing import Drawing
+from galvo_core.kerf import _components
 
 FILL_METHODS = ("scanline", "zigzag")
-#: upper bound on chain steps spent searching for long cell paths, per region piece
-MAX_EFFORT = 400_000
+#: search steps for long cell paths per monotone cell of a region piece (plus EFFORT_BASE);
+#: when they are spent the cells left are covered by greedy walks (linear, no search)
+EFFORT_PER_CELL = 300
+EFFORT_BASE = 3000
+#: the old name of the per-piece bound (now per cell)
+MAX_EFFORT = EFFORT_PER_CELL
 #: a U-turn cell's lines stop this many spacings short of the side run along the boundary
 #: (horizontally); below 1, so every point between them stays within half a spacing of a mark
 UTURN_OFFSET = 0.9
@@ -296,25 +303,11 @@ class _Hatch:
     def cells(self) -> None:
         """Monotone cells: chains of segments joined by one-to-one strips."""
         ns = self.n_seg
-        parent = list(range(2 * ns))
-
-        def find(a: int) -> int:
-            while parent[a] != a:
-                parent[a] = parent[parent[a]]
-                a = parent[a]
-            return a
-
-        seg = self.seg
-        sa = self.side_after
-        nxt = self.next
-        for c in range(self.n):
-            d = int(nxt[c])
-            # piece c -> d: on side sa[c] of c's line; at d it lies on side 1 - sa[d]
-            u = find(2 * int(seg[c]) + int(sa[c]))
-            v = find(2 * int(seg[d]) + 1 - int(sa[d]))
-            if u != v:
-                parent[u] = v
-        roots = np.array([find(a) for a in range(2 * ns)], dtype=np.int64)
+        # piece c -> next[c]: on side sa[c] of c's line; at next[c] it lies on side
+        # 1 - sa[next[c]]; the strips (segment, side) a piece joins are one strip
+        d = self.next
+        roots = _components(2 * ns, 2 * self.seg + self.side_after,
+                            2 * self.seg[d] + 1 - self.side_after[d])
         self.comp_dn = roots[0::2]
         self.comp_up = roots[1::2]
         n_b = np.bincount(self.comp_up, minlength=2 * ns)  # segments below each strip
@@ -347,6 +340,9 @@ class _Hatch:
         a = np.concatenate(self.rings)
         b = np.concatenate([np.roll(r, -1, axis=0) for r in self.rings])
         self._ea, self._eb = a, b
+        self._ring_cat = a
+        self._ring_len = np.array([len(r) for r in self.rings], dtype=np.int64)
+        self._ring_off = np.cumsum(self._ring_len) - self._ring_len
         self._tiny = 1e-9 * max(1.0, float(np.abs(a).max()))
         self._rungs: dict[tuple[int, bool], tuple | None] = {}
         self._uok: dict[tuple[int, int, int, bool, bool], bool] = {}
@@ -359,9 +355,34 @@ class _Hatch:
         sa = np.array(segs, dtype=np.int64)
         y = self.y0 + self.seg_k[sa] * self.s
         xs = np.stack([self.x[self.seg_cross[sa, 0]], self.x[self.seg_cross[sa, 1]]], 1)
-        pcs = [[self.piece_points(int(self.seg_cross[g, side]), 1) for g in segs[:-1]]
-               for side in (0, 1)]
-        return y, xs, pcs
+        if len(sa) < 2:
+            return y, xs, [[], []]
+        cr = self.seg_cross[sa[:-1]]
+        pcs = self._pieces_up(np.concatenate([cr[:, 0], cr[:, 1]]))
+        m = len(sa) - 1
+        return y, xs, [pcs[:m], pcs[m:]]
+
+    def _pieces_up(self, cs: np.ndarray) -> list[np.ndarray]:
+        """:meth:`piece_points` ``(c, 1)`` for every crossing c of ``cs`` at once."""
+        fwd = self.side_after[cs] == 1
+        a = np.where(fwd, cs, self.prev[cs])
+        b = np.where(fwd, self.next[cs], cs)
+        ring = self.ring[a]
+        nv = self._ring_len[ring]
+        ea, eb = self.edge[a], self.edge[b]
+        cnt = np.maximum(np.where(b > a, eb - ea, eb + nv - ea), 0)
+        tot = int(cnt.sum())
+        if tot == 0:
+            return [np.empty((0, 2))] * len(cs)
+        first = np.cumsum(cnt) - cnt
+        jj = np.arange(tot) - np.repeat(first, cnt)
+        cr = np.repeat(cnt, cnt)
+        jj = np.where(np.repeat(fwd, cnt), jj, cr - 1 - jj)
+        idx = (np.repeat(ea, cnt) + 1 + jj) % np.repeat(nv, cnt) + np.repeat(
+            self._ring_off[ring], cnt)
+        pts = self._ring_cat[idx]
+        ends = (first + cnt).tolist()
+        return [pts[i:j] for i, j in zip(first.tolist(), ends, strict=True)]
 
     def _split(self, p0: np.ndarray, piece: np.ndarray, p1: np.ndarray, ym: float
                ) -> tuple[float, np.ndarray, np.ndarray] | None:
@@ -449,19 +470,19 @@ class _Hatch:
                 sign = 1.0 if s == 0 else -1.0
                 m = n if cap else n - 1  # rungs 0..m-1 are shortened on side s
                 ok = bool(((xs[:m, 1] - xs[:m, 0]) > a * 1.05).all())
-                for j in range(m - 1):
-                    if not ok:
+                for sd, want in ((s, 1.0), (1 - s, -1.0)):
+                    if not ok or m < 2:
                         break
+                    ps = pcs[sd][:m - 1]
+                    lens = np.fromiter((len(q) for q in ps), dtype=np.int64, count=len(ps))
+                    if not lens.any():
+                        continue
+                    p = np.concatenate(ps)
+                    j = np.repeat(np.arange(m - 1), lens)
                     ox0, ox1 = xs[j, s] + sign * a, xs[j + 1, s] + sign * a
-                    for sd, want in ((s, 1.0), (1 - s, -1.0)):
-                        p = pcs[sd][j]
-                        if len(p) == 0:
-                            continue
-                        t = (p[:, 1] - y[j]) / (y[j + 1] - y[j])
-                        cx = ox0 + t * (ox1 - ox0)
-                        if not bool((want * sign * (cx - p[:, 0]) > self._tiny).all()):
-                            ok = False
-                            break
+                    t = (p[:, 1] - y[j]) / (y[j + 1] - y[j])
+                    cx = ox0 + t * (ox1 - ox0)
+                    ok = bool((want * sign * (cx - p[:, 0]) > self._tiny).all())
         self._uok[key] = ok
         return ok
 
@@ -526,25 +547,37 @@ class _Hatch:
         self._opt_cache[key] = out
         return out
 
-    def walk(self, max_effort: int) -> list[list[tuple]]:
-        """Cover the cells by few paths (semi-Hamiltonian paths of the cell graph, depth-first
-        with an effort bound): each path is one stroke. A path element is
-        (cell, entry end, entry side, uturn, extra, cap, exit side)."""
+    def walk(self, effort_per_cell: int = EFFORT_PER_CELL) -> list[list[tuple]]:
+        """Cover the cells by few paths (semi-Hamiltonian paths of the cell graph): each path
+        is one stroke. A path element is (cell, entry end, entry side, uturn, extra, cap,
+        exit side).
+
+        Exact where it is cheap, bounded everywhere: stroke by stroke, the longest path
+        through the connected part of the cells left that holds the cell with the fewest
+        free neighbours is searched depth-first (Warnsdorff's rule first), within a share
+        of ``EFFORT_BASE + effort_per_cell * cells`` steps for the whole piece (a search
+        that ends before its share is exact: the longest path there is); when the piece's
+        steps are spent, the cells left are covered by greedy walks (each step to the free
+        neighbour with the fewest free neighbours, no backtracking; every cell is entered
+        once). Every path covers at least one new cell, so strokes <= cells, and the work
+        is linear in the cells. :attr:`effort` counts the search and walk steps."""
         self.cells()
         nc = len(self.cell_segs)
+        self.effort = 0
         if nc == 0:
             return []
         self._prepare_walk()
-        nbrs: list[set[int]] = [set() for _ in range(nc)]
+        nbrs: list[list[int]] = [[] for _ in range(nc)]
         for c in range(nc):
             for end in (0, 1):
                 for side in (0, 1):
                     t = self._target(c, end, side)
                     if t is not None and t[0] != c:
-                        nbrs[c].add(t[0])
-                        nbrs[t[0]].add(c)
+                        nbrs[c].append(t[0])
+                        nbrs[t[0]].append(c)
+        nbrs = [list(dict.fromkeys(n)) for n in nbrs]
         visited = np.zeros(nc, dtype=bool)
-        total = max(1000, int(max_effort))
+        total = EFFORT_BASE + max(0, int(effort_per_cell)) * nc
         paths: list[list[tuple]] = []
         depth_cap = max(50, sys.getrecursionlimit() - 200)
         # search state of the current stroke: cells left, best path, path so far, effort
@@ -583,28 +616,82 @@ class _Hatch:
             seen[c] = False
             return done
 
-        while not visited.all():
-            starts = [c for c in range(nc) if not visited[c]]
-            st.update(left=len(starts), best=(0, 0.0, []), cur=[], seen=visited.copy(),
+        def component(c0: int) -> list[int]:
+            """The cells left that are connected to c0 (c0 first)."""
+            mark = {c0}
+            out = [c0]
+            for c in out:
+                for d in nbrs[c]:
+                    if not visited[d] and d not in mark:
+                        mark.add(d)
+                        out.append(d)
+            return out
+
+        def greedy(c0: int) -> list[tuple]:
+            """The longer of the two greedy walks from c0 (entered at either end)."""
+            best: list[tuple] = []
+            seen = st["seen"] = visited.copy()
+            for e0 in (0, 1):
+                path: list[tuple] = []
+                c, e, s = c0, e0, None
+                while True:
+                    self.effort += 1
+                    seen[c] = True
+                    opts = [o for o in self._options(c, e, s) if not seen[o[0][0]]]
+                    if not opts:
+                        path.append((c, e, s, False, False, False, None))
+                        break
+                    nx, _ee, t, ut, extra, cap, _oc = min(
+                        opts, key=lambda o: (free_nbrs(o[0][0]), o[6]))
+                    path.append((c, e, s, ut, extra, cap, t))
+                    c, e, s = nx
+                for el in path:
+                    seen[el[0]] = False
+                if len(path) > len(best):
+                    best = path
+            return best
+
+        pending = sorted(range(nc), key=lambda c: len(nbrs[c]))
+        head = 0
+        while head < nc:
+            while head < nc and visited[pending[head]]:
+                head += 1
+            if head >= nc:
+                break
+            c_first = pending[head]
+            if total <= 0:  # the bounded construction
+                path = greedy(c_first)
+                for el in path:
+                    visited[el[0]] = True
+                paths.append(path)
+                continue
+            comp = component(c_first)
+            self.effort += len(comp)
+            total -= len(comp)
+            st.update(left=len(comp), best=(0, 0.0, []), cur=[], seen=visited.copy(),
                       full_at=-1, budget=0)
-            starts.sort(key=free_nbrs)
+            starts = sorted(comp, key=free_nbrs)
+            share = min(total, EFFORT_BASE + max(0, int(effort_per_cell)) * len(comp))
             fin = False
             for k, c0 in enumerate(starts):
                 for e0 in (0, 1):
-                    if total <= 0:
+                    if share <= 0:
                         break
-                    allow = min(total, max(200, total // max(1, 2 * (len(starts) - k))))
+                    allow = min(share, max(200, share // max(1, 2 * (len(starts) - k))))
                     st["budget"] = allow
                     st["full_at"] = -1 if st["best"][0] < st["left"] else allow
                     fin = dfs(c0, e0, None, 0.0, 0)
-                    total -= allow - max(0, st["budget"])
+                    used = allow - max(0, st["budget"])
+                    share -= used
+                    total -= used
+                    self.effort += used
                     if fin:
                         break
-                if fin or total <= 0:
+                if fin or share <= 0:
                     break
             best = st["best"]
-            if not best[0]:  # out of effort: one cell per stroke for the rest
-                best = (1, 0.0, [(starts[0], 0, None, False, False, False, None)])
+            if not best[0]:
+                best = (1, 0.0, greedy(c_first))
             for el in best[2]:
                 visited[el[0]] = True
             paths.append(best[2])
@@ -697,7 +784,7 @@ def hatch(
     passes: int = 1,
     angle_step_deg: float = 90.0,
     inset_units: float = 0.0,
-    max_effort: int = MAX_EFFORT,
+    max_effort: int = EFFORT_PER_CELL,
 ) -> list[HatchStroke]:
     """Hatch strokes filling the regions of the drawing's closed paths.
 

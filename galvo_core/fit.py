@@ -57,7 +57,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from galvo_core.drawing import Drawing
-from galvo_core.errors import ParamError
+from galvo_core.errors import Cancelled, ParamError
 from galvo_core.geometry import (
     cubic_eval,
     cubic_length,
@@ -922,8 +922,8 @@ def fit_drawing(
     return tuple(out)
 
 
-class FitCancelled(Exception):
-    """Raised by :func:`fit_drawing` when its ``cancel`` callback says stop."""
+#: what :func:`fit_drawing` raises when its ``cancel`` callback says stop
+FitCancelled = Cancelled
 
 
 def warm_up() -> None:

@@ -284,21 +284,6 @@ def _sampled_candidates(
             hi[m, o] = su[np.minimum(j + 1, ns)]
 
 
-def nearest_on_cubic_warm(
-    ctrl: object, pts: object, t0: np.ndarray, *, iters: int = 4
-) -> tuple[np.ndarray, np.ndarray]:
-    """Nearest-point refinement from known starting parameters ``t0`` (K,) (no seeding).
-
-    Cheap and local: for a curve that changed little since ``t0`` was computed (used inside
-    the fitting bisection). Returns ``(t, dist)`` like :func:`nearest_on_cubic`.
-    """
-    c = _ctrl(ctrl)
-    p = np.asarray(pts, dtype=np.float64).reshape(-1, 2)
-    u = _newton_nearest(c, p, np.asarray(t0, dtype=np.float64), 0.0, 1.0, iters)
-    r = cubic_eval(c, u) - p
-    return u, np.hypot(r[:, 0], r[:, 1])
-
-
 def point_segment_distance(pts: object, a: object, b: object) -> np.ndarray:
     """Euclidean distance of each point to the closed segment [a, b].
 

@@ -208,6 +208,12 @@ class Job:
     strokes: tuple[Stroke, ...]
     stats: dict[str, Any] = dc_field(default_factory=dict)
     warnings: tuple[Warning, ...] = ()
+    # pen layers (issue 19): one row per pen the strokes use (galvo_core.layers
+    # LayerSettings.as_dict()), the laser source, and whether a software field correction
+    # was applied to the marks (None: not applied). Written only when set.
+    layers: tuple[dict[str, Any], ...] = ()
+    laser_source: str = "fiber"
+    field_correction: dict[str, Any] | None = None
 
     def header_json(self, version: int = VERSION) -> dict[str, Any]:
         """Every top-level key of the file but the strokes (shared by both forms; keys
@@ -215,7 +221,7 @@ class Job:
         stats = dict(self.stats)
         stats["warnings"] = [w.as_dict() for w in self.warnings]
         fm = self.field_map
-        return {
+        out: dict[str, Any] = {
             "format": FORMAT,
             "version": version,
             "generator": GENERATOR,
@@ -228,6 +234,12 @@ class Job:
             "strokes": [],
             "stats": _jsonable(stats),
         }
+        if self.layers:
+            out["layers"] = _jsonable(list(self.layers))
+            out["laser_source"] = self.laser_source
+        if self.field_correction is not None:
+            out["field_correction"] = _jsonable(self.field_correction)
+        return out
 
     def to_json(self) -> dict[str, Any]:
         """The version 1 document as Python objects (slow for big jobs: one object per
@@ -487,16 +499,22 @@ def _header(doc: Any, name: str, version: int) -> tuple[FieldMap, dict[str, Any]
     return fm, doc
 
 
-def _finish(doc: dict[str, Any], fm: FieldMap, strokes: list[Stroke]) -> Job:
+def _finish(doc: dict[str, Any], fm: FieldMap, strokes: list[Stroke], name: str) -> Job:
     src = doc["source"]
     stats = dict(doc.get("stats", {}))
     warns = tuple(
         Warning(int(w.get("line", 0)), int(w.get("col", 0)), str(w.get("message", "")))
         for w in stats.pop("warnings", []) if isinstance(w, dict)
     )
+    layers = doc.get("layers", [])
+    if not (isinstance(layers, list) and all(isinstance(r, dict) for r in layers)):
+        raise InputError(name, "layers must be a list of tables")
+    corr = doc.get("field_correction")
+    if corr is not None and not isinstance(corr, dict):
+        raise InputError(name, "field_correction must be a table")
     return Job(str(src.get("name", "")), str(src.get("sha256", "")), fm,
                dict(doc.get("params", {})), dict(doc.get("laser", {})), tuple(strokes), stats,
-               warns)
+               warns, tuple(layers), str(doc.get("laser_source", "fiber")), corr)
 
 
 def job_from_json(doc: Any, name: str = "<job>") -> Job:
@@ -521,7 +539,7 @@ def job_from_json(doc: Any, name: str = "<job>") -> Job:
         strokes.append(Stroke(kind, int(_req(s, "source_index", where, name)),
                               bool(_req(s, "closed", where, name)), marks, segs,
                               int(s.get("pen", 1))))
-    return _finish(doc, fm, strokes)
+    return _finish(doc, fm, strokes, name)
 
 
 def _segments_v1(segs_in: Any, where: str, name: str) -> Segments:
@@ -676,8 +694,4 @@ def _strokes_from_arrays(arr: dict[str, np.ndarray], n: int, fm: FieldMap,
                 if ss[i + 1] > ss[i] else empty)
         strokes.append(Stroke(kinds[i], src[i], closed[i], marks[ms[i]:ms[i + 1]], segs,
                               pen[i]))
-    return _finish(doc, fm, strokes)
-
-
-def strokes_marks(strokes: Sequence[Stroke]) -> list[np.ndarray]:
-    return [s.marks for s in strokes]
+    return _finish(doc, fm, strokes, name)

@@ -117,6 +117,10 @@ ARC_SHARE = 1.0 / 16.0
 ASSIGN_STRIDE = 4
 #: scan spacing of the rectangle method as a fraction of d
 RECT_SPACING = 0.25
+#: the even-odd ray test cuts the plane into columns of about this many edge ends each
+CROSS_COLUMN_EDGES = 128
+#: ... unless the plain ray count pairs at most this many times (points + edges)
+CROSS_PLAIN_PAIRS = 8
 
 
 # --------------------------------------------------------------------------- public API
@@ -624,7 +628,7 @@ def _even_odd_general(rings: list[np.ndarray]) -> BaseGeometry:
     if len(faces) == 0:
         return shapely.Polygon()
     pts = shapely.get_coordinates(shapely.point_on_surface(faces))
-    odd = _crossings(pts, a[rep], b[rep]) % 2 == 1
+    odd = _odd_crossings(pts, a[rep], b[rep])
     inside = faces[odd]
     if len(inside) == 0:
         return shapely.Polygon()
@@ -802,6 +806,132 @@ def _nest(polys: np.ndarray) -> BaseGeometry:
                            holes.get(int(s), [])) for s in shells]
     geom = shapely.MultiPolygon(out) if len(out) > 1 else out[0]
     return shapely.orient_polygons(geom)
+
+
+def _odd_crossings(pts: np.ndarray, a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """For each point, whether a horizontal ray to +x crosses an odd number of the edges
+    (a, b) (the parity of :func:`_crossings`; the edges must form closed rings mod 2, as
+    :func:`_odd_edges` leaves them: every vertex in an even number of edges).
+
+    Linear in the points and edges for any layout: the plane is cut into vertical columns
+    (equal numbers of edge ends each, boundaries half-way between two vertex x values, so
+    no vertex lies on one) and each point's ray is replaced by a path with the same
+    crossing parity (a closed curve crosses closed rings an even number of times): along
+    its line to its column's right boundary, then up that boundary. The first leg meets
+    only the edges of its column; the second is a count of the boundary's crossing heights
+    above the point (a binary search). A point where the path meets an edge exactly at its
+    corner (a tie) is counted with the plain ray instead. :func:`_crossings` alone pairs
+    every point with every edge spanning its height: for drawings side by side that is
+    every edge to the right on the same rows, quadratic in the number of drawings."""
+    n, m = len(pts), len(a)
+    if n == 0 or m == 0:
+        return np.zeros(n, dtype=bool)
+    # few point-edge pairs (most layouts of a few drawings): the plain count is cheaper
+    sy = np.sort(pts[:, 1])
+    ylo_, yhi_ = np.minimum(a[:, 1], b[:, 1]), np.maximum(a[:, 1], b[:, 1])
+    pairs = int(np.maximum(np.searchsorted(sy, yhi_) - np.searchsorted(sy, ylo_), 0).sum())
+    if pairs <= CROSS_PLAIN_PAIRS * (n + m):
+        return _crossings(pts, a, b) % 2 == 1
+    n_col = min(m // CROSS_COLUMN_EDGES, 1 << 16)
+    xs = np.sort(np.concatenate([a[:, 0], b[:, 0]]))
+    if n_col >= 2:
+        q = np.linspace(0, len(xs) - 1, n_col + 1)[1:-1].astype(np.int64)
+        lo_x, hi_x = xs[q], xs[np.minimum(q + 1, len(xs) - 1)]
+        # the first vertex x above each quantile, so the boundary falls strictly between two
+        nxt = np.searchsorted(xs, lo_x, side="right")
+        ok = nxt < len(xs)
+        lo_x, hi_x = lo_x[ok], xs[nxt[ok]]
+        mid = 0.5 * (lo_x + hi_x)
+        bnd = np.unique(mid[(mid > lo_x) & (mid < hi_x)])
+    else:
+        bnd = np.zeros(0)
+    if len(bnd) == 0:
+        return _crossings(pts, a, b) % 2 == 1
+    nc = len(bnd) + 1
+    right = np.r_[bnd, np.inf]  # right boundary of each column
+    px, py = pts[:, 0], pts[:, 1]
+    pcol = np.searchsorted(bnd, px, side="right")
+    # points by column, then height
+    porder = np.lexsort((py, pcol))
+    pstart = np.searchsorted(pcol[porder], np.arange(nc + 1))
+    spy = py[porder]
+    cnt_h = np.zeros(n, dtype=np.int64)
+    tie = np.zeros(n, dtype=bool)
+    ax, ay, bx, by = a[:, 0], a[:, 1], b[:, 0], b[:, 1]
+    xlo, xhi = np.minimum(ax, bx), np.maximum(ax, bx)
+    ylo, yhi = np.minimum(ay, by), np.maximum(ay, by)
+    # ---- first leg: the edges of each column (an edge in every column its x range meets)
+    ec0 = np.searchsorted(bnd, xlo, side="right")
+    ec1 = np.searchsorted(bnd, xhi, side="right")
+    slanted = np.flatnonzero(yhi > ylo)  # a horizontal edge is never crossed (half-open)
+    rep = (ec1 - ec0 + 1)[slanted]
+    e_id = np.repeat(slanted, rep)
+    e_col = np.repeat(ec0[slanted], rep) + (
+        np.arange(len(e_id)) - np.repeat(np.cumsum(rep) - rep, rep))
+    o = np.argsort(e_col, kind="stable")
+    e_id, e_col = e_id[o], e_col[o]
+    estart = np.searchsorted(e_col, np.arange(nc + 1))
+    lo = np.empty(len(e_id), dtype=np.int64)
+    hi = np.empty(len(e_id), dtype=np.int64)
+    for c in range(nc):
+        s0, s1 = int(estart[c]), int(estart[c + 1])
+        if s0 == s1:
+            continue
+        p0, p1 = int(pstart[c]), int(pstart[c + 1])
+        col_y = spy[p0:p1]
+        ids = e_id[s0:s1]
+        lo[s0:s1] = p0 + np.searchsorted(col_y, ylo[ids], side="left")
+        hi[s0:s1] = p0 + np.searchsorted(col_y, yhi[ids], side="left")
+    cnt = hi - lo
+    sel = np.flatnonzero(cnt > 0)
+    csum = np.cumsum(cnt[sel])
+    chunk = 4_000_000
+    start = 0
+    while start < len(sel):
+        stop = int(np.searchsorted(csum, (csum[start - 1] if start else 0) + chunk,
+                                   side="right"))
+        stop = max(stop, start + 1)
+        rows = sel[start:stop]
+        c = cnt[rows]
+        row = np.repeat(rows, c)
+        k = lo[row] + (np.arange(len(row)) - np.repeat(np.cumsum(c) - c, c))
+        pi = porder[k]
+        e = e_id[row]
+        x = ax[e] + (py[pi] - ay[e]) * (bx[e] - ax[e]) / (by[e] - ay[e])
+        lim = right[e_col[row]]
+        hit = (x > px[pi]) & (x < lim)
+        cnt_h += np.bincount(pi[hit], minlength=n)
+        tie[pi[(x > px[pi]) & (x == lim)]] = True
+        start = stop
+    # ---- second leg: up each column's right boundary (edges strictly across it)
+    rep = np.maximum(ec1 - ec0, 0)
+    crossing = np.flatnonzero(rep)
+    rep = rep[crossing]
+    v_id = np.repeat(crossing, rep)
+    v_col = np.repeat(ec0[crossing], rep) + (
+        np.arange(len(v_id)) - np.repeat(np.cumsum(rep) - rep, rep))
+    xb = bnd[v_col]
+    yc = ay[v_id] + (xb - ax[v_id]) * (by[v_id] - ay[v_id]) / (bx[v_id] - ax[v_id])
+    o = np.lexsort((yc, v_col))
+    yc, v_col = yc[o], v_col[o]
+    vstart = np.searchsorted(v_col, np.arange(nc + 1))
+    above = np.zeros(n, dtype=np.int64)
+    for c in range(nc - 1):
+        s0, s1 = int(vstart[c]), int(vstart[c + 1])
+        p0, p1 = int(pstart[c]), int(pstart[c + 1])
+        if s0 == s1 or p0 == p1:
+            continue
+        ys = yc[s0:s1]
+        qy = spy[p0:p1]
+        r = np.searchsorted(ys, qy, side="right")
+        above[porder[p0:p1]] = (s1 - s0) - r
+        t = r != np.searchsorted(ys, qy, side="left")
+        tie[porder[p0:p1][t]] = True
+    odd = (cnt_h + above) % 2 == 1
+    if tie.any():
+        ti = np.flatnonzero(tie)
+        odd[ti] = _crossings(pts[ti], a, b) % 2 == 1
+    return odd
 
 
 def _crossings(pts: np.ndarray, a: np.ndarray, b: np.ndarray) -> np.ndarray:

@@ -16,8 +16,12 @@ Methods:
   and Or-opt moves of 1-3 strokes, over nearest-neighbour lists), the best direction / start
   point of every stroke for that order (exact: :func:`orient_strokes`), then iterated local
   search (double-bridge kicks within a few dozen strokes, each repaired by local search and
-  kept if shorter) until the time budget is spent. Never longer than greedy; the same result
-  for the same input and ``seed`` unless the budget cuts the search at a different point.
+  kept if shorter) until it stops improving (a window of kicks gains less than
+  :data:`STALL_GAIN`), after :data:`KICKS_PER_STROKE` kicks per stroke, or at the time
+  budget, whichever comes first. Every move rewrites at most :data:`MOVE_SPAN` positions
+  (longer ones only while their total work is linear), so the work grows linearly with the
+  strokes. Never longer than greedy; the same result for the same input and ``seed`` unless
+  the budget cuts the search at a different point.
 
 Precedence (``before`` pairs ``(a, b)``: stroke ``a`` before stroke ``b``) is kept by every
 method except ``file``; :func:`nesting_constraints` makes the usual ones: inner contours
@@ -43,6 +47,20 @@ MAX_STARTS = 48
 NEIGHBOURS = 10
 #: a kick's two swapped blocks are at most this many strokes long
 KICK_SPAN = 50
+#: the iterated local search stops after this many kicks per stroke (at least KICKS_MIN:
+#: linear work), or
+#: earlier when a window of max(STALL_WINDOW_MIN, strokes / 4) kicks shortened the travel by
+#: no more than STALL_GAIN of it, or at the time budget, whichever comes first
+KICKS_PER_STROKE = 2
+KICKS_MIN = 1000
+STALL_WINDOW_MIN = 250
+STALL_GAIN = 1e-4
+#: a 2-opt or Or-opt move rewrites at most this many tour positions (two per stroke): each
+#: move then costs at most a constant, so a local search is linear in the strokes (no move
+#: is left out below 10,000 strokes)
+MOVE_SPAN = 20_000
+#: longer moves are allowed until they have rewritten this many times the tour's positions
+LONG_WORK = 40
 
 
 @dataclass(frozen=True, slots=True)
@@ -489,8 +507,13 @@ class _EndTour:
         self.start_cand: dict[int, int] = {}
         self.t: list[int] = [self.D]
         self.pos = [0] * (2 * n + 1)
+        self.written = 0  # tour positions rewritten by moves (work done)
+        self.ls_steps = 0  # ends looked at by local searches
         self.load(cands)
         self.M = len(self.t) - 1  # the last position
+        # moves longer than MOVE_SPAN positions while their total stays under LONG_WORK * M
+        self.span_cap = self.M
+        self.long_work = 0
         # precedence pairs the starting tour keeps (a cycle of pairs cannot be kept)
         self.cons_of: list[list[tuple[int, int]]] = [[] for _ in range(n)]
         pos = self.pos
@@ -543,9 +566,18 @@ class _EndTour:
     # ---- changes
     def _write(self, r0: int, new: list[int]) -> None:
         t, pos = self.t, self.pos
-        t[r0:r0 + len(new)] = new
-        for k in range(r0, r0 + len(new)):
-            pos[t[k]] = k
+        m = len(new)
+        self.written += m
+        t[r0:r0 + m] = new
+        if m > 64:
+            list(map(pos.__setitem__, new, range(r0, r0 + m)))
+        else:
+            for k in range(r0, r0 + m):
+                pos[t[k]] = k
+        if m > MOVE_SPAN:  # long moves: allowed while their work stays linear overall
+            self.long_work += m
+            if self.long_work > LONG_WORK * self.M:
+                self.span_cap = MOVE_SPAN
 
     def commit(self, r0: int, new: list[int]) -> bool:
         """Put ``new`` (whole strokes) at positions r0..; False (and nothing changed) if that
@@ -576,6 +608,7 @@ class _EndTour:
         (nearest first: the scan stops at the first one too far to gain) and its gain;
         ``(-1, ...)`` when none gains."""
         t, pos, X, Y, M, D, hyp = self.t, self.pos, self.X, self.Y, self.M, self.D, math.hypot
+        span_cap = self.span_cap
         i = pos[t1]
         x1, y1 = X[t1], Y[t1]
         odd = i & 1
@@ -591,7 +624,7 @@ class _EndTour:
             if g <= 0.0:
                 break
             j = pos[t3]
-            if (j & 1) != odd:
+            if (j & 1) != odd or abs(j - i) > span_cap:
                 continue
             t4 = t[j - 1] if odd else (t[j + 1] if j < M else D)
             if t3 == t2 or t4 == t1:
@@ -636,7 +669,7 @@ class _EndTour:
                 if dc >= rem:
                     break
                 j = pos[c]
-                if lo <= j <= hi:
+                if lo <= j <= hi or abs(j - i) > span_cap:
                     continue
                 if j & 1:  # c an entry: y - other end .. t1 - c
                     if j - 1 == hi:
@@ -715,6 +748,7 @@ def _local_search(tour: _EndTour, nb: list[list[int]], queue: list[int],
     steps = 0
     while dq:
         steps += 1
+        tour.ls_steps += 1
         if (steps & 15) == 0 and perf() > deadline:
             return gained, False
         t1 = dq.popleft()
@@ -734,30 +768,49 @@ def _local_search(tour: _EndTour, nb: list[list[int]], queue: list[int],
 
 
 def _improve(prob: _Problem, cands: Sequence[int], before: Sequence[tuple[int, int]],
-             deadline: float, seed: int = 0, max_kicks: int | None = None) -> list[int]:
+             deadline: float, seed: int = 0, max_kicks: int | None = None,
+             stats: dict | None = None) -> list[int]:
     """A candidate sequence no longer than ``cands`` (and keeping the precedence pairs that
     ``cands`` keeps): local search, the best direction / start point of every stroke for that
-    order (:func:`_orient`), then iterated local search until the deadline (or ``max_kicks``
+    order (:func:`_orient`), then iterated local search until it stops improving, after
+    :data:`KICKS_PER_STROKE` kicks per stroke or at the deadline (or after ``max_kicks``
     kicks): a double bridge within :data:`KICK_SPAN` strokes, local search around its cuts,
     kept if shorter, else undone. Deterministic for a given seed up to where the deadline
-    cuts it."""
+    cuts it. ``stats`` (a dict), if given, receives the work done: ``kicks``,
+    ``ls_steps`` (ends looked at by the local searches), ``written`` (tour positions
+    rewritten by moves)."""
     m = len(cands)
     if m < 3:
         return list(cands)
     nb = _end_neighbours(prob, NEIGHBOURS)
     tour = _EndTour(prob, cands, before)
-    if not _local_search(tour, nb, tour.t[1:], deadline)[1]:
+    kicks = 0
+
+    def finish() -> list[int]:
+        if stats is not None:
+            stats.update(kicks=kicks, ls_steps=tour.ls_steps, written=tour.written)
         return _orient(prob, [e >> 1 for e in tour.t[1::2]])
+
+    if not _local_search(tour, nb, tour.t[1:], deadline)[1]:
+        return finish()
     old_entries = tour.t[1::2]
     tour.load(_orient(prob, [e >> 1 for e in old_entries]))
     turned = [e for e, f in zip(tour.t[1::2], old_entries, strict=True) if e != f]
     if not _local_search(tour, nb, turned + [e ^ 1 for e in turned], deadline)[1]:
-        return _orient(prob, [e >> 1 for e in tour.t[1::2]])
+        return finish()
     rng = random.Random(seed)
     span = min(m - 1, KICK_SPAN)
     tour.log = []
-    kicks = 0
-    while time.perf_counter() < deadline and (max_kicks is None or kicks < max_kicks):
+    limit = max(KICKS_MIN, KICKS_PER_STROKE * m) if max_kicks is None else max_kicks
+    window = max(STALL_WINDOW_MIN, m // 4)
+    length = tour.length()
+    window_start = length
+    while time.perf_counter() < deadline and kicks < limit:
+        if max_kicks is None and kicks and kicks % window == 0:
+            # stopped improving: the last window of kicks gained (almost) nothing
+            if window_start - length <= STALL_GAIN * window_start:
+                break
+            window_start = length
         kicks += 1
         s1 = rng.randrange(0, m - 1)
         s2 = min(s1 + rng.randint(1, span), m - 1)
@@ -769,12 +822,13 @@ def _improve(prob: _Problem, cands: Sequence[int], before: Sequence[tuple[int, i
         gain, finished = _local_search(tour, nb, ends, deadline)
         if gain - delta > 1e-9:  # shorter: keep
             tour.log.clear()
+            length -= gain - delta
         else:
             tour.undo()
         if not finished:
             break
     tour.log = None
-    return _orient(prob, [e >> 1 for e in tour.t[1::2]])
+    return finish()
 
 
 def order_strokes(

@@ -8,9 +8,13 @@ compensation (paper 003) happens on the region outlines before fitting, so the f
 and marks follow the compensated outline; the hatch (paper 002) fills the compensated
 regions; the order stage orders every stroke of the job.
 
-Each stage's result is cached under the drawing's identity and the :class:`Params` fields
-that stage reads (:data:`galvo_core.params.STAGE_FIELDS`): moving ``e_per`` refits but does
-not re-read the file; moving the magnification re-samples but does not refit.
+Caching. Each stage's result is cached under a key made of *everything it depends on*: the
+input drawing (by identity; the cache entry holds the drawing, so its identity cannot be
+reused while the entry lives), the whole parameter group the stage reads
+(:meth:`Params.group`, frozen and hashable), the whole :class:`FieldMap` when the stage
+converts through the field, and the key of the stage before it. So moving ``e_per`` refits
+but does not re-read or re-offset; moving the magnification re-samples but does not refit;
+and no change of any parameter can return a result computed under other values.
 """
 
 from __future__ import annotations
@@ -19,185 +23,240 @@ import threading
 import time
 from collections import OrderedDict
 from collections.abc import Callable, Hashable
-from dataclasses import dataclass
-from typing import Any, TypeVar, cast
+from dataclasses import dataclass, field
+from typing import Any, TypeVar
 
 import numpy as np
 
 from galvo_core.drawing import Drawing, Warning
+from galvo_core.errors import Cancelled
 from galvo_core.field import FieldMap, check_in_field, make_field
 from galvo_core.fill import HatchStroke, hatch
 from galvo_core.fit import FitCancelled, FittedPath, control_points, fit_drawing
 from galvo_core.job import Job, Segments, Stroke
 from galvo_core.kerf import compensate_indexed
 from galvo_core.order import order_job_strokes
-from galvo_core.params import STAGE_FIELDS, Params
-from galvo_core.sample import ROUNDING_BOUND_BITS, SampleReport, polyline_marks, sample_paths
+from galvo_core.params import UNITS_PER_MM, Params
+from galvo_core.sample import (
+    ROUNDING_BOUND_BITS,
+    SampleReport,
+    polyline_marks,
+    sample_geometry,
+    sample_paths,
+)
 from galvo_core.timing import estimate_with_dwell
 
+__all__ = ["Cancelled", "Pipeline", "RunResult", "coordinate_quantum", "process"]
+
 T = TypeVar("T")
+Cancel = Callable[[], bool] | None
 
 
-class Cancelled(Exception):
-    """Raised inside a run when its ``cancel`` callback says stop."""
+class _Cache:
+    """A small LRU of stage results. Each entry holds the input drawing it was computed
+    from and is returned only for that very object (ids are reused after garbage
+    collection; the held reference prevents it while the entry lives, the identity check
+    makes it certain)."""
 
-
-class _LRU:
     def __init__(self, size: int) -> None:
         self.size = size
-        self.data: OrderedDict[Hashable, Any] = OrderedDict()
+        self.data: OrderedDict[Hashable, tuple[object, Any]] = OrderedDict()
         self.lock = threading.Lock()
 
-    def get(self, key: Hashable, make: Callable[[], T]) -> T:
+    def get(self, anchor: object, key: Hashable, make: Callable[[], T]) -> T:
+        full = (id(anchor), key)
         with self.lock:
-            if key in self.data:
-                self.data.move_to_end(key)
-                return self.data[key]  # type: ignore[no-any-return]
+            hit = self.data.get(full)
+            if hit is not None and hit[0] is anchor:
+                self.data.move_to_end(full)
+                return hit[1]  # type: ignore[no-any-return]
         value = make()
         with self.lock:
-            self.data[key] = value
+            self.data[full] = (anchor, value)
+            self.data.move_to_end(full)
             while len(self.data) > self.size:
                 self.data.popitem(last=False)
         return value
 
 
-def _key(params: Params, stage: str) -> tuple[Any, ...]:
-    return tuple(getattr(params, f) for f in STAGE_FIELDS[stage])
+@dataclass
+class _Run:
+    """What one run recomputed and how long each stage took (local to :meth:`Pipeline.run`)."""
+
+    cancel: Cancel
+    ran: list[str] = field(default_factory=list)
+    timings: dict[str, float] = field(default_factory=dict)
+
+    def stage(self, name: str, make: Callable[[], T]) -> Callable[[], T]:
+        def timed() -> T:
+            self.check()
+            t0 = time.perf_counter()
+            out = make()
+            self.timings[name] = self.timings.get(name, 0.0) + time.perf_counter() - t0
+            self.ran.append(name)
+            return out
+
+        return timed
+
+    def check(self) -> None:
+        if self.cancel is not None and self.cancel():
+            raise Cancelled()
 
 
-@dataclass(frozen=True)
-class RunInfo:
-    """What a run recomputed (for tests of the caching and for the GUI's progress)."""
+@dataclass(frozen=True, eq=False)
+class RunResult:
+    """One finished run: the job and what it was made from.
 
+    ``work``: the drawing after kerf compensation (``drawing`` itself without kerf) and
+    ``origin[i]`` the input path that ``work.paths[i]`` came from; ``fitted``: the fitted
+    paths of ``work``; ``sample_report``: what the sampler measured; ``stages_run``: the
+    stages recomputed (the rest came from the cache); ``timings``: seconds per recomputed
+    stage (plus "order" and "stats", which always run).
+    """
+
+    job: Job
+    drawing: Drawing
+    params: Params
+    field_map: FieldMap
+    work: Drawing
+    origin: tuple[int, ...]
+    fitted: tuple[FittedPath, ...]
+    sample_report: SampleReport | None
     stages_run: tuple[str, ...]
+    timings: dict[str, float]
     seconds: float
 
 
+@dataclass(frozen=True, eq=False)
+class _Marks:
+    marks: tuple[np.ndarray, ...]
+    report: SampleReport
+
+
 class Pipeline:
-    """Cached stages. Thread-safe for one caller at a time per pipeline (the GUI's worker)."""
+    """Cached stages. One caller at a time per pipeline (the GUI's worker, the CLI)."""
 
     def __init__(self, cache_size: int = 4) -> None:
-        self._kerf = _LRU(cache_size)
-        self._fit = _LRU(cache_size)
-        self._fill = _LRU(cache_size)
-        self._marks = _LRU(cache_size)
-        # facts of a drawing or a fit that every run needs (bbox, coordinate quantum,
-        # counts, the stroke segments): computed once per object, not per run
-        self._facts = _LRU(4 * cache_size)
-        self.last_info = RunInfo((), 0.0)
+        self._cache = _Cache(6 * cache_size)
+        # facts of a drawing (bbox, coordinate quantum, point count) and of a fit (counts,
+        # segments): computed once per object, not per run
+        self._facts = _Cache(8 * cache_size)
 
-    def _fact(self, obj: Any, name: str, make: Callable[[], T]) -> T:
-        """``make()`` cached by ``obj``'s identity (the entry keeps ``obj`` alive, so the id
-        cannot be reused while it is cached; drawings and fits are immutable)."""
-        if not isinstance(obj, (tuple, Drawing)):  # a mutable sequence: not cached
-            return make()
-        held, value = self._facts.get((id(obj), name), lambda: (obj, make()))
-        if held is not obj:  # pragma: no cover - an id reused after eviction
-            value = make()
-            with self._facts.lock:
-                self._facts.data[(id(obj), name)] = (obj, value)
-        return cast(T, value)
+    def _fact(self, obj: object, name: str, make: Callable[[], T]) -> T:
+        return self._facts.get(obj, name, make)
 
     def bbox(self, drawing: Drawing) -> tuple[float, float, float, float] | None:
         """``drawing.bbox()``, cached."""
         return self._fact(drawing, "bbox", drawing.bbox)
 
     # ---------------------------------------------------------------- stages
-    def compensated(self, drawing: Drawing, params: Params,
-                    fm: FieldMap) -> tuple[Drawing, tuple[int, ...]]:
-        """The kerf stage (paper 003): the drawing with its regions offset, and for each of
-        its paths the index of the input path it came from (identity without kerf)."""
-        if params.kerf_mm == 0:
-            return drawing, tuple(range(len(drawing.paths)))
-        key = (id(drawing), drawing.sha256, _key(params, "kerf"), fm.magnification)
-
-        def make() -> tuple[Drawing, tuple[int, ...]]:
-            self._ran.append("kerf")
-            return compensate_indexed(drawing, kerf_mm=params.kerf_mm, side=params.kerf_side,
-                                      method=params.kerf_method, fm=fm,
-                                      arc_tol_bits=params.arc_tol_bits)
-
-        return self._kerf.get(key, make)
-
-    def hatched(self, work: Drawing, params: Params, fm: FieldMap) -> list[HatchStroke]:
-        """The fill stage (paper 002): hatch strokes of the (compensated) regions."""
-        if params.fill == "none":
-            return []
-        key = (id(work), work.sha256, _key(params, "fill"), fm.magnification)
-
-        def make() -> list[HatchStroke]:
-            self._ran.append("fill")
-            return hatch(work, fill=params.fill,
-                         spacing_units=fm.mm_to_units(params.hatch_spacing_mm),
-                         angle_deg=params.hatch_angle_deg, passes=params.hatch_passes,
-                         angle_step_deg=params.hatch_angle_step_deg,
-                         inset_units=fm.mm_to_units(params.hatch_inset_mm))
-
-        return self._fill.get(key, make)
-
-    def fitted(self, drawing: Drawing, params: Params,
-               cancel: Callable[[], bool] | None = None) -> tuple[FittedPath, ...]:
-        key = (id(drawing), drawing.sha256, _key(params, "fit"))
-
-        def make() -> tuple[FittedPath, ...]:
-            self._ran.append("fit")
-            # all paths of a batch are thinned and fitted together; cancel() between batches
-            try:
-                return fit_drawing(drawing, eps_line=params.eps_line, e_per=params.e_per,
-                                   eps_sum=params.eps_sum, batch=512, cancel=cancel)
-            except FitCancelled:
-                raise Cancelled() from None
-
-        return self._fit.get(key, make)
-
     def field_map(self, drawing: Drawing, params: Params) -> FieldMap:
-        default_mag = params.field_bits / params.field_size_mm / 40.0  # true size
+        """The field mapping of ``drawing`` (reads the field group; an outward kerf grows
+        the drawing by kerf/2 on the workpiece, so the margin reads the kerf group too)."""
+        true_size = params.field_bits / params.field_size_mm / UNITS_PER_MM
         mag = params.magnification
         if mag is None and not params.fit_field:
-            mag = default_mag
-        # an outward kerf grows the drawing by kerf/2 on the workpiece: leave room for it
+            mag = true_size
         grow_bits = (params.kerf_mm / 2 if params.kerf_side == "outside" else 0.0) / (
             params.field_size_mm / params.field_bits)
         return make_field(self.bbox(drawing), magnification=mag, fit_field=params.fit_field,
                           field_bits=params.field_bits, field_size_mm=params.field_size_mm,
                           offset_bits=params.offset_bits, margin_bits=grow_bits)
 
-    def marks(self, drawing: Drawing, params: Params, fitted: tuple[FittedPath, ...],
-              fm: FieldMap, cancel: Callable[[], bool] | None = None) -> tuple[np.ndarray, ...]:
-        """One stroke of marks per fitted path (int64 bits, before any clamping), cached by
-        the fit and sample fields and the field mapping; what the sampler measured is kept
-        for :meth:`stats` (``self.sample_report``)."""
-        key = (id(drawing), drawing.sha256, _key(params, "fit"), _key(params, "sample"),
-               fm.magnification, fm.offset_bits, fm.field_bits, fm.field_size_mm)
+    @staticmethod
+    def _kerf_key(params: Params, fm: FieldMap) -> Hashable:
+        return None if params.kerf_mm == 0 else (params.group("kerf"), fm)
+
+    def compensated(self, drawing: Drawing, params: Params, fm: FieldMap,
+                    run: _Run | None = None) -> tuple[Drawing, tuple[int, ...]]:
+        """The kerf stage (paper 003): the drawing with its regions offset, and for each of
+        its paths the index of the input path it came from (identity without kerf)."""
+        if params.kerf_mm == 0:
+            return drawing, tuple(range(len(drawing.paths)))
+        run = run or _Run(None)
+
+        def make() -> tuple[Drawing, tuple[int, ...]]:
+            return compensate_indexed(drawing, kerf_mm=params.kerf_mm, side=params.kerf_side,
+                                      method=params.kerf_method, fm=fm,
+                                      arc_tol_bits=params.arc_tol_bits)
+
+        return self._cache.get(drawing, ("kerf", self._kerf_key(params, fm)),
+                               run.stage("kerf", make))
+
+    def fitted(self, drawing: Drawing, params: Params, fm: FieldMap | None = None,
+               run: _Run | None = None) -> tuple[FittedPath, ...]:
+        """The fit stage (paper 000 §2-3) on the (compensated) drawing."""
+        fm = fm or self.field_map(drawing, params)
+        run = run or _Run(None)
+        work, _ = self.compensated(drawing, params, fm, run)
+
+        def make() -> tuple[FittedPath, ...]:
+            # all paths of a batch are thinned and fitted together; cancel() between batches
+            try:
+                return tuple(fit_drawing(work, eps_line=params.eps_line, e_per=params.e_per,
+                                         eps_sum=params.eps_sum, batch=512, cancel=run.cancel))
+            except FitCancelled:
+                raise Cancelled() from None
+
+        key = ("fit", self._kerf_key(params, fm), params.group("fit"))
+        return self._cache.get(drawing, key, run.stage("fit", make))
+
+    def marks(self, drawing: Drawing, params: Params, fm: FieldMap,
+              run: _Run | None = None) -> _Marks:
+        """One stroke of marks per fitted path (int64 bits, before any clamping) with what
+        the sampler measured."""
+        run = run or _Run(None)
+        work, _ = self.compensated(drawing, params, fm, run)
+        fitted = self.fitted(drawing, params, fm, run)
 
         def make() -> _Marks:
-            self._ran.append("sample")
-            if cancel is not None and cancel():
-                raise Cancelled()
             res = sample_paths(
                 fitted, fm, interpolation=params.interpolation,
                 chord_tol_bits=params.chord_tol_bits, min_step_bits=params.min_step_bits,
                 max_step_bits=params.max_step_bits, fixed_step_bits=params.fixed_step_bits,
                 fixed_slope_tol=params.fixed_slope_tol,
-                raw_points=[drawing.paths[fp.source_index].points for fp in fitted],
-                cancel=cancel,
+                raw_points=[work.paths[fp.source_index].points for fp in fitted],
+                cancel=run.cancel,
+                geometry=self._fact(fitted, "sample_geometry", lambda: sample_geometry(fitted)),
             )
-            return _Marks(res.marks, res.report)
+            return _Marks(tuple(res.marks), res.report)
 
-        out = self._marks.get(key, make)
-        self.sample_report: SampleReport | None = out.report
-        return out
+        key = ("sample", self._kerf_key(params, fm), params.group("fit"),
+               params.group("sample"), fm)
+        return self._cache.get(drawing, key, run.stage("sample", make))
+
+    def hatched(self, drawing: Drawing, params: Params, fm: FieldMap,
+                run: _Run | None = None) -> tuple[tuple[HatchStroke, np.ndarray], ...]:
+        """The fill stage (paper 002): hatch strokes of the (compensated) regions, each with
+        its marks (int64 bits, before any clamping)."""
+        if params.fill == "none":
+            return ()
+        run = run or _Run(None)
+        work, _ = self.compensated(drawing, params, fm, run)
+
+        def make() -> tuple[tuple[HatchStroke, np.ndarray], ...]:
+            strokes = hatch(work, fill=params.fill,
+                            spacing_units=fm.mm_to_units(params.hatch_spacing_mm),
+                            angle_deg=params.hatch_angle_deg, passes=params.hatch_passes,
+                            angle_step_deg=params.hatch_angle_step_deg,
+                            inset_units=fm.mm_to_units(params.hatch_inset_mm))
+            run.check()
+            return tuple((h, polyline_marks(h.points, fm, min_step_bits=params.min_step_bits))
+                         for h in strokes)
+
+        key = ("fill", self._kerf_key(params, fm), params.group("fill"), fm,
+               params.min_step_bits)
+        return self._cache.get(drawing, key, run.stage("fill", make))
 
     # ---------------------------------------------------------------- the whole run
-    def run(self, drawing: Drawing, params: Params,
-            cancel: Callable[[], bool] | None = None) -> Job:
+    def run(self, drawing: Drawing, params: Params, cancel: Cancel = None) -> RunResult:
         """Process a drawing into a job. Raises ParamError for values that cannot work (a
         drawing that leaves the field without ``clamp``), Cancelled when ``cancel()`` says so."""
         t0 = time.perf_counter()
-        self._ran: list[str] = []
+        run = _Run(cancel)
         fm = self.field_map(drawing, params)
-        work, origin = self.compensated(drawing, params, fm)
-        fitted = self.fitted(work, params, cancel)
+        work, origin = self.compensated(drawing, params, fm, run)
+        fitted = self.fitted(drawing, params, fm, run)
         warnings: list[Warning] = list(work.warnings)
         quantum = self._fact(drawing, "quantum", lambda: coordinate_quantum(drawing))
         if quantum is not None and params.e_per < 0.5 * quantum:
@@ -209,8 +268,35 @@ class Pipeline:
         out_msg = check_in_field(fm, self.bbox(work), clamp=params.clamp)
         if out_msg:
             warnings.append(Warning(0, 0, out_msg))
-        marks = self.marks(work, params, fitted, fm, cancel)
-        strokes = []
+        sampled = self.marks(drawing, params, fm, run)
+        hatched = self.hatched(drawing, params, fm, run)
+        strokes, clamped = self._strokes(work, origin, fitted, sampled, hatched, params, fm)
+        run.check()
+        t1 = time.perf_counter()
+        ordered: list[Stroke] = order_job_strokes(  # type: ignore[assignment]
+            strokes, fm, method=params.scan_order, time_budget_s=params.order_time_budget_s)
+        t2 = time.perf_counter()
+        stats = self.stats(drawing, params, fitted, fm, ordered, sampled.report)
+        if clamped:
+            warnings.append(Warning(0, 0, f"{clamped} marks were outside the field and clamped"))
+        if stats["dwell_points"]:
+            warnings.append(Warning(0, 0, (
+                f"dwell: {stats['dwell_points']} consecutive marks closer than "
+                f"{params.laser.mark_speed_mm_s * params.laser.point_period_us * 1e-3:.2f} µm "
+                "(mark speed × point period): the beam stands still there and may burn")))
+        job = Job(drawing.name, drawing.sha256, fm, params.processing_dict(),
+                  params.laser.as_dict(), tuple(ordered), stats, tuple(warnings))
+        t3 = time.perf_counter()
+        run.timings["order"] = t2 - t1
+        run.timings["stats"] = t3 - t2
+        return RunResult(job, drawing, params, fm, work, origin, fitted, sampled.report,
+                         tuple(run.ran), dict(run.timings), t3 - t0)
+
+    def _strokes(self, work: Drawing, origin: tuple[int, ...], fitted: tuple[FittedPath, ...],
+                 sampled: _Marks, hatched: tuple[tuple[HatchStroke, np.ndarray], ...],
+                 params: Params, fm: FieldMap) -> tuple[list[Stroke], int]:
+        """The job's strokes in the stages' order (contours, then hatch), clamped when asked;
+        and how many marks were clamped."""
         clamped = 0
 
         def clamp(m: np.ndarray) -> np.ndarray:
@@ -223,42 +309,20 @@ class Pipeline:
 
         segs = self._fact(fitted, "segments", lambda: [
             Segments(fp.is_cubic, fp.points) for fp in fitted])
-        for fp, m, sg in zip(fitted, marks, segs, strict=True):
-            if len(m) == 0:
-                continue
-            strokes.append(Stroke("contour", origin[fp.source_index], fp.closed, clamp(m),
-                                  sg, fp.pen))
-        for h in self.hatched(work, params, fm):
-            src = origin[h.source_index]
-            hm = polyline_marks(h.points, fm, min_step_bits=params.min_step_bits)
-            strokes.append(Stroke("hatch", src, False, clamp(hm), (),
-                                  work.paths[h.source_index].pen))
-        if cancel is not None and cancel():
-            raise Cancelled()
-        strokes = cast(list[Stroke], order_job_strokes(
-            strokes, fm, method=params.scan_order, time_budget_s=params.order_time_budget_s))
-        stats = self.stats(drawing, params, fitted, fm, strokes)
-        if clamped:
-            warnings.append(Warning(0, 0, f"{clamped} marks were outside the field and clamped"))
-        if stats["dwell_points"]:
-            warnings.append(Warning(0, 0, (
-                f"dwell: {stats['dwell_points']} consecutive marks closer than "
-                f"{params.laser.mark_speed_mm_s * params.laser.point_period_us * 1e-3:.2f} µm "
-                "(mark speed × 10 µs): the beam stands still there and may burn")))
-        job = Job(drawing.name, drawing.sha256, fm, params.processing_dict(),
-                  params.laser.as_dict(), tuple(strokes), stats, tuple(warnings))
-        self.last_info = RunInfo(tuple(self._ran), time.perf_counter() - t0)
-        return job
+        strokes = [Stroke("contour", origin[fp.source_index], fp.closed, clamp(m), sg, fp.pen)
+                   for fp, m, sg in zip(fitted, sampled.marks, segs, strict=True) if len(m)]
+        strokes += [Stroke("hatch", origin[h.source_index], False, clamp(hm), (),
+                           work.paths[h.source_index].pen) for h, hm in hatched]
+        return strokes, clamped
 
     def stats(self, drawing: Drawing, params: Params, fitted: tuple[FittedPath, ...],
-              fm: FieldMap, strokes: list[Stroke]) -> dict[str, Any]:
+              fm: FieldMap, strokes: list[Stroke], report: SampleReport | None
+              ) -> dict[str, Any]:
         """Counts, lengths, the time estimate (:mod:`galvo_core.timing`) and what the
         sampler measured: the largest chord height before and after rounding (bits, against
         the true curve; None for raw marks), chords above the tolerance, min-step
         overrides, marks outside the field (before clamping), dwell points."""
-        ms = [s.marks for s in strokes]
-        t, dwell = estimate_with_dwell(ms, params.laser, fm.mm_per_bit)
-        rep = getattr(self, "sample_report", None)
+        t, dwell = estimate_with_dwell([s.marks for s in strokes], params.laser, fm.mm_per_bit)
         n_input = self._fact(drawing, "n_points", lambda: drawing.n_points)
         fit_err, n_control, n_lines, n_cubics = self._fact(fitted, "counts", lambda: (
             max((f.max_error for f in fitted), default=0.0),
@@ -292,26 +356,15 @@ class Pipeline:
             "outside_points": 0,
             "dwell_points": dwell,
         }
-        if rep is not None:
+        if report is not None:
             out.update({
-                "max_chord_height_bits": rep.max_chord_height_bits,
-                "max_chord_height_int_bits": rep.max_chord_height_int_bits,
-                "chord_height_violations": rep.chord_violations,
-                "min_step_overrides": rep.min_step_overrides,
-                "outside_points": rep.outside_points,
+                "max_chord_height_bits": report.max_chord_height_bits,
+                "max_chord_height_int_bits": report.max_chord_height_int_bits,
+                "chord_height_violations": report.chord_violations,
+                "min_step_overrides": report.min_step_overrides,
+                "outside_points": report.outside_points,
             })
         return out
-
-
-class _Marks(tuple):  # type: ignore[type-arg]
-    """The sampled strokes (a tuple of (M, 2) int64 arrays) with the sampler's report."""
-
-    report: SampleReport
-
-    def __new__(cls, marks: list[np.ndarray], report: SampleReport) -> _Marks:
-        obj = super().__new__(cls, marks)
-        obj.report = report
-        return obj
 
 
 def coordinate_quantum(drawing: Drawing) -> float | None:
@@ -326,9 +379,6 @@ def coordinate_quantum(drawing: Drawing) -> float | None:
     return 1.0
 
 
-_default = Pipeline()
-
-
 def process(drawing: Drawing, params: Params | None = None) -> Job:
-    """Process with the module's shared pipeline (convenience for scripts and the CLI)."""
-    return _default.run(drawing, params or Params())
+    """Process with a fresh pipeline (convenience for scripts)."""
+    return Pipeline().run(drawing, params or Params()).job

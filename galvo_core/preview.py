@@ -27,11 +27,12 @@ from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
+from numba import njit
 
 from galvo_core.drawing import Drawing, Warning
 from galvo_core.field import FieldMap
 from galvo_core.fit import FittedPath
-from galvo_core.geometry import cubic_eval, flatten_cubic, point_polyline_distance
+from galvo_core.geometry import flatten_cubic
 from galvo_core.job import Job
 from galvo_core.pipeline import Cancelled
 
@@ -64,6 +65,9 @@ __all__ = [
     "units_to_mm",
     "warning_path",
 ]
+
+#: Layers whose geometry is computed only when shown (``build_preview(layers=...)``).
+OPTIONAL_LAYERS = frozenset({"control", "deviation"})
 
 #: An empty (0, 2) point array.
 EMPTY = np.empty((0, 2), dtype=np.float64)
@@ -244,6 +248,75 @@ def _piece_indices(first: int, last: int, n: int, closed: bool) -> np.ndarray:
     return idx[(idx >= 0) & (idx < n)]
 
 
+@njit(cache=True, nogil=True)
+def _deviation_kernel(src: np.ndarray, off: np.ndarray, npts: np.ndarray, closed: np.ndarray,
+                      ctrl: np.ndarray, first: np.ndarray, last: np.ndarray, ks: np.ndarray,
+                      starts: np.ndarray, a_out: np.ndarray, b_out: np.ndarray,
+                      e_out: np.ndarray) -> None:  # pragma: no cover - jit
+    """Segment ``j``: ``ks[j]`` samples (Bernstein form, uniform parameters), each sample's
+    distance to the source points ``first .. last`` of its path (the path's points are
+    ``src[off[j] : off[j] + npts[j]]``; indices modulo ``npts`` when ``closed``); chords
+    ``starts[j] ..`` of the outputs."""
+    for j in range(ctrl.shape[0]):
+        k = ks[j]
+        if k == 0:
+            continue
+        n = npts[j]
+        o = off[j]
+        p0x, p0y = ctrl[j, 0, 0], ctrl[j, 0, 1]
+        p1x, p1y = ctrl[j, 1, 0], ctrl[j, 1, 1]
+        p2x, p2y = ctrl[j, 2, 0], ctrl[j, 2, 1]
+        p3x, p3y = ctrl[j, 3, 0], ctrl[j, 3, 1]
+        lo = first[j]
+        hi = last[j]
+        if not closed[j]:
+            lo = max(lo, 0)
+            hi = min(hi, n - 1)
+        prev_x = 0.0
+        prev_y = 0.0
+        prev_e = 0.0
+        for i in range(k):
+            t = i / (k - 1)
+            u = 1.0 - t
+            x = u * u * u * p0x + 3.0 * u * u * t * p1x + 3.0 * u * t * t * p2x + t * t * t * p3x
+            y = u * u * u * p0y + 3.0 * u * u * t * p1y + 3.0 * u * t * t * p2y + t * t * t * p3y
+            best = np.inf
+            qx = src[o + lo % n, 0]
+            qy = src[o + lo % n, 1]
+            if hi == lo:
+                best = (x - qx) ** 2 + (y - qy) ** 2
+            for m in range(lo + 1, hi + 1):
+                rx = src[o + m % n, 0]
+                ry = src[o + m % n, 1]
+                vx = rx - qx
+                vy = ry - qy
+                den = vx * vx + vy * vy
+                dx = x - qx
+                dy = y - qy
+                s = 0.0
+                if den > 0.0:
+                    s = (dx * vx + dy * vy) / den
+                    s = min(max(s, 0.0), 1.0)
+                ex = dx - s * vx
+                ey = dy - s * vy
+                d = ex * ex + ey * ey
+                if d < best:
+                    best = d
+                qx = rx
+                qy = ry
+            e = np.sqrt(best)
+            if i > 0:
+                r = starts[j] + i - 1
+                a_out[r, 0] = prev_x
+                a_out[r, 1] = prev_y
+                b_out[r, 0] = x
+                b_out[r, 1] = y
+                e_out[r] = max(prev_e, e)
+            prev_x = x
+            prev_y = y
+            prev_e = e
+
+
 def deviation_samples(
     drawing: Drawing,
     fitted: Sequence[FittedPath],
@@ -260,35 +333,55 @@ def deviation_samples(
     path). Returns ``(a, b, err)``: the sample chords as start points ``a`` (K, 2) and end
     points ``b`` (K, 2) in input units, and ``err`` (K,) the larger error of the chord's two
     ends, in input units. Segments whose source points are unknown are skipped.
+
+    Compiled (numba), one call for the whole drawing: a loop over samples and the source
+    points each segment replaces, so the work is about ``max_samples`` × the input points
+    at most; Python only gathers each segment's control points once.
     """
-    a_out: list[np.ndarray] = []
-    b_out: list[np.ndarray] = []
-    e_out: list[np.ndarray] = []
-    for j, fp in enumerate(fitted):
-        if cancel is not None and j % 32 == 0 and cancel():
-            raise Cancelled()
-        if not 0 <= fp.source_index < len(drawing.paths):
-            continue
-        src = drawing.paths[fp.source_index].points
-        n = len(src)
-        for s in fp.segments:
-            idx = _piece_indices(s.first, s.last, n, fp.closed)
-            if not len(idx):
-                continue
-            piece = src[idx]
-            k = int(np.clip(2 * len(piece), min_samples, max_samples))
-            t = np.linspace(0.0, 1.0, k)
-            if s.kind == "cubic":
-                pts = cubic_eval(s.points, t)
-            else:
-                pts = s.points[0] + t[:, None] * (s.points[-1] - s.points[0])
-            err = point_polyline_distance(pts, piece)
-            a_out.append(pts[:-1])
-            b_out.append(pts[1:])
-            e_out.append(np.maximum(err[:-1], err[1:]))
-    if not a_out:
+    fps = [fp for fp in fitted if 0 <= fp.source_index < len(drawing.paths) and fp.segments
+           and len(drawing.paths[fp.source_index].points)]
+    if not fps:
         return EMPTY, EMPTY, np.empty(0)
-    return np.concatenate(a_out), np.concatenate(b_out), np.concatenate(e_out)
+    if cancel is not None and cancel():
+        raise Cancelled()
+    srcs = [drawing.paths[fp.source_index].points for fp in fps]
+    plen = np.fromiter((len(p) for p in srcs), dtype=np.int64, count=len(srcs))
+    poff = np.concatenate(([0], np.cumsum(plen)[:-1]))
+    src = np.ascontiguousarray(np.concatenate(srcs), dtype=np.float64)
+    nseg = np.fromiter((len(fp.segments) for fp in fps), dtype=np.int64, count=len(fps))
+    segs = [sg for fp in fps for sg in fp.segments]
+    first = np.fromiter((sg.first for sg in segs), dtype=np.int64, count=len(segs))
+    last = np.fromiter((sg.last for sg in segs), dtype=np.int64, count=len(segs))
+    pts = [sg.points for sg in segs]
+    if cancel is not None and cancel():
+        raise Cancelled()
+    is_cubic = np.fromiter((len(q) == 4 for q in pts), dtype=bool, count=len(pts))
+    ctrl = np.empty((len(segs), 4, 2))
+    if is_cubic.any():
+        ctrl[is_cubic] = np.stack([q for q, c in zip(pts, is_cubic, strict=True) if c])
+    if not is_cubic.all():
+        # a line as a cubic with its inner points at thirds: B(t) = P0 + t (P3 - P0)
+        ends = np.stack([(q[0], q[-1]) for q, c in zip(pts, is_cubic, strict=True) if not c])
+        d = ends[:, 1] - ends[:, 0]
+        ctrl[~is_cubic] = np.stack((ends[:, 0], ends[:, 0] + d / 3.0,
+                                    ends[:, 0] + 2.0 * d / 3.0, ends[:, 1]), axis=1)
+    off = np.repeat(poff, nseg)
+    npts = np.repeat(plen, nseg)
+    closed = np.repeat(np.fromiter((bool(fp.closed) for fp in fps), dtype=bool,
+                                   count=len(fps)), nseg)
+    count = np.where(closed, np.maximum(last - first + 1, 0),
+                     np.maximum(np.minimum(last, npts - 1) - np.maximum(first, 0) + 1, 0))
+    ks = np.where(count > 0, np.clip(2 * count, min_samples, max_samples), 0)
+    chords = np.maximum(ks - 1, 0)
+    total = int(chords.sum())
+    if not total:
+        return EMPTY, EMPTY, np.empty(0)
+    starts = np.concatenate(([0], np.cumsum(chords)[:-1]))
+    a = np.empty((total, 2))
+    b = np.empty((total, 2))
+    e = np.empty(total)
+    _deviation_kernel(src, off, npts, closed, ctrl, first, last, ks, starts, a, b, e)
+    return a, b, e
 
 
 # ------------------------------------------------------------------ job geometry
@@ -301,27 +394,44 @@ def stroke_curves(job: Job, tol: float, kinds: Iterable[str] = ("contour",)) -> 
                     (s.source_index for s in strokes))
 
 
+def _all_marks(strokes: Sequence[Any]) -> tuple[np.ndarray, np.ndarray]:
+    """Every mark of ``strokes`` in order as one (M, 2) int64 array, and each stroke's mark
+    count (one concatenation, no Python work per mark)."""
+    if not strokes:
+        return np.empty((0, 2), dtype=np.int64), np.empty(0, dtype=np.int64)
+    lens = np.fromiter((len(s.marks) for s in strokes), dtype=np.int64, count=len(strokes))
+    if not lens.sum():
+        return np.empty((0, 2), dtype=np.int64), lens
+    allm = np.concatenate([s.marks for s in strokes if len(s.marks)])
+    return np.asarray(allm, dtype=np.int64).reshape(-1, 2), lens
+
+
 def mark_points(job: Job, kinds: Iterable[str] | None = None) -> tuple[np.ndarray, np.ndarray]:
     """Every mark of the job's strokes (of ``kinds``; all when None) in marking order:
     ``(bits (M, 2) int64, ids (M,) source_index)``."""
-    strokes = [s for s in job.strokes if kinds is None or s.kind in set(kinds)]
+    want = None if kinds is None else set(kinds)
+    strokes = [s for s in job.strokes if want is None or s.kind in want]
     if not strokes:
         return np.empty((0, 2), dtype=np.int64), _NO_IDS
-    marks = [np.asarray(s.marks, dtype=np.int64).reshape(-1, 2) for s in strokes]
-    ids = np.repeat(np.fromiter((s.source_index for s in strokes), dtype=np.int64,
-                                count=len(strokes)),
-                    [len(m) for m in marks])
-    return np.concatenate(marks), ids
+    marks, lens = _all_marks(strokes)
+    src = np.fromiter((s.source_index for s in strokes), dtype=np.int64, count=len(strokes))
+    return marks, np.repeat(src, lens)
 
 
 def jump_segments(job: Job) -> np.ndarray:
     """The laser-off moves between consecutive strokes (last mark -> next first mark) as
     NaN-separated pairs, galvo bits (float)."""
-    ends = [(s.marks[0], s.marks[-1]) for s in job.strokes if len(s.marks)]
-    if len(ends) < 2:
+    return _jumps_from(*_all_marks(job.strokes))
+
+
+def _jumps_from(marks: np.ndarray, lens: np.ndarray) -> np.ndarray:
+    lens = lens[lens > 0]
+    if len(lens) < 2:
         return EMPTY
-    starts = np.array([e[0] for e in ends[1:]], dtype=np.float64)
-    stops = np.array([e[1] for e in ends[:-1]], dtype=np.float64)
+    ends = np.cumsum(lens)
+    firsts = marks[ends - lens].astype(np.float64)
+    lasts = marks[ends - 1].astype(np.float64)
+    starts, stops = firsts[1:], lasts[:-1]
     moving = (starts != stops).any(axis=1)
     starts, stops = starts[moving], stops[moving]
     out = np.full((3 * len(starts), 2), np.nan)
@@ -444,6 +554,12 @@ class Preview:
     tolerance_units: float
     #: bounding box (mm) of everything drawn, None when nothing is
     bounds: tuple[float, float, float, float] | None
+    #: the optional layers computed ("control", "deviation"); None: all of them
+    layers: frozenset[str] | None = None
+
+    def has_layer(self, key: str) -> bool:
+        """True when this preview holds the geometry of layer ``key`` (computed)."""
+        return self.layers is None or key not in OPTIONAL_LAYERS or key in self.layers
 
     @property
     def um_per_unit(self) -> float:
@@ -576,8 +692,13 @@ def build_preview(
     *,
     cache: PreviewCache | None = None,
     cancel: Callable[[], bool] | None = None,
+    layers: Iterable[str] | None = None,
 ) -> Preview:
     """All display geometry of a run (or of a loaded job file: no drawing, no fit).
+
+    ``layers`` (keys of the GUI's layers; None: all) limits the costly optional layers to
+    those shown: the control points (``"control"``) and the deviation overlay
+    (``"deviation"``) are left empty when not asked for. ``Preview.layers`` says which were.
 
     Without ``fitted`` the fitted-curve layer is taken from the job's contour strokes' stored
     segments (no control points, no deviation). The kerf layer shows the job's contour-stroke
@@ -604,23 +725,38 @@ def build_preview(
     else:
         original, o_pts, o_ids, o_box = Polylines(), EMPTY, _NO_IDS, None
 
+    want = None if layers is None else frozenset(layers)
+
+    def shown(key: str) -> bool:
+        return want is None or key in want
+
     if fitted is not None:
         fit_tuple = fitted
+        key = (id(fit_tuple), id(drawing), round(tol_units, 12))
 
-        def make_fit() -> tuple[Any, ...]:
+        def make_curve() -> tuple[Any, ...]:
             curve = fitted_curve(fit_tuple, tol_units)
-            c_xy, c_role = control_layer(fit_tuple)
-            if drawing is not None:
-                da, db, de = deviation_samples(drawing, fit_tuple, cancel=cancel)
-            else:
-                da, db, de = EMPTY, EMPTY, np.empty(0)
-            return fit_tuple, drawing, curve, bbox(curve.xy), c_xy, c_role, da, db, de
+            return fit_tuple, drawing, curve, bbox(curve.xy)
 
-        (_, _, curve, c_box, c_xy, c_role, dev_a, dev_b, dev_e) = cache.get(
-            ("fit", id(fit_tuple), id(drawing), round(tol_units, 12)), make_fit)
-        (_, dev_level) = cache.get(
-            ("level", id(dev_e), e_tol),
-            lambda: (dev_e, np.clip(dev_e / e_tol, 0.0, 1.0) if e_tol > 0 else dev_e * 0.0))
+        _, _, curve, c_box = cache.get(("curve", *key), make_curve)
+        if shown("control"):
+            _, c_xy, c_role = cache.get(("control", id(fit_tuple)),
+                                        lambda: (fit_tuple, *control_layer(fit_tuple)))
+        else:
+            c_xy, c_role = EMPTY, np.empty(0, dtype=np.int8)
+        if shown("deviation") and drawing is not None:
+            def make_dev() -> tuple[Any, ...]:
+                return (fit_tuple, drawing,
+                        *deviation_samples(drawing, fit_tuple, cancel=cancel))
+
+            _, _, dev_a, dev_b, dev_e = cache.get(("deviation", id(fit_tuple), id(drawing)),
+                                                  make_dev)
+            (_, dev_level) = cache.get(
+                ("level", id(dev_e), e_tol),
+                lambda: (dev_e, np.clip(dev_e / e_tol, 0.0, 1.0) if e_tol > 0
+                         else dev_e * 0.0))
+        else:
+            dev_a, dev_b, dev_e, dev_level = EMPTY, EMPTY, np.empty(0), np.empty(0)
     else:
         curve = stroke_curves(job, tol_units)
         c_box = bbox(curve.xy)
@@ -630,9 +766,12 @@ def build_preview(
     kerf_on = float(job.params.get("kerf_mm", 0.0) or 0.0) > 0.0
     kerf = stroke_curves(job, tol_units) if kerf_on else Polylines()
 
-    marks_bits, mark_ids = mark_points(job)
+    marks_bits, lens = _all_marks(job.strokes)  # once for the marks and the jumps
+    src = np.fromiter((s.source_index for s in job.strokes), dtype=np.int64,
+                      count=len(job.strokes))
+    mark_ids = np.repeat(src, lens)
     marks = marks_bits.astype(np.float64)
-    jumps = jump_segments(job)
+    jumps = _jumps_from(marks_bits, lens)
     hatch = hatch_polylines(job)
 
     bounds = _union(_affine_box(_union(o_box, c_box, bbox(kerf.xy)), scale, offset),
@@ -660,6 +799,7 @@ def build_preview(
         deviation_level=dev_level,
         tolerance_units=e_tol,
         bounds=bounds,
+        layers=None if want is None else frozenset(want & OPTIONAL_LAYERS),
     )
 
 

@@ -91,16 +91,16 @@ import math
 import threading
 from collections import OrderedDict
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, fields
 from typing import Any
 
 import numpy as np
 
-from galvo_core.errors import ParamError
+from galvo_core.errors import Cancelled, ParamError
 from galvo_core.field import FieldMap
 from galvo_core.fit import FittedPath
 from galvo_core.geometry import power_coeffs_into
-from galvo_core.timing import CORNER_DEG
+from galvo_core.turns import CORNER_DEG, turn_deg
 
 __all__ = [
     "E_MIN_RATIO",
@@ -119,7 +119,23 @@ __all__ = [
 E_MIN_RATIO = 0.97
 #: the most that rounding a mark to whole bits adds to a chord height
 ROUNDING_BOUND_BITS = math.sqrt(2.0) / 2.0
+#: trials of one chord's step before the search takes the longest chord found to pass
 _MAX_TRIALS = 60
+#: a chord this close to ``max_step`` (as a share of it) is long enough to be accepted even
+#: below E_min: asking for more would only shave the last few percent of the step
+_MAX_STEP_ACCEPT = 0.98
+#: when the step would break ``max_step``, the next trial aims this far below it
+_MAX_STEP_AIM = 0.99
+#: the bracket [lo, hi] of a chord's step is collapsed when narrower than this share of hi
+_BRACKET_REL = 1e-9
+#: the height grows as step**p between two trials; p is kept in this range (2: a smooth
+#: curve's chord height, 1: a corner's, up to 4 near an inflection) and is 2 until measured
+_GROWTH_MIN, _GROWTH_MAX, _GROWTH_DEFAULT = 1.0, 4.0, 2.0
+#: a chord stretched to the minimum step: corrections of its length (the length is not
+#: linear in the parameter) and the largest stretch per correction
+_MIN_STEP_FIXES, _MIN_STEP_GROWTH = 3, 4.0
+#: the search looks at ``cancel`` every this many rounds
+_CANCEL_EVERY = 64
 _OVER_SAMPLES = 64
 #: about how many marks a chain of smoothly joined cubics gathers before it is cut
 _CHAIN_MARKS = 64
@@ -557,9 +573,7 @@ def _search_h(curves: _Curves, ids0: np.ndarray, t0: np.ndarray,
     rounds = 0
     while len(k):
         rounds += 1
-        if cancel is not None and rounds % 64 == 0 and cancel():
-            from galvo_core.pipeline import Cancelled
-
+        if cancel is not None and rounds % _CANCEL_EVERY == 0 and cancel():
             raise Cancelled()
         ids = ids0[k]
         te = t1[k]
@@ -570,14 +584,14 @@ def _search_h(curves: _Curves, ids0: np.ndarray, t0: np.ndarray,
         H, L = curves.height(ids, ta, tb)
         trials += len(k)
         ok = (H <= e_max) & (L <= max_step)
-        acc = ok & (end | (H >= e_min) | (L >= 0.98 * max_step))
+        acc = ok & (end | (H >= e_min) | (L >= _MAX_STEP_ACCEPT * max_step))
         it += 1
         lo = np.where(ok, np.maximum(lo, trial), lo)
         hi = np.where(ok, hi, np.minimum(hi, trial))
         # the minimum step: a chord shorter than it is only taken at the curve's end
         short_fail = ~ok & (L < min_step)
         short_acc = acc & ~end & (L < min_step)
-        stuck = ~acc & ~short_fail & ((np.isfinite(hi) & ((hi - lo) <= 1e-9 * hi))
+        stuck = ~acc & ~short_fail & ((np.isfinite(hi) & ((hi - lo) <= _BRACKET_REL * hi))
                                        | (it >= _MAX_TRIALS))
         ovr = short_fail | short_acc | (stuck & (lo <= 0.0))
         take_lo = stuck & (lo > 0.0)
@@ -586,20 +600,10 @@ def _search_h(curves: _Curves, ids0: np.ndarray, t0: np.ndarray,
         stretch = np.where(np.isfinite(stretch), stretch, rem)
         t_new = tb.copy()
         t_new[take_lo] = (ta + lo)[take_lo]
-        if ovr.any():  # a chord of min_step length: L(Δt) is not linear, correct twice
+        if ovr.any():
             io = np.flatnonzero(ovr)
-            dto = np.maximum(stretch, trial)[io]
-            for _ in range(3):
-                t_try = np.minimum(ta[io] + dto, te[io])
-                d = curves.point(ids[io], t_try) - curves.point(ids[io], ta[io])
-                lo_len = np.sqrt((d * d).sum(axis=1))
-                with np.errstate(divide="ignore", invalid="ignore"):
-                    f = min_step / lo_len
-                grow = np.isfinite(f) & (f > 1.0) & (t_try < te[io])
-                if not grow.any():
-                    break
-                dto = np.where(grow, dto * np.minimum(f, 4.0), dto)
-            t_new[io] = np.minimum(ta[io] + dto, te[io])
+            t_new[io] = _min_step_end(curves, ids[io], ta[io], te[io],
+                                      np.maximum(stretch, trial)[io], min_step)
         done = acc | ovr | take_lo
         if done.any():
             out_k.append(k[done])
@@ -608,16 +612,7 @@ def _search_h(curves: _Curves, ids0: np.ndarray, t0: np.ndarray,
             # the measured height belongs to the chord ta -> tb: only where t_new is tb
             out_h.append(np.where(ovr | take_lo, np.nan, H)[done])
             out_a.append(np.where(ovr | take_lo, np.nan, ta)[done])
-        # next trial for the rest: rescale by the measured growth law, inside the bracket
-        with np.errstate(divide="ignore", invalid="ignore"):
-            p = np.log(H / pH) / np.log(trial / pdt)
-        p = np.where(np.isfinite(p), np.clip(p, 1.0, 4.0), 2.0)
-        with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
-            nxt = trial * (hp / np.maximum(H, _TINY)) ** (1.0 / p)
-            nxt = np.where(L > max_step, np.minimum(nxt, trial * 0.99 * max_step / L), nxt)
-        inside = (nxt > lo) & (nxt < hi) & np.isfinite(nxt)
-        mid = np.where(np.isfinite(hi), np.where(lo > 0.0, 0.5 * (lo + hi), 0.5 * hi), 2.0 * lo)
-        nxt = np.where(inside, nxt, mid)
+        nxt = _next_trial(trial, H, L, pdt, pH, lo, hi, hp, max_step)
         pdt, pH, dt = trial, H, nxt
         # accepted: move on (curves that reached their end leave)
         ta = np.where(done, t_new, ta)
@@ -641,6 +636,44 @@ def _search_h(curves: _Curves, ids0: np.ndarray, t0: np.ndarray,
     aa = np.concatenate(out_a)
     order = np.argsort(kk, kind="stable")  # rounds emit increasing t per curve
     return kk[order], tt[order], oo[order], trials, hh[order], aa[order]
+
+
+def _min_step_end(curves: _Curves, ids: np.ndarray, ta: np.ndarray, te: np.ndarray,
+                  dto: np.ndarray, min_step: float) -> np.ndarray:
+    """The end parameter of a chord from ``ta`` stretched to ``min_step`` long (not past
+    ``te``), from the first guess ``ta + dto``: the chord's length is not linear in the
+    parameter, so the guess is corrected a few times."""
+    for _ in range(_MIN_STEP_FIXES):
+        t_try = np.minimum(ta + dto, te)
+        d = curves.point(ids, t_try) - curves.point(ids, ta)
+        length = np.sqrt((d * d).sum(axis=1))
+        with np.errstate(divide="ignore", invalid="ignore"):
+            f = min_step / length
+        grow = np.isfinite(f) & (f > 1.0) & (t_try < te)
+        if not grow.any():
+            break
+        dto = np.where(grow, dto * np.minimum(f, _MIN_STEP_GROWTH), dto)
+    return np.minimum(ta + dto, te)
+
+
+def _next_trial(trial: np.ndarray, H: np.ndarray, L: np.ndarray, pdt: np.ndarray,
+                pH: np.ndarray, lo: np.ndarray, hi: np.ndarray, hp: float,
+                max_step: float) -> np.ndarray:
+    """The next step to try for the chords not yet accepted: the last step rescaled by the
+    growth law measured between the last two trials (height ~ step**p) to hit the middle
+    of the window ``hp``, kept under ``max_step`` and inside the bracket [lo, hi] of steps
+    known to pass and to fail (else the bracket's middle, or twice ``lo`` when nothing has
+    failed yet)."""
+    with np.errstate(divide="ignore", invalid="ignore"):
+        p = np.log(H / pH) / np.log(trial / pdt)
+    p = np.where(np.isfinite(p), np.clip(p, _GROWTH_MIN, _GROWTH_MAX), _GROWTH_DEFAULT)
+    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
+        nxt = trial * (hp / np.maximum(H, _TINY)) ** (1.0 / p)
+        nxt = np.where(L > max_step, np.minimum(nxt, trial * _MAX_STEP_AIM * max_step / L),
+                       nxt)
+    inside = (nxt > lo) & (nxt < hi) & np.isfinite(nxt)
+    mid = np.where(np.isfinite(hi), np.where(lo > 0.0, 0.5 * (lo + hi), 0.5 * hi), 2.0 * lo)
+    return np.where(inside, nxt, mid)
 
 
 def _fix_short_ends(curves: _Curves, ids0: np.ndarray, t0: np.ndarray,
@@ -994,16 +1027,8 @@ class _Geometry:
         corner = np.zeros(g, dtype=bool)
         if g > 1:
             a, b = te[:-1], ts[1:]
-            ax_, ay_, bx_, by_ = a[:, 0], a[:, 1], b[:, 0], b[:, 1]
-            cr = ax_ * by_
-            cr -= ay_ * bx_
-            dot = ax_ * bx_
-            dot += ay_ * by_
-            ang = np.arctan2(cr, dot)
-            del cr, dot
-            np.abs(ang, out=ang)
-            np.degrees(ang, out=ang)
-            deg = ~(((ax_ != 0) | (ay_ != 0)) & ((bx_ != 0) | (by_ != 0)))
+            ang = turn_deg(a, b)
+            deg = ~((a != 0).any(axis=1) & (b != 0).any(axis=1))
             corner[:-1] = ((ang > CORNER_DEG) | deg) & (self.seg_path[:-1] ==
                                                          self.seg_path[1:])
             del ang, deg
@@ -1019,27 +1044,12 @@ class _Geometry:
         return out
 
 
-_GEO_CACHE: OrderedDict[int, tuple[Sequence[FittedPath], _Geometry]] = OrderedDict()
-_GEO_LOCK = threading.Lock()
-
-
-def _geometry(fitted: Sequence[FittedPath]) -> _Geometry:
-    """:class:`_Geometry` of ``fitted``, cached by identity for tuples (the pipeline's
-    cached fit): a re-sample at another magnification or tolerance gathers nothing again.
-    Each entry holds its tuple, so an id cannot be reused while cached."""
-    if not isinstance(fitted, tuple):
-        return _Geometry(fitted)
-    with _GEO_LOCK:
-        hit = _GEO_CACHE.get(id(fitted))
-        if hit is not None and hit[0] is fitted:
-            _GEO_CACHE.move_to_end(id(fitted))
-            return hit[1]
-    geo = _Geometry(fitted)
-    with _GEO_LOCK:
-        _GEO_CACHE[id(fitted)] = (fitted, geo)
-        while len(_GEO_CACHE) > 2:
-            _GEO_CACHE.popitem(last=False)
-    return geo
+def sample_geometry(fitted: Sequence[FittedPath]) -> _Geometry:
+    """Every segment of ``fitted`` gathered for the sampler (paths, kinds, control points):
+    made once per fit and passed to :func:`sample_paths` again (``geometry=``) when the same
+    fit is re-sampled at another magnification or tolerance (the pipeline keeps it with
+    its cached fit)."""
+    return _Geometry(fitted)
 
 
 def sample_paths(
@@ -1054,98 +1064,151 @@ def sample_paths(
     fixed_slope_tol: float = 0.05,
     raw_points: Sequence[np.ndarray] | None = None,
     cancel: Callable[[], bool] | None = None,
+    geometry: _Geometry | None = None,
 ) -> SampleResult:
     """Marks of many fitted paths at once (one stroke each, (M, 2) int64 bits, in the
     direction of the segments; empty for a path without segments), and what was measured.
 
     All cubics of all paths are searched together, so the cost per mark stays low however
     many paths there are. ``raw_points[i]`` are the input points of ``fitted[i]`` (needed for
-    ``raw``).
+    ``raw``). The steps: the marks' curve parameters (cubics by the search or paper 001's
+    fixed step, lines by their ends), merged in path order; the minimum step; rounding to
+    whole bits; every chord measured against the true curve; one stroke per path.
     """
     if interpolation not in ("adaptive", "fixed", "raw"):
         raise ParamError(f"interpolation must be adaptive, fixed or raw; got {interpolation!r}")
     tol = float(chord_tol_bits)
     report = SampleReport(interpolation, tol)
     res = SampleResult([], report)
-    mx = fm.max_bit
     if interpolation == "raw":
-        for i, _fp in enumerate(fitted):
-            pts = raw_points[i] if raw_points is not None else np.empty((0, 2))
-            m = _dedup(fm.to_bits(np.asarray(pts, dtype=np.float64).reshape(-1, 2)))
-            res.marks.append(m)
-            report.outside_points += int(((m < 0) | (m > mx)).any(axis=1).sum()) if len(m) else 0
+        res.marks = _raw_marks(fitted, fm, raw_points, report)
         return res
     ms_max = math.inf if max_step_bits is None else float(max_step_bits)
     min_step = float(min_step_bits)
-    # ---- every segment of every path, in bits, in power form
-    geo = _geometry(fitted)
-    path_first, path_n, is_cubic = geo.path_first, geo.path_n, geo.is_cubic
-    if not len(is_cubic):
+    # every segment of every path, in bits, in power form (a line's: a = b = 0)
+    geo = geometry if geometry is not None else sample_geometry(fitted)
+    if not len(geo.is_cubic):
         res.marks = [np.empty((0, 2), dtype=np.int64) for _ in fitted]
         return res
-    ends, coef, corner, cf = geo.fielded(fm)  # a line's power form: a = b = 0
+    ends, coef, corner, cf = geo.fielded(fm)
     cs = _CubicSet(coef, cf=cf)
     res.coef = coef
-    # ---- marks (segment id, t) per segment, t in (0, 1], last at 1
-    seg_ids: list[np.ndarray] = []
-    seg_ts: list[np.ndarray] = []
-    # the search's own measurement of the chord ending at each mark, and that chord's start
-    # parameter (NaN where there is none): reused below where the chord is still that one
-    seg_h: list[np.ndarray] = []
-    seg_a: list[np.ndarray] = []
-    cub = np.flatnonzero(is_cubic)
-    if len(cub):
-        if interpolation == "adaptive":
-            # cubics meeting smoothly are searched as one curve: no mark is forced at
-            # their joint, and no partial chord is left at the end of each cubic
-            first, n = _smooth_chains(cf, is_cubic, corner, geo.seg_path, tol)
-            chains = _ChainSet(cs, first, n)
-            ck = np.arange(len(first))
-            s0 = np.zeros(len(first))
-            kk, ss, oo, trials, hh, aa = _search_h(
-                chains, ck, s0, n.astype(np.float64), e_min=E_MIN_RATIO * tol, e_max=tol,
-                min_step=min_step, max_step=ms_max, cancel=cancel)
-            _fix_short_ends(chains, ck, s0, kk, ss, e_max=tol, min_step=min_step, h=hh, a=aa)
-            report.min_step_overrides = int(oo.sum())
-            report.trials = trials
-            gid, tt = chains.locate(kk, ss, ending=True)
-            # the search's measurement is reused for chords within one cubic only
-            aa = aa - (gid - first[kk])
-            within = aa >= 0.0  # NaN compares False
-            seg_ids.append(gid)
-            seg_ts.append(tt)
-            seg_h.append(np.where(within, hh, np.nan))
-            seg_a.append(np.where(within, aa, np.nan))
-        else:
-            for g in cub.tolist():
-                tf = _fixed_params(cs, g, float(fixed_step_bits), float(fixed_slope_tol))
-                seg_ids.append(np.full(len(tf), g))
-                seg_ts.append(tf)
-    lines = np.flatnonzero(~is_cubic)
-    if len(lines):
-        if math.isfinite(ms_max):
-            ln = np.hypot(*(ends[lines, 1] - ends[lines, 0]).T)
-            nseg = np.maximum(1, np.ceil(ln / ms_max - 1e-9)).astype(np.int64)
-            rep = np.repeat(lines, nseg)
-            start = np.cumsum(nseg) - nseg
-            idx = np.arange(len(rep)) - np.repeat(start, nseg) + 1
-            seg_ids.append(rep)
-            seg_ts.append(idx / np.repeat(nseg, nseg))
-        else:
-            seg_ids.append(lines)
-            seg_ts.append(np.ones(len(lines)))
-    # the start mark of every non-empty path: (first segment, t = 0); every other mark has
-    # t > 0
-    seg_path = geo.seg_path
-    firsts = path_first[path_n > 0]
-    sid = np.concatenate([firsts] + seg_ids).astype(np.int64)
-    st = np.concatenate([np.zeros(len(firsts))] + seg_ts)
-    n_known = sum(len(x) for x in seg_h)
-    hm = np.full(len(sid), np.nan)
-    am = np.full(len(sid), np.nan)
-    if n_known:  # the search's block comes right after the starts
-        hm[len(firsts):len(firsts) + n_known] = np.concatenate(seg_h)
-        am[len(firsts):len(firsts) + n_known] = np.concatenate(seg_a)
+    blocks = _cubic_params(cs, cf, geo, corner, interpolation, tol, min_step, ms_max,
+                           float(fixed_step_bits), float(fixed_slope_tol), report, cancel)
+    blocks.append(_line_params(np.flatnonzero(~geo.is_cubic), ends, ms_max))
+    mk = _merged_marks(cs, geo, ends, corner, blocks)
+    if min_step > 0.0:
+        mk = _min_step_pass(mk, cs, tol, min_step, report)
+    r, mk = _rounded(mk)
+    report.outside_points = int(((r < 0) | (r > fm.max_bit)).any(axis=1).sum())
+    _measure_into(report, mk, r, cs, geo.is_cubic, tol)
+    # one stroke per path
+    cuts = np.searchsorted(mk.pid, np.arange(len(fitted) + 1)).tolist()
+    cuts[-1] = len(mk.pid)
+    spans = list(zip(cuts[:-1], cuts[1:], strict=True))
+    res.marks = [r[a:b] for a, b in spans]
+    res.float_marks = [mk.pos[a:b] for a, b in spans]
+    res.params = [(mk.sid[a:b], mk.st[a:b]) for a, b in spans]
+    return res
+
+
+def _raw_marks(fitted: Sequence[FittedPath], fm: FieldMap,
+               raw_points: Sequence[np.ndarray] | None, report: SampleReport
+               ) -> list[np.ndarray]:
+    """``raw``: the input points themselves, rounded, consecutive repeats dropped."""
+    out = []
+    for i, _fp in enumerate(fitted):
+        pts = raw_points[i] if raw_points is not None else np.empty((0, 2))
+        m = _dedup(fm.to_bits(np.asarray(pts, dtype=np.float64).reshape(-1, 2)))
+        out.append(m)
+        report.outside_points += (int(((m < 0) | (m > fm.max_bit)).any(axis=1).sum())
+                                  if len(m) else 0)
+    return out
+
+
+@dataclass
+class _ParamBlock:
+    """Marks as (segment id, t) with t in (0, 1], and, where the search measured it, the
+    chord ending at each mark (height ``h`` and its start parameter ``a``; NaN: unknown)."""
+
+    ids: np.ndarray
+    ts: np.ndarray
+    h: np.ndarray | None = None
+    a: np.ndarray | None = None
+
+
+def _cubic_params(cs: _CubicSet, cf: CF, geo: _Geometry, corner: np.ndarray,
+                  interpolation: str, tol: float, min_step: float, ms_max: float,
+                  fixed_step: float, fixed_slope_tol: float, report: SampleReport,
+                  cancel: Callable[[], bool] | None) -> list[_ParamBlock]:
+    """The marks on the cubics: the adaptive search (paper 000 §4, 004) over chains of
+    cubics that meet smoothly (no mark forced at their joints, no partial chord left at the
+    end of each cubic), or paper 001's fixed step cubic by cubic."""
+    cub = np.flatnonzero(geo.is_cubic)
+    if not len(cub):
+        return []
+    if interpolation != "adaptive":
+        return [_ParamBlock(np.full(len(tf), g), tf) for g in cub.tolist()
+                for tf in (_fixed_params(cs, g, fixed_step, fixed_slope_tol),)]
+    first, n = _smooth_chains(cf, geo.is_cubic, corner, geo.seg_path, tol)
+    chains = _ChainSet(cs, first, n)
+    ck = np.arange(len(first))
+    s0 = np.zeros(len(first))
+    kk, ss, oo, trials, hh, aa = _search_h(
+        chains, ck, s0, n.astype(np.float64), e_min=E_MIN_RATIO * tol, e_max=tol,
+        min_step=min_step, max_step=ms_max, cancel=cancel)
+    _fix_short_ends(chains, ck, s0, kk, ss, e_max=tol, min_step=min_step, h=hh, a=aa)
+    report.min_step_overrides = int(oo.sum())
+    report.trials = trials
+    gid, tt = chains.locate(kk, ss, ending=True)
+    # the search's measurement is reused for chords within one cubic only
+    aa = aa - (gid - first[kk])
+    within = aa >= 0.0  # NaN compares False
+    return [_ParamBlock(gid, tt, np.where(within, hh, np.nan), np.where(within, aa, np.nan))]
+
+
+def _line_params(lines: np.ndarray, ends: np.ndarray, ms_max: float) -> _ParamBlock:
+    """The marks on the lines: their ends, and steps of at most ``ms_max`` between."""
+    if not math.isfinite(ms_max) or not len(lines):
+        return _ParamBlock(lines, np.ones(len(lines)))
+    ln = np.hypot(*(ends[lines, 1] - ends[lines, 0]).T)
+    nseg = np.maximum(1, np.ceil(ln / ms_max - 1e-9)).astype(np.int64)
+    start = np.cumsum(nseg) - nseg
+    idx = np.arange(int(nseg.sum())) - np.repeat(start, nseg) + 1
+    return _ParamBlock(np.repeat(lines, nseg), idx / np.repeat(nseg, nseg))
+
+
+@dataclass
+class _MarkRows:
+    """Every mark of every path in path order: segment id, parameter, float position
+    (bits), path, the search's chord height and start (NaN: unknown), first/last of a
+    stroke, protected (stroke ends and corner joints: never merged)."""
+
+    sid: np.ndarray
+    st: np.ndarray
+    pos: np.ndarray
+    pid: np.ndarray
+    hm: np.ndarray
+    am: np.ndarray
+    first_of: np.ndarray
+    last_of: np.ndarray
+    prot: np.ndarray
+
+    def keep(self, keep: np.ndarray) -> _MarkRows:
+        return _MarkRows(*(getattr(self, f.name)[keep] for f in fields(self)))
+
+
+def _merged_marks(cs: _CubicSet, geo: _Geometry, ends: np.ndarray, corner: np.ndarray,
+                  blocks: list[_ParamBlock]) -> _MarkRows:
+    """The blocks and the start mark of every non-empty path (first segment, t = 0; every
+    other mark has t > 0), in path order, with their positions."""
+    firsts = geo.path_first[geo.path_n > 0]
+    sid = np.concatenate([firsts] + [b.ids for b in blocks]).astype(np.int64)
+    st = np.concatenate([np.zeros(len(firsts))] + [b.ts for b in blocks])
+    hm = np.concatenate([np.full(len(firsts), np.nan)] + [
+        b.h if b.h is not None else np.full(len(b.ids), np.nan) for b in blocks])
+    am = np.concatenate([np.full(len(firsts), np.nan)] + [
+        b.a if b.a is not None else np.full(len(b.ids), np.nan) for b in blocks])
     # each block is sorted by (segment, t) and starts come first: a stable sort by segment
     # merges the runs (timsort, about linear here)
     order = np.argsort(sid, kind="stable")
@@ -1155,86 +1218,93 @@ def sample_paths(
     pos[at1] = ends[sid[at1], 1]  # segment ends exactly (continuity)
     at0 = st <= 0.0
     pos[at0] = ends[sid[at0], 0]
-    pid = seg_path[sid]
-    # ---- protected marks: stroke ends and corner joints
+    pid = geo.seg_path[sid]
     first_of = np.r_[True, pid[1:] != pid[:-1]]
     last_of = np.r_[pid[1:] != pid[:-1], True]
     prot = first_of | last_of | (at1 & corner[sid])
-    # ---- the minimum step between consecutive marks (rarely needed after the search)
-    if min_step > 0.0 and len(pid) > 2:
-        dd = np.hypot(pos[1:, 0] - pos[:-1, 0], pos[1:, 1] - pos[:-1, 1])
-        short = (dd < min_step) & ~last_of[:-1]
-        if short.any():  # every stroke at once; the loop runs only near short chords
-            keep = np.zeros(len(pid), dtype=bool)
-            forced: list[int] = []
+    return _MarkRows(sid, st, pos, pid, hm, am, first_of, last_of, prot)
 
-            # the filter asks, around the short chords q -> q + 1, whether a chord that
-            # would replace a few marks holds (q -> q + 2 mostly, q -> q + 3 after a drop,
-            # q - 1 -> q + 1, q - 1 -> q + 2 when the mark before is dropped instead):
-            # measured here for all of them at once (a chord's height does not depend on
-            # the others measured with it), any other question one by one
-            q = np.flatnonzero(short)
-            npid = len(pid)
-            qa = np.concatenate([q, q, q - 1, q - 1])
-            qb = np.concatenate([q + 2, q + 3, q + 1, q + 2])
-            ok = (qa >= 0) & (qb < npid)
-            qa, qb = qa[ok], qb[ok]
-            ok = pid[qa] == pid[qb]
-            qa, qb = qa[ok], qb[ok]
-            hq = _chords_heights(cs, sid[qa], st[qa], sid[qb], st[qb], pos[qa], pos[qb])
-            known = dict(zip(zip(qa.tolist(), qb.tolist(), strict=True),
-                             (hq <= tol).tolist(), strict=True))
 
-            def merge_ok(a: int, b: int) -> bool:
-                """The chord from mark a to mark b keeps within the tolerance."""
-                hit = known.get((a, b))
-                if hit is not None:
-                    return hit
-                h = _chords_heights(cs, sid[[a]], st[[a]], sid[[b]], st[[b]], pos[[a]],
-                                    pos[[b]])
-                return bool(h[0] <= tol)
+def _min_step_pass(mk: _MarkRows, cs: _CubicSet, tol: float, min_step: float,
+                   report: SampleReport) -> _MarkRows:
+    """Marks closer than ``min_step`` merged (rarely needed after the search), every stroke
+    at once; a merge that would leave a chord above the tolerance is refused (counted)."""
+    if len(mk.pid) <= 2:
+        return mk
+    pos = mk.pos
+    dd = np.hypot(pos[1:, 0] - pos[:-1, 0], pos[1:, 1] - pos[:-1, 1])
+    short = (dd < min_step) & ~mk.last_of[:-1]
+    if not short.any():
+        return mk
+    sid, st, pid = mk.sid, mk.st, mk.pid
+    # the filter asks, around the short chords q -> q + 1, whether a chord that would
+    # replace a few marks holds (q -> q + 2 mostly, q -> q + 3 after a drop, q - 1 -> q + 1,
+    # q - 1 -> q + 2 when the mark before is dropped instead): measured here for all of them
+    # at once (a chord's height does not depend on the others measured with it), any other
+    # question one by one
+    q = np.flatnonzero(short)
+    qa = np.concatenate([q, q, q - 1, q - 1])
+    qb = np.concatenate([q + 2, q + 3, q + 1, q + 2])
+    ok = (qa >= 0) & (qb < len(pid))
+    qa, qb = qa[ok], qb[ok]
+    ok = pid[qa] == pid[qb]
+    qa, qb = qa[ok], qb[ok]
+    hq = _chords_heights(cs, sid[qa], st[qa], sid[qb], st[qb], pos[qa], pos[qb])
+    known = dict(zip(zip(qa.tolist(), qb.tolist(), strict=True), (hq <= tol).tolist(),
+                     strict=True))
 
-            keep[_min_step_filter(pos, prot, min_step, first=first_of, d=dd,
-                                  merge_ok=merge_ok, forced=forced)] = True
-            report.min_step_overrides += len(forced)
-            sid, st, pos, pid, hm, am = (x[keep] for x in (sid, st, pos, pid, hm, am))
-            first_of, last_of = first_of[keep], last_of[keep]
-    # ---- rounding to whole bits; consecutive repeats dropped (the stroke's end kept)
-    r = _round(pos)
+    def merge_ok(a: int, b: int) -> bool:
+        """The chord from mark a to mark b keeps within the tolerance."""
+        hit = known.get((a, b))
+        if hit is not None:
+            return hit
+        h = _chords_heights(cs, sid[[a]], st[[a]], sid[[b]], st[[b]], pos[[a]], pos[[b]])
+        return bool(h[0] <= tol)
+
+    keep = np.zeros(len(mk.pid), dtype=bool)
+    forced: list[int] = []
+    keep[_min_step_filter(pos, mk.prot, min_step, first=mk.first_of, d=dd,
+                          merge_ok=merge_ok, forced=forced)] = True
+    report.min_step_overrides += len(forced)
+    return mk.keep(keep)
+
+
+def _rounded(mk: _MarkRows) -> tuple[np.ndarray, _MarkRows]:
+    """Marks rounded to whole bits, consecutive repeats dropped (a stroke's true end is
+    kept: its twin before it goes instead, unless that twin is the start)."""
+    r = _round(mk.pos)
+    first_of, last_of = mk.first_of, mk.last_of
     same = np.r_[False, (r[1:, 0] == r[:-1, 0]) & (r[1:, 1] == r[:-1, 1]) & ~first_of[1:]]
-    if same.any():
-        drop = same.copy()
-        for e in np.flatnonzero(same & last_of).tolist():
-            j = e - 1  # keep the true end, drop its twin before it unless that is the start
-            while same[j]:
-                j -= 1
-            if not first_of[j]:
-                drop[e] = False
-                drop[j] = True
-        keep = ~drop
-        sid, st, pos, pid, r = sid[keep], st[keep], pos[keep], pid[keep], r[keep]
-        hm, am = hm[keep], am[keep]
-        last_of = last_of[keep] | np.r_[pid[1:] != pid[:-1], True]
-    report.outside_points = int(((r < 0) | (r > mx)).any(axis=1).sum())
-    # ---- measurement of every chord against the true curve
-    pair = ~last_of[:-1] if len(pid) > 1 else np.zeros(0, dtype=bool)
-    if pair.any():
-        hf, hi_max = _measure_marks(cs, sid, st, pos, r, hm, am, pair, is_cubic)
-        report.chords = int(np.count_nonzero(pair))
-        report.max_chord_height_bits = float(hf.max())
-        report.max_chord_height_int_bits = hi_max
-        report.chord_violations = int(np.count_nonzero(hf > tol * (1.0 + 1e-9)))
-    else:
+    if not same.any():
+        return r, mk
+    drop = same.copy()
+    for e in np.flatnonzero(same & last_of).tolist():
+        j = e - 1
+        while same[j]:
+            j -= 1
+        if not first_of[j]:
+            drop[e] = False
+            drop[j] = True
+    keep = ~drop
+    out = mk.keep(keep)
+    out.last_of = out.last_of | np.r_[out.pid[1:] != out.pid[:-1], True]
+    return r[keep], out
+
+
+def _measure_into(report: SampleReport, mk: _MarkRows, r: np.ndarray, cs: _CubicSet,
+                  is_cubic: np.ndarray, tol: float) -> None:
+    """Every chord between consecutive marks of a stroke measured against the true curve
+    (float and rounded marks), into ``report``."""
+    pair = ~mk.last_of[:-1] if len(mk.pid) > 1 else np.zeros(0, dtype=bool)
+    if not pair.any():
         report.max_chord_height_bits = 0.0
         report.max_chord_height_int_bits = 0.0
-    # ---- one stroke per path
-    cuts = np.searchsorted(pid, np.arange(len(fitted) + 1)).tolist()
-    cuts[-1] = len(pid)
-    spans = list(zip(cuts[:-1], cuts[1:], strict=True))
-    res.marks = [r[a:b] for a, b in spans]
-    res.float_marks = [pos[a:b] for a, b in spans]
-    res.params = [(sid[a:b], st[a:b]) for a, b in spans]
-    return res
+        return
+    hf, hi_max = _measure_marks(cs, mk.sid, mk.st, mk.pos, r, mk.hm, mk.am, pair, is_cubic)
+    report.chords = int(np.count_nonzero(pair))
+    report.max_chord_height_bits = float(hf.max())
+    report.max_chord_height_int_bits = hi_max
+    report.chord_violations = int(np.count_nonzero(hf > tol * (1.0 + 1e-9)))
 
 
 def _first_nonzero(first: np.ndarray,
@@ -1389,7 +1459,6 @@ def polyline_marks(points: np.ndarray, fm: FieldMap, *, min_step_bits: float,
     if n >= 3:
         a = pts[1:-1] - pts[:-2]
         b = pts[2:] - pts[1:-1]
-        ang = np.degrees(np.abs(np.arctan2(_cross(a, b), _dot(a, b))))
-        prot[1:-1] = ang > corner_deg
+        prot[1:-1] = turn_deg(a, b) > corner_deg
     keep = _min_step_filter(pts, prot, min_step_bits)
     return _dedup(_round(pts[keep]))

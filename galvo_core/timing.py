@@ -28,8 +28,7 @@ from collections.abc import Sequence
 import numpy as np
 
 from galvo_core.params import LaserParams
-
-CORNER_DEG = 15.0
+from galvo_core.turns import CORNER_DEG, consecutive_turns_deg
 
 
 def stroke_lengths_mm(marks: np.ndarray, mm_per_bit: float) -> np.ndarray:
@@ -39,23 +38,13 @@ def stroke_lengths_mm(marks: np.ndarray, mm_per_bit: float) -> np.ndarray:
     return np.hypot(d[:, 0], d[:, 1]) * mm_per_bit
 
 
-def _turns_deg(d: np.ndarray) -> np.ndarray:
-    """Direction change (degrees) between consecutive non-zero vectors ``d`` (K, 2)."""
-    if len(d) < 2:
-        return np.zeros(0)
-    a, b = d[:-1], d[1:]
-    cross = a[:, 0] * b[:, 1] - a[:, 1] * b[:, 0]
-    dot = (a * b).sum(axis=1)
-    return np.degrees(np.abs(np.arctan2(cross, dot)))
-
-
 def corners(marks: np.ndarray, corner_deg: float = CORNER_DEG) -> int:
     """Interior vertices where the direction turns by more than ``corner_deg``."""
     if len(marks) < 3:
         return 0
     d = np.diff(marks.astype(np.float64), axis=0)
     d = d[(d != 0).any(axis=1)]
-    return int((_turns_deg(d) > corner_deg).sum())
+    return int((consecutive_turns_deg(d) > corner_deg).sum())
 
 
 def _periods(length_mm: np.ndarray, speed_mm_s: float, period_s: float) -> np.ndarray:
@@ -111,9 +100,8 @@ def estimate_with_dwell(
     vx, vy, vsid = vx[nz], vy[nz], vsid[nz]
     n_corners = 0
     if len(vx) >= 2:
-        cross = vx[:-1] * vy[1:] - vy[:-1] * vx[1:]
-        dot = vx[:-1] * vx[1:] + vy[:-1] * vy[1:]
-        turn = np.degrees(np.abs(np.arctan2(cross, dot)))
+        v = np.stack([vx, vy], axis=1)
+        turn = consecutive_turns_deg(v)
         n_corners = int(np.count_nonzero((turn > CORNER_DEG) & (vsid[1:] == vsid[:-1])))
     # jumps
     jv = allm[starts[1:]] - allm[ends[:-1]]
@@ -143,3 +131,43 @@ def dwell_count(strokes: Sequence[np.ndarray], laser: LaserParams, mm_per_bit: f
     """Consecutive marks closer than mark speed × point period: the beam stands still there
     (the controller cannot move less than one step per period, so it dwells)."""
     return estimate_with_dwell(strokes, laser, mm_per_bit)[1]
+
+
+def estimate_layers(
+    layers: Sequence[tuple[Sequence[np.ndarray], LaserParams, int]], mm_per_bit: float
+) -> tuple[dict[str, float | int], list[dict[str, float | int]]]:
+    """The time of a job marked layer by layer (issue 19): ``layers`` in marking order, each
+    (its strokes' marks in job order, its laser settings, its passes). A layer's strokes are
+    marked ``passes`` times in a row with that layer's speeds and delays (:func:`estimate`
+    of the repeated sequence, so the jumps between passes count); the jump from the end of
+    one layer to the start of the next counts in the next layer, at its jump speed and delay.
+
+    Returns the totals (the keys of :func:`estimate`) and one dict per layer with the same
+    keys plus ``passes``.
+    """
+    per: list[dict[str, float | int]] = []
+    last: np.ndarray | None = None
+    for strokes, laser, passes in layers:
+        ms = [np.asarray(m).reshape(-1, 2) for m in strokes if len(m)]
+        t = estimate(ms * passes, laser, mm_per_bit)
+        if ms and last is not None:
+            # the jump into this layer: its own speed and delay
+            d = float(np.hypot(*(ms[0][0] - last).astype(np.float64))) * mm_per_bit
+            period = laser.point_period_us * 1e-6
+            jt = float(_periods(np.array([d]), laser.jump_speed_mm_s, period)[0]) * period
+            jd = (laser.jump_delay_long_us if d > laser.long_jump_mm
+                  else laser.jump_delay_us) * 1e-6
+            t["jump_length_mm"] = float(t["jump_length_mm"]) + d
+            t["jump_time_s"] = float(t["jump_time_s"]) + jt
+            t["delay_time_s"] = float(t["delay_time_s"]) + jd
+            t["estimated_time_s"] = float(t["estimated_time_s"]) + jt + jd
+            t["jumps"] = int(t["jumps"]) + 1
+        if ms:
+            last = ms[-1][-1]
+        t["passes"] = int(passes)
+        per.append(t)
+    keys = ("mark_length_mm", "jump_length_mm", "estimated_time_s", "corners",
+            "laser_switches", "jumps", "mark_points", "mark_time_s", "jump_time_s",
+            "delay_time_s")
+    total: dict[str, float | int] = {k: sum(p[k] for p in per) for k in keys}
+    return total, per

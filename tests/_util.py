@@ -12,7 +12,26 @@ SAMPLES = ROOT / "resources" / "samples"
 
 
 def run_cli(*args: str, timeout: float = 120) -> subprocess.CompletedProcess[str]:
-    """Run ``galvo-core`` in a subprocess, as a user would."""
+    """Run ``galvo-core`` in this process (its ``main(argv)``), as a user would see it: the
+    exit code, stdout and stderr. ``timeout`` is kept for :func:`run_cli_subprocess`'s
+    signature and not used here."""
+    import contextlib
+    import io
+
+    from galvo_core import cli
+
+    out, err = io.StringIO(), io.StringIO()
+    with contextlib.chdir(ROOT), contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
+        try:
+            code = cli.main(list(args))
+        except SystemExit as exc:  # argparse: --help (0), usage errors (2)
+            code = exc.code if isinstance(exc.code, int) else (0 if exc.code is None else 2)
+    return subprocess.CompletedProcess(["galvo-core", *args], code, out.getvalue(),
+                                       err.getvalue())
+
+
+def run_cli_subprocess(*args: str, timeout: float = 120) -> subprocess.CompletedProcess[str]:
+    """Run ``galvo-core`` in a subprocess, end to end (the one test that does so)."""
     env = dict(os.environ)
     return subprocess.run(
         [sys.executable, "-m", "galvo_core.cli", *args],

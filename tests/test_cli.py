@@ -6,7 +6,7 @@ import json
 import re
 
 import pytest
-from _util import SAMPLES, circle_plt, run_cli
+from _util import SAMPLES, circle_plt, run_cli, run_cli_subprocess
 
 from galvo_core.job import load_job
 
@@ -165,3 +165,17 @@ def test_kerf_fill_and_order_options_reach_the_job(tmp_path):
     assert {s["kind"] for s in doc["strokes"]} == {"contour", "hatch"}
     r = run_cli(*base, "--kerf-mm", "-0.1")
     assert r.returncode == 2 and r.stderr.startswith("error:") and "kerf_mm" in r.stderr
+
+
+def test_end_to_end_in_a_subprocess(tmp_path):
+    """The one test that starts ``galvo-core`` as a separate program: exit codes, the JSON
+    summary on stdout, one error line on stderr, the job on disk."""
+    out = tmp_path / "job.json"
+    r = run_cli_subprocess("process", str(SAMPLES / "curve_1181.plt"), "-o", str(out),
+                           "--magnification", "36")
+    assert r.returncode == 0, r.stderr
+    assert json.loads(r.stdout)["stats"]["strokes"] >= 1
+    assert json.loads(out.read_text())["version"] == 1
+    bad = run_cli_subprocess("info", str(tmp_path / "missing.plt"))
+    assert bad.returncode == 2 and bad.stderr.count("\n") == 1
+    assert bad.stderr.startswith("error: ") and "Traceback" not in bad.stderr

@@ -335,7 +335,11 @@ def test_leading_semicolon_lines() -> None:
     d = load("straight-coding__gcode-hpgl-viewer__b_fabric_nesting.plt")
     assert d.n_points == 168904
     assert d.bbox()[2] == pytest.approx(718304, abs=1)
-    assert d.warnings == ()
+    # the file never selects a pen (no SP): drawn with pen 1, said once (issue 20 rule 6)
+    assert [w.message for w in d.warnings] == [
+        "40705 path(s) drawn before any pen was selected (SP): imported with pen 1 "
+        "(an HP-GL/2 device would not draw them)"]
+    assert {p.pen for p in d.paths} == {1}
 
 
 def test_polygon_mode_pads_are_closed_rings() -> None:

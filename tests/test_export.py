@@ -22,7 +22,7 @@ from galvo_core.pipeline import Pipeline
 @pytest.fixture(scope="module")
 def job():
     d = read_file(SAMPLES / "curve_1181.plt")
-    return Pipeline().run(d, Params(magnification=36))
+    return Pipeline().run(d, Params(magnification=36)).job
 
 
 def test_plt_of_the_marks_reads_back_point_for_point(job, tmp_path):

@@ -166,3 +166,53 @@ def test_passes_inset_none() -> None:
     assert hatch(DISC, fill="none", spacing_units=2.0) == []
     with pytest.raises(ValueError):
         hatch(DISC, fill="spiral", spacing_units=2.0)
+
+
+def comb(teeth: int) -> Drawing:
+    """A bar with `teeth` teeth on top and as many below, shifted: many monotone cells
+    whose graph has no path through all of them (a zig-zag needs several strokes)."""
+    pts = [(0.0, 0.0)]
+    for k in range(teeth):  # teeth below, left to right
+        x = 30.0 * k
+        pts += [(x + 5, 0.0), (x + 5, -40.0), (x + 20, -40.0), (x + 20, 0.0)]
+    pts += [(30.0 * teeth, 0.0), (30.0 * teeth, 20.0)]
+    for k in range(teeth - 1, -1, -1):  # teeth above, right to left
+        x = 30.0 * k + 12
+        pts += [(x + 15, 20.0), (x + 15, 60.0), (x, 60.0), (x, 20.0)]
+    pts += [(0.0, 20.0)]
+    return Drawing((ring(pts),))
+
+
+@pytest.mark.parametrize("effort", [0, 300])
+def test_zigzag_bounded_search_keeps_the_guarantees(effort: int) -> None:
+    """With no search steps at all (greedy walks only) and with the default share, a comb of
+    many cells is covered inside the region, nothing marked twice, strokes <= cells."""
+    d = comb(12)
+    st = hatch(d, fill="zigzag", spacing_units=2.0, max_effort=effort)
+    cells = monotone_cells(d, spacing_units=2.0)
+    assert cells >= 25
+    assert len(st) <= cells and sum(s.cells for s in st) == cells
+    check_inside(d, st)
+    m = fill_metrics(d, st, spacing_units=2.0)
+    assert m["retraced_length"] == 0.0
+    assert m["coverage"] >= 0.995
+    assert all(LineString(s.points).is_simple for s in st)
+
+
+def test_zigzag_search_work_is_linear_in_the_cells() -> None:
+    """Search and walk steps of a region piece stay within a constant per cell (plus a
+    constant), however many cells it has and whether or not one path covers them; the
+    old fixed budget spent 400 000 steps on pieces of a few dozen cells."""
+    from galvo_core.fill import EFFORT_BASE, EFFORT_PER_CELL, _Hatch, _rings_rotated, _rotation
+
+    effort = []
+    cells = []
+    for teeth in (8, 80):
+        (_, poly), = region_polygons(find_regions(comb(teeth)))
+        h = _Hatch(_rings_rotated(poly, _rotation(0.0)), 2.0)
+        paths = h.walk()
+        cells.append(len(h.cell_segs))
+        effort.append(h.effort)
+        assert sum(len(p) for p in paths) == cells[-1]
+        assert h.effort <= EFFORT_BASE + (EFFORT_PER_CELL + 4) * cells[-1]
+    assert cells[1] >= 9 * cells[0]

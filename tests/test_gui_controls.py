@@ -147,10 +147,12 @@ def test_larger_e_per_gives_fewer_control_points(qtbot, circle):
     win = make_window(qtbot, circle)
     move(win, "e_per", 0.005)
     few_tol = shown(win, "control_points")
+    fitted_before = win.result.fitted
     move(win, "e_per", 0.5)
     assert win.result.params.e_per == pytest.approx(0.5, rel=0.01)
     assert shown(win, "control_points") < few_tol
-    assert "fit" in win.result.stages_run
+    # refitted (by this run, or by a run the release cancelled after its fit stage)
+    assert win.result.fitted is not fitted_before
 
 
 def test_larger_magnification_gives_more_marks_without_refitting(qtbot, circle):
@@ -393,7 +395,7 @@ def test_clicking_a_warning_zooms_to_its_path(qtbot):
     assert x1 - x0 < 40  # zoomed in (the whole drawing is 60 mm wide)
     assert win.selected == 2
     (rx0, rx1), _ = win.processed.getPlotItem().getViewBox().viewRange()
-    assert (rx0, rx1) == pytest.approx((x0, x1))
+    assert (rx0, rx1) == pytest.approx((x0, x1), abs=0.01 * (x1 - x0))  # linked, to a pixel
 
 
 def test_layers_toggle_and_show_empty_when_off(qtbot, circle):
@@ -421,12 +423,12 @@ def test_refused_and_empty_files(qtbot, tmp_path, dialogs, circle):
     empty = tmp_path / "empty.plt"
     empty.write_bytes(b"")
     for f in (bad, empty):
-        assert win.load_file(f) is False
+        assert win.load_file(f, wait=True) is False
         assert win.drawing is kept
     assert len(dialogs) == 2 and "empty" in dialogs[1].informativeText()
     no_geometry = tmp_path / "nothing.plt"
     no_geometry.write_bytes(b"IN;SP1;PU;")
-    assert win.load_file(no_geometry) is True
+    assert win.load_file(no_geometry, wait=True) is True
     assert win.wait_for_result(30)
     assert win.processed.counts["marks"] == 0
     assert any("no pen-down" in t for t in win.warnings_panel.texts())
@@ -436,7 +438,7 @@ def test_export_job_png_and_load_the_job_back(qtbot, tmp_path, dialogs):
     src = tmp_path / "circle.plt"
     src.write_bytes(circle_plt())
     win = make_window(qtbot)
-    assert win.load_file(src) and win.wait_for_result(60)
+    assert win.load_file(src, wait=True) and win.wait_for_result(60)
     job_path = tmp_path / "circle.json"
     assert win.export("job", job_path)
     job = load_job(job_path)
@@ -451,13 +453,13 @@ def test_export_job_png_and_load_the_job_back(qtbot, tmp_path, dialogs):
     assert [p.name for p in tmp_path.iterdir() if p.name.startswith(".tmp")] == []
     # the job file back: its marks, and the source found beside it
     n_marks = win.processed.counts["marks"]
-    assert win.load_file(job_path) and win.wait_for_result(30)
+    assert win.load_file(job_path, wait=True) and win.wait_for_result(30)
     assert win.job_path == job_path and win.banner.isVisible()
     assert win.processed.counts["marks"] == n_marks
     assert win.original.counts["original"] > 0
     assert not win.controls.isEnabled()
     src.unlink()  # without the source: the original view is empty
-    assert win.load_job_file(job_path) and win.wait_for_result(30)
+    assert win.load_job_file(job_path, wait=True) and win.wait_for_result(30)
     assert win.original.counts["original"] == 0 and win.processed.counts["marks"] == n_marks
     assert "job" in win.windowTitle() or "circle.json" in win.windowTitle()
 
@@ -483,7 +485,7 @@ def test_reload_when_the_file_changes_on_disk(qtbot, tmp_path):
     f = tmp_path / "live.plt"
     f.write_bytes(b"IN;SP1;PU0,0;PD1000,0,1000,1000;PU;")
     win = make_window(qtbot)
-    assert win.load_file(f) and win.wait_for_result(30)
+    assert win.load_file(f, wait=True) and win.wait_for_result(30)
     assert win.original.counts["original"] == 3
     f.write_bytes(b"IN;SP1;PU0,0;PD1000,0,1000,1000,0,1000,0,0;PU;")
     qtbot.waitUntil(lambda: win.drawing is not None and win.drawing.n_points == 5,
@@ -501,7 +503,7 @@ def test_settings_and_recent_files_persist(qtbot, tmp_path):
     win = MainWindow(settings=QSettings(str(ini), QSettings.Format.IniFormat))
     qtbot.addWidget(win)
     win.show()
-    assert win.load_file(f) and win.wait_for_result(30)
+    assert win.load_file(f, wait=True) and win.wait_for_result(30)
     win.apply_changes({"e_per": 0.123})
     win.layer_boxes["jumps"].setChecked(False)
     win.close()

@@ -207,7 +207,7 @@ def test_titles_axes_and_icon(qtbot):
 def _plot_items(view) -> list:
     return [i for i in view.getPlotItem().items
             if isinstance(i, (pg.PlotDataItem, views.DeviationItem, views.PointsItem,
-                              views.ControlItem))]
+                              views.ControlItem, views.LinesItem))]
 
 
 @pytest.mark.parametrize("n_paths", [1, 500, 3000])
@@ -218,7 +218,7 @@ def test_number_of_plot_items_is_fixed(qtbot, n_paths):
     # one item per layer, plus the field outline and the selection highlight
     assert len(_plot_items(win.original)) == n_left + 2
     assert len(_plot_items(win.processed)) == n_right + 2
-    kinds = (pg.PlotDataItem, views.PointsItem)
+    kinds = (pg.PlotDataItem, views.PointsItem, views.LinesItem)
     scene_items = [i for i in win.original.scene().items() if isinstance(i, kinds)]
     assert len(scene_items) == n_left + 2
     assert win.original.counts["original"] == 4 * n_paths
@@ -256,15 +256,19 @@ def test_status_bar_counts(qtbot):
     )
     win = shown(qtbot, MainWindow())
     win.set_drawing(d, "/some/where/two.plt")
+    assert win.wait_idle(60)
     summary = win.status_summary()
     assert win.status_label.text() == summary
     assert "2 paths" in summary
     assert "7 points" in summary
     assert "1 closed" in summary
     assert "100.00 × 50.00 mm" in summary
-    assert "0 warnings" in summary
     assert "two.plt" in summary
     assert "two.plt" in win.windowTitle()
+    # one warning count in the status bar (the job's, which includes the file's)
+    assert "warning" not in summary
+    n = len(win.result.job.warnings)
+    assert win.warnings_label.text().split()[-2:] == [str(n), "warning" + ("s" if n != 1 else "")]
 
 
 # --- loading: refused files and crashes become dialogs, the drawing stays -----------------------
@@ -277,7 +281,7 @@ def test_refused_file_shows_dialog_and_keeps_drawing(qtbot, monkeypatch, dialogs
         raise InputError(FsPath(path).name, "not an HP-GL file")
 
     monkeypatch.setattr(window_mod, "load_drawing", refuse)
-    assert win.load_file(tmp_path / "bad.plt") is False
+    assert win.load_file(tmp_path / "bad.plt", wait=True) is False
     assert len(dialogs) == 1
     box = dialogs[0]
     assert box.icon() == QMessageBox.Icon.Critical
@@ -296,7 +300,7 @@ def test_unexpected_exception_becomes_dialog(qtbot, monkeypatch, dialogs, tmp_pa
         raise ZeroDivisionError("division by zero")
 
     monkeypatch.setattr(window_mod, "load_drawing", boom)
-    assert win.load_file(tmp_path / "x.plt") is False
+    assert win.load_file(tmp_path / "x.plt", wait=True) is False
     assert len(dialogs) == 1
     msg = dialogs[0].informativeText()
     assert "x.plt" in msg and "ZeroDivisionError" in msg
@@ -306,7 +310,7 @@ def test_unexpected_exception_becomes_dialog(qtbot, monkeypatch, dialogs, tmp_pa
 def test_unreadable_file_shows_dialog(qtbot, dialogs, tmp_path):
     win = shown(qtbot, MainWindow(square_drawing("keep.plt")))
     kept = win.drawing
-    win.load_file(tmp_path / "does_not_exist.plt")  # InputError or OSError from the importer
+    win.load_file(tmp_path / "does_not_exist.plt", wait=True)  # InputError or OSError
     assert len(dialogs) == 1
     assert "does_not_exist.plt" in dialogs[0].informativeText()
     assert win.drawing is kept
@@ -323,7 +327,7 @@ def test_error_dialog_is_buildable(qtbot):
 # --- with the real importer ----------------------------------------------------------------------
 def test_window_opens_on_a_file(qtbot, importer, square_plt):
     win = shown(qtbot, MainWindow())
-    assert win.load_file(square_plt) is True
+    assert win.load_file(square_plt, wait=True) is True
     assert win.wait_for_result(60)
     assert "square.plt" in win.windowTitle()
     assert "100.00 × 100.00 mm" in win.status_summary()
@@ -339,7 +343,7 @@ def test_garbage_file_is_refused_with_importer_message(qtbot, importer, dialogs,
         importer(garbage_plt)
     win = shown(qtbot, MainWindow(square_drawing("keep.plt")))
     kept = win.drawing
-    assert win.load_file(garbage_plt) is False
+    assert win.load_file(garbage_plt, wait=True) is False
     assert len(dialogs) == 1
     assert str(info.value) in dialogs[0].informativeText()
     assert win.drawing is kept
@@ -386,6 +390,7 @@ def test_drop_a_file_loads_it(qtbot, monkeypatch, tmp_path):
         Qt.KeyboardModifier.NoModifier,
     )
     win.dropEvent(ev)
+    assert win.wait_idle(30)
     assert win.drawing is not None
     assert "dropped.plt" in win.windowTitle()
     assert win.recent_files()[0].endswith("dropped.plt")

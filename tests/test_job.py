@@ -33,9 +33,10 @@ def jobs():
     """A contour job with lines and cubics, and one with hatch strokes and greedy order
     (reversed strokes) on a kerf-compensated drawing."""
     d = read_file(SAMPLES / "seal.plt")
-    plain = Pipeline().run(d, Params(fit_field=True, e_per=0.75))
+    plain = Pipeline().run(d, Params(fit_field=True, e_per=0.75)).job
     filled = Pipeline().run(d, Params(fit_field=True, e_per=0.75, fill="zigzag",
-                                      hatch_spacing_mm=0.5, scan_order="greedy", kerf_mm=0.1))
+                                      hatch_spacing_mm=0.5, scan_order="greedy",
+                                      kerf_mm=0.1)).job
     return plain, filled
 
 
@@ -249,7 +250,7 @@ def test_a_run_and_both_writers_build_no_object_per_segment(tmp_path):
     jobmod.Segments.__iter__ = counting_iter  # type: ignore[method-assign]
     try:
         job = p.run(d, Params(fit_field=True, e_per=0.75, scan_order="greedy", fill="zigzag",
-                              hatch_spacing_mm=0.5))
+                              hatch_spacing_mm=0.5)).job
         write_job(job, tmp_path / "a.gjob")
         write_job(job, tmp_path / "a.json")
     finally:

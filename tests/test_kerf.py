@@ -635,3 +635,69 @@ def test_dense_and_sparse_groups_are_grown_alike(monkeypatch: pytest.MonkeyPatch
     assert len(shapely.get_parts(out[0.0])) == len(shapely.get_parts(out[1e9]))
     assert shapely.hausdorff_distance(out[0.0].boundary, out[1e9].boundary,
                                       densify=0.1) <= 0.1
+
+
+def _tiled_rings(rng: np.random.Generator, tiles: int, *, grid: bool) -> list[np.ndarray]:
+    """Star-shaped rings (some self-crossing) in `tiles` drawings side by side; on whole
+    numbers when `grid` (vertices and test points then meet exactly: ties)."""
+    rings = []
+    for t in range(tiles):
+        for _ in range(4):
+            c = np.array([t * 100.0 + rng.uniform(20, 80), rng.uniform(20, 80)])
+            k = int(rng.integers(3, 30))
+            ang = rng.uniform(0, 2 * np.pi, k)
+            if rng.random() < 0.7:
+                ang = np.sort(ang)
+            p = c + np.c_[rng.uniform(2, 30, k) * np.cos(ang), rng.uniform(2, 30, k) * np.sin(ang)]
+            if grid:
+                p = np.round(p)
+            rings.append(np.vstack([p, p[:1]]))
+    return rings
+
+
+@pytest.mark.parametrize("grid", [False, True])
+def test_odd_crossings_is_the_parity_of_the_plain_ray_count(grid: bool,
+                                                           monkeypatch: pytest.MonkeyPatch
+                                                           ) -> None:
+    """The column-and-boundary path gives every point the parity of the plain ray to +x,
+    including points level with vertices and boundary crossings (whole-number drawings)."""
+    import galvo_core.kerf as kerf_mod
+    from galvo_core.kerf import _crossings, _odd_crossings, _odd_edges
+
+    rng = np.random.default_rng(21 if grid else 20)
+    monkeypatch.setattr(kerf_mod, "CROSS_PLAIN_PAIRS", 0)  # always the column path
+    for cols in (4, 16, 128):
+        monkeypatch.setattr(kerf_mod, "CROSS_COLUMN_EDGES", cols)
+        rings = _tiled_rings(rng, 12, grid=grid)
+        a, b, _, rep = _odd_edges(rings)
+        pts = np.c_[rng.uniform(-10, 1210, 3000), rng.uniform(-10, 110, 3000)]
+        if grid:
+            pts = np.round(pts * 2) / 2  # on and half-way between the vertices' lines
+        got = _odd_crossings(pts, a[rep], b[rep])
+        assert np.array_equal(got, _crossings(pts, a[rep], b[rep]) % 2 == 1)
+        assert got.any() and not got.all()
+
+
+def test_odd_crossings_work_is_linear_for_drawings_side_by_side(
+        monkeypatch: pytest.MonkeyPatch) -> None:
+    """Point-edge pairs examined grow like the input (10x the drawings side by side: about
+    10x the pairs), where the plain ray pairs every point with every edge to its right."""
+    import galvo_core.kerf as kerf_mod
+
+    pairs: list[int] = []
+    real_repeat = np.repeat
+
+    def counting_repeat(x, r, *args, **kw):  # type: ignore[no-untyped-def]
+        out = real_repeat(x, r, *args, **kw)
+        pairs[-1] += len(out)
+        return out
+
+    monkeypatch.setattr(kerf_mod.np, "repeat", counting_repeat)
+    rng = np.random.default_rng(3)
+    for tiles in (20, 200):
+        rings = _tiled_rings(rng, tiles, grid=False)
+        a, b, _, rep = kerf_mod._odd_edges(rings)
+        pts = np.c_[rng.uniform(0, tiles * 100, 50 * tiles), rng.uniform(0, 100, 50 * tiles)]
+        pairs.append(0)
+        kerf_mod._odd_crossings(pts, a[rep], b[rep])
+    assert pairs[1] < 20 * pairs[0]

@@ -12,7 +12,11 @@ import pytest
 from galvo_core.field import FieldMap
 from galvo_core.job import Stroke
 from galvo_core.order import (
+    KICKS_MIN,
+    KICKS_PER_STROKE,
+    STALL_WINDOW_MIN,
     Placement,
+    _cands_length,
     _greedy,
     _improve,
     _Problem,
@@ -138,21 +142,18 @@ def test_job_strokes_segments_follow_marks() -> None:
     assert np.array_equal(rot.segments[0][1][0], sq[2])
 
 
-def test_ten_thousand_strokes_fast() -> None:
+def test_ten_thousand_strokes_greedy() -> None:
     rng = np.random.default_rng(3)
     a = rng.uniform(0, 10000, (10000, 2))
     strokes = list(np.stack([a, a + rng.normal(0, 20, (10000, 2))], axis=1))
-    t0 = time.perf_counter()
     pl = order_strokes(strokes, method="greedy")
-    dt = time.perf_counter() - t0
     valid(pl, len(strokes))
-    assert dt < 4.0  # ~0.8 s on the 2-core development machine; slack for a loaded CI
     f = travel_length(strokes, [Placement(i) for i in range(len(strokes))])
     assert travel_length(strokes, pl) < 0.05 * f
 
 
-def test_optimized_uses_its_budget_and_keeps_precedence() -> None:
-    """2-opt / Or-opt with reversal, then double-bridge kicks until the budget is spent:
+def test_optimized_improves_on_greedy_and_keeps_precedence() -> None:
+    """2-opt / Or-opt with reversal, then double-bridge kicks until they stop improving:
     well below greedy on random segments (LKH is about 0.74x greedy here), never above it,
     and the precedence pairs hold after every kick."""
     rng = np.random.default_rng(11)
@@ -170,17 +171,52 @@ def test_optimized_uses_its_budget_and_keeps_precedence() -> None:
         strokes, order_strokes(strokes, method="greedy", before=before)) + 1e-9
 
 
-def test_ten_thousand_strokes_optimized_within_budget() -> None:
+def test_ten_thousand_strokes_optimized_not_longer_than_greedy() -> None:
     rng = np.random.default_rng(5)
     a = rng.uniform(0, 10000, (10000, 2))
     strokes = list(np.stack([a, a + rng.normal(0, 20, (10000, 2))], axis=1))
-    t0 = time.perf_counter()
     pl = order_strokes(strokes, method="optimized", time_budget_s=1.0)
-    dt = time.perf_counter() - t0
     valid(pl, len(strokes))
-    assert dt < 4.0  # ~1.1 s on the 2-core development machine; slack for a loaded CI
     g = travel_length(strokes, order_strokes(strokes, method="greedy"))
     assert travel_length(strokes, pl) <= g + 1e-9
+
+
+def segments(n: int, seed: int, side: float = 1000.0) -> list[np.ndarray]:
+    rng = np.random.default_rng(seed)
+    a = rng.uniform(0, side, (n, 2))
+    return list(np.stack([a, a + rng.normal(0, 10, (n, 2))], axis=1))
+
+
+def improve_stats(strokes: list[np.ndarray]) -> tuple[dict, float, float]:
+    """Work of the optimized search run to its own end (no deadline), its travel and
+    greedy's."""
+    prob = _Problem(strokes, [False] * len(strokes), None)
+    start = _greedy(prob, [])
+    stats: dict = {}
+    out = _improve(prob, start, [], time.perf_counter() + 1e6, stats=stats)
+    return stats, _cands_length(prob, out), _cands_length(prob, start)
+
+
+def test_optimized_stops_when_it_stops_improving() -> None:
+    """A small job does not spend a budget: with no deadline the search ends after one
+    window of kicks that gains nothing (here the order is already the best)."""
+    strokes = [np.array([(i * 10.0, 0.0), (i * 10.0 + 5, 0.0)]) for i in range(40)]
+    stats, length, _ = improve_stats(strokes)
+    assert length == pytest.approx(39 * 5)
+    assert stats["kicks"] <= STALL_WINDOW_MIN
+
+
+def test_optimized_work_grows_linearly() -> None:
+    """Kicks, local-search steps and rewritten tour positions at 10x the strokes (same
+    density): at most ~20x (linear with a wide margin; moves are bounded by MOVE_SPAN, kicks
+    by KICKS_PER_STROKE per stroke), and the travel well below greedy at both sizes."""
+    small = improve_stats(segments(300, 1))
+    big = improve_stats(segments(3000, 2, side=1000.0 * 10 ** 0.5))
+    for key in ("kicks", "ls_steps", "written"):
+        assert big[0][key] <= 20 * max(small[0][key], 300), key
+    assert big[0]["kicks"] <= max(KICKS_MIN, KICKS_PER_STROKE * 3000)
+    for _, length, greedy in (small, big):
+        assert length < 0.85 * greedy
 
 
 def test_orient_strokes_is_optimal_for_a_fixed_order() -> None:

@@ -24,32 +24,28 @@ def circle() -> Drawing:
 def test_moving_e_per_refits_but_moving_magnification_only_resamples(circle):
     pipe = Pipeline()
     p = Params(magnification=20.0)
-    pipe.run(circle, p)
-    assert pipe.last_info.stages_run == ("fit", "sample")
-    pipe.run(circle, p.replace(magnification=30.0))
-    assert pipe.last_info.stages_run == ("sample",)
-    pipe.run(circle, p.replace(chord_tol_bits=3.0))
-    assert pipe.last_info.stages_run == ("sample",)
-    pipe.run(circle, p.replace(e_per=0.1))
-    assert pipe.last_info.stages_run == ("fit", "sample")
-    pipe.run(circle, p)  # back to the first settings: both cached
-    assert pipe.last_info.stages_run == ()
+    assert pipe.run(circle, p).stages_run == ("fit", "sample")
+    assert pipe.run(circle, p.replace(magnification=30.0)).stages_run == ("sample",)
+    assert pipe.run(circle, p.replace(chord_tol_bits=3.0)).stages_run == ("sample",)
+    assert pipe.run(circle, p.replace(e_per=0.1)).stages_run == ("fit", "sample")
+    # back to the first settings: both cached
+    assert pipe.run(circle, p).stages_run == ()
 
 
 def test_cached_results_equal_fresh_ones(circle):
     a = Pipeline()
     a.run(circle, Params(magnification=20.0, e_per=0.1))
-    ja = a.run(circle, Params(magnification=36.0, e_per=0.1))
-    jb = Pipeline().run(circle, Params(magnification=36.0, e_per=0.1))
+    ja = a.run(circle, Params(magnification=36.0, e_per=0.1)).job
+    jb = Pipeline().run(circle, Params(magnification=36.0, e_per=0.1)).job
     assert [s.marks.tolist() for s in ja.strokes] == [s.marks.tolist() for s in jb.strokes]
     assert ja.stats == jb.stats
 
 
 def test_more_magnification_more_marks_and_looser_tolerance_fewer(circle):
     pipe = Pipeline()
-    n = [pipe.run(circle, Params(magnification=m)).stats["mark_points"] for m in (10, 20, 40)]
+    n = [pipe.run(circle, Params(magnification=m)).job.stats["mark_points"] for m in (10, 20, 40)]
     assert n[0] < n[1] < n[2]
-    t = [pipe.run(circle, Params(magnification=40, chord_tol_bits=c)).stats["mark_points"]
+    t = [pipe.run(circle, Params(magnification=40, chord_tol_bits=c)).job.stats["mark_points"]
          for c in (0.5, 2, 8)]
     assert t[0] > t[1] > t[2]
 
@@ -92,7 +88,7 @@ def test_out_of_field_refused_unless_clamped():
     d = Drawing((Path.from_points([(0, 0), (100000, 0)]),), name="wide.plt")
     with pytest.raises(ParamError, match="field"):
         Pipeline().run(d, Params(magnification=1.0))
-    job = Pipeline().run(d, Params(magnification=1.0, clamp=True))
+    job = Pipeline().run(d, Params(magnification=1.0, clamp=True)).job
     marks = np.concatenate([s.marks for s in job.strokes])
     assert marks.min() >= 0 and marks.max() <= 65535
     assert any("clamped" in w.message for w in job.warnings)
@@ -100,15 +96,15 @@ def test_out_of_field_refused_unless_clamped():
 
 def test_integer_coordinates_warn_that_e_per_is_below_their_rounding():
     d = read_bytes(b"IN;SP1;PU0,0;PD100,3,200,10,300,24,400,41,500,65;PU;", "int.plt")
-    job = Pipeline().run(d, Params())
+    job = Pipeline().run(d, Params()).job
     assert any("rounded" in w.message and "e_per" in w.message for w in job.warnings)
-    job = Pipeline().run(d, Params(e_per=0.75))
+    job = Pipeline().run(d, Params(e_per=0.75)).job
     assert not any("rounded" in w.message for w in job.warnings)
 
 
 def test_empty_drawing_gives_an_empty_job():
     d = read_bytes(b"IN;SP1;LBHELLO\x03;", "label.plt")
-    job = Pipeline().run(d, Params())
+    job = Pipeline().run(d, Params()).job
     assert job.strokes == () and job.stats["mark_points"] == 0
 
 
@@ -133,8 +129,8 @@ def test_facts_of_a_drawing_are_computed_once(circle, monkeypatch):
 
     monkeypatch.setattr(Drawing, "bbox", counting_bbox)
     pipe = Pipeline()
-    jobs = [pipe.run(circle, Params(magnification=m, chord_tol_bits=c))
+    jobs = [pipe.run(circle, Params(magnification=m, chord_tol_bits=c)).job
             for m in (10.0, 12.0) for c in (1.0, 0.5)]
     assert calls == {"quantum": 1, "bbox": 1}
-    fresh = Pipeline().run(circle, Params(magnification=12.0, chord_tol_bits=0.5))
+    fresh = Pipeline().run(circle, Params(magnification=12.0, chord_tol_bits=0.5)).job
     assert jobs[-1].stats == fresh.stats and jobs[-1].warnings == fresh.warnings

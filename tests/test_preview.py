@@ -26,7 +26,7 @@ def circle() -> Drawing:
 def run(circle):
     pipe = Pipeline()
     params = Params(magnification=20.0, e_per=0.05)
-    job = pipe.run(circle, params)
+    job = pipe.run(circle, params).job
     return pipe, params, job, pipe.fitted(circle, params)
 
 
@@ -178,10 +178,10 @@ def test_resample_only_run_reuses_the_fit_geometry(circle):
     pipe = Pipeline()
     cache = pv.PreviewCache()
     p1 = Params(magnification=20.0)
-    j1 = pipe.run(circle, p1)
+    j1 = pipe.run(circle, p1).job
     a = pv.build_preview(j1, circle, pipe.fitted(circle, p1), cache=cache)
     p2 = p1.replace(magnification=40.0)
-    j2 = pipe.run(circle, p2)
+    j2 = pipe.run(circle, p2).job
     b = pv.build_preview(j2, circle, pipe.fitted(circle, p2), cache=cache)
     assert b.fitted.xy is a.fitted.xy  # same arrays: the GUI changes only the transform
     assert b.control_xy is a.control_xy and b.original.xy is a.original.xy

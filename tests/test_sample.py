@@ -325,11 +325,11 @@ def test_lines_are_their_end_points_and_max_step_splits():
 def test_counts_grow_with_magnification_and_shrink_with_tolerance():
     d = read_bytes(circle_plt(), "circle.plt")
     pipe = Pipeline()
-    n = [pipe.run(d, Params(magnification=m)).stats["mark_points"] for m in (5, 10, 20, 40)]
+    n = [pipe.run(d, Params(magnification=m)).job.stats["mark_points"] for m in (5, 10, 20, 40)]
     assert n == sorted(n) and len(set(n)) == 4
     # chords scale like sqrt(r / tol): four times the magnification, about twice the marks
     assert 1.7 < n[3] / n[1] < 2.3
-    t = [pipe.run(d, Params(magnification=30, chord_tol_bits=c)).stats["mark_points"]
+    t = [pipe.run(d, Params(magnification=30, chord_tol_bits=c)).job.stats["mark_points"]
          for c in (0.25, 1.0, 4.0)]
     assert t[0] > t[1] > t[2]
     assert 1.7 < t[0] / t[1] < 2.3
@@ -340,7 +340,7 @@ def test_paper_000_table_1_counts():
     d = read_file(SAMPLES / "curve_1181.plt")
     pipe = Pipeline()
     for mag, paper in ((36, 207), (72, 288)):
-        job = pipe.run(d, Params(magnification=mag))
+        job = pipe.run(d, Params(magnification=mag)).job
         st_ = job.stats
         assert abs(st_["mark_points"] - paper) <= 0.05 * paper
         assert st_["max_chord_height_bits"] <= 1.0 and st_["chord_height_violations"] == 0
@@ -383,15 +383,15 @@ def test_outside_points_counted_before_clamping():
 
 def test_pipeline_stats_carry_the_measurements():
     d = read_file(SAMPLES / "curve_1181.plt")
-    stats = Pipeline().run(d, Params(magnification=36)).stats
+    stats = Pipeline().run(d, Params(magnification=36)).job.stats
     for key in ("mark_points", "control_points", "strokes", "laser_switches",
                 "mark_length_mm", "jump_length_mm", "estimated_time_s",
                 "max_chord_height_bits", "max_chord_height_int_bits", "max_fit_error",
                 "dwell_points", "outside_points", "min_step_overrides"):
         assert key in stats
-    raw = Pipeline().run(d, Params(magnification=36, interpolation="raw")).stats
+    raw = Pipeline().run(d, Params(magnification=36, interpolation="raw")).job.stats
     assert raw["mark_points"] == 1181 and raw["max_chord_height_bits"] is None
-    fixed = Pipeline().run(d, Params(magnification=36, interpolation="fixed")).stats
+    fixed = Pipeline().run(d, Params(magnification=36, interpolation="fixed")).job.stats
     assert fixed["max_chord_height_bits"] > 1.0  # the legacy method has no height bound
 
 
@@ -487,4 +487,4 @@ def test_resampling_a_cached_fit_gives_what_a_fresh_fit_gives():
     runs = [(m, c) for m in (10.0, 20.0, 10.0) for c in (1.0, 0.3)]
     for m, c in runs:
         p = Params(magnification=m, chord_tol_bits=c)
-        assert pipe.run(d, p).stats == Pipeline().run(d, p).stats
+        assert pipe.run(d, p).job.stats == Pipeline().run(d, p).job.stats

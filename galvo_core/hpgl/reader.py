@@ -8,16 +8,22 @@ What it reads
   flattened by the HP-GL chord rule (:mod:`.arcs`), CT chord-tolerance mode honoured;
   Béziers BZ BR (and BA, the name paper 001 uses for BZ) flattened within 0.1 unit; XT/YT
   tick marks.
-* Polygon mode: PM0/PM1/PM2 fill a polygon buffer; the first EP or FP after it emits each
-  sub-polygon once as a closed ring (geometry, not paint: an edged *and* filled polygon is
-  one region, not two).
+* Polygon mode: PM0/PM1/PM2 fill a polygon buffer, each edge with its pen state; PM1/PM2
+  close a sub-polygon with the pen state of the moment, the point after PM1 starts the next
+  one with a pen-up move. EP gives the runs of pen-down edges (an open polyline stays open),
+  FP each sub-polygon as a closed ring; a buffer edged *and* filled is one region (FP after
+  EP replaces EP's edges). A pen-up move inside PM0 also ends a sub-polygon (its ring is
+  its own region), where the reference would join the pieces by pen-up edges into one
+  ring; files use it for separate pieces.
 * Geometry state: IN DF IP IR SC (types 0, 1, 2) RO IW PS SP; user units are converted to
   plotter units, RO rotates about the plotter origin (x, y) -> (-y, x) for 90 degrees,
   IW clips pen-down lines to the window (one warning says how many paths were clipped).
   IR with two numbers moves P1 and keeps the P1-P2 distance (P2 moves along).
 * Recorded, not drawn: LT VS FS PW LA PT FT and the like; labels LB/BL/WD (skipped to their
-  terminator, DT honoured), CO comments, SM symbols, vendor ``!XX`` commands.
-* Wrappers: PCL (ESC E, ESC%#A / ESC%#B, parameterised escapes with binary data), PJL
+  terminator, DT honoured; LB moves the pen over the text: SI/SR/default cell, CR/LF/BS,
+  DI/DR; LO is not applied), CO comments, SM symbols, vendor ``!XX`` commands.
+* Wrappers: PCL (ESC E, ESC%#A / ESC%#B, parameterised escapes with binary data: ESC...#W
+  and ESC&p#X; ESC*p#X is cursor positioning, no data), PJL
   (``@PJL ENTER LANGUAGE=HPGL2``), UEL, HP 7475A device control ESC.( ESC.I…: (also with
   the ESC byte lost), NUL padding.
 
@@ -37,8 +43,12 @@ Syntax decisions (where the standard is ambiguous or files break it)
 * An unquoted CO comment ends at ``;``, at the label terminator or at the end of the line.
 * Default P1/P2 (for SC without IP, and IR) are those of an HP 7475A on ANSI A paper:
   (250, 596) and (10250, 7796); after PS w,h they are (0, 0) and (w, h).
-* SP and IN lift the pen; RO and IW end the current path (the pen stays down, the next
-  pen-down move starts a new path); IP and SC only change later coordinates.
+* IN lifts the pen. SP ends the current path; it keeps the pen down in HP-GL/2 ("the pen
+  remains down ... until a PU or IN") and lifts it in HP-GL/1 (a plotter stores the pen):
+  a file is HP-GL/2 once it shows it (PCL/PJL entry, BP PS PE PW BZ ... see HPGL2_ONLY).
+  Without any SP the paths are drawn with pen 1 and one warning says so. RO and IW end the
+  current path (the pen stays down, the next pen-down move starts a new path); IP and SC
+  only change later coordinates. PS with a length <= 0 is ignored.
 * IW without numbers is the hard-clip window: the page PS gave, (0, 0)-(w, h), when RO is
   0; without PS (a galvo has no paper) or under RO there is no window.
 * PE: a pair without ``<`` puts the pen down; a PE that ends with a pen-up move leaves the
@@ -56,15 +66,27 @@ HP-GL/2 -- escapes alone do not count as HP-GL --, mostly unreadable) raises
 :class:`~galvo_core.errors.InputError`. A malformed or unknown command inside a good file is
 skipped with a warning naming line and column. Time and memory are linear in the file size
 (also for ``PEPEPE...``: see :mod:`.pe`).
+
+Speed
+-----
+Large inputs (from ``_COMPILED_MIN_BYTES``), or any input once numba is loaded, are read by
+the compiled scanner (:mod:`.scan`) wherever a PU/PD/PA/PR/SP command starts, and PE by its
+compiled decoder; the general reader takes every other command. Smaller inputs in a fresh
+process use the numpy runs of :mod:`.fastrun`. All three read the same geometry bit for bit
+(tests/test_hpgl_scan.py, tests/test_hpgl_fuzz.py).
 """
 
 from __future__ import annotations
 
+import gc
 import math
 import os
 import re
+import sys
 from collections import Counter
 from collections.abc import Callable
+from itertools import repeat
+from typing import Any
 
 import numpy as np
 
@@ -101,12 +123,68 @@ KNOWN = frozenset(
     ).split()
 )
 
+#: commands that only HP-GL/2 (and PCL's HP-GL/2) has: a file using one is read as HP-GL/2
+HPGL2_ONLY = frozenset("BP BR BZ CR FR LA MC MG NP PC PE PP PS PW QL RF SV TR WU".split())
+
 # one ordinary command with its leading separators: mnemonic, parameters, optional ';'
 _CMD_RE = re.compile(rb"[\x00-\x1a\x1c-\x20;,]*([A-Za-z]{2})([^A-Za-z;\x1b]*)(;?)")
 _RUN_RE = re.compile(
     rb"(?:[\x00-\x1a\x1c-\x20;,]*[Pp][UuDdAaRr][-+0-9.,;\x00-\x1a\x1c-\x20]*)+"
 )
 _FAST_MIN_BYTES = 256  # shorter runs go command by command
+#: inputs from this size on are read with the compiled scanner (:mod:`.scan`, numba); smaller
+#: ones with the numpy runs of :mod:`.fastrun` -- unless numba is loaded already (the GUI,
+#: ``process``), so that ``galvo-core info small.plt`` does not pay numba's import
+_COMPILED_MIN_BYTES = 1 << 20
+_CHUNK_POINTS = 1 << 16  # points per output chunk of the compiled scanner
+_PE_MESSAGES = {  # scan.PE_* problem codes -> the messages of pe.decode_pe
+    1: "PE number out of range; clamped",
+    2: "PE fractional bits {} out of range 0..26",
+    3: "PE run ends with half a coordinate pair; it was dropped",
+    4: "PE run ends with a flag that has no number",
+}
+_SCAN_CMDS = frozenset((b"PU", b"PD", b"PA", b"PR", b"SP"))  # what the scanner reads
+
+
+def _is_letter_or_esc(c: int) -> bool:
+    return 65 <= c <= 90 or 97 <= c <= 122 or c == 0x1B
+
+
+def _use_compiled(size: int) -> bool:
+    return size >= _COMPILED_MIN_BYTES or "numba" in sys.modules
+
+
+class _Chunk:
+    """Output of the compiled scanner: points and the segments (paths) found in them."""
+
+    __slots__ = ("pts", "seg_start", "seg_off", "seg_pen", "seg_line", "seg_col", "npts",
+                 "nseg")
+
+    def __init__(self, cap: int) -> None:
+        self.pts = np.empty((cap, 2), dtype=np.float64)
+        self.seg_start = np.empty(cap // 2 + 4, dtype=np.int32)
+        self.seg_off = np.empty(cap // 2 + 4, dtype=np.int32)
+        self.seg_pen = np.empty(cap // 2 + 4, dtype=np.int32)
+        self.seg_line = np.empty(cap // 2 + 4, dtype=np.int32)
+        self.seg_col = np.empty(cap // 2 + 4, dtype=np.int32)
+        self.npts = 0
+        self.nseg = 0
+
+
+class _Batch:
+    """Paths the compiled scanner read: ``pts[starts[k]:ends[k]]`` drawn with ``pens[k]``,
+    starting at line ``lines[k]``, column ``cols[k]`` of the file."""
+
+    __slots__ = ("chunk", "starts", "ends", "lines", "cols", "pens")
+
+    def __init__(self, chunk: _Chunk, starts: np.ndarray, ends: np.ndarray, lines: np.ndarray,
+                 cols: np.ndarray, pens: np.ndarray) -> None:
+        self.chunk = chunk
+        self.starts = starts
+        self.ends = ends
+        self.lines = lines
+        self.cols = cols
+        self.pens = pens
 _SEP_RE = re.compile(rb"[\x00-\x1a\x1c-\x20;,]*")
 _NUM_RE = re.compile(rb"[-+]?(?:\d+\.?\d*|\.\d+)")
 _JUNK_PARAM_RE = re.compile(rb"[^\s,0-9.+\-\x00]+")
@@ -122,6 +200,8 @@ _PCL_SCAN_RE = re.compile(
 _VENDOR_RE = re.compile(rb"!([A-Za-z]{2})([^;\x1b\n]*);?")
 _PCL_START_RE = re.compile(rb"[\x00-\x20]*(?:\x1bE|\x1b%-12345X|@PJL|\x1b[&*(]|\x1b%-?\d*A)")
 
+_POW10 = 10.0 ** np.arange(0, 23)
+_EMPTY_I32 = np.empty(0, dtype=np.int32)
 _WARN_CAP = 20  # warnings of one kind kept verbatim; the rest are counted
 
 
@@ -161,7 +241,17 @@ class _Reader:
         self.term = ETX
         self._no_term_after: dict[int, int] = {}
         self._pe_cache = PECache()
+        self.compiled = _use_compiled(self.n)
+        self._chunk: _Chunk | None = None
+        self._scan: Any = None  # the compiled scanner's module, imported at its first use
+        self._lc = (0, 1, -1)  # scanner position: offset, its line, the newline before it
+        self.chunks: list[_Chunk] = []
+        self.batched = 0  # paths in _Batch items of self.paths
         self.hpgl_mode = True
+        # dialect: HP-GL/2 once the file shows it (PCL/PJL entry, an HP-GL/2-only command)
+        self.hpgl2 = False
+        self.pen_selected = False  # no SP yet: drawn with pen 1 (warned)
+        self.unselected_paths = 0
         # geometry state
         self.reset()
         self.pen = 1
@@ -193,12 +283,19 @@ class _Reader:
         self.term = ETX
         self.poly: list[list[tuple[float, float]]] | None = None  # rings while in PM
         self.poly_ring: list[tuple[float, float]] = []
-        self.poly_buffer: list[list[tuple[float, float]]] = []
+        self.poly_down: list[bool] = []  # pen state of each edge of poly_ring
+        # sub-polygons: points, pen-down flag of each edge (the closing edge last)
+        self.poly_buffer: list[tuple[list[tuple[float, float]], list[bool]]] = []
         self.poly_emitted = True
+        self.poly_edged: tuple[int, int] | None = None  # self.paths range EP emitted
         self.poly_fresh = False
         self.poly_offset = 0
         self.tick = (0.5, 0.5)
+        self.char_size: tuple[float, float] | None = None  # SI: width, height (plotter units)
+        self.char_rel: tuple[float, float] | None = None  # SR: % of P2-P1
+        self.label_dir = (1.0, 0.0)  # DI/DR: unit vector of the text direction
         self.cur: list[float] = []  # current pen-down path, flat x, y (plotter units)
+        self.cur_parts: list[np.ndarray] = []  # its earlier points, read by the scanner
         self.cur_offset = 0
 
     def defaults(self) -> None:
@@ -212,6 +309,9 @@ class _Reader:
         self.term = ETX
         self.poly = None
         self.tick = (0.5, 0.5)
+        self.char_size = None
+        self.char_rel = None
+        self.label_dir = (1.0, 0.0)
 
     # ------------------------------------------------------------------ units
     def to_plotter(self, x: float, y: float) -> tuple[float, float]:
@@ -309,10 +409,20 @@ class _Reader:
                 else len(piece) >= 4 and piece[0, 0] == piece[-1, 0] and piece[0, 1] == piece[-1, 1]
             )
             self.paths.append((piece, self.pen, bool(is_closed), offset))
+            if not self.pen_selected:
+                self.unselected_paths += 1
 
     def flush(self) -> None:
         cur = getattr(self, "cur", None)
-        if cur:
+        parts = getattr(self, "cur_parts", None)
+        if parts:
+            if cur:
+                parts.append(np.array(cur, dtype=np.float64).reshape(-1, 2))
+            pts = parts[0].copy() if len(parts) == 1 else np.concatenate(parts)
+            self.cur = []
+            self.cur_parts = []
+            self.emit(pts, self.cur_offset)
+        elif cur:
             self.emit(np.array(cur, dtype=np.float64).reshape(-1, 2), self.cur_offset)
             self.cur = []
 
@@ -324,9 +434,11 @@ class _Reader:
             ring_pts = ring_pts.copy()
             ring_pts[-1] = ring_pts[0]
         if self.poly is not None:
-            self._poly_close_ring()
-            self.poly_buffer.append([tuple(p) for p in ring_pts.tolist()])
+            self._poly_close_ring(self.pen_down)
+            ring = [tuple(p) for p in ring_pts.tolist()]
+            self.poly_buffer.append((ring, [True] * (len(ring) - 1) + [True]))
             self.poly_ring = [(self.x, self.y)]
+            self.poly_down = []
             return
         self.emit(ring_pts, offset, closed=len(ring_pts) >= 4)
 
@@ -336,7 +448,7 @@ class _Reader:
         if self.poly is not None:
             self._poly_move(x, y)
         elif self.pen_down:
-            if not self.cur:
+            if not self.cur and not self.cur_parts:
                 self.cur = [self.x, self.y]
                 self.cur_offset = offset
             self.cur.append(x)
@@ -351,7 +463,7 @@ class _Reader:
             for px, py in pts.tolist():
                 self._poly_move(px, py)
         elif self.pen_down:
-            if not self.cur:
+            if not self.cur and not self.cur_parts:
                 self.cur = [self.x, self.y]
                 self.cur_offset = offset
             self.cur.extend(pts.ravel().tolist())
@@ -416,21 +528,28 @@ class _Reader:
             # whatever the pen state (HP-GL/2 PM; hp2xx and ezhpgl read it so too)
             self.poly_fresh = False
             self.poly_ring = [(x, y)]
+            self.poly_down = []
             return
         if self.pen_down:
             self.poly_ring.append((x, y))
+            self.poly_down.append(True)
         else:
+            # a pen-up move ends the sub-polygon (its closing edge is a pen-up edge); the
+            # fill region of each piece is its own ring, not one ring joined by pen-up edges
             if len(self.poly_ring) > 1:
-                self._poly_close_ring()
+                self._poly_close_ring(False)
             self.poly_ring = [(x, y)]
+            self.poly_down = []
 
-    def _poly_close_ring(self) -> None:
+    def _poly_close_ring(self, down: bool) -> None:
+        """End the current sub-polygon; its closing edge has pen state ``down`` (PM1/PM2
+        close with the current pen state: a pen-up closure is part of the fill region's
+        boundary but EP does not draw it)."""
         ring = self.poly_ring
         if len(ring) > 1:
-            if ring[0] != ring[-1]:
-                ring = ring + [ring[0]]
-            self.poly_buffer.append(ring)
+            self.poly_buffer.append((ring, self.poly_down + [down]))
         self.poly_ring = [(self.x, self.y)]
+        self.poly_down = []
 
     def do_pm(self, v: list[float], offset: int) -> None:
         mode = int(v[0]) if v else 0
@@ -441,34 +560,62 @@ class _Reader:
             self.poly = []
             self.poly_buffer = []
             self.poly_ring = [(self.x, self.y)]
+            self.poly_down = []
             self.poly_fresh = False
             self.poly_emitted = False
+            self.poly_edged = None
             self.poly_offset = offset
         elif mode == 1:
             if self.poly is None:
                 self.warn(offset, "PM1 outside polygon mode ignored")
                 return
-            self._poly_close_ring()
+            self._poly_close_ring(self.pen_down)
             self.poly_fresh = True
         elif mode == 2:
             if self.poly is None:
                 self.warn(offset, "PM2 outside polygon mode ignored")
                 return
-            self._poly_close_ring()
+            self._poly_close_ring(self.pen_down)
             self.poly = None
         else:
             self.warn(offset, f"PM{mode}: unknown polygon mode ignored")
 
     def do_edge_fill(self, mn: str, offset: int) -> None:
+        """EP draws the pen-down edges of the polygon buffer; FP fills it: every sub-polygon
+        is one closed ring (its region). A buffer is geometry, not paint: edged and filled
+        it is one region (FP after EP replaces EP's edges by the rings, EP after FP adds
+        nothing: its edges lie on the rings)."""
         if self.poly is not None:
             self.warn(offset, f"{mn} inside polygon mode ignored")
             return
-        if self.poly_emitted:
-            return  # the same buffer edged and filled: one region
+        if mn == "EP":
+            if self.poly_emitted:
+                return
+            self.poly_emitted = True
+            first = len(self.paths)
+            for ring, downs in self.poly_buffer:
+                for run in _pen_down_runs(ring, downs):
+                    self.emit(np.array(run, dtype=np.float64), self.poly_offset)
+            self.poly_edged = (first, len(self.paths))
+            return
+        if self.poly_emitted and self.poly_edged is None:
+            return  # filled already
+        rings = []
+        for ring, _downs in self.poly_buffer:
+            closed_ring = ring if ring[0] == ring[-1] else ring + [ring[0]]
+            rings.append(np.array(closed_ring, dtype=np.float64))
+        if self.poly_edged is not None:
+            a, b = self.poly_edged
+            tail = self.paths[b:]
+            del self.paths[a:]
+            for arr in rings:
+                self.emit(arr, self.poly_offset, closed=len(arr) >= 4)
+            self.paths.extend(tail)
+        else:
+            for arr in rings:
+                self.emit(arr, self.poly_offset, closed=len(arr) >= 4)
         self.poly_emitted = True
-        for ring in self.poly_buffer:
-            pts = np.array(ring, dtype=np.float64)
-            self.emit(pts, self.poly_offset, closed=len(pts) >= 4)
+        self.poly_edged = None
 
     # ------------------------------------------------------------------ commands
     def do_arc(self, cx: float, cy: float, sweep: float, chord_arg: float | None,
@@ -511,7 +658,7 @@ class _Reader:
         self.emit_ring(pts, offset)
 
     def flush_if_drawing(self) -> None:
-        if self.poly is None and self.cur:
+        if self.poly is None and (self.cur or self.cur_parts):
             self.flush()
             if self.pen_down:
                 self.cur = []
@@ -678,23 +825,44 @@ class _Reader:
             if not self.hpgl_mode:
                 i = self._pcl(i)
                 continue
-            if self.poly is None and i >= slow_until:
+            m = None
+            if self.compiled and self.poly is None:
+                m = cmd_match(data, i)
+                if m is not None and m.group(1).upper() in _SCAN_CMDS:
+                    j = self._compiled_run(i)
+                    if j != i:
+                        i = j
+                        continue
+            elif self.poly is None and i >= slow_until:
                 rm = run_match(data, i)
                 if rm is not None:
-                    if rm.end() - i >= _FAST_MIN_BYTES and self._fast_run(i, rm.end()):
-                        i = rm.end()
+                    end = rm.end()
+                    if end < n and not _is_letter_or_esc(data[end]):
+                        # the run stops inside a command's parameters (``PD1:2``): that
+                        # command is read by the general reader, which warns
+                        k = end - 1
+                        while k > i and not _is_letter_or_esc(data[k]):
+                            k -= 1
+                        end = k - 1
+                    if end > i and end - i >= _FAST_MIN_BYTES and self._fast_run(i, end):
+                        i = end
                         continue
                     slow_until = rm.end()  # read this run command by command
-            m = cmd_match(data, i)
+            if m is None:
+                m = cmd_match(data, i)
             if m is not None:
                 mn = m.group(1).upper().decode()
                 start = m.start(1)
                 if mn in _SPECIAL:
+                    if mn == "PE":
+                        self.hpgl2 = True
                     commands[mn] += 1
                     self.recognised += 1
                     i = _SPECIAL[mn](self, start + 2)
                     continue
                 commands[mn] += 1
+                if mn in HPGL2_ONLY:
+                    self.hpgl2 = True
                 h = handlers.get(mn)
                 if h is not None:
                     self.recognised += 1
@@ -744,6 +912,123 @@ class _Reader:
         elif not self.poly_emitted and self.poly_buffer:
             self.warn(self.poly_offset,
                       "polygon defined with PM but never edged or filled (EP/FP): not drawn")
+
+    # ------------------------------------------------------------------ compiled runs
+    def _new_chunk(self, need: int, at: int = 0) -> _Chunk:
+        # about one point per 16 bytes still to read (real files: 10-50 bytes per point), at
+        # most _CHUNK_POINTS: a small file does not get a large chunk; more come as needed
+        cap = max(need + 2, min(_CHUNK_POINTS, (self.n - at) // 16 + 64))
+        ch = _Chunk(cap)
+        self._chunk = ch
+        self.chunks.append(ch)
+        return ch
+
+    def _compiled_run(self, i: int) -> int:
+        """Read the PU/PD/PA/PR/SP commands from ``i`` on with the compiled scanner; returns
+        the offset where it stopped (``i`` when the next command is not one it reads)."""
+        scan = self._scan
+        if scan is None:
+            from galvo_core.hpgl import scan as scan_module
+
+            scan = self._scan = scan_module
+            self._u8 = np.frombuffer(self.data, dtype=np.uint8)
+            self._ist = np.zeros(scan.N_ISTATE, dtype=np.int64)
+            self._fst = np.zeros(scan.N_FSTATE, dtype=np.float64)
+        ist, fst = self._ist, self._fst
+        pos, line, last_nl = self._lc
+        if i != pos:  # the general reader's bytes since the last call
+            cnt = self.data.count(b"\n", pos, i)
+            if cnt:
+                line += cnt
+                last_nl = self.data.rfind(b"\n", pos, i)
+        while True:
+            ch = self._chunk
+            if ch is None or len(ch.pts) - ch.npts < 2 or len(ch.seg_start) - ch.nseg < 3:
+                ch = self._new_chunk(0, i)
+            was_open = self.pen_down and bool(self.cur or self.cur_parts)
+            # the state in slot order (see scan.I_*)
+            ist[:] = (i, self.pen_down, self.absolute, was_open, ch.npts, ch.nseg,
+                      0, 0, 0, 0, 0, 0, 0, self.pen, self.hpgl2, 0, self.pen_selected,
+                      line, last_nl)
+            sc = self.sc
+            fst[:] = (self.x, self.y, 0.0, 0.0, 0.0, 0.0, 0.0) if sc is None else \
+                (self.x, self.y, sc[0], sc[1], sc[2], sc[3], 1.0)
+            scan.scan_moves(self._u8, ist, fst, ch.pts, ch.seg_start, ch.seg_off, ch.seg_pen,
+                            ch.seg_line, ch.seg_col, _POW10, scan.CLASS)
+            out = ist.tolist()
+            self._take_segments(ch, out)
+            self.x, self.y = fst[0].item(), fst[1].item()
+            self.pen_down = bool(out[scan.I_PEN])
+            self.absolute = bool(out[scan.I_ABS])
+            self.pen = out[scan.I_PENNO]
+            counts = out[scan.I_NU : scan.I_NR + 1] + [out[scan.I_NSP]]
+            if any(counts):
+                for name, c in zip(("PU", "PD", "PA", "PR", "SP"), counts, strict=True):
+                    if c:
+                        self.commands[name] += c
+                self.recognised += sum(counts)
+            i = out[scan.I_POS]
+            self._lc = (i, out[scan.I_LINE], out[scan.I_LASTNL])
+            if not out[scan.I_FULL]:
+                return i
+            line, last_nl = out[scan.I_LINE], out[scan.I_LASTNL]
+            self._new_chunk(out[scan.I_NEED], i)
+
+    def _take_segments(self, ch: _Chunk, ist: list[int]) -> None:
+        scan = self._scan
+        s0, s1 = ch.nseg, ist[scan.I_NSEG]
+        p1 = ist[scan.I_NPTS]
+        ch.nseg, ch.npts = s1, p1
+        if s1 == s0:
+            return
+        starts = ch.seg_start[s0:s1].astype(np.int64)
+        ends = np.empty_like(starts)
+        ends[:-1] = starts[1:]
+        ends[-1] = p1
+        offs = ch.seg_off[s0:s1]
+        pens = ch.seg_pen[s0:s1]
+        lines = ch.seg_line[s0:s1]
+        cols = ch.seg_col[s0:s1]
+        a, b = 0, s1 - s0
+        still_open = bool(ist[scan.I_OPEN])
+        if ist[scan.I_CONT]:
+            st, en = int(starts[0]), int(ends[0])
+            if en > st:
+                if self.cur:
+                    self.cur_parts.append(np.array(self.cur, dtype=np.float64).reshape(-1, 2))
+                    self.cur = []
+                self.cur_parts.append(ch.pts[st:en])
+            if b > 1 or not still_open:
+                self.flush()
+            a = 1
+        open_last = still_open and b > a
+        if open_last:
+            b -= 1
+        if b > a:
+            self._add_batch(ch, starts[a:b], ends[a:b], offs[a:b], pens[a:b], lines[a:b],
+                            cols[a:b])
+        if open_last:
+            self.cur = []
+            self.cur_parts = [ch.pts[int(starts[b]) : int(ends[b])]]
+            self.cur_offset = int(offs[b])
+
+    def _add_batch(self, ch: _Chunk, starts: np.ndarray, ends: np.ndarray,
+                   offs: np.ndarray, pens: np.ndarray, lines: np.ndarray,
+                   cols: np.ndarray) -> None:
+        span = ch.pts[int(starts[0]) : int(ends[-1])]
+        if self.window is None and self.rot == 0 and np.isfinite(span).all():
+            self.paths.append(_Batch(ch, starts.copy(), ends.copy(),  # type: ignore[arg-type]
+                                     lines.copy(), cols.copy(), pens.copy()))
+            self.batched += len(starts)
+            if not self.pen_selected:  # (the scanner reads SP only once a pen was selected)
+                self.unselected_paths += len(starts)
+            return
+        pen = self.pen
+        for s, e, off, p in zip(starts.tolist(), ends.tolist(), offs.tolist(), pens.tolist(),
+                                strict=True):
+            self.pen = p
+            self.emit(ch.pts[s:e].copy(), off)
+        self.pen = pen
 
     def _fast_run(self, start: int, end: int) -> bool:
         """Read a run of PU/PD/PA/PR commands in one vectorised step (see fastrun).
@@ -802,13 +1087,11 @@ class _Reader:
         # continuation of a path open before the run
         cont = d_idx[d_path < 0]
         if len(cont):
-            if not self.cur:  # the pen is down but the path was ended (CI, SP, IW...)
+            if not self.cur and not self.cur_parts:  # pen down, path ended (CI, SP, IW..)
                 self.cur = [self.x, self.y]
                 self.cur_offset = start + int(tok.cmd_pos[pair_cmd[cont[0]]])
             self.cur.extend(q[cont + 1].ravel().tolist())
-        elif self.pen_down and not self.cur:
-            pass
-        if self.cur and (len(trans) or not bool(pen_after[-1])):
+        if (self.cur or self.cur_parts) and (len(trans) or not bool(pen_after[-1])):
             self.flush()
         npaths = len(trans)
         if npaths:
@@ -873,10 +1156,15 @@ class _Reader:
             return h
 
         def pen(params: bytes, off: int, mn: str) -> None:
+            # HP-GL/2: "the pen remains down ... until a PU or IN" (SP ends the path: the
+            # next move starts a new one with the new pen); an HP-GL/1 plotter puts the
+            # pen back in its stall, so there SP lifts it (see self.hpgl2)
             v = _nums(params)
             self.flush()
-            self.pen_down = False
+            if not self.hpgl2:
+                self.pen_down = False
             self.pen = int(v[0]) if v else 0
+            self.pen_selected = True
 
         def ro(params: bytes, off: int, mn: str) -> None:
             v = _nums(params)
@@ -889,6 +1177,10 @@ class _Reader:
 
         def ps(params: bytes, off: int, mn: str) -> None:
             v = _nums(params)
+            if any(x <= 0 for x in v[:2]):
+                # "if a length is <= 0 the device ignores the instruction"
+                self.warn(off, "PS with a length <= 0 ignored", key="args-PS")
+                return
             if len(v) >= 2:
                 w, h = abs(v[0]), abs(v[1])
             elif len(v) == 1:
@@ -907,6 +1199,28 @@ class _Reader:
         def tl(params: bytes, off: int, mn: str) -> None:
             v = _nums(params)
             self.tick = (v[0] if v else 0.5, v[1] if len(v) > 1 else (0.0 if v else 0.5))
+
+        def si(params: bytes, off: int, mn: str) -> None:
+            v = _nums(params)
+            if len(v) >= 2:
+                self.char_size = (abs(v[0]) * 400.0, abs(v[1]) * 400.0)  # cm -> units
+            else:
+                self.char_size = None
+            self.char_rel = None
+
+        def sr(params: bytes, off: int, mn: str) -> None:
+            v = _nums(params)
+            self.char_rel = (abs(v[0]), abs(v[1])) if len(v) >= 2 else (0.75, 1.5)
+            self.char_size = None
+
+        def di(params: bytes, off: int, mn: str) -> None:
+            v = _nums(params)
+            run, rise = (v[0], v[1]) if len(v) >= 2 else (1.0, 0.0)
+            if mn == "DR":
+                (p1x, p1y), (p2x, p2y) = self.p1, self.p2
+                run, rise = run * (p2x - p1x) / 100.0, rise * (p2y - p1y) / 100.0
+            r = math.hypot(run, rise)
+            self.label_dir = (run / r, rise / r) if r > 0 and math.isfinite(r) else (1.0, 0.0)
 
         def pg(params: bytes, off: int, mn: str) -> None:
             self.flush()
@@ -962,6 +1276,10 @@ class _Reader:
             "DF": df,
             "PG": pg,
             "LT": lt,
+            "SI": si,
+            "SR": sr,
+            "DI": di,
+            "DR": di,
         }
 
     # ------------------------------------------------------------------ text-like commands
@@ -980,15 +1298,73 @@ class _Reader:
         return self.n if j < 0 else j + 1
 
     def label(self, pos: int) -> int:
-        """LB/BL/WD: skip text to the terminator; returns the offset after it."""
+        """LB/BL/WD: skip text to the terminator; returns the offset after it.
+
+        The letters are not drawn, but LB moves the pen as the plotter would: one character
+        cell per character along the label direction, CR back to the line's start, LF one
+        line down, BS one cell back (see :meth:`label_advance`). BL (buffer) and WD (a
+        display) do not move it.
+        """
         self.labels += 1
+        mn = self.data[pos - 2 : pos].upper()
         j = self._find_term(pos, self.term)
         if j < 0:
             end = self._end_of_line(pos)
             self.warn(pos - 2, "label without its terminator: ended at the end of the line",
                       key="label-unterminated")
-            return end
-        return j + 1
+            text_end = end
+        else:
+            text_end, end = j, j + 1
+        if mn == b"LB":
+            self.label_advance(self.data[pos:text_end])
+        return end
+
+    def char_cell(self) -> tuple[float, float]:
+        """(advance along the text, line spacing) in plotter units.
+
+        The character cell of the HP stick font: 1.5 x the character width along the line,
+        2 x the character height between lines (HP 7475A manual, SI; the HP-GL/2 default
+        font, 9 characters per inch, is within 1 % of the same 0.187 cm x 1.5). Width and
+        height come from SI (cm), from SR (% of P2 - P1) or are SI's defaults, 0.187 x
+        0.269 cm.
+        """
+        if self.char_rel is not None:
+            (p1x, p1y), (p2x, p2y) = self.p1, self.p2
+            w = self.char_rel[0] / 100.0 * abs(p2x - p1x)
+            h = self.char_rel[1] / 100.0 * abs(p2y - p1y)
+        elif self.char_size is not None:
+            w, h = self.char_size
+        else:
+            w, h = 0.187 * 400.0, 0.269 * 400.0
+        return 1.5 * w, 2.0 * h
+
+    def label_advance(self, text: bytes) -> None:
+        """Move the current position over ``text`` as LB does (the pen state is kept: the
+        path being drawn ends at the label, the next pen-down move starts at its end)."""
+        if not text:
+            return
+        adv, line = self.char_cell()
+        ux, uy = self.label_dir
+        nx, ny = uy, -ux  # one line down: to the right of the direction of the text
+        col = 0.0
+        row = 0.0
+        for c in text:
+            if c == 0x0D:
+                col = 0.0
+            elif c == 0x0A:
+                row += 1.0
+            elif c == 0x08:
+                col -= 1.0
+            elif c >= 0x20:
+                col += 1.0
+        if col == 0.0 and row == 0.0:
+            return
+        self.flush_if_drawing()
+        x = self.x + col * adv * ux + row * line * nx
+        y = self.y + col * adv * uy + row * line * ny
+        if self.poly is not None:
+            self._poly_move(x, y)  # pen-up (or pen-down) move in the polygon buffer
+        self.x, self.y = x, y
 
     def dt(self, pos: int) -> int:
         data, n = self.data, self.n
@@ -1032,29 +1408,65 @@ class _Reader:
         return min(k + 1, n)
 
     def pe(self, pos: int) -> int:
+        if self.compiled:
+            return self._pe_compiled(pos)
         res = decode_pe(self.data, pos, self._pe_cache)
         for off, msg in res.problems:
             self.warn(off, msg, key="pe")
+        items = [(item.kind == "pen", item.value if item.kind == "pen" else 0, item.x, item.y,
+                  item.pen_up, item.absolute) for item in res.items]
+        self._pe_apply(items, pos)
+        return res.end
+
+    def _pe_compiled(self, pos: int) -> int:
+        """PE decoded by the compiled decoder (scan.decode_pe, the same decoding)."""
+        if self._scan is None:
+            from galvo_core.hpgl import scan as scan_module
+
+            self._scan = scan_module
+            self._u8 = np.frombuffer(self.data, dtype=np.uint8)
+            self._ist = np.zeros(scan_module.N_ISTATE, dtype=np.int64)
+            self._fst = np.zeros(scan_module.N_FSTATE, dtype=np.float64)
+        scan = self._scan
+        if not hasattr(self, "_pe_span"):
+            self._pe_span = np.array([-1, -1, -1, -1], dtype=np.int64)
+        end, kinds, xs, ys, flags, ni, p_off, p_code, p_val, npb = scan.decode_pe(
+            self._u8, pos, self._pe_span)
+        for off, code, val in zip(p_off[:npb].tolist(), p_code[:npb].tolist(),
+                                  p_val[:npb].tolist(), strict=True):
+            self.warn(off, _PE_MESSAGES[code].format(val), key="pe")
+        if ni:
+            xl = xs[:ni].tolist()
+            fl = flags[:ni].tolist()
+            items = [(k == 0, int(x) if k == 0 else 0, x, y, bool(f & 1), bool(f & 2))
+                     for k, x, y, f in zip(kinds[:ni].tolist(), xl, ys[:ni].tolist(), fl,
+                                           strict=True)]
+            self._pe_apply(items, pos)
+        return int(end)
+
+    def _pe_apply(self, items: list[tuple[bool, int, float, float, bool, bool]],
+                  pos: int) -> None:
+        """Apply decoded PE items: (is pen select, pen, x, y, pen up, absolute)."""
         saved_abs = self.absolute
-        for item in res.items:
-            if item.kind == "pen":
+        for is_pen, pen, ix, iy, pen_up, absolute in items:
+            if is_pen:
                 self.flush()
-                self.pen = item.value
+                self.pen = pen
+                self.pen_selected = True
                 continue
-            if item.pen_up:
+            if pen_up:
                 self.set_pen_down(False, pos)
             elif not self.pen_down:
                 self.set_pen_down(True, pos)
-            if item.absolute:
-                x, y = self.to_plotter(item.x, item.y)
+            if absolute:
+                x, y = self.to_plotter(ix, iy)
             else:
-                dx, dy = self.delta_to_plotter(item.x, item.y)
+                dx, dy = self.delta_to_plotter(ix, iy)
                 x, y = self.x + dx, self.y + dy
             self.pen_to(x, y, pos)
             # after a pen-up move the next pair (without '<') puts the pen down again; a
             # PE that ends with a pen-up move leaves the pen up (and draws no dot there)
         self.absolute = saved_abs
-        return res.end
 
     # ------------------------------------------------------------------ escapes and PCL
     def _escape_in_hpgl(self, i: int) -> int:
@@ -1079,7 +1491,9 @@ class _Reader:
     def _skip_pcl_data(self, m: re.Match[bytes]) -> int:
         end = m.end()
         term = m.group(5)
-        if term in (b"W", b"X") and (term == b"W" or m.group(2) == b"p"):
+        # ESC ... #W (raster, font, pattern data) and ESC&p#X (transparent print data)
+        # carry # bytes of data; ESC*p#X is cursor positioning and carries none
+        if term == b"W" or (term == b"X" and m.group(1) == b"&" and m.group(2) == b"p"):
             try:
                 count = int(float(m.group(4) or b"0"))
             except ValueError:
@@ -1097,12 +1511,14 @@ class _Reader:
             lang = m.group(1).upper().replace(b"-", b"")
             if lang.startswith(b"HPGL"):
                 self.hpgl_mode = True
+                self.hpgl2 = True
             return m.end()
         e = _PCL_ESC_RE.match(data, m.start())
         if e is None:
             return m.start() + 1
         if e.group(1) == b"%" and e.group(5) == b"B":
             self.hpgl_mode = True
+            self.hpgl2 = True
             return e.end()
         return self._skip_pcl_data(e)
 
@@ -1116,6 +1532,34 @@ _SPECIAL: dict[str, Callable[[_Reader, int], int]] = {
     "PE": _Reader.pe,
     "SM": _Reader.sm,
 }
+
+
+def _pen_down_runs(ring: list[tuple[float, float]],
+                   downs: list[bool]) -> list[list[tuple[float, float]]]:
+    """The pieces of a sub-polygon that EP draws: runs of pen-down edges.
+
+    ``downs[k]`` is the pen state of the edge from ``ring[k]`` to ``ring[k + 1]``; the last
+    entry is the closing edge back to ``ring[0]`` (none when the ring already ends there).
+    A ring whose edges are all pen-down comes back as one closed run.
+    """
+    pts = list(ring)
+    flags = list(downs[: len(ring) - 1])
+    if ring[0] != ring[-1]:
+        pts.append(ring[0])
+        flags.append(downs[-1] if len(downs) >= len(ring) else False)
+    runs: list[list[tuple[float, float]]] = []
+    cur: list[tuple[float, float]] = []
+    for k, down in enumerate(flags):
+        if down:
+            if not cur:
+                cur = [pts[k]]
+            cur.append(pts[k + 1])
+        elif cur:
+            runs.append(cur)
+            cur = []
+    if cur:
+        runs.append(cur)
+    return runs
 
 
 def _near(a: np.ndarray, b: np.ndarray) -> bool:
@@ -1168,16 +1612,97 @@ def _clip_polyline(pts: np.ndarray, win: tuple[float, float, float, float]) -> l
     return out
 
 
-def _line_cols(data: bytes, offsets: list[int]) -> list[tuple[int, int]]:
-    if not offsets:
-        return []
+def _line_cols_arrays(data: bytes, offs: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """1-based line and column of each byte offset (one pass over the newlines)."""
+    if not len(offs):
+        return np.zeros(0, np.int64), np.zeros(0, np.int64)
     nl = np.flatnonzero(np.frombuffer(data, dtype=np.uint8) == 10)
-    offs = np.asarray(offsets, dtype=np.int64)
     idx = np.searchsorted(nl, offs, side="left")  # newlines strictly before offset
-    line_start = np.where(idx > 0, nl[np.maximum(idx - 1, 0)] + 1 if len(nl) else 0, 0)
-    lines = idx + 1
-    cols = offs - line_start + 1
-    return list(zip(lines.tolist(), cols.tolist(), strict=True))
+    if len(nl):
+        line_start = np.where(idx > 0, nl[np.maximum(idx - 1, 0)] + 1, 0)
+    else:
+        line_start = np.zeros_like(offs)
+    return idx + 1, offs - line_start + 1
+
+
+def _line_cols(rd: _Reader, offs: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """1-based line and column of each offset: counted between the sorted offsets (bytes
+    counts newlines in C) when there are few, else in one pass over the bytes."""
+    if len(offs) > 2000:
+        return _line_cols_arrays(rd.data, offs)
+    data = rd.data
+    order = np.argsort(offs, kind="stable").tolist()
+    lines = np.empty(len(offs), dtype=np.int64)
+    cols = np.empty(len(offs), dtype=np.int64)
+    pos, line, last_nl = 0, 1, -1
+    offs_l = offs.tolist()
+    for k in order:
+        o = max(offs_l[k], 0)
+        if o > pos:
+            cnt = data.count(b"\n", pos, o)
+            if cnt:
+                line += cnt
+                last_nl = data.rfind(b"\n", pos, o)
+            pos = o
+        lines[k] = line
+        cols[k] = offs_l[k] - last_nl
+    return lines, cols
+
+
+_new_obj = object.__new__
+_set_attr = object.__setattr__
+
+
+def _new_path(points: np.ndarray, pen: int, closed: bool, line: int, col: int) -> Path:
+    """A Path without the copy its constructor makes: ``points`` is a read-only float64
+    (N, 2) array already (a view of the scanner's frozen chunk, or the reader's own)."""
+    sp = _new_obj(SourcePos)
+    _set_attr(sp, "line", line)
+    _set_attr(sp, "col", col)
+    p = _new_obj(Path)
+    _set_attr(p, "points", points)
+    _set_attr(p, "pen", pen)
+    _set_attr(p, "closed", closed)
+    _set_attr(p, "start", sp)
+    return p
+
+
+def _batch_paths(b: _Batch, out: list[Path]) -> None:
+    """Append the paths of a scanner batch to ``out``.
+
+    Tens of thousands of paths: the objects are made and filled by ``map`` (loops in C),
+    each path's points a view of the frozen chunk.
+    """
+    pts = b.chunk.pts
+    starts, ends = b.starts, b.ends
+    m = len(starts)
+    first = pts[starts]
+    last = pts[ends - 1]
+    closed = ((ends - starts >= 4) & (first[:, 0] == last[:, 0])
+              & (first[:, 1] == last[:, 1])).tolist()
+    views = list(map(pts.__getitem__, map(slice, starts.tolist(), ends.tolist())))
+    sps = list(map(_new_obj, repeat(SourcePos, m)))
+    any(map(_SP_LINE, sps, b.lines.tolist()))
+    any(map(_SP_COL, sps, b.cols.tolist()))
+    objs = list(map(_new_obj, repeat(Path, m)))
+    any(map(_P_POINTS, objs, views))
+    any(map(_P_PEN, objs, b.pens.tolist()))
+    any(map(_P_CLOSED, objs, closed))
+    any(map(_P_START, objs, sps))
+    out.extend(objs)
+
+
+# slot setters of the frozen dataclasses (member descriptors: no frozen __setattr__)
+def _slot_setter(cls: type, name: str) -> Callable[[object, object], None]:
+    return cls.__dict__[name].__set__  # type: ignore[no-any-return]
+
+
+_SP_LINE = _slot_setter(SourcePos, "line")
+_SP_COL = _slot_setter(SourcePos, "col")
+_P_POINTS = _slot_setter(Path, "points")
+_P_PEN = _slot_setter(Path, "pen")
+_P_CLOSED = _slot_setter(Path, "closed")
+_P_START = _slot_setter(Path, "start")
 
 
 def read_bytes(data: bytes, name: str = "<bytes>") -> Drawing:
@@ -1190,13 +1715,26 @@ def read_bytes(data: bytes, name: str = "<bytes>") -> Drawing:
     reason = refusal_reason(head)
     if reason is not None:
         raise InputError(name, reason)
+    # the reader makes tens of thousands of objects that all live on (paths, positions):
+    # the cyclic garbage collector would walk them again and again for nothing
+    gc_was_on = gc.isenabled()
+    gc.disable()
+    try:
+        return _read(data, name)
+    finally:
+        if gc_was_on:
+            gc.enable()
+
+
+def _read(data: bytes, name: str) -> Drawing:
     rd = _Reader(data, name)
     try:
         with np.errstate(all="ignore"):  # out-of-range numbers are dropped, not warned twice
             rd.run()
     except RecursionError as exc:  # pragma: no cover - defensive
         raise InputError(name, "file too deeply nested to read") from exc
-    body = len(data) - data.count(b"\x00")
+    # bytes that are not NUL padding (counted only when some bytes were not HP-GL)
+    body = len(data) - data.count(b"\x00") if rd.junk_bytes else len(data)
     if rd.recognised == 0:
         if not rd.hpgl_mode or _PCL_START_RE.match(data.lstrip(b"\x00")):
             raise InputError(name, "a PCL/PJL print job without HP-GL/2 graphics")
@@ -1215,7 +1753,11 @@ def read_bytes(data: bytes, name: str = "<bytes>") -> Drawing:
         rd.warn(-1, "line types (LT) are not applied: every line is imported solid")
     if rd.text_symbols:
         rd.warn(-1, "symbol mode (SM) characters are not drawn")
-    pen0 = sum(1 for p in rd.paths if p[1] == 0)
+    if rd.unselected_paths:
+        rd.warn(-1, f"{rd.unselected_paths} path(s) drawn before any pen was selected (SP): "
+                   "imported with pen 1 (an HP-GL/2 device would not draw them)")
+    pen0 = sum(
+        int((p.pens == 0).sum()) if isinstance(p, _Batch) else int(p[1] == 0) for p in rd.paths)
     if pen0:
         rd.warn(-1, f"{pen0} path(s) drawn with pen 0 (SP0 puts the pen away: a pen plotter "
                    "would not draw them); imported anyway")
@@ -1224,15 +1766,31 @@ def read_bytes(data: bytes, name: str = "<bytes>") -> Drawing:
     for key, count in rd._warn_count.items():
         if count > _WARN_CAP:
             rd._warn.append((-1, f"... and {count - _WARN_CAP} more warnings like: {key}"))
-    # positions
-    offsets = [p[3] for p in rd.paths]
-    w_offsets = [w[0] for w in rd._warn]
-    lc = _line_cols(data, offsets + w_offsets)
-    paths = []
-    for (pts, pen, closed, _), (line, col) in zip(rd.paths, lc[: len(offsets)], strict=True):
-        paths.append(Path(pts, pen=pen, closed=closed, start=SourcePos(line, col)))
+    # positions: the scanner's paths carry theirs; the others' and the warnings' from offsets
+    offs = np.array([p[3] for p in rd.paths if not isinstance(p, _Batch)]
+                    + [w[0] for w in rd._warn], dtype=np.int64)
+    lines, cols = _line_cols(rd, offs)
+    lines_l = lines.tolist()
+    cols_l = cols.tolist()
+    for ch in rd.chunks:
+        ch.seg_start = ch.seg_off = ch.seg_pen = ch.seg_line = ch.seg_col = _EMPTY_I32
+        if len(ch.pts) - ch.npts > max(ch.npts // 4, 4096):
+            ch.pts = ch.pts[: ch.npts].copy()  # the drawing keeps only what was used
+        ch.pts.setflags(write=False)
+    paths: list[Path] = []
+    k = 0
+    for item in rd.paths:
+        if isinstance(item, _Batch):
+            _batch_paths(item, paths)
+        else:
+            pts, pen, closed, _ = item
+            pts = np.ascontiguousarray(pts, dtype=np.float64)
+            pts.setflags(write=False)
+            paths.append(_new_path(pts, pen, closed, lines_l[k], cols_l[k]))
+            k += 1
+    lc = list(zip(lines_l[k:], cols_l[k:], strict=True))
     warnings = []
-    for (off, msg), (line, col) in zip(rd._warn, lc[len(offsets) :], strict=True):
+    for (off, msg), (line, col) in zip(rd._warn, lc, strict=True):
         if off < 0:
             line, col = 0, 0
         warnings.append(Warning(line, col, msg))

@@ -18,9 +18,17 @@ _SIGNATURES: list[tuple[bytes, str]] = [
     (b"MZ", "a Windows program, not HP-GL"),
     (b"AC10", "an AutoCAD DWG drawing, not HP-GL (plot it to PLT first)"),
     (b"\xef\xbb\xbf<", "an XML/SVG document, not HP-GL"),
+    (b"\xfd7zXZ\x00", "an xz-compressed file, not HP-GL (decompress it first)"),
+    (b"\x28\xb5\x2f\xfd", "a zstd-compressed file, not HP-GL (decompress it first)"),
+    (b"\x1f\x9d", "a compress (.Z) file, not HP-GL (decompress it first)"),
 ]
 
 _DXF_RE = re.compile(rb"\A\s*0\s*\r?\n\s*SECTION\b")
+_BZIP2_RE = re.compile(rb"\ABZh[1-9]1AY&SY")
+_CDR_RE = re.compile(rb"\ARIFF....CDR", re.S)
+# Gerber (RS-274X: %FS / %MO parameters, G04 comments) and Excellon drill files (M48)
+_GERBER_RE = re.compile(rb"\A\s*(?:G04[^\n]*\n\s*)*%(?:FS|MO|TF)")
+_EXCELLON_RE = re.compile(rb"\A\s*(?:;[^\n]*\n\s*)*M48\s*\n")
 _XML_RE = re.compile(rb"\A\s*<(\?xml|svg|!DOCTYPE|html)", re.I)
 _DMPL_RE = re.compile(rb"\A[\s\x00]*(?:\x1b;@:|;:[A-Z ])|;:H ?A\b")
 _GCODE_RE = re.compile(rb"\A(\s*(\(.*\)|;.*)?\s*\n)*\s*[GM]\d+\b[^\n]*\n\s*[GMXYZF]", re.M)
@@ -53,6 +61,14 @@ def refusal_reason(head: bytes) -> str | None:
     for sig, reason in _SIGNATURES:
         if head.startswith(sig):
             return reason
+    if _BZIP2_RE.match(head):
+        return "a bzip2-compressed file, not HP-GL (decompress it first)"
+    if _CDR_RE.match(head):
+        return "a CorelDRAW drawing, not HP-GL (export it as PLT/HP-GL first)"
+    if _GERBER_RE.match(head):
+        return "a Gerber (RS-274X) file, not HP-GL"
+    if _EXCELLON_RE.match(head):
+        return "an Excellon drill file, not HP-GL"
     if _XML_RE.match(head):
         return "an XML/SVG/HTML document, not HP-GL"
     if _DXF_RE.match(head):

@@ -1,0 +1,312 @@
+"""One truth on screen (issue 18): what the views show, the title, the stats and what Export
+writes always belong to the same file and parameters; nothing long runs on the GUI thread.
+
+Driven through the window's scripting surface (``load_file``, ``set_param``, ``wait_idle``,
+``export``, ``current_job``), offscreen, on the bundled samples.
+"""
+
+from __future__ import annotations
+
+import threading
+from pathlib import Path as FsPath
+
+import numpy as np
+import pytest
+
+pytest.importorskip("pytestqt")
+
+from _util import SAMPLES, circle_plt  # noqa: E402
+from PySide6.QtGui import QImage  # noqa: E402
+from PySide6.QtWidgets import QMessageBox  # noqa: E402
+
+import app.window as window_mod  # noqa: E402
+from app.window import MainWindow, _user_path_message  # noqa: E402
+from galvo_core.job import load_job  # noqa: E402
+
+pytestmark = pytest.mark.gui
+
+SIZE = (1200, 760)
+SEAL = SAMPLES / "seal.plt"
+LOGO = SAMPLES / "dense_logo.plt"
+
+
+@pytest.fixture
+def dialogs(monkeypatch) -> list[QMessageBox]:
+    boxes: list[QMessageBox] = []
+
+    def fake_exec(box):
+        boxes.append(box)
+        return int(QMessageBox.StandardButton.Ok)
+
+    monkeypatch.setattr(QMessageBox, "exec", fake_exec)
+    return boxes
+
+
+@pytest.fixture
+def win(qtbot) -> MainWindow:
+    w = MainWindow(restore=False)
+    qtbot.addWidget(w)
+    w.resize(*SIZE)
+    w.show()
+    qtbot.waitExposed(w)
+    return w
+
+
+class Gate:
+    """Holds ``load_drawing`` of one file until released (a slow file, deterministically)."""
+
+    def __init__(self, monkeypatch, name: str) -> None:
+        self.event = threading.Event()
+        self.threads: list[str] = []
+        real = window_mod.load_drawing
+
+        def gated(path):
+            self.threads.append(threading.current_thread().name)
+            if FsPath(path).name == name:
+                assert self.event.wait(30)
+            return real(path)
+
+        monkeypatch.setattr(window_mod, "load_drawing", gated)
+
+
+def rgb(image: QImage) -> np.ndarray:
+    img = image.convertToFormat(QImage.Format.Format_RGB32)
+    w, h = img.width(), img.height()
+    buf = np.frombuffer(img.constBits(), np.uint8, count=img.sizeInBytes())
+    return buf.reshape(h, img.bytesPerLine())[:, : w * 4].reshape(h, w, 4)[:, :, 2::-1].astype(int)
+
+
+def dark_pixels(w: MainWindow, view) -> int:
+    """Pixels of the view that are clearly ink (dark), not background or dimmed ink."""
+    a = rgb(w.grab().toImage())
+    x, y, ww, hh = view.view_rect_in(w)
+    a = a[y + 2 : y + hh - 2, x + 2 : x + ww - 2]
+    return int((a.sum(axis=2) < 3 * 140).sum())
+
+
+def test_export_while_another_file_opens_is_refused_and_esc_returns_to_the_shown_one(
+        win, qtbot, monkeypatch, dialogs, tmp_path):
+    gate = Gate(monkeypatch, LOGO.name)
+    assert win.load_file(SEAL, wait=True)
+    seal_job = win.current_job()
+    assert seal_job is not None and seal_job.source_name == "seal.plt"
+    seal_marks = win.processed.counts["marks"]
+
+    win.load_file(LOGO)  # held on the worker: seal's result stays on screen
+    qtbot.waitUntil(lambda: win.stale_bar.isVisible(), timeout=5000)
+    assert "seal.plt" in win.windowTitle() and "dense_logo.plt" in win.windowTitle()
+    assert "dense_logo.plt" in win.stale_bar.text()
+    assert win.current_job() is None  # nothing current to export
+    out = tmp_path / "dense_logo.json"
+    assert win.export("job", out) is False
+    assert not out.exists()
+    assert dialogs and "not exported" in dialogs[-1].informativeText()
+    assert win.processed.counts["marks"] == seal_marks  # still seal's, and dimmed
+
+    win.cancel_processing()  # Esc
+    gate.event.set()
+    assert win.wait_idle(60)
+    assert win.run_label.text() == "cancelled"
+    assert not win.stale_bar.isVisible()
+    assert win.windowTitle().startswith("seal.plt")
+    assert win.file_path == SEAL and win.current_job() is seal_job
+    # Export now writes seal's job under the name it proposes (seal), and the job says so
+    out = tmp_path / "after_cancel.json"
+    assert win.export("job", out)
+    assert load_job(out).source_name == "seal.plt"
+    # the file is read on a worker thread, never on the GUI thread
+    assert gate.threads and threading.main_thread().name not in gate.threads
+
+
+def test_new_file_result_replaces_everything_at_once(win, qtbot, monkeypatch, dialogs, tmp_path):
+    assert win.load_file(SEAL, wait=True)
+    win.select_path(0)
+    x, _ = win.original.highlight.getData()
+    assert x is not None and len(x) > 0
+    assert win.load_file(LOGO)
+    assert win.wait_idle(120)
+    # the previous file's selection is not drawn over the next file
+    assert win.selected is None
+    for view in (win.original, win.processed):
+        x, _ = view.highlight.getData()
+        assert x is None or len(x) == 0
+    assert win.windowTitle().startswith("dense_logo.plt")
+    job = win.current_job()
+    assert job is not None and job.source_name == "dense_logo.plt"
+    assert win.stats_panel.shown_number("mark_points") == job.stats["mark_points"]
+    out = tmp_path / "logo.json"
+    assert win.export("job", out)
+    assert load_job(out).source_sha256 == win.drawing.sha256
+    assert not dialogs
+
+
+def test_stale_views_are_visibly_dimmed(win, qtbot, monkeypatch):
+    gate = Gate(monkeypatch, LOGO.name)
+    assert win.load_file(SEAL, wait=True)
+    win.fit()
+    qtbot.wait(50)
+    before = dark_pixels(win, win.original)
+    assert before > 200
+    win.load_file(LOGO)
+    qtbot.waitUntil(lambda: win.stale_bar.isVisible(), timeout=5000)
+    qtbot.wait(50)
+    during = dark_pixels(win, win.original)
+    gate.event.set()
+    assert win.wait_idle(120)
+    assert during < 0.2 * before, (before, during)
+
+
+def test_a_job_with_an_error_or_no_strokes_is_never_exported_silently(
+        win, qtbot, dialogs, tmp_path):
+    src = tmp_path / "circle.plt"
+    src.write_bytes(circle_plt())
+    assert win.load_file(src, wait=True)
+    assert win.set_param("magnification", 2000.0) and win.wait_idle(60)
+    assert win.run_error and "field" in win.run_error
+    out = tmp_path / "out.json"
+    for kind in ("job", "plt", "svg"):
+        n = len(dialogs)
+        assert win.export(kind, out.with_suffix("." + kind)) is False
+        assert len(dialogs) == n + 1
+        assert "field" in dialogs[-1].informativeText()
+    assert not list(tmp_path.glob("out.*"))
+    # no pen-down at all: the job has no strokes
+    empty = tmp_path / "nothing.plt"
+    empty.write_bytes(b"IN;SP1;PU100,100;")
+    assert win.load_file(empty, wait=True)
+    assert win.current_job() is not None and not win.current_job().strokes
+    assert win.export("job", out) is False
+    assert "no strokes" in dialogs[-1].informativeText()
+    assert not out.exists()
+
+
+def test_export_errors_name_the_users_file_not_the_temporary_one(
+        win, qtbot, monkeypatch, dialogs, tmp_path):
+    src = tmp_path / "circle.plt"
+    src.write_bytes(circle_plt())
+    assert win.load_file(src, wait=True)
+    target = tmp_path / "job.json"
+
+    def bad_replace(a, b):
+        raise RuntimeError(f"cannot move {a} into place")
+
+    monkeypatch.setattr(window_mod.os, "replace", bad_replace)  # the os module is shared
+    assert win.export("job", target) is False
+    text = dialogs[-1].informativeText()
+    assert str(target) in text and ".tmp-" not in text
+    assert [p.name for p in tmp_path.iterdir() if p.name.startswith(".tmp")] == []
+    assert _user_path_message("x /a/b/.tmp-12ab.json: no", FsPath("/a/b/job.json")) == \
+        "x /a/b/job.json: no"
+
+
+def test_export_and_job_load_run_on_a_worker(win, qtbot, monkeypatch, tmp_path):
+    src = tmp_path / "circle.plt"
+    src.write_bytes(circle_plt())
+    assert win.load_file(src, wait=True)
+    threads: list[str] = []
+    real = window_mod.write_job
+
+    def recording(job, path):
+        threads.append(threading.current_thread().name)
+        real(job, path)
+
+    win.export_kinds["job"] = window_mod.ExportKind("Job", "*.json", ".json", recording)
+    out = tmp_path / "circle.json"
+    assert win.export("job", out)
+    real_load = window_mod.load_job
+
+    def load(path):
+        threads.append(threading.current_thread().name)
+        return real_load(path)
+
+    monkeypatch.setattr(window_mod, "load_job", load)
+    n = win.processed.counts["marks"]
+    assert win.load_file(out, wait=True)
+    assert win.job_path == out and win.processed.counts["marks"] == n
+    assert len(threads) == 2 and threading.main_thread().name not in threads
+
+
+def test_set_param_and_current_job(win, qtbot, tmp_path):
+    src = tmp_path / "circle.plt"
+    src.write_bytes(circle_plt())
+    assert win.load_file(src, wait=True)
+    assert win.set_param("e_per", 0.3)
+    assert win.current_job() is None  # pending: the shown job is not the current one
+    assert win.wait_idle(60)
+    assert win.current_job().params["e_per"] == 0.3
+    assert win.controls.sliders["e_per"].value() == pytest.approx(0.3, rel=1e-3)
+    assert win.set_param("mark_speed_mm_s", 500.0) and win.wait_idle(60)
+    assert win.current_job().laser["mark_speed_mm_s"] == 500.0
+    assert win.set_param("no_such_thing", 1) is False
+    assert win.set_param("e_per", -1.0) is False
+    assert win.current_job().params["e_per"] == 0.3
+
+
+def test_drawing_bigger_than_the_field_opens_with_fit_field(win, qtbot, dialogs, tmp_path):
+    # 400 x 400 mm at 40 units per mm: bigger than the 110 mm field at true size
+    big = tmp_path / "big.plt"
+    big.write_bytes(b"IN;SP1;PU0,0;PD16000,0,16000,16000,0,16000,0,0;PU;")
+    assert win.params.magnification is None and not win.params.fit_field
+    assert win.load_file(big, wait=True)
+    assert win.params.fit_field and win.run_error is None
+    assert win.banner.isVisible() and "Fit field" in win.banner.text()
+    assert win.current_job() is not None and win.current_job().strokes
+    assert not dialogs
+
+
+def test_deviation_is_computed_only_when_shown(win, qtbot, tmp_path):
+    src = tmp_path / "circle.plt"
+    src.write_bytes(circle_plt())
+    win.layer_boxes["deviation"].setChecked(False)
+    assert win.load_file(src, wait=True)
+    assert not win.result.preview.has_layer("deviation")
+    assert len(win.result.preview.deviation_err) == 0
+    win.layer_boxes["deviation"].setChecked(True)
+    assert win.wait_idle(60)
+    assert win.result.preview.has_layer("deviation")
+    assert len(win.result.preview.deviation_err) > 0
+    assert win.processed.layers["deviation"].n_chords == len(win.result.preview.deviation_err)
+
+
+def test_export_kinds_can_be_extended(win, qtbot, tmp_path):
+    src = tmp_path / "circle.plt"
+    src.write_bytes(circle_plt())
+    assert win.load_file(src, wait=True)
+    written: list[str] = []
+    win.export_kinds["txt"] = window_mod.ExportKind(
+        "Export &Text…", "Text (*.txt)", ".txt",
+        lambda job, path: (written.append(job.source_name), path.write_text("x")))
+    win.rebuild_export_menu()
+    assert "txt" in win.export_actions and win.export_actions["txt"].isEnabled()
+    assert win.export("txt", tmp_path / "a.txt") and written == ["circle.plt"]
+
+
+def test_big_job_files_are_written_and_read_the_same_way(tmp_path, monkeypatch):
+    """The stroke-by-stroke JSON of app.offload is byte for byte write_job's, and a job
+    read in the helper process equals the one read directly."""
+    from app import offload
+    from galvo_core.hpgl import read_file
+    from galvo_core.job import write_job
+    from galvo_core.params import Params
+    from galvo_core.pipeline import Pipeline
+
+    job = Pipeline().run(read_file(SEAL), Params(fit_field=True)).job
+    a = tmp_path / "a.json"
+    write_job(job, a)
+    assert offload.job_json_bytes(job) == a.read_bytes()
+    monkeypatch.setattr(offload, "BIG_JOB_ITEMS", 0)
+    b = tmp_path / "b.json"
+    offload.write_job_file(write_job, job, b)
+    assert b.read_bytes() == a.read_bytes()
+    monkeypatch.setattr(offload, "BIG_JOB_BYTES", 0)
+    monkeypatch.setattr(offload, "CHUNK_SEGMENTS", 50)
+    back = offload.load_job_file(a, lambda p: pytest.fail("read in the helper process"))
+    direct = load_job(a)
+    assert len(back.strokes) == len(direct.strokes) > 1
+    for s, t in zip(back.strokes, direct.strokes, strict=True):
+        assert np.array_equal(s.marks, t.marks) and len(s.segments) == len(t.segments)
+    assert back.stats == direct.stats and back.source_sha256 == direct.source_sha256
+    bad = tmp_path / "bad.json"
+    bad.write_text("{not json")
+    with pytest.raises(Exception, match="bad.json"):
+        offload.load_job_file(bad, load_job)

@@ -1,0 +1,136 @@
+"""The compiled scanner (galvo_core.hpgl.scan) reads exactly what the command-by-command
+reader reads: same points (bit for bit), pens, closed flags, positions, warnings and command
+counts, also when its output chunks fill up in the middle of paths and commands."""
+
+from __future__ import annotations
+
+import random
+from unittest import mock
+
+import numpy as np
+import pytest
+
+import galvo_core.hpgl.reader as reader
+from galvo_core.hpgl import read_bytes
+
+pytest.importorskip("numba")
+
+
+def _read(data: bytes, compiled: bool, chunk: int = reader._CHUNK_POINTS):
+    with mock.patch.object(reader, "_use_compiled", lambda size: compiled), \
+            mock.patch.object(reader, "_FAST_MIN_BYTES", 10**12), \
+            mock.patch.object(reader, "_CHUNK_POINTS", chunk):
+        return read_bytes(data, "scan.plt")
+
+
+def assert_same(a, b) -> None:
+    assert len(a.paths) == len(b.paths)
+    for p, q in zip(a.paths, b.paths, strict=True):
+        assert np.array_equal(p.points, q.points)
+        assert (p.pen, p.closed, p.start) == (q.pen, q.closed, q.start)
+        assert not p.points.flags.writeable
+    assert a.warnings == b.warnings
+    assert dict(a.commands) == dict(b.commands)
+
+
+def _program(rng: random.Random, n: int) -> bytes:
+    out = [b"IN;SP1;"]
+    for _ in range(n):
+        r = rng.random()
+        if r < 0.3:
+            out.append(b"PU%d,%d;" % (rng.randint(-999, 999), rng.randint(-999, 999)))
+        elif r < 0.6:
+            k = rng.randint(0, 40)
+            nums = ",".join(f"{rng.uniform(-500, 500):.{rng.randint(0, 3)}f}" for _ in range(2 * k))
+            out.append(b"PD" + nums.encode() + b";")
+        elif r < 0.7:
+            out.append(b"PR;" if rng.random() < 0.5 else b"PA;")
+        elif r < 0.8:
+            out.append(b"SP%d;" % rng.randint(0, 4))
+        elif r < 0.85:
+            out.append(rng.choice([b"LT;", b"CI5;", b"PD1:2;", b"PD1,2,3;", b"BP;", b"\n",
+                                   b"SC0,100,0,100;", b"SC;", b"PD1.2.3,4;", b"LBab\x03"]))
+        else:
+            out.append(b"PD%d,%d" % (rng.randint(0, 99), rng.randint(0, 99)))  # no ';'
+    return b"".join(out)
+
+
+@pytest.mark.parametrize("seed", range(12))
+@pytest.mark.parametrize("chunk", [8, 1 << 16])
+def test_compiled_scanner_reads_what_the_general_reader_reads(seed: int, chunk: int) -> None:
+    data = _program(random.Random(seed), 400)
+    assert_same(_read(data, True, chunk), _read(data, False))
+
+
+def test_one_long_command_across_many_chunks() -> None:
+    """A single PD with 5000 pairs, chunks of 8 points: the chunk grows, the path is one."""
+    body = ",".join(f"{k},{k % 7}" for k in range(5000)).encode()
+    data = b"IN;SP1;PU0,0;PD" + body + b";PU;"
+    a, b = _read(data, True, 8), _read(data, False)
+    assert_same(a, b)
+    assert len(a.paths) == 1 and len(a.paths[0].points) == 5001
+
+
+def test_path_open_across_an_interruption_is_one_path() -> None:
+    """A path the scanner leaves open goes on after a command it hands over (LT)."""
+    data = b"IN;SP1;PU0,0;PD1,1;LT;PD2,2;LT;PD3,3;PU;"
+    a = _read(data, True, 8)
+    assert_same(a, _read(data, False))
+    np.testing.assert_array_equal(a.paths[0].points, [[0, 0], [1, 1], [2, 2], [3, 3]])
+
+
+# ------------------------------------------------------------------ PE
+def _pe_both(data: bytes, pos: int = 0):
+    from galvo_core.hpgl import scan
+    from galvo_core.hpgl.pe import PECache, decode_pe
+
+    ref = decode_pe(data, pos, PECache())
+    end, kinds, xs, ys, flags, ni, p_off, p_code, p_val, npb = scan.decode_pe(
+        np.frombuffer(data, np.uint8), pos, np.array([-1, -1, -1, -1], np.int64))
+    got = [("pen", int(x), 0.0, 0.0, False, False) if k == 0 else
+           ("pair", 0, x, y, bool(f & 1), bool(f & 2))
+           for k, x, y, f in zip(kinds[:ni].tolist(), xs[:ni].tolist(), ys[:ni].tolist(),
+                                 flags[:ni].tolist(), strict=True)]
+    want = [(it.kind, it.value if it.kind == "pen" else 0, it.x if it.kind == "pair" else 0.0,
+             it.y if it.kind == "pair" else 0.0, it.pen_up, it.absolute) for it in ref.items]
+    msgs = [reader._PE_MESSAGES[c].format(v) for c, v in zip(p_code[:npb].tolist(),
+                                                            p_val[:npb].tolist(), strict=True)]
+    return (end, got, list(zip(p_off[:npb].tolist(), msgs, strict=True))), \
+        (ref.end, want, ref.problems)
+
+
+@pytest.mark.parametrize("seed", range(40))
+def test_compiled_pe_decoder_matches_the_python_one(seed: int) -> None:
+    from galvo_core.hpgl.pe import encode_number
+
+    rng = random.Random(seed)
+    parts = []
+    for _ in range(rng.randint(0, 60)):
+        r = rng.random()
+        seven = False
+        if r < 0.05:
+            parts.append(b"7")
+            seven = True
+        elif r < 0.15:
+            parts.append(rng.choice([b":", b"<", b">", b"=", b" ", b"\n", b"\x80"]))
+        elif r < 0.2:
+            parts.append(bytes([rng.randrange(256)]))  # noise, maybe the end of the run
+        else:
+            v = rng.choice([rng.randint(-100, 100), rng.randint(-10**6, 10**6),
+                            rng.randint(-10**17, 10**17), rng.randint(0, 30)])
+            parts.append(encode_number(v, seven=seven))
+    data = b"".join(parts) + rng.choice([b";", b"", b"PU;", b"\x1b%0A"])
+    got, want = _pe_both(data)
+    assert got == want
+
+
+def test_compiled_pe_reads_files_as_the_python_decoder() -> None:
+    """A PE-heavy HP-GL/2 job (PCL-wrapped, polygons), read both ways: the same drawing."""
+    from pathlib import Path
+
+    f = Path(__file__).resolve().parents[2] / "shared" / "corpus" / "plt" / \
+        "artifexsoftware__ghostpdl__grashopp.pcl"
+    if not f.is_file():
+        pytest.skip("corpus file not present")
+    data = f.read_bytes()
+    assert_same(_read(data, True), _read(data, False))
