@@ -1242,22 +1242,27 @@ def _min_step_pass(mk: _MarkRows, cs: _CubicSet, tol: float, min_step: float,
     # q - 1 -> q + 2 when the mark before is dropped instead): measured here for all of them
     # at once (a chord's height does not depend on the others measured with it), any other
     # question one by one
+    n = len(pid)
     q = np.flatnonzero(short)
-    qa = np.concatenate([q, q, q - 1, q - 1])
-    qb = np.concatenate([q + 2, q + 3, q + 1, q + 2])
-    ok = (qa >= 0) & (qb < len(pid))
-    qa, qb = qa[ok], qb[ok]
-    ok = pid[qa] == pid[qb]
-    qa, qb = qa[ok], qb[ok]
-    hq = _chords_heights(cs, sid[qa], st[qa], sid[qb], st[qb], pos[qa], pos[qb])
-    known = dict(zip(zip(qa.tolist(), qb.tolist(), strict=True), (hq <= tol).tolist(),
-                     strict=True))
+    # step (2 or 3) -> per mark a: -1 not measured, else whether a -> a + step holds
+    known: dict[int, np.ndarray] = {}
+    for step in (2, 3):
+        a = np.unique(np.concatenate([q, q - 1]))
+        a = a[(a >= 0) & (a + step < n)]
+        a = a[pid[a] == pid[a + step]]
+        res = np.full(n, -1, dtype=np.int8)
+        for c in range(0, len(a), 1 << 16):  # in pieces: the height temporaries stay small
+            ac = a[c:c + (1 << 16)]
+            bc = ac + step
+            hq = _chords_heights(cs, sid[ac], st[ac], sid[bc], st[bc], pos[ac], pos[bc])
+            res[ac] = hq <= tol
+        known[step] = res
 
     def merge_ok(a: int, b: int) -> bool:
         """The chord from mark a to mark b keeps within the tolerance."""
-        hit = known.get((a, b))
-        if hit is not None:
-            return hit
+        res = known.get(b - a)
+        if res is not None and res[a] >= 0:
+            return bool(res[a])
         h = _chords_heights(cs, sid[[a]], st[[a]], sid[[b]], st[[b]], pos[[a]], pos[[b]])
         return bool(h[0] <= tol)
 
