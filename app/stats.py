@@ -105,7 +105,9 @@ def stat_label(key: str) -> str:
 
 def ordered_stats(stats: dict[str, Any]) -> list[tuple[str, Any]]:
     known = [(k, stats[k]) for k in STAT_LABELS if k in stats]
-    rest = sorted((k, v) for k, v in stats.items() if k not in STAT_LABELS and k != "warnings")
+    # the time per layer shows in the layer table (app.layers_dock), not as "n entries"
+    rest = sorted((k, v) for k, v in stats.items()
+                  if k not in STAT_LABELS and k not in ("warnings", "layers"))
     return known + rest
 
 

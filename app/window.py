@@ -459,6 +459,8 @@ class MainWindow(QMainWindow):
 
         self._build_menus()
         self._build_status_bar()
+        from .layers_dock import LayersDock
+        self.layers = LayersDock(self)  # the layer table, pen table files, LMC export
         for view in (self.original, self.processed):
             view.scene().sigMouseMoved.connect(lambda pos, v=view: self._on_mouse_moved(v, pos))
             view.scene().sigMouseClicked.connect(lambda ev, v=view: self._on_mouse_clicked(v, ev))
@@ -625,9 +627,9 @@ class MainWindow(QMainWindow):
             return None
         from .worker import pipeline_task_safe
 
-        gen = self.runner.request(pipeline_task_safe(
+        gen = self.runner.request(self.layers.wrap(pipeline_task_safe(
             self.pipeline, self.preview_cache, self.drawing, self.params, self.file_path,
-            self.wanted_layers(), self.prepared_cache))
+            self.wanted_layers(), self.prepared_cache)))
         self._update_stale()
         return gen
 
@@ -702,7 +704,8 @@ class MainWindow(QMainWindow):
             return self.drawing is not None
         if res.job_path is not None or self.job_path is not None:
             return res.job_path != self.job_path
-        return res.drawing is not self.drawing or res.params != self.params
+        return (res.drawing is not self.drawing or res.params != self.params
+                or not self.layers.is_current(res))
 
     def shown_name(self) -> str:
         """The name of the file whose result the views show ('' when none)."""
@@ -785,6 +788,7 @@ class MainWindow(QMainWindow):
             if res.params is not None:
                 self.params = res.params
                 self.controls.set_params(res.params, res.preview.field_map)
+            self.layers.restore(res)  # and the pen table
             self._watch(self.file_path)
         self.run_label.setText("cancelled")
         self.statusBar().showMessage(

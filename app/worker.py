@@ -56,6 +56,8 @@ class RunResult:
     #: worker (QPainterPaths, rectangles: :func:`app.views.prepare_layer`)
     arrays: dict[str, tuple[np.ndarray, ...]] | None = None
     prepared: dict[str, tuple] | None = None
+    #: the pen table applied to ``job`` (app.layers_dock: part of what the result was made of)
+    pens: Any = None
 
 
 _NO_POINTS = np.empty((0, 2))

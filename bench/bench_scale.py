@@ -10,6 +10,8 @@ Stages, called as the pipeline calls them with default parameters except:
 * order: ``order_strokes(method="optimized")`` on the contours and hatch strokes (input
   units) with no time budget (``--order-budget``, default 1e6 s): the search stops by itself.
 
+``--crossings-only --per-row 1000000``: the even-odd ray test alone, all drawings in one row.
+
     python bench/bench_scale.py --sizes 100000 1000000
 """
 
@@ -64,10 +66,15 @@ def crossings_only(d) -> dict:  # type: ignore[no-untyped-def]
     return out
 
 
-def measure(n: int, repeat: int, budget: float) -> dict:
-    d = tiled(n)
+def measure(n: int, repeat: int, budget: float, per_row: int = 20,
+            crossings_alone: bool = False) -> dict:
+    d = tiled(n, per_row=per_row)
     pts = sum(len(p.points) for p in d.paths)
-    row: dict = {"n": n, "points": pts, "paths": len(d.paths)}
+    row: dict = {"n": n, "points": pts, "paths": len(d.paths), "per_row": per_row}
+    if crossings_alone:
+        row["crossings"] = crossings_only(d)
+        print(json.dumps(row), file=sys.stderr)
+        return row
     t, st = best_cpu(lambda: hatch(d, fill="zigzag", spacing_units=2.0), repeat)
     row.update(fill_s=t, hatch_strokes=len(st), cells=sum(s.cells for s in st))
     params = Params(kerf_mm=0.1, kerf_side="outside", kerf_method="vector")
@@ -96,9 +103,21 @@ def main() -> None:
     ap.add_argument("--sizes", type=int, nargs="+", default=[100_000, 1_000_000])
     ap.add_argument("--repeat", type=int, default=1)
     ap.add_argument("--order-budget", type=float, default=1e6)
+    ap.add_argument("--per-row", type=int, default=20, help="drawings per row of the tiling")
+    ap.add_argument("--crossings-only", action="store_true",
+                    help="only the even-odd ray test: _odd_crossings against _crossings")
     ap.add_argument("--out", type=Path, default=ROOT / "bench" / "out" / "scale.json")
     args = ap.parse_args()
-    rows = [measure(n, args.repeat, args.order_budget) for n in args.sizes]
+    rows = [measure(n, args.repeat, args.order_budget, args.per_row, args.crossings_only)
+            for n in args.sizes]
+    if args.crossings_only:
+        print("| points | drawings per row | faces | edges | _crossings s | _odd_crossings s |")
+        print("| ---: | ---: | ---: | ---: | ---: | ---: |")
+        for r in rows:
+            c = r["crossings"]
+            print(f"| {r['points']} | {r['per_row']} | {c['faces']} | {c['edges']} | "
+                  f"{c.get('crossings_s', float('nan')):.3f} | {c['odd_crossings_s']:.3f} |")
+        return
     args.out.parent.mkdir(parents=True, exist_ok=True)
     args.out.write_text(json.dumps(rows, indent=1))
     print("| points | stage | CPU s | growth exponent vs previous size |")

@@ -14,3 +14,13 @@ echo "## fill"
 echo
 echo "## order"
 "$VENV/bin/python" bench/bench_order.py
+echo
+echo "## zig-zag strokes per file (issue 21; compare with --root OLD_CHECKOUT, see the script)"
+"$VENV/bin/python" bench/bench_zigzag.py --out bench/out/zigzag.json
+echo
+echo "## order that stops by itself (issue 21)"
+"$VENV/bin/python" bench/bench_order_stop.py
+echo
+echo "## fill / kerf / order growth on real drawings side by side (issue 21)"
+"$VENV/bin/python" bench/bench_scale.py --sizes 100000 1000000
+"$VENV/bin/python" bench/bench_scale.py --crossings-only --per-row 1000000 --sizes 100000 1000000

@@ -52,7 +52,7 @@ from galvo_core.kerf import _components
 FILL_METHODS = ("scanline", "zigzag")
 #: search steps for long cell paths per monotone cell of a region piece (plus EFFORT_BASE);
 #: when they are spent the cells left are covered by greedy walks (linear, no search)
-EFFORT_PER_CELL = 300
+EFFORT_PER_CELL = 100
 EFFORT_BASE = 3000
 #: the old name of the per-piece bound (now per cell)
 MAX_EFFORT = EFFORT_PER_CELL
@@ -61,6 +61,9 @@ MAX_EFFORT = EFFORT_PER_CELL
 UTURN_OFFSET = 0.9
 #: search steps spent looking for a cheaper cover once one stroke covers a whole piece
 FULL_COVER_EXTRA = 3000
+#: each start of a stroke's search gets this share of the steps the stroke has left (the
+#: starts with the fewest free neighbours first, so they get the most)
+ALLOC_DIV = 4
 
 
 @dataclass(frozen=True, eq=False)
@@ -610,7 +613,8 @@ class _Hatch:
                     st["best"] = (n_cells, cost, [*cur, (c, e, s, False, False, False, None)])
                 if n_cells == st["left"] and st["full_at"] < 0:
                     st["full_at"] = st["budget"]
-                # a full cover: stop when it costs nothing or after a little more search
+                # as long as no path can be: stop when it costs nothing or after a little
+                # more search
                 done = n_cells == st["left"] and (
                     cost == 0.0 or st["full_at"] - st["budget"] > FULL_COVER_EXTRA)
             seen[c] = False
@@ -668,16 +672,22 @@ class _Hatch:
             comp = component(c_first)
             self.effort += len(comp)
             total -= len(comp)
-            st.update(left=len(comp), best=(0, 0.0, []), cur=[], seen=visited.copy(),
-                      full_at=-1, budget=0)
-            starts = sorted(comp, key=free_nbrs)
+            st["seen"] = visited
+            free = [free_nbrs(c) for c in comp]
+            # a cell with one free neighbour can only end a path: no path holds more than
+            # two of them (the longest possible path, found: the search is done)
+            leaves = sum(1 for f in free if f <= 1)
+            st.update(left=len(comp) - max(0, leaves - 2), best=(0, 0.0, []), cur=[],
+                      seen=visited.copy(), full_at=-1, budget=0)
+            starts = [c for _, c in sorted(zip(free, comp, strict=True),
+                                           key=lambda fc: fc[0])]
             share = min(total, EFFORT_BASE + max(0, int(effort_per_cell)) * len(comp))
             fin = False
-            for k, c0 in enumerate(starts):
+            for c0 in starts:
                 for e0 in (0, 1):
                     if share <= 0:
                         break
-                    allow = min(share, max(200, share // max(1, 2 * (len(starts) - k))))
+                    allow = min(share, max(200, share // ALLOC_DIV))
                     st["budget"] = allow
                     st["full_at"] = -1 if st["best"][0] < st["left"] else allow
                     fin = dfs(c0, e0, None, 0.0, 0)
@@ -711,8 +721,10 @@ class _Hatch:
             r = self._oriented(self._rungs_of(c, extra), e == 1)  # type: ignore[arg-type]
             y, xs, pcs = r
 
-            def pt(j: int, sd: int, y: np.ndarray = y, xs: np.ndarray = xs) -> np.ndarray:
-                return np.array([[xs[j, sd], y[j]]])
+            ends = (np.column_stack([xs[:, 0], y]), np.column_stack([xs[:, 1], y]))
+
+            def pt(j: int, sd: int, ends: tuple = ends) -> np.ndarray:
+                return ends[sd][j:j + 1]
 
             if not ut:
                 sd = s
@@ -792,6 +804,9 @@ def hatch(
     ``inset_units`` are input units; pass ``p`` uses ``angle_deg + p * angle_step_deg``.
     Strokes come region by region (file order of the outer rings), pass by pass, bottom to
     top of the rotated frame; order them for the job with :func:`galvo_core.order`.
+    ``max_effort``: zig-zag search steps per monotone cell of a region piece (plus
+    :data:`EFFORT_BASE`), after which greedy walks cover the cells left (see
+    :meth:`_Hatch.walk`; 0: greedy walks only).
     """
     if fill == "none":
         return []

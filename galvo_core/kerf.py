@@ -118,7 +118,7 @@ ASSIGN_STRIDE = 4
 #: scan spacing of the rectangle method as a fraction of d
 RECT_SPACING = 0.25
 #: the even-odd ray test cuts the plane into columns of about this many edge ends each
-CROSS_COLUMN_EDGES = 128
+CROSS_COLUMN_EDGES = 512
 #: ... unless the plain ray count pairs at most this many times (points + edges)
 CROSS_PLAIN_PAIRS = 8
 
@@ -892,9 +892,9 @@ def _odd_crossings(pts: np.ndarray, a: np.ndarray, b: np.ndarray) -> np.ndarray:
                                    side="right"))
         stop = max(stop, start + 1)
         rows = sel[start:stop]
-        c = cnt[rows]
-        row = np.repeat(rows, c)
-        k = lo[row] + (np.arange(len(row)) - np.repeat(np.cumsum(c) - c, c))
+        rc = cnt[rows]
+        row = np.repeat(rows, rc)
+        k = lo[row] + (np.arange(len(row)) - np.repeat(np.cumsum(rc) - rc, rc))
         pi = porder[k]
         e = e_id[row]
         x = ax[e] + (py[pi] - ay[e]) * (bx[e] - ax[e]) / (by[e] - ay[e])

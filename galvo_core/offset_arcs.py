@@ -98,19 +98,65 @@ def two_sided_arcs(geom: BaseGeometry, d: float, tol: float, *, check: bool = Tr
     if geom.is_empty or not (0.0 < tol < d):
         return geom, none
     parts = shapely.get_parts(geom)
-    n_holes = shapely.get_num_interior_rings(parts)
-    owner = np.repeat(np.arange(len(parts)), n_holes + 1)  # polygon of each ring
-    xy_c, ring_c = shapely.get_coordinates(shapely.get_rings(parts), return_index=True)
-    # distinct vertices of each ring (drop the closing copy)
-    last = np.append(ring_c[1:] != ring_c[:-1], True)
-    xy = xy_c[~last]
-    ring = ring_c[~last]
-    n_r = len(owner)
-    size = np.bincount(ring, minlength=n_r)
-    start = np.concatenate(([0], np.cumsum(size)[:-1]))
-    pos = np.arange(len(xy)) - start[ring]
-    prev = start[ring] + (pos - 1) % size[ring]
-    nxt = start[ring] + (pos + 1) % size[ring]
+    rings = _Rings.of(parts)
+    runs = _join_runs(rings, d)
+    if runs is None:
+        return geom, none
+    k, rr = join_plan(d, tol, np.where(runs.cand, np.abs(runs.phi), 0.0))
+    use = runs.cand & (k > 0) & (k < runs.r_len - 1)
+    if not use.any():
+        return geom, none
+    closed_xy, closed_ring, closed_prot, touched = _redrawn(rings, runs, use, k, rr)
+    polys = shapely.polygons(shapely.linearrings(closed_xy, indices=closed_ring),
+                             indices=rings.owner)
+    changed = np.zeros(len(parts), dtype=bool)
+    changed[rings.owner[touched]] = True
+    polys, changed = _keep_valid(parts, polys, changed, check)
+    if polys is None or not changed.any():
+        return geom, none
+    out = polys[0] if len(polys) == 1 else shapely.MultiPolygon(list(polys))
+    return out, _keep_mask(rings, changed, closed_ring, closed_prot)
+
+
+class _Rings:
+    """The distinct vertices of every ring of some polygons (closing copies dropped), in
+    order: ``xy``, ``ring`` (ring of each vertex), ``owner`` (polygon of each ring),
+    ``size``/``start`` per ring, and each vertex's place, predecessor and successor in its
+    ring."""
+
+    def __init__(self, owner: np.ndarray, xy: np.ndarray, ring: np.ndarray) -> None:
+        self.owner, self.xy, self.ring = owner, xy, ring
+        self.n = len(owner)
+        self.size = np.bincount(ring, minlength=self.n)
+        self.start = np.concatenate(([0], np.cumsum(self.size)[:-1]))
+        self.pos = np.arange(len(xy)) - self.start[ring]
+        self.prev = self.start[ring] + (self.pos - 1) % self.size[ring]
+        self.nxt = self.start[ring] + (self.pos + 1) % self.size[ring]
+
+    @classmethod
+    def of(cls, parts: np.ndarray) -> _Rings:
+        n_holes = shapely.get_num_interior_rings(parts)
+        owner = np.repeat(np.arange(len(parts)), n_holes + 1)
+        xy_c, ring_c = shapely.get_coordinates(shapely.get_rings(parts), return_index=True)
+        last = np.append(ring_c[1:] != ring_c[:-1], True)
+        return cls(owner, xy_c[~last], ring_c[~last])
+
+
+class _Runs:
+    """Candidate joins: each ring rotated to begin where a run begins (``xy``, ``same``:
+    the edge into a vertex is a chord of the run), runs ``r_first..r_last`` (``run_id`` per
+    vertex), each run's centre ``ctr``, signed sweep ``phi`` and whether it is a join
+    (``cand``: on one circle of radius d, turning one way)."""
+
+    def __init__(self, **arrays: np.ndarray) -> None:
+        self.__dict__.update(arrays)
+
+
+def _join_runs(rings: _Rings, d: float) -> _Runs | None:
+    """The runs of vertices on one circle of radius ``d`` turning one way (GEOS's round
+    joins), found from the outline alone; None when there is none of 3 vertices or more."""
+    xy, ring, start, size, pos = rings.xy, rings.ring, rings.start, rings.size, rings.pos
+    prev, nxt, n_r = rings.prev, rings.nxt, rings.n
     cc, rad = _circumcircles(xy[prev], xy, xy[nxt])
     inner = (np.abs(rad - d) <= _ON_CIRCLE * d) & (size[ring] >= 4)
     # "same": the edge from a vertex's predecessor to it is a chord of one join
@@ -137,7 +183,7 @@ def two_sided_arcs(geom: BaseGeometry, d: float, tol: float, *, check: bool = Tr
     r_last = r_first + r_len - 1
     cand = r_len >= 3
     if not cand.any():
-        return geom, none
+        return None
     # each join's centre from its two ends and middle vertex (far apart: a well-conditioned
     # circle, where three neighbours a small angle apart would carry the rounding of large
     # coordinates into the centre)
@@ -155,13 +201,19 @@ def two_sided_arcs(geom: BaseGeometry, d: float, tol: float, *, check: bool = Tr
     stp = np.where(np.append(inner_steps, False), step, 0.0)
     pos_n = np.bincount(run_id, weights=(stp > 0), minlength=n_run)
     neg_n = np.bincount(run_id, weights=(stp < 0), minlength=n_run)
-    phi_s = np.bincount(run_id, weights=stp, minlength=n_run)
-    one_way = (pos_n == r_len - 1) | (neg_n == r_len - 1)
-    cand &= one_way
-    k, rr = join_plan(d, tol, np.where(cand, np.abs(phi_s), 0.0))
-    use = cand & (k > 0) & (k < r_len - 1)
-    if not use.any():
-        return geom, none
+    phi = np.bincount(run_id, weights=stp, minlength=n_run)
+    cand &= (pos_n == r_len - 1) | (neg_n == r_len - 1)
+    return _Runs(xy=xy, same=same, run_id=run_id, r_len=r_len, r_first=r_first,
+                 r_last=r_last, ctr=ctr, phi=phi, cand=cand)
+
+
+def _redrawn(rings: _Rings, runs: _Runs, use: np.ndarray, k: np.ndarray, rr: np.ndarray
+             ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """The rings with the joins ``use`` redrawn (``k`` chords each, inner vertices at radius
+    ``rr``): closed coordinates, their ring, whether each is protected (a redrawn join's
+    vertex, ends included), and the rings touched."""
+    xy, same, ring = runs.xy, runs.same, rings.ring
+    r_first, r_last, ctr, phi = runs.r_first, runs.r_last, runs.ctr, runs.phi
     # the new joins: first vertex, k - 1 inner ones, last vertex
     u = np.flatnonzero(use)
     ku = k[u]
@@ -169,13 +221,13 @@ def two_sided_arcs(geom: BaseGeometry, d: float, tol: float, *, check: bool = Tr
     n_in = ku - 1
     jrun = np.repeat(np.arange(len(u)), n_in)
     jj = np.arange(int(n_in.sum())) - np.repeat(np.cumsum(n_in) - n_in, n_in) + 1
-    th = a0[jrun] + phi_s[u][jrun] * jj / ku[jrun]
+    th = a0[jrun] + phi[u][jrun] * jj / ku[jrun]
     new_xy = ctr[u][jrun] + rr[u][jrun, None] * np.c_[np.cos(th), np.sin(th)]
     new_key = r_first[u][jrun] + jj / ku[jrun]  # between the run's first and last
     drop = np.zeros(len(xy), dtype=bool)
     inner_v = same.copy()  # a run's vertices past its first ...
     inner_v[r_last] = False  # ... and before its last
-    drop[inner_v & use[run_id]] = True
+    drop[inner_v & use[runs.run_id]] = True
     ends_v = np.zeros(len(xy), dtype=bool)  # the used joins' end vertices
     ends_v[r_first[u]] = True
     ends_v[r_last[u]] = True
@@ -194,16 +246,20 @@ def two_sided_arcs(geom: BaseGeometry, d: float, tol: float, *, check: bool = Tr
     all_ring[p_new] = ring[r_first[u]][jrun]
     all_prot = np.ones(n_all, dtype=bool)
     all_prot[p_old] = ends_v[kept_at]
-    # close the rings and build the polygons; a polygon that is not valid keeps its rings
+    # close the rings
     starts2 = np.flatnonzero(np.diff(all_ring, prepend=-1))
     at = np.append(starts2[1:], len(all_xy))
     closed_xy = np.insert(all_xy, at, all_xy[starts2], axis=0)
     closed_ring = np.insert(all_ring, at, all_ring[starts2])
     closed_prot = np.insert(all_prot, at, all_prot[starts2])
-    polys = shapely.polygons(shapely.linearrings(closed_xy, indices=closed_ring), indices=owner)
-    changed = np.zeros(len(parts), dtype=bool)
-    changed[owner[np.unique(ring[r_first[u]])]] = True
-    polys[~changed] = parts[~changed]  # (the others exactly as they came)
+    return closed_xy, closed_ring, closed_prot, np.unique(ring[r_first[u]])
+
+
+def _keep_valid(parts: np.ndarray, polys: np.ndarray, changed: np.ndarray, check: bool
+                ) -> tuple[np.ndarray | None, np.ndarray]:
+    """The unchanged polygons exactly as they came; with ``check``, a changed polygon that
+    is not valid, or now meets another, keeps its old rings (None: give up on all)."""
+    polys[~changed] = parts[~changed]
     ch = np.flatnonzero(changed)
     bad = ch[~(shapely.is_valid(polys[ch]) & ~shapely.is_empty(polys[ch]))] if check else ch[:0]
     polys[bad] = parts[bad]
@@ -218,22 +274,24 @@ def two_sided_arcs(geom: BaseGeometry, d: float, tol: float, *, check: bool = Tr
         polys[meet] = parts[meet]
         changed[meet] = False
         if len(meet) and not shapely.MultiPolygon(list(polys)).is_valid:
-            return geom, none  # (a reverted polygon meets another changed one: rare)
-    if not changed.any():
-        return geom, none
-    out = polys[0] if len(polys) == 1 else shapely.MultiPolygon(list(polys))
-    # the mask over the result's vertices (rings in order, each closed): a changed ring's
-    # from closed_prot, the others' all False
-    new_ring = changed[owner]
-    cnt = np.where(new_ring, np.bincount(closed_ring, minlength=n_r), size + 1)
+            return None, changed  # (a reverted polygon meets another changed one: rare)
+    return polys, changed
+
+
+def _keep_mask(rings: _Rings, changed: np.ndarray, closed_ring: np.ndarray,
+               closed_prot: np.ndarray) -> np.ndarray:
+    """The mask over the result's vertices (rings in order, each closed): a changed ring's
+    from ``closed_prot``, the others' all False."""
+    n_r = rings.n
+    new_ring = changed[rings.owner]
+    cnt = np.where(new_ring, np.bincount(closed_ring, minlength=n_r), rings.size + 1)
     first = np.concatenate(([0], np.cumsum(cnt)[:-1]))
     mask = np.zeros(int(cnt.sum()), dtype=bool)
     sel = new_ring[closed_ring]
     row0 = np.concatenate(([0], np.cumsum(np.bincount(closed_ring, minlength=n_r))[:-1]))
     dest = first[closed_ring[sel]] + (np.flatnonzero(sel) - row0[closed_ring[sel]])
     mask[dest] = closed_prot[sel]
-    return out, mask
-
+    return mask
 
 
 def _circumcircles(a: np.ndarray, b: np.ndarray, c: np.ndarray

@@ -52,8 +52,8 @@ KICK_SPAN = 50
 #: earlier when a window of max(STALL_WINDOW_MIN, strokes / 4) kicks shortened the travel by
 #: no more than STALL_GAIN of it, or at the time budget, whichever comes first
 KICKS_PER_STROKE = 2
-KICKS_MIN = 1000
-STALL_WINDOW_MIN = 250
+KICKS_MIN = 2000
+STALL_WINDOW_MIN = 500
 STALL_GAIN = 1e-4
 #: a 2-opt or Or-opt move rewrites at most this many tour positions (two per stroke): each
 #: move then costs at most a constant, so a local search is linear in the strokes (no move
@@ -61,6 +61,9 @@ STALL_GAIN = 1e-4
 MOVE_SPAN = 20_000
 #: longer moves are allowed until they have rewritten this many times the tour's positions
 LONG_WORK = 40
+#: the local searches that repair kicks make moves of at most this many positions (a kick is
+#: local; no limit below 2,000 strokes): each kick then costs at most a constant
+KICK_MOVE_SPAN = 4000
 
 
 @dataclass(frozen=True, slots=True)
@@ -800,6 +803,7 @@ def _improve(prob: _Problem, cands: Sequence[int], before: Sequence[tuple[int, i
         return finish()
     rng = random.Random(seed)
     span = min(m - 1, KICK_SPAN)
+    tour.span_cap = KICK_MOVE_SPAN  # a kick is repaired near its cuts
     tour.log = []
     limit = max(KICKS_MIN, KICKS_PER_STROKE * m) if max_kicks is None else max_kicks
     window = max(STALL_WINDOW_MIN, m // 4)

@@ -398,8 +398,10 @@ class OrderParams(ParamGroup):
         help="file: as drawn; greedy: nearest next stroke; optimized: greedy then improved "
              "(shorter jumps)")
     order_time_budget_s: float = param(
-        1.0, unit="s", label="Order time budget", lo=0.0, lo_open=True, hi=3600.0,
-        help="most time the optimized order may spend improving")
+        30.0, unit="s", label="Order time cap", lo=0.0, lo_open=True, hi=3600.0,
+        help="safety cap on the optimized order's search, which stops by itself when it "
+             "stops improving (then the order depends on the job alone); only a job that "
+             "reaches the cap gets an order that depends on the machine's speed")
 
 
 @_named

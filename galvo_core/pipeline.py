@@ -313,8 +313,9 @@ class Pipeline:
             strokes = [Stroke("contour", origin[fp.source_index], fp.closed, clamp(m), sg,
                               fp.pen)
                        for fp, m, sg in zip(fitted, sampled.marks, segs, strict=True) if len(m)]
-            strokes += [Stroke("hatch", origin[h.source_index], False, clamp(hm), (),
-                               work.paths[h.source_index].pen) for h, hm in hatched]
+            strokes += [Stroke("hatch", origin[h.source_index], False, clamp(hm),
+                               Segments.empty(), work.paths[h.source_index].pen)
+                        for h, hm in hatched]
         return strokes, clamped
 
     def stats(self, drawing: Drawing, params: Params, fitted: tuple[FittedPath, ...],

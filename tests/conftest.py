@@ -20,3 +20,14 @@ from hypothesis import settings  # noqa: E402
 settings.register_profile("ci", derandomize=True, deadline=None, print_blob=True)
 if os.environ.get("CI"):
     settings.load_profile("ci")
+
+
+import pytest  # noqa: E402
+
+
+@pytest.fixture(autouse=True)
+def _own_settings_file(tmp_path_factory, monkeypatch):
+    """Each test starts from no saved settings: what one test leaves in the workstation's
+    settings (a hidden layer, a parameter) must not reach the next one."""
+    path = tmp_path_factory.mktemp("settings") / "settings.ini"
+    monkeypatch.setenv("GALVO_WORKSTATION_SETTINGS", str(path))

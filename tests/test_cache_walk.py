@@ -37,7 +37,7 @@ CONTROLS: dict[str, tuple[object, ...]] = {
     "hatch_spacing_mm": (0.15, 0.3, 1.0),
     "hatch_angle_deg": (0.0, 30.0),
     "hatch_passes": (1, 2),
-    "scan_order": ("file", "greedy"),
+    "scan_order": ("file", "greedy", "optimized"),
 }
 
 STEP = st.sampled_from(sorted(CONTROLS)).flatmap(

@@ -1126,161 +1126,162 @@ class _Reader:
         return True
 
     def _handlers(self) -> dict[str, Callable[[bytes, int, str], None]]:
-        def move(mode: bool | None, down: bool | None) -> Callable[[bytes, int, str], None]:
-            def h(params: bytes, off: int, mn: str) -> None:
-                if mode is not None:
-                    self.absolute = mode
-                if down is not None:
-                    self.set_pen_down(down, off)
-                if params:
-                    self.move_params(params, off, mn)
-            return h
-
-        def nums(fn: Callable[[list[float], int], None]) -> Callable[[bytes, int, str], None]:
-            return lambda params, off, mn: fn(_nums(params), off)
-
-        def nums_mn(fn: Callable[[list[float], int, str], None]) -> Callable[..., None]:
-            return lambda params, off, mn: fn(_nums(params), off, mn)
-
-        def arc(relative: bool) -> Callable[[bytes, int, str], None]:
-            def h(params: bytes, off: int, mn: str) -> None:
-                v = _nums(params)
-                if len(v) < 3:
-                    self.warn(off, f"{mn} needs centre and sweep; ignored", key=f"args-{mn}")
-                    return
-                cx, cy = v[0], v[1]
-                if relative:
-                    ux, uy = self.to_user(self.x, self.y)
-                    cx, cy = ux + cx, uy + cy
-                self.do_arc(cx, cy, v[2], v[3] if len(v) > 3 else None, off)
-            return h
-
-        def pen(params: bytes, off: int, mn: str) -> None:
-            # HP-GL/2: "the pen remains down ... until a PU or IN" (SP ends the path: the
-            # next move starts a new one with the new pen); an HP-GL/1 plotter puts the
-            # pen back in its stall, so there SP lifts it (see self.hpgl2)
-            v = _nums(params)
-            self.flush()
-            if not self.hpgl2:
-                self.pen_down = False
-            self.pen = int(v[0]) if v else 0
-            self.pen_selected = True
-
-        def ro(params: bytes, off: int, mn: str) -> None:
-            v = _nums(params)
-            self.flush()
-            ang = int(v[0]) % 360 if v else 0
-            if ang not in (0, 90, 180, 270):
-                self.warn(off, f"RO{ang}: only 0, 90, 180, 270 exist; treated as 0")
-                ang = 0
-            self.rot = ang
-
-        def ps(params: bytes, off: int, mn: str) -> None:
-            v = _nums(params)
-            if any(x <= 0 for x in v[:2]):
-                # "if a length is <= 0 the device ignores the instruction"
-                self.warn(off, "PS with a length <= 0 ignored", key="args-PS")
-                return
-            if len(v) >= 2:
-                w, h = abs(v[0]), abs(v[1])
-            elif len(v) == 1:
-                w = h = abs(v[0])
-            else:
-                w, h = DEFAULT_P2[0] - DEFAULT_P1[0], DEFAULT_P2[1] - DEFAULT_P1[1]
-            self.hard = ((0.0, 0.0), (w, h))
-            self.page_known = bool(v)
-            self.p1, self.p2 = self.hard
-            self.update_scaling(off)
-
-        def ct(params: bytes, off: int, mn: str) -> None:
-            v = _nums(params)
-            self.ct_tol = bool(v and int(v[0]) == 1)
-
-        def tl(params: bytes, off: int, mn: str) -> None:
-            v = _nums(params)
-            self.tick = (v[0] if v else 0.5, v[1] if len(v) > 1 else (0.0 if v else 0.5))
-
-        def si(params: bytes, off: int, mn: str) -> None:
-            v = _nums(params)
-            if len(v) >= 2:
-                self.char_size = (abs(v[0]) * 400.0, abs(v[1]) * 400.0)  # cm -> units
-            else:
-                self.char_size = None
-            self.char_rel = None
-
-        def sr(params: bytes, off: int, mn: str) -> None:
-            v = _nums(params)
-            self.char_rel = (abs(v[0]), abs(v[1])) if len(v) >= 2 else (0.75, 1.5)
-            self.char_size = None
-
-        def di(params: bytes, off: int, mn: str) -> None:
-            v = _nums(params)
-            run, rise = (v[0], v[1]) if len(v) >= 2 else (1.0, 0.0)
-            if mn == "DR":
-                (p1x, p1y), (p2x, p2y) = self.p1, self.p2
-                run, rise = run * (p2x - p1x) / 100.0, rise * (p2y - p1y) / 100.0
-            r = math.hypot(run, rise)
-            self.label_dir = (run / r, rise / r) if r > 0 and math.isfinite(r) else (1.0, 0.0)
-
-        def pg(params: bytes, off: int, mn: str) -> None:
-            self.flush()
-            self.pages += 1
-
-        def lt(params: bytes, off: int, mn: str) -> None:
-            if _nums(params):
-                self.line_types += 1
-
-        def in_(params: bytes, off: int, mn: str) -> None:
-            self.reset()
-
-        def df(params: bytes, off: int, mn: str) -> None:
-            self.defaults()
-
-        def edge_fill(params: bytes, off: int, mn: str) -> None:
-            self.do_edge_fill(mn, off)
-
+        """The command table: mnemonic -> handler(params, offset, mnemonic)."""
         return {
-            "PA": move(True, None),
-            "PR": move(False, None),
-            "PU": move(None, False),
-            "PD": move(None, True),
-            "AA": arc(False),
-            "AR": arc(True),
-            "AT": nums_mn(lambda v, o, mn: self.do_three_point(v, False, o, mn)),
-            "RT": nums_mn(lambda v, o, mn: self.do_three_point(v, True, o, mn)),
-            "CI": nums(self.do_circle),
-            "EA": nums_mn(lambda v, o, mn: self.do_rect(v, False, o, mn)),
-            "RA": nums_mn(lambda v, o, mn: self.do_rect(v, False, o, mn)),
-            "ER": nums_mn(lambda v, o, mn: self.do_rect(v, True, o, mn)),
-            "RR": nums_mn(lambda v, o, mn: self.do_rect(v, True, o, mn)),
-            "EW": nums_mn(self.do_wedge),
-            "WG": nums_mn(self.do_wedge),
-            "BZ": nums_mn(lambda v, o, mn: self.do_bezier(v, False, o, mn)),
-            "BA": nums_mn(lambda v, o, mn: self.do_bezier(v, False, o, mn)),
-            "BR": nums_mn(lambda v, o, mn: self.do_bezier(v, True, o, mn)),
-            "PM": nums(self.do_pm),
-            "EP": edge_fill,
-            "FP": edge_fill,
+            "PA": self._move(True, None),
+            "PR": self._move(False, None),
+            "PU": self._move(None, False),
+            "PD": self._move(None, True),
+            "AA": self._arc(False),
+            "AR": self._arc(True),
+            "AT": self._nums_mn_of(lambda v, o, mn: self.do_three_point(v, False, o, mn)),
+            "RT": self._nums_mn_of(lambda v, o, mn: self.do_three_point(v, True, o, mn)),
+            "CI": self._nums_of(self.do_circle),
+            "EA": self._nums_mn_of(lambda v, o, mn: self.do_rect(v, False, o, mn)),
+            "RA": self._nums_mn_of(lambda v, o, mn: self.do_rect(v, False, o, mn)),
+            "ER": self._nums_mn_of(lambda v, o, mn: self.do_rect(v, True, o, mn)),
+            "RR": self._nums_mn_of(lambda v, o, mn: self.do_rect(v, True, o, mn)),
+            "EW": self._nums_mn_of(self.do_wedge),
+            "WG": self._nums_mn_of(self.do_wedge),
+            "BZ": self._nums_mn_of(lambda v, o, mn: self.do_bezier(v, False, o, mn)),
+            "BA": self._nums_mn_of(lambda v, o, mn: self.do_bezier(v, False, o, mn)),
+            "BR": self._nums_mn_of(lambda v, o, mn: self.do_bezier(v, True, o, mn)),
+            "PM": self._nums_of(self.do_pm),
+            "EP": self.cmd_edge_fill,
+            "FP": self.cmd_edge_fill,
             "XT": lambda p, o, mn: self.do_tick(True, o),
             "YT": lambda p, o, mn: self.do_tick(False, o),
-            "TL": tl,
-            "SP": pen,
-            "RO": ro,
-            "PS": ps,
-            "IP": nums(self.do_ip),
-            "IR": nums(self.do_ir),
-            "SC": nums(self.do_sc),
-            "IW": nums(self.do_iw),
-            "CT": ct,
-            "IN": in_,
-            "DF": df,
-            "PG": pg,
-            "LT": lt,
-            "SI": si,
-            "SR": sr,
-            "DI": di,
-            "DR": di,
+            "TL": self.cmd_tl,
+            "SP": self.cmd_sp,
+            "RO": self.cmd_ro,
+            "PS": self.cmd_ps,
+            "IP": self._nums_of(self.do_ip),
+            "IR": self._nums_of(self.do_ir),
+            "SC": self._nums_of(self.do_sc),
+            "IW": self._nums_of(self.do_iw),
+            "CT": self.cmd_ct,
+            "IN": self.cmd_in,
+            "DF": self.cmd_df,
+            "PG": self.cmd_pg,
+            "LT": self.cmd_lt,
+            "SI": self.cmd_si,
+            "SR": self.cmd_sr,
+            "DI": self.cmd_di,
+            "DR": self.cmd_di,
         }
+
+    def _move(self, mode: bool | None, down: bool | None) -> Callable[[bytes, int, str], None]:
+        def h(params: bytes, off: int, mn: str) -> None:
+            if mode is not None:
+                self.absolute = mode
+            if down is not None:
+                self.set_pen_down(down, off)
+            if params:
+                self.move_params(params, off, mn)
+        return h
+
+    def _nums_of(self, fn: Callable[[list[float], int], None]) -> Callable[[bytes, int, str], None]:
+        return lambda params, off, mn: fn(_nums(params), off)
+
+    def _nums_mn_of(self, fn: Callable[[list[float], int, str], None]) -> Callable[..., None]:
+        return lambda params, off, mn: fn(_nums(params), off, mn)
+
+    def _arc(self, relative: bool) -> Callable[[bytes, int, str], None]:
+        def h(params: bytes, off: int, mn: str) -> None:
+            v = _nums(params)
+            if len(v) < 3:
+                self.warn(off, f"{mn} needs centre and sweep; ignored", key=f"args-{mn}")
+                return
+            cx, cy = v[0], v[1]
+            if relative:
+                ux, uy = self.to_user(self.x, self.y)
+                cx, cy = ux + cx, uy + cy
+            self.do_arc(cx, cy, v[2], v[3] if len(v) > 3 else None, off)
+        return h
+
+    def cmd_sp(self, params: bytes, off: int, mn: str) -> None:
+        # HP-GL/2: "the pen remains down ... until a PU or IN" (SP ends the path: the
+        # next move starts a new one with the new pen); an HP-GL/1 plotter puts the
+        # pen back in its stall, so there SP lifts it (see self.hpgl2)
+        v = _nums(params)
+        self.flush()
+        if not self.hpgl2:
+            self.pen_down = False
+        self.pen = int(v[0]) if v else 0
+        self.pen_selected = True
+
+    def cmd_ro(self, params: bytes, off: int, mn: str) -> None:
+        v = _nums(params)
+        self.flush()
+        ang = int(v[0]) % 360 if v else 0
+        if ang not in (0, 90, 180, 270):
+            self.warn(off, f"RO{ang}: only 0, 90, 180, 270 exist; treated as 0")
+            ang = 0
+        self.rot = ang
+
+    def cmd_ps(self, params: bytes, off: int, mn: str) -> None:
+        v = _nums(params)
+        if any(x <= 0 for x in v[:2]):
+            # "if a length is <= 0 the device ignores the instruction"
+            self.warn(off, "PS with a length <= 0 ignored", key="args-PS")
+            return
+        if len(v) >= 2:
+            w, h = abs(v[0]), abs(v[1])
+        elif len(v) == 1:
+            w = h = abs(v[0])
+        else:
+            w, h = DEFAULT_P2[0] - DEFAULT_P1[0], DEFAULT_P2[1] - DEFAULT_P1[1]
+        self.hard = ((0.0, 0.0), (w, h))
+        self.page_known = bool(v)
+        self.p1, self.p2 = self.hard
+        self.update_scaling(off)
+
+    def cmd_ct(self, params: bytes, off: int, mn: str) -> None:
+        v = _nums(params)
+        self.ct_tol = bool(v and int(v[0]) == 1)
+
+    def cmd_tl(self, params: bytes, off: int, mn: str) -> None:
+        v = _nums(params)
+        self.tick = (v[0] if v else 0.5, v[1] if len(v) > 1 else (0.0 if v else 0.5))
+
+    def cmd_si(self, params: bytes, off: int, mn: str) -> None:
+        v = _nums(params)
+        if len(v) >= 2:
+            self.char_size = (abs(v[0]) * 400.0, abs(v[1]) * 400.0)  # cm -> units
+        else:
+            self.char_size = None
+        self.char_rel = None
+
+    def cmd_sr(self, params: bytes, off: int, mn: str) -> None:
+        v = _nums(params)
+        self.char_rel = (abs(v[0]), abs(v[1])) if len(v) >= 2 else (0.75, 1.5)
+        self.char_size = None
+
+    def cmd_di(self, params: bytes, off: int, mn: str) -> None:
+        v = _nums(params)
+        run, rise = (v[0], v[1]) if len(v) >= 2 else (1.0, 0.0)
+        if mn == "DR":
+            (p1x, p1y), (p2x, p2y) = self.p1, self.p2
+            run, rise = run * (p2x - p1x) / 100.0, rise * (p2y - p1y) / 100.0
+        r = math.hypot(run, rise)
+        self.label_dir = (run / r, rise / r) if r > 0 and math.isfinite(r) else (1.0, 0.0)
+
+    def cmd_pg(self, params: bytes, off: int, mn: str) -> None:
+        self.flush()
+        self.pages += 1
+
+    def cmd_lt(self, params: bytes, off: int, mn: str) -> None:
+        if _nums(params):
+            self.line_types += 1
+
+    def cmd_in(self, params: bytes, off: int, mn: str) -> None:
+        self.reset()
+
+    def cmd_df(self, params: bytes, off: int, mn: str) -> None:
+        self.defaults()
+
+    def cmd_edge_fill(self, params: bytes, off: int, mn: str) -> None:
+        self.do_edge_fill(mn, off)
 
     # ------------------------------------------------------------------ text-like commands
     def _find_term(self, start: int, term: int) -> int:
