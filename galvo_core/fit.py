@@ -71,6 +71,7 @@ from galvo_core.geometry import (
     power_coeffs_into,
     power_coeffs_many,
 )
+from galvo_core.job import gc_paused
 from galvo_core.runs import segmented_cumsum, split_pieces_many
 from galvo_core.thin import check_positive, thin_many
 
@@ -695,20 +696,22 @@ def fit_paths(
     klen = np.array([len(k) for k in kept_all], dtype=np.intp)
     out: list[FittedPath | None] = [None] * npth
     mk = FittedPath.from_arrays
-    for k in np.flatnonzero(klen == 1).tolist():  # a dot: all points equal
-        out[k] = mk(src[k], pen[k], cl[k], _DOT_KIND, _read_only(works[k][[0, 0]]),
-                    _ZERO_FIRST, _read_only(np.array([len(works[k]) - 1], dtype=np.int64)),
-                    0.0, ns[k], 1)
-    for k in np.flatnonzero(wlen == 0).tolist():
-        out[k] = FittedPath(src[k], pen[k], cl[k], (), 0.0, 0, 0)
     todo = np.flatnonzero((wlen > 0) & (klen != 1))
     if len(todo):
         is_cubic, points, first, last, seg_cut, pt_cut, worst = _fit_concatenated(
             works, kept_all, todo, cl, e_per, eps_sum)
-        for t, k in enumerate(todo.tolist()):
-            a, b = seg_cut[t], seg_cut[t + 1]
-            out[k] = mk(src[k], pen[k], cl[k], is_cubic[a:b], points[pt_cut[t]:pt_cut[t + 1]],
-                        first[a:b], last[a:b], worst[t], ns[k], int(klen[k]))
+    with gc_paused():  # one object per path (and its array views), no cycles
+        for k in np.flatnonzero(klen == 1).tolist():  # a dot: all points equal
+            out[k] = mk(src[k], pen[k], cl[k], _DOT_KIND, _read_only(works[k][[0, 0]]),
+                        _ZERO_FIRST, _read_only(np.array([len(works[k]) - 1], dtype=np.int64)),
+                        0.0, ns[k], 1)
+        for k in np.flatnonzero(wlen == 0).tolist():
+            out[k] = FittedPath(src[k], pen[k], cl[k], (), 0.0, 0, 0)
+        if len(todo):
+            for t, k in enumerate(todo.tolist()):
+                a, b = seg_cut[t], seg_cut[t + 1]
+                out[k] = mk(src[k], pen[k], cl[k], is_cubic[a:b], points[pt_cut[t]:pt_cut[t + 1]],
+                            first[a:b], last[a:b], worst[t], ns[k], int(klen[k]))
     return out  # type: ignore[return-value]
 
 

@@ -25,6 +25,8 @@ and never a half-written one. :func:`load_job` validates what readers rely on an
 
 from __future__ import annotations
 
+import contextlib
+import gc
 import json
 import math
 import os
@@ -59,6 +61,21 @@ _STROKE_KINDS = ("contour", "hatch")
 def _read_only(a: np.ndarray) -> np.ndarray:
     a.setflags(write=False)
     return a
+
+
+@contextlib.contextmanager
+def gc_paused() -> Any:
+    """Python's cyclic garbage collector paused while a block builds many objects that hold
+    no reference cycles (strokes, their segments and mark views): with hundreds of
+    thousands of strokes its passes over the growing heap took more time than the
+    building itself (loading 827 k strokes: 3.5 s with it, 1.5 s without)."""
+    was = gc.isenabled()
+    gc.disable()
+    try:
+        yield
+    finally:
+        if was:
+            gc.enable()
 
 
 _NO_KINDS = _read_only(np.zeros(0, dtype=bool))
@@ -518,6 +535,11 @@ def _finish(doc: dict[str, Any], fm: FieldMap, strokes: list[Stroke], name: str)
 
 
 def job_from_json(doc: Any, name: str = "<job>") -> Job:
+    with gc_paused():
+        return _job_from_json(doc, name)
+
+
+def _job_from_json(doc: Any, name: str = "<job>") -> Job:
     fm, doc = _header(doc, name, VERSION)
     bits = fm.field_bits
     strokes_in = _req(doc, "strokes", "the file", name)
@@ -630,7 +652,8 @@ def job_from_compact(raw: bytes, name: str = "<job>") -> Job:
         if off + nbytes > len(buf):
             raise InputError(name, f"{where} runs past the end of the file (truncated?)")
         arr[key] = np.frombuffer(buf, dtype=dtype, count=count, offset=off).reshape(shape)
-    return _strokes_from_arrays(arr, n, fm, doc, name)
+    with gc_paused():
+        return _strokes_from_arrays(arr, n, fm, doc, name)
 
 
 def _offsets(a: np.ndarray, n: int, total: int, key: str, name: str) -> np.ndarray:

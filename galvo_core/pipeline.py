@@ -33,7 +33,7 @@ from galvo_core.errors import Cancelled
 from galvo_core.field import FieldMap, check_in_field, make_field
 from galvo_core.fill import HatchStroke, hatch
 from galvo_core.fit import FitCancelled, FittedPath, control_points, fit_drawing
-from galvo_core.job import Job, Segments, Stroke
+from galvo_core.job import Job, Segments, Stroke, gc_paused
 from galvo_core.kerf import compensate_indexed
 from galvo_core.order import order_job_strokes
 from galvo_core.params import UNITS_PER_MM, Params
@@ -307,13 +307,15 @@ class Pipeline:
             clamped += int((c != m).any(axis=1).sum())
             return c
 
-        segs = self._fact(fitted, "segments", lambda: [
-            Segments(fp.is_cubic, fp.points) for fp in fitted])
-        strokes = [Stroke("contour", origin[fp.source_index], fp.closed, clamp(m), sg, fp.pen)
-                   for fp, m, sg in zip(fitted, sampled.marks, segs, strict=True) if len(m)]
-        strokes += [Stroke("hatch", origin[h.source_index], False, clamp(hm),
-                           Segments.empty(), work.paths[h.source_index].pen)
-                    for h, hm in hatched]
+        with gc_paused():  # one object per stroke, no cycles: no collector passes
+            segs = self._fact(fitted, "segments", lambda: [
+                Segments(fp.is_cubic, fp.points) for fp in fitted])
+            strokes = [Stroke("contour", origin[fp.source_index], fp.closed, clamp(m), sg,
+                              fp.pen)
+                       for fp, m, sg in zip(fitted, sampled.marks, segs, strict=True) if len(m)]
+            strokes += [Stroke("hatch", origin[h.source_index], False, clamp(hm),
+                               Segments.empty(), work.paths[h.source_index].pen)
+                        for h, hm in hatched]
         return strokes, clamped
 
     def stats(self, drawing: Drawing, params: Params, fitted: tuple[FittedPath, ...],

@@ -989,6 +989,25 @@ class _Geometry:
         p3 = pb[row + np.where(is_cubic, 3, 1)]
         ic = np.flatnonzero(is_cubic)
         il = np.flatnonzero(~is_cubic)
+        # inner control points: a cubic's own, a line's at 1/3 and 2/3 (in place: few
+        # temporaries, these arrays are as long as the fit)
+        p1 = np.empty_like(p0)
+        p2 = np.empty_like(p0)
+        if len(ic):
+            p1[ic] = pb[row[ic] + 1]
+            p2[ic] = pb[row[ic] + 2]
+        if len(il):
+            c0 = p0[il]
+            d = p3[il]
+            d -= c0
+            t = d / 3.0
+            t += c0
+            p1[il] = t
+            np.multiply(d, 2.0, out=t)
+            t /= 3.0
+            t += c0
+            p2[il] = t
+            del c0, d, t
         # power coefficients laid out (4, 2, G): each of a, b, d, e in x and y is one
         # contiguous row, so the eight flat arrays the kernels want are views, not copies;
         # a line exactly a = b = 0, d = P3 − P0, e = P0
@@ -997,19 +1016,14 @@ class _Geometry:
         block[1] = 0.0
         np.subtract(p3.T, p0.T, out=block[2])
         block[3] = p0.T
-        ts = np.empty((g, 2))
-        te = np.empty((g, 2))
         if len(ic):
-            c0, c1, c2, c3 = p0[ic], pb[row[ic] + 1], pb[row[ic] + 2], p3[ic]
             sub = np.empty((4, 2, len(ic)))
-            power_coeffs_into(sub, c0.T, c1.T, c2.T, c3.T)
+            power_coeffs_into(sub, p0[ic].T, p1[ic].T, p2[ic].T, p3[ic].T)
             block[:, :, ic] = sub
-            ts[ic], te[ic] = _tangents(c0, c1, c2, c3)
-        if len(il):
-            c0, c3 = p0[il], p3[il]
-            d = c3 - c0
-            ts[il], te[il] = _tangents(c0, c0 + d / 3.0, c0 + 2.0 * d / 3.0, c3)
         coef = block.transpose(2, 0, 1)  # (G, 4, 2) view
+        # end tangents: the first non-zero control leg at each end
+        ts = _first_nonzero(p1 - p0, (lambda z: p2[z] - p0[z], lambda z: p3[z] - p0[z]))
+        te = _first_nonzero(p3 - p2, (lambda z: p3[z] - p1[z], lambda z: p3[z] - p0[z]))
         corner = np.zeros(g, dtype=bool)
         if g > 1:
             a, b = te[:-1], ts[1:]
@@ -1017,6 +1031,8 @@ class _Geometry:
             deg = ~((a != 0).any(axis=1) & (b != 0).any(axis=1))
             corner[:-1] = ((ang > CORNER_DEG) | deg) & (self.seg_path[:-1] ==
                                                          self.seg_path[1:])
+            del ang, deg
+        del ts, te
         cf = tuple(block[i, j] for i in range(4) for j in range(2))
         ends = np.stack((p0, p3), axis=1)  # (G, 2, 2): P0, P3
         for x in (ends, coef, corner, *cf):
@@ -1220,10 +1236,33 @@ def _min_step_pass(mk: _MarkRows, cs: _CubicSet, tol: float, min_step: float,
     short = (dd < min_step) & ~mk.last_of[:-1]
     if not short.any():
         return mk
-    sid, st = mk.sid, mk.st
+    sid, st, pid = mk.sid, mk.st, mk.pid
+    # the filter asks, around the short chords q -> q + 1, whether a chord that would
+    # replace a few marks holds (q -> q + 2 mostly, q -> q + 3 after a drop, q - 1 -> q + 1,
+    # q - 1 -> q + 2 when the mark before is dropped instead): measured here for all of them
+    # at once (a chord's height does not depend on the others measured with it), any other
+    # question one by one
+    n = len(pid)
+    q = np.flatnonzero(short)
+    # step (2 or 3) -> per mark a: -1 not measured, else whether a -> a + step holds
+    known: dict[int, np.ndarray] = {}
+    for step in (2, 3):
+        a = np.unique(np.concatenate([q, q - 1]))
+        a = a[(a >= 0) & (a + step < n)]
+        a = a[pid[a] == pid[a + step]]
+        res = np.full(n, -1, dtype=np.int8)
+        for c in range(0, len(a), 1 << 16):  # in pieces: the height temporaries stay small
+            ac = a[c:c + (1 << 16)]
+            bc = ac + step
+            hq = _chords_heights(cs, sid[ac], st[ac], sid[bc], st[bc], pos[ac], pos[bc])
+            res[ac] = hq <= tol
+        known[step] = res
 
     def merge_ok(a: int, b: int) -> bool:
         """The chord from mark a to mark b keeps within the tolerance."""
+        res = known.get(b - a)
+        if res is not None and res[a] >= 0:
+            return bool(res[a])
         h = _chords_heights(cs, sid[[a]], st[[a]], sid[[b]], st[[b]], pos[[a]], pos[[b]])
         return bool(h[0] <= tol)
 
@@ -1273,22 +1312,16 @@ def _measure_into(report: SampleReport, mk: _MarkRows, r: np.ndarray, cs: _Cubic
     report.chord_violations = int(np.count_nonzero(hf > tol * (1.0 + 1e-9)))
 
 
-def _first_nonzero(legs: tuple[np.ndarray, ...]) -> np.ndarray:
-    out = legs[0]
-    for alt in legs[1:]:
-        zero = (out[:, 0] == 0) & (out[:, 1] == 0)
-        if zero.any():
-            out = out.copy()
-            out[zero] = alt[zero]
+def _first_nonzero(first: np.ndarray,
+                   alternatives: tuple[Callable[[np.ndarray], np.ndarray], ...]) -> np.ndarray:
+    """Rows of ``first`` (N, 2), a row that is (0, 0) replaced by the next alternative's
+    row there (each alternative a function of the row indices, evaluated only on them)."""
+    out = first
+    for alt in alternatives:
+        zero = np.flatnonzero((out[:, 0] == 0) & (out[:, 1] == 0))
+        if len(zero):
+            out[zero] = alt(zero)
     return out
-
-
-def _tangents(p0: np.ndarray, p1: np.ndarray, p2: np.ndarray, p3: np.ndarray
-              ) -> tuple[np.ndarray, np.ndarray]:
-    """Start and end tangent directions of cubics given by their control points (N, 2)
-    each (first non-zero control leg)."""
-    return (_first_nonzero((p1 - p0, p2 - p0, p3 - p0)),
-            _first_nonzero((p3 - p2, p3 - p1, p3 - p0)))
 
 
 def _measure_marks(cs: _CubicSet, sid: np.ndarray, st: np.ndarray, pos: np.ndarray,
