@@ -71,6 +71,7 @@ from galvo_core.geometry import (
     power_coeffs_into,
     power_coeffs_many,
 )
+from galvo_core.precision import coordinate_quantum, path_quanta
 from galvo_core.runs import segmented_cumsum, split_pieces_many
 from galvo_core.thin import check_positive, thin_many
 
@@ -93,6 +94,8 @@ DEFAULT_EPS_LINE = 0.02
 DEFAULT_E_PER = 0.02
 DEFAULT_EPS_SUM = 0.002
 
+#: the rounding square's half diagonal per unit of side
+_HALF_DIAGONAL = math.sqrt(0.5)
 _BISECT_SAMPLE = 128
 _MAX_BISECT = 40
 
@@ -293,7 +296,7 @@ class _BatchFitter:
         kept: np.ndarray,
         t_in: np.ndarray,
         t_out: np.ndarray,
-        e_per: float,
+        e_per: float | np.ndarray,
         eps_sum: float,
         arc: np.ndarray,
     ) -> None:
@@ -302,7 +305,8 @@ class _BatchFitter:
         self.q = work[kept]
         self.t_in = t_in
         self.t_out = t_out
-        self.e_per = e_per
+        # the bound of a piece starting at thinned point k (its path's): e_per + rounding
+        self.e_per = np.broadcast_to(np.asarray(e_per, dtype=np.float64), (len(kept),))
         self.eps_sum = eps_sum
         self.arc = arc
         self._cubics: list[tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]] = []
@@ -426,7 +430,7 @@ class _BatchFitter:
                 done |= stop
         return self._ctrl(p0, qq, p3, t)
 
-    def _accept(self, ctrl: np.ndarray, i0: np.ndarray, i1: np.ndarray):
+    def _accept(self, ctrl: np.ndarray, i0: np.ndarray, i1: np.ndarray, e2: np.ndarray):
         """Per piece: bound of the max input-point error, pass/fail of both sides of the
         guarantee, and the flat per-point errors (with the offsets of each piece)."""
         m = len(ctrl)
@@ -445,12 +449,12 @@ class _BatchFitter:
         u[starts + cnt - 1] = 1.0
         d2[ends] = 0.0
         dist = np.sqrt(d2)
-        e2 = self.e_per
         # Newton may have stopped in a local minimum: seeded search for the points over the
         # bound, in pieces that miss it by little (a piece far off is a bad fit anyway; the
         # check only decides between keeping and splitting, never weakens the guarantee)
         emax0 = np.maximum.reduceat(dist, starts)
-        far = np.flatnonzero((dist > e2) & (emax0[pid] <= 4.0 * e2))
+        e2p = e2[pid]
+        far = np.flatnonzero((dist > e2p) & (emax0[pid] <= 4.0 * e2p))
         if len(far):
             tu, td = nearest_on_cubics(ctrl, pid[far], pts[far])
             better = td < dist[far]
@@ -488,7 +492,7 @@ class _BatchFitter:
             if len(A):
                 i0, i1 = self.kept[A], self.kept[B]
                 ctrl = self._dichotomy(p0[ok], qq[ok], p3[ok], sig[ok], i0, i1)
-                good, emax, dist, starts = self._accept(ctrl, i0, i1)
+                good, emax, dist, starts = self._accept(ctrl, i0, i1, self.e_per[A])
                 self._cubics.append((A[good], B[good], ctrl[good], emax[good]))
                 bad = ~good
                 k = self._split_points(A[bad], B[bad], dist, starts[bad])
@@ -548,6 +552,7 @@ def fit_path(
     eps_sum: float = DEFAULT_EPS_SUM,
     source_index: int = 0,
     pen: int = 1,
+    quantum_units: float | None = None,
 ) -> FittedPath:
     """Fit one path's points (N, 2) (input units) with lines and cubics.
 
@@ -564,6 +569,7 @@ def fit_path(
         eps_sum=eps_sum,
         source_indices=[source_index],
         pens=[pen],
+        quantum_units=None if quantum_units is None else [quantum_units],
     )[0]
 
 
@@ -576,6 +582,7 @@ def fit_paths(
     eps_sum: float = DEFAULT_EPS_SUM,
     source_indices: Sequence[int] | None = None,
     pens: Sequence[int] | None = None,
+    quantum_units: float | Sequence[float] | None = None,
 ) -> list[FittedPath]:
     """:func:`fit_path` for many paths at once (the same result as one call per path).
 
@@ -585,6 +592,11 @@ def fit_paths(
     :class:`_BatchFitter`; pieces never cross a path), the errors of all lines and the exact
     errors of the cubics that decide a path's ``max_error``. The fixed cost per path is a
     few Python operations (building its segments), not a few hundred array calls.
+
+    ``quantum_units``: the grid the points were rounded to (input units; one value for all
+    paths or one per path; 0 for exact input). Default: detected from each path's points
+    (:func:`galvo_core.precision.path_quanta`). The bounds are then ``eps_line`` and
+    ``e_per`` beyond the rounding (see :func:`rounding_slack`).
     """
     eps_line, e_per, eps_sum = _check_params(eps_line, e_per, eps_sum)
     npth = len(paths)
@@ -594,7 +606,8 @@ def fit_paths(
     pen = [1] * npth if pens is None else [int(p) for p in pens]
     cl = [bool(c) for c in closed]
     works, ns = _closed_works(paths, cl)
-    kept_all = thin_many(works, eps_line)
+    slack = rounding_slack(works, quantum_units)
+    kept_all = thin_many(works, eps_line, per_path=eps_line + slack)
     wlen = np.array([len(w) for w in works], dtype=np.intp)
     klen = np.array([len(k) for k in kept_all], dtype=np.intp)
     out: list[FittedPath | None] = [None] * npth
@@ -605,11 +618,29 @@ def fit_paths(
         out[k] = FittedPath(src[k], pen[k], cl[k], (), 0.0, 0, 0)
     todo = np.flatnonzero((wlen > 0) & (klen != 1))
     if len(todo):
-        fitted = _fit_concatenated(works, kept_all, todo, cl, e_per, eps_sum)
+        fitted = _fit_concatenated(works, kept_all, todo, cl, e_per + slack[todo], eps_sum)
         for t, k in enumerate(todo.tolist()):
             segs, worst = fitted[t]
             out[k] = FittedPath(src[k], pen[k], cl[k], segs, worst, ns[k], int(klen[k]))
     return out  # type: ignore[return-value]
+
+
+def rounding_slack(
+    paths: Sequence[object], quantum_units: float | Sequence[float] | None = None
+) -> np.ndarray:
+    """Per path: how far the design may lie from an input point, ``q / √2`` (the rounding
+    square's half diagonal) for the path's quantum ``q`` (``quantum_units``: one value, one
+    per path, or None to detect each path's from its points). The fit's bounds on a path
+    are ``eps_line + slack`` and ``e_per + slack`` from the input points and polyline, i.e.
+    ``eps_line`` / ``e_per`` beyond the rounding; exactly the user's values when q is 0."""
+    n = len(paths)
+    if quantum_units is None:
+        q = path_quanta(paths)
+    else:
+        q = np.broadcast_to(np.asarray(quantum_units, dtype=np.float64).reshape(-1), (n,))
+        if not (np.isfinite(q) & (q >= 0.0)).all():
+            raise ParamError(f"quantum_units must be finite numbers >= 0, got {quantum_units!r}")
+    return q * _HALF_DIAGONAL
 
 
 def _closed_works(
@@ -638,7 +669,7 @@ def _fit_concatenated(
     kept_all: list[np.ndarray],
     todo: np.ndarray,
     closed: list[bool],
-    e_per: float,
+    e_per: np.ndarray,
     eps_sum: float,
 ) -> list[tuple[tuple[Segment, ...], float]]:
     """Segments and max_error of the paths ``todo`` (>= 2 thinned points each), all at once
@@ -657,7 +688,9 @@ def _fit_concatenated(
     is_kend = np.zeros(len(Q), dtype=bool)
     is_kend[kend] = True
     pa, pb, curve, t_in, t_out = split_pieces_many(Q, tlen, np.asarray(closed)[todo])
-    fitter = _BatchFitter(W, K, t_in, t_out, e_per, eps_sum, _arc_per_path(W, wlen))
+    fitter = _BatchFitter(
+        W, K, t_in, t_out, np.repeat(e_per, tlen), eps_sum, _arc_per_path(W, wlen)
+    )
     with np.errstate(invalid="ignore", divide="ignore"):
         fitter.fit(np.stack([pa[curve], pb[curve]], axis=1))
     ca, cb, ctrl, bound, fla = fitter.results()
@@ -779,12 +812,20 @@ def fit_drawing(
     eps_sum: float = DEFAULT_EPS_SUM,
     batch: int = 4096,
     cancel: Callable[[], bool] | None = None,
+    quantum_units: float | Sequence[float] | None = None,
 ) -> tuple[FittedPath, ...]:
     """:func:`fit_path` for every path of the drawing, in order (``source_index`` = position),
     fitted ``batch`` paths at a time (:func:`fit_paths`). ``cancel`` is called between
-    batches; when it returns True, :class:`FitCancelled` is raised."""
+    batches; when it returns True, :class:`FitCancelled` is raised. ``quantum_units``: as in
+    :func:`fit_paths`; default: detected on the whole drawing, per path where a path is off
+    the drawing's grid (:func:`galvo_core.precision.path_quanta`)."""
     _check_params(eps_line, e_per, eps_sum)
     paths = drawing.paths
+    if quantum_units is None:
+        qs = path_quanta([p.points for p in paths])
+    else:
+        qs = np.broadcast_to(np.asarray(quantum_units, dtype=np.float64).reshape(-1),
+                             (len(paths),))
     out: list[FittedPath] = []
     for b0 in range(0, len(paths), max(1, int(batch))):
         if cancel is not None and cancel():
@@ -798,6 +839,7 @@ def fit_drawing(
             eps_sum=eps_sum,
             source_indices=range(b0, b0 + len(chunk)),
             pens=[p.pen for p in chunk],
+            quantum_units=qs[b0 : b0 + len(chunk)],
         )
     return tuple(out)
 
@@ -819,15 +861,33 @@ def fit_report(
     eps_line: float = DEFAULT_EPS_LINE,
     e_per: float = DEFAULT_E_PER,
     eps_sum: float = DEFAULT_EPS_SUM,
+    quantum_units: float | Sequence[float] | None = None,
+    per_path: bool = False,
 ) -> dict[str, object]:
     """Paper 000 Table 1 row for a drawing: input_points, thinned_points, control_points
     (see :func:`control_points`), lines, cubics, max_error (input units), seconds (wall
-    time of the fit; the one-time load of the compiled thinning is not counted)."""
+    time of the fit; the one-time load of the compiled thinning is not counted), and the
+    precision in effect: quantum_units (the drawing's grid, 0 for exact input; the largest
+    of the paths'), eps_line_in_effect / e_per_in_effect (the bounds from the input points:
+    the user's values plus the rounding, :func:`rounding_slack`).
+
+    With ``per_path``: "paths", one dict per path (index, pen, closed, input_points,
+    segments, lines, cubics, quantum_units, bound, max_error) with the path's own bound
+    (max of the two tolerances in effect) and worst true input-point error."""
     warm_up()
+    pts = [p.points for p in drawing.paths]
+    if quantum_units is None:
+        qs = path_quanta(pts)
+    else:
+        qs = np.broadcast_to(np.asarray(quantum_units, dtype=np.float64).reshape(-1),
+                             (len(pts),))
     t0 = time.perf_counter()
-    fitted = fit_drawing(drawing, eps_line=eps_line, e_per=e_per, eps_sum=eps_sum)
+    fitted = fit_drawing(drawing, eps_line=eps_line, e_per=e_per, eps_sum=eps_sum,
+                         quantum_units=qs)
     secs = time.perf_counter() - t0
-    return {
+    qmax = float(qs.max()) if len(qs) else 0.0
+    slack = qmax * _HALF_DIAGONAL
+    out: dict[str, object] = {
         "input_points": drawing.n_points,
         "thinned_points": sum(f.n_thinned for f in fitted),
         "control_points": sum(control_points(f) for f in fitted),
@@ -835,13 +895,44 @@ def fit_report(
         "cubics": sum(f.n_cubics for f in fitted),
         "max_error": max((f.max_error for f in fitted), default=0.0),
         "seconds": secs,
+        "quantum_units": qmax,
+        "eps_line_in_effect": float(eps_line) + slack,
+        "e_per_in_effect": float(e_per) + slack,
     }
+    if per_path:
+        out["paths"] = [
+            {
+                "index": f.source_index,
+                "pen": f.pen,
+                "closed": f.closed,
+                "input_points": f.n_input,
+                "segments": len(f.segments),
+                "lines": f.n_lines,
+                "cubics": f.n_cubics,
+                "quantum_units": float(q),
+                "bound": max(float(eps_line), float(e_per)) + float(q) * _HALF_DIAGONAL,
+                "max_error": f.max_error,
+            }
+            for f, q in zip(fitted, qs.tolist(), strict=True)
+        ]
+    return out
 
 
 def check_fit(
-    points: object, fitted: FittedPath, e_per: float, eps_line: float
-) -> tuple[float, float]:
+    points: object,
+    fitted: FittedPath,
+    e_per: float,
+    eps_line: float,
+    *,
+    quantum_units: float | None = None,
+    report: bool = False,
+) -> tuple[float, float] | dict[str, float]:
     """Measure both sides of the fitting guarantee with true distances (input units).
+
+    With ``report``: a dict with those two numbers ("max_in_to_curve",
+    "max_curve_to_polyline"), "segments", "quantum_units" (given, or detected from the
+    points when None) and "bound" (max(e_per, eps_line) + q/√2: the guarantee measured from
+    the points themselves) and "violation" (1.0 when either side exceeds the bound, else 0.0).
 
     Returns ``(max_in_to_curve, max_curve_to_polyline)``:
 
@@ -858,6 +949,10 @@ def check_fit(
     pts = np.asarray(points, dtype=np.float64).reshape(-1, 2)
     n = len(pts)
     if n == 0 or not fitted.segments:
+        if report:
+            return {"max_in_to_curve": 0.0, "max_curve_to_polyline": 0.0, "segments": 0.0,
+                    "quantum_units": 0.0, "bound": max(float(e_per), float(eps_line)),
+                    "violation": 0.0}
         return 0.0, 0.0
     ext = np.vstack([pts, pts[:1]]) if fitted.segments[-1].last >= n else pts
     h = min(float(e_per), float(eps_line)) / 4.0
@@ -878,4 +973,16 @@ def check_fit(
             samp = cubic_eval(s.points, np.linspace(0.0, 1.0, m))
         best[s.first : s.last + 1] = np.minimum(best[s.first : s.last + 1], d)
         out_max = max(out_max, float(point_polyline_distance(samp, loc).max()))
-    return float(best.max()), out_max
+    if not report:
+        return float(best.max()), out_max
+    q = coordinate_quantum(pts) if quantum_units is None else float(quantum_units)
+    bound = max(float(e_per), float(eps_line)) + q * _HALF_DIAGONAL
+    e_in = float(best.max())
+    return {
+        "max_in_to_curve": e_in,
+        "max_curve_to_polyline": out_max,
+        "segments": float(len(fitted.segments)),
+        "quantum_units": q,
+        "bound": bound,
+        "violation": float(max(e_in, out_max) > bound * (1.0 + 1e-9)),
+    }
