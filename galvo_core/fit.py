@@ -299,10 +299,13 @@ class _BatchFitter:
         e_per: float | np.ndarray,
         eps_sum: float,
         arc: np.ndarray,
+        q: np.ndarray | None = None,
     ) -> None:
         self.work = work
         self.kept = kept
-        self.q = work[kept]
+        self.q = work[kept] if q is None else q
+        #: per thinned point its path's quantum (None: exact input everywhere)
+        self.quant: np.ndarray | None = None
         self.t_in = t_in
         self.t_out = t_out
         # the bound of a piece starting at thinned point k (its path's): e_per + rounding
@@ -480,6 +483,10 @@ class _BatchFitter:
         ab = np.asarray(curve_pieces, dtype=np.intp).reshape(-1, 2)
         while len(ab):
             line = ab[:, 1] - ab[:, 0] == 1
+            if self.quant is not None and line.any():
+                as_cubic = self._bulging_segments(ab, line)
+                ab = ab[~as_cubic]
+                line = line[~as_cubic]
             self._lines.append(ab[line, 0])
             ab = ab[~line]
             if len(ab) == 0:
@@ -493,11 +500,116 @@ class _BatchFitter:
                 i0, i1 = self.kept[A], self.kept[B]
                 ctrl = self._dichotomy(p0[ok], qq[ok], p3[ok], sig[ok], i0, i1)
                 good, emax, dist, starts = self._accept(ctrl, i0, i1, self.e_per[A])
+                if self.quant is not None:
+                    rq = np.flatnonzero(self.quant[A] > 0.0)
+                    if len(rq):
+                        self._prefer_least_squares(rq, A, B, ctrl, good, emax, dist, starts)
                 self._cubics.append((A[good], B[good], ctrl[good], emax[good]))
                 bad = ~good
                 k = self._split_points(A[bad], B[bad], dist, starts[bad])
                 todo.append(_halves(A[bad], B[bad], k))
             ab = np.concatenate(todo)
+
+    def _least_squares(self, A: np.ndarray, B: np.ndarray, i0: np.ndarray, i1: np.ndarray):
+        """Per piece: the cubic with the piece's end points and end tangents whose two
+        handle lengths minimise the squared distances of (a sample of) its input points at
+        their parameters (chord length, then twice the nearest point's), Schneider's
+        fit; (ctrl (m, 4, 2), ok (m,): positive handles no longer than twice the chord)."""
+        m = len(A)
+        p0, p3 = self.q[A], self.q[B]
+        t0, t3 = self.t_out[A], self.t_in[B]
+        L = i1 - i0 - 1
+        stride = np.maximum(1, -(-L // _BISECT_SAMPLE))
+        cnt = -(-L // stride)
+        pid, off = _ragged(np.zeros(m, dtype=np.intp), cnt)
+        idx = i0[pid] + 1 + stride[pid] * off
+        pts = self.work[idx]
+        span = self.arc[i1] - self.arc[i0]
+        u = (self.arc[idx] - self.arc[i0][pid]) / np.where(span > 0, span, 1.0)[pid]
+        chord = np.hypot(*(p3 - p0).T)
+        ctrl = np.zeros((m, 4, 2))
+        ok = np.zeros(m, dtype=bool)
+        for it in range(3):
+            s = 1.0 - u
+            b0, b1, b2, b3 = s * s * s, 3 * s * s * u, 3 * s * u * u, u * u * u
+            a1 = b1[:, None] * t0[pid]
+            a2 = -b2[:, None] * t3[pid]
+            r = pts - (b0 + b1)[:, None] * p0[pid] - (b2 + b3)[:, None] * p3[pid]
+            c11 = np.bincount(pid, (a1 * a1).sum(1), m)
+            c12 = np.bincount(pid, (a1 * a2).sum(1), m)
+            c22 = np.bincount(pid, (a2 * a2).sum(1), m)
+            x1 = np.bincount(pid, (r * a1).sum(1), m)
+            x2 = np.bincount(pid, (r * a2).sum(1), m)
+            det = c11 * c22 - c12 * c12
+            with np.errstate(divide="ignore", invalid="ignore"):
+                al = (x1 * c22 - x2 * c12) / det
+                be = (c11 * x2 - c12 * x1) / det
+            ok = (np.abs(det) > 1e-12 * (c11 * c22 + 1e-300)) & (al > 0) & (be > 0)
+            ok &= (al < 2.0 * chord) & (be < 2.0 * chord)
+            al = np.where(ok, al, chord / 3.0)
+            be = np.where(ok, be, chord / 3.0)
+            ctrl = np.stack([p0, p0 + al[:, None] * t0, p3 - be[:, None] * t3, p3], axis=1)
+            if it == 2:
+                break
+            cf = gather_coeffs(power_coeffs_many(ctrl), pid)
+            u, _ = newton_nearest_many(cf, pts.T, u, 2)
+        return ctrl, ok
+
+    def _bulging_segments(self, ab: np.ndarray, line: np.ndarray) -> np.ndarray:
+        """Rounded input: the one-segment pieces (``line``) whose input points bulge to one
+        side of the segment (mean signed distance over a fifth of the quantum, at least 4
+        points between: a curve stretch, not a rounded straight line) and that a
+        least-squares cubic with the end tangents fits within the bound; those cubics are
+        accepted here. Returns the mask of such pieces (over ``ab``)."""
+        out = np.zeros(len(ab), dtype=bool)
+        cand = np.flatnonzero(line & (self.quant[ab[:, 0]] > 0.0))
+        if len(cand) == 0:
+            return out
+        A, B = ab[cand, 0], ab[cand, 1]
+        i0, i1 = self.kept[A], self.kept[B]
+        enough = i1 - i0 - 1 >= 4
+        cand, A, B, i0, i1 = cand[enough], A[enough], B[enough], i0[enough], i1[enough]
+        if len(cand) == 0:
+            return out
+        own, off = _ragged(np.zeros(len(A), dtype=np.intp), i1 - i0 - 1)
+        idx = i0[own] + 1 + off
+        p0, p3 = self.q[A], self.q[B]
+        ch = p3 - p0
+        ln = np.hypot(ch[:, 0], ch[:, 1])
+        ln = np.where(ln > 0, ln, 1.0)
+        rel = self.work[idx] - p0[own]
+        sd = (rel[:, 0] * ch[own, 1] - rel[:, 1] * ch[own, 0]) / ln[own]
+        mean = np.bincount(own, sd, len(A)) / np.bincount(own, minlength=len(A))
+        bulge = np.abs(mean) > 0.2 * self.quant[A]
+        if not bulge.any():
+            return out
+        cand, A, B, i0, i1 = cand[bulge], A[bulge], B[bulge], i0[bulge], i1[bulge]
+        cl, okl = self._least_squares(A, B, i0, i1)
+        if not okl.any():
+            return out
+        g, e, _, _ = self._accept(cl[okl], i0[okl], i1[okl], self.e_per[A[okl]])
+        sel = np.flatnonzero(okl)[g]
+        self._cubics.append((A[sel], B[sel], cl[sel], e[g]))
+        out[cand[sel]] = True
+        return out
+
+    def _prefer_least_squares(self, rq, A, B, ctrl, good, emax, dist, starts) -> None:
+        """Rounded input: where the least-squares cubic (:meth:`_least_squares`) passes the
+        same acceptance test, it replaces the dichotomy's (it follows the middle of the
+        rounding noise, not just its signed balance), in place; a piece the dichotomy
+        failed that the least-squares cubic passes is accepted."""
+        a, b = A[rq], B[rq]
+        i0, i1 = self.kept[a], self.kept[b]
+        cl, okl = self._least_squares(a, b, i0, i1)
+        if not okl.any():
+            return
+        sel = rq[okl]
+        g2, e2, d2, s2 = self._accept(cl[okl], i0[okl], i1[okl], self.e_per[a[okl]])
+        use = sel[g2]
+        ctrl[use] = cl[okl][g2]
+        emax[use] = e2[g2]
+        good[use] = True
+        # the failed pieces keep the dichotomy's errors for choosing their split point
 
     def results(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
         """``(a, b, ctrl, bound, line_a)``: the accepted cubics (thinned index ranges a..b,
@@ -618,7 +730,10 @@ def fit_paths(
         out[k] = FittedPath(src[k], pen[k], cl[k], (), 0.0, 0, 0)
     todo = np.flatnonzero((wlen > 0) & (klen != 1))
     if len(todo):
-        fitted = _fit_concatenated(works, kept_all, todo, cl, e_per + slack[todo], eps_sum)
+        rounding = np.stack([eps_line + slack[todo], slack[todo] / _HALF_DIAGONAL], axis=1)
+        fitted = _fit_concatenated(
+            works, kept_all, todo, cl, e_per + slack[todo], eps_sum, rounding
+        )
         for t, k in enumerate(todo.tolist()):
             segs, worst = fitted[t]
             out[k] = FittedPath(src[k], pen[k], cl[k], segs, worst, ns[k], int(klen[k]))
@@ -671,6 +786,7 @@ def _fit_concatenated(
     closed: list[bool],
     e_per: np.ndarray,
     eps_sum: float,
+    rounding: np.ndarray | None = None,
 ) -> list[tuple[tuple[Segment, ...], float]]:
     """Segments and max_error of the paths ``todo`` (>= 2 thinned points each), all at once
     on the concatenation of every path's points (global indices below)."""
@@ -687,10 +803,16 @@ def _fit_concatenated(
     Q = W[K]
     is_kend = np.zeros(len(Q), dtype=bool)
     is_kend[kend] = True
-    pa, pb, curve, t_in, t_out = split_pieces_many(Q, tlen, np.asarray(closed)[todo])
-    fitter = _BatchFitter(
-        W, K, t_in, t_out, np.repeat(e_per, tlen), eps_sum, _arc_per_path(W, wlen)
+    pa, pb, curve, t_in, t_out, smooth = split_pieces_many(
+        Q, tlen, np.asarray(closed)[todo], rounding=rounding, return_smooth=True
     )
+    arc = _arc_per_path(W, wlen)
+    if rounding is not None and (rounding[:, 1] > 0.0).any():
+        Q = Q.copy()
+        _on_the_design(W, K, Q, arc, t_in, t_out, smooth, np.repeat(rounding[:, 1], tlen), tlen)
+    fitter = _BatchFitter(W, K, t_in, t_out, np.repeat(e_per, tlen), eps_sum, arc, q=Q)
+    if rounding is not None and (rounding[:, 1] > 0.0).any():
+        fitter.quant = np.repeat(rounding[:, 1], tlen)
     with np.errstate(invalid="ignore", divide="ignore"):
         fitter.fit(np.stack([pa[curve], pb[curve]], axis=1))
     ca, cb, ctrl, bound, fla = fitter.results()
@@ -727,6 +849,81 @@ def _fit_concatenated(
     bounds = np.searchsorted(seg_owner, np.arange(len(todo) + 1)).tolist()
     wl = worst.tolist()
     return [(tuple(segs[bounds[t] : bounds[t + 1]]), wl[t]) for t in range(len(todo))]
+
+
+def _local_fits(
+    W: np.ndarray, arc: np.ndarray, lo: np.ndarray, hi: np.ndarray, at: np.ndarray
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Least-squares quadratics x(s), y(s) in arc length s through the input points lo..hi
+    (inclusive global indices) of each window, evaluated at the point ``at``: (position
+    (V, 2), unit tangent (V, 2) in the path's direction, ok (V,): at least 4 points and a
+    well-conditioned fit)."""
+    cnt = hi - lo + 1
+    v = len(lo)
+    pos = np.zeros((v, 2))
+    tan = np.zeros((v, 2))
+    ok = cnt >= 4
+    if not ok.any():
+        return pos, tan, ok
+    own, off = _ragged(np.zeros(v, dtype=np.intp), np.where(ok, cnt, 0))
+    idx = lo[own] + off
+    scale = np.maximum(arc[hi] - arc[lo], 1e-300)
+    sv = (arc[idx] - arc[at][own]) / scale[own]  # in [-1, 1]: well scaled
+    pw = np.stack([np.ones_like(sv), sv, sv * sv, sv**3, sv**4])
+    starts = np.cumsum(np.where(ok, cnt, 0)) - np.where(ok, cnt, 0)
+    okk = np.flatnonzero(ok)
+    mom = np.add.reduceat(pw, starts[okk], axis=1)  # (5, V')
+    rx = np.add.reduceat(pw[:3] * W[idx, 0], starts[okk], axis=1)
+    ry = np.add.reduceat(pw[:3] * W[idx, 1], starts[okk], axis=1)
+    A = np.stack([mom[0:3], mom[1:4], mom[2:5]]).transpose(2, 0, 1)  # (V', 3, 3)
+    det = np.linalg.det(A)
+    good = np.abs(det) > 1e-9 * np.abs(A).max(axis=(1, 2)) ** 3
+    A[~good] = np.eye(3)
+    cx = np.linalg.solve(A, rx.T[:, :, None])[:, :, 0]
+    cy = np.linalg.solve(A, ry.T[:, :, None])[:, :, 0]
+    pos[okk] = np.stack([cx[:, 0], cy[:, 0]], axis=1)
+    t = np.stack([cx[:, 1], cy[:, 1]], axis=1)
+    ln = np.hypot(t[:, 0], t[:, 1])
+    good &= ln > 0.0
+    tan[okk] = t / np.where(ln > 0.0, ln, 1.0)[:, None]
+    ok[okk] = good
+    return pos, tan, ok
+
+
+def _on_the_design(W, K, Q, arc, t_in, t_out, smooth, quant, tlen) -> None:
+    """Rounded input (per thinned point its path's quantum ``quant``): the smooth thinned
+    vertices (inside curve runs) moved onto a least-squares estimate of the design curve
+    (a quadratic in arc length through the input points between the middles of the two
+    thinned segments around it), kept inside the point's rounding square, with the fit's
+    tangent as both of its tangents; the ends of curve runs keep their place and get
+    one-sided fitted tangents. In place on ``Q``, ``t_in``, ``t_out``."""
+    n = len(Q)
+    last = np.cumsum(tlen) - 1
+    first = last - tlen + 1
+    is_first = np.zeros(n, dtype=bool)
+    is_first[first] = True
+    is_last = np.zeros(n, dtype=bool)
+    is_last[last] = True
+    rnd = quant > 0.0
+    sm = np.flatnonzero(smooth & rnd & ~is_first & ~is_last)
+    if len(sm):
+        lo = (K[sm - 1] + K[sm] + 1) // 2
+        hi = (K[sm] + K[sm + 1]) // 2
+        pos, tan, ok = _local_fits(W, arc, np.minimum(lo, K[sm]), np.maximum(hi, K[sm]), K[sm])
+        k = sm[ok]
+        h = 0.5 * quant[k][:, None]
+        Q[k] = np.clip(pos[ok], W[K[k]] - h, W[K[k]] + h)
+        t_in[k] = tan[ok]
+        t_out[k] = tan[ok]
+    # one-sided tangents at the other vertices (corners, ends of runs)
+    co = np.flatnonzero(~smooth & rnd & ~is_last)
+    if len(co):
+        _, tan, ok = _local_fits(W, arc, K[co], K[co + 1], K[co])
+        t_out[co[ok]] = tan[ok]
+    ci = np.flatnonzero(~smooth & rnd & ~is_first)
+    if len(ci):
+        _, tan, ok = _local_fits(W, arc, K[ci - 1], K[ci], K[ci])
+        t_in[ci[ok]] = tan[ok]
 
 
 def _arc_per_path(W: np.ndarray, wlen: np.ndarray) -> np.ndarray:
