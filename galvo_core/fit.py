@@ -823,10 +823,15 @@ def _fit_concatenated(
     end_w = o_w + wlen[todo] - 1  # each path's last input point (trailing repeats included)
     # line points (read-only views of one array) and their true max error
     lpts = np.stack([Q[la], Q[lb]], axis=1)
-    lpts.setflags(write=False)
     lfirst = K[la]
     llast = np.where(is_kend[lb], end_w[owner[lb]], K[lb])
     lerr = _line_errors(W, lpts, lfirst, llast)
+    lkey = 3 * la
+    if rounding is not None:
+        la, lpts, lfirst, llast, lerr, lkey = _valid_lines(
+            W, K, Q, la, lb, lpts, lfirst, llast, lerr, np.repeat(rounding[:, 0], tlen)
+        )
+    lpts.setflags(write=False)
     worst = np.zeros(len(todo))
     np.fmax.at(worst, owner[la], lerr)  # NaN (overflow) ignored, as max() did
     # cubics: a segment ending at the path's last thinned point takes its trailing repeats
@@ -838,7 +843,7 @@ def _fit_concatenated(
         worst = _cubic_worst(W, ctrl, cfirst, clast, bound, owner[ca], worst)
     # all segments in path order
     seg_a = np.concatenate([la, ca])
-    order = np.argsort(seg_a, kind="stable")
+    order = np.argsort(np.concatenate([lkey, 3 * ca]), kind="stable")
     nl = len(la)
     kinds = np.array(["line", "cubic"])[(order >= nl).astype(np.intp)].tolist()
     pts = list(lpts) + list(ctrl)
@@ -849,6 +854,36 @@ def _fit_concatenated(
     bounds = np.searchsorted(seg_owner, np.arange(len(todo) + 1)).tolist()
     wl = worst.tolist()
     return [(tuple(segs[bounds[t] : bounds[t + 1]]), wl[t]) for t in range(len(todo))]
+
+
+def _valid_lines(W, K, Q, la, lb, lpts, lfirst, llast, lerr, eps):
+    """Rounded input: a line between thinned vertices that :func:`_on_the_design` moved may
+    miss its input points by more than the thinning's tolerance ``eps`` (per thinned
+    point); such a line is replaced by the thinned line between the input points (valid by
+    construction of the thinning) and short connectors from the moved vertices to them
+    (inside the rounding square, no input point between). Returns the lines (start thinned
+    index, points, first, last, error, sort key 3 a + 0/1/2) with the replacements."""
+    bad = lerr > eps[la] * (1.0 + 1e-9)
+    if not bad.any():
+        return la, lpts, lfirst, llast, lerr, 3 * la
+    orig = W[K]
+    b = np.flatnonzero(bad)
+    a0, b0 = la[b], lb[b]
+    parts = [(la[~bad], lpts[~bad], lfirst[~bad], llast[~bad], 3 * la[~bad] + 1)]
+    mid = np.stack([orig[a0], orig[b0]], axis=1)
+    parts.append((a0, mid, lfirst[b], llast[b], 3 * a0 + 1))
+    ma = (Q[a0] != orig[a0]).any(axis=1)
+    parts.append((a0[ma], np.stack([Q[a0[ma]], orig[a0[ma]]], axis=1), lfirst[b][ma],
+                  lfirst[b][ma], 3 * a0[ma]))
+    mb = (Q[b0] != orig[b0]).any(axis=1)
+    parts.append((a0[mb], np.stack([orig[b0[mb]], Q[b0[mb]]], axis=1), llast[b][mb],
+                  llast[b][mb], 3 * a0[mb] + 2))
+    la2 = np.concatenate([p[0] for p in parts])
+    pts2 = np.concatenate([p[1] for p in parts])
+    f2 = np.concatenate([p[2] for p in parts])
+    l2 = np.concatenate([p[3] for p in parts])
+    key = np.concatenate([p[4] for p in parts])
+    return la2, pts2, f2, l2, _line_errors(W, pts2, f2, l2), key
 
 
 def _local_fits(
@@ -924,6 +959,32 @@ def _on_the_design(W, K, Q, arc, t_in, t_out, smooth, quant, tlen) -> None:
     if len(ci):
         _, tan, ok = _local_fits(W, arc, K[ci - 1], K[ci], K[ci])
         t_in[ci[ok]] = tan[ok]
+
+
+def _keep_lines_valid(W, K, Q, eps, tlen) -> None:
+    """Every thinned segment stays a valid line (its input points within ``eps``, the
+    thinning's tolerance, of it) after :func:`_on_the_design` moved vertices: both ends of
+    a segment that fails go back to their input points, until none fails (the unmoved
+    segments are the thinning's own, valid). In place on ``Q``."""
+    n = len(Q)
+    last = np.cumsum(tlen) - 1
+    inner = np.ones(n, dtype=bool)
+    inner[last] = False
+    seg = np.flatnonzero(inner)  # segment k -> k + 1 inside a path
+    orig = W[K]
+    for _ in range(64):
+        moved = (Q != orig).any(axis=1)
+        chk = seg[moved[seg] | moved[seg + 1]]
+        if len(chk) == 0:
+            return
+        pts = np.stack([Q[chk], Q[chk + 1]], axis=1)
+        err = _line_errors(W, pts, K[chk], K[chk + 1])
+        bad = chk[err > eps[chk]]
+        if len(bad) == 0:
+            return
+        Q[bad] = orig[bad]
+        Q[bad + 1] = orig[bad + 1]
+    Q[:] = orig
 
 
 def _arc_per_path(W: np.ndarray, wlen: np.ndarray) -> np.ndarray:
