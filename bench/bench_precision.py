@@ -68,7 +68,8 @@ def main() -> None:
     if a.eps_line:
         kw["eps_line"] = a.eps_line
     rows = []
-    print("| style | input | points | own | segments | x own | to true curve | violations | cpu s |")
+    print("| style | input | points | own | segments | x own | to true curve "
+          "| violations | cpu s |")
     print("| --- | --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: |")
     for whole in (True, False):
         for st in a.styles.split(","):

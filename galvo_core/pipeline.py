@@ -32,6 +32,7 @@ from galvo_core.job import Job, Stroke
 from galvo_core.kerf import compensate_indexed
 from galvo_core.order import order_job_strokes
 from galvo_core.params import STAGE_FIELDS, Params
+from galvo_core.precision import drawing_quantum
 from galvo_core.sample import ROUNDING_BOUND_BITS, SampleReport, polyline_marks, sample_paths
 from galvo_core.timing import estimate_with_dwell
 
@@ -199,13 +200,9 @@ class Pipeline:
         work, origin = self.compensated(drawing, params, fm)
         fitted = self.fitted(work, params, cancel)
         warnings: list[Warning] = list(work.warnings)
-        quantum = self._fact(drawing, "quantum", lambda: coordinate_quantum(drawing))
-        if quantum is not None and params.e_per < 0.5 * quantum:
-            warnings.append(Warning(0, 0, (
-                f"the file's coordinates are whole multiples of {quantum:g} unit: its points "
-                f"are rounded by up to {0.5 * quantum:g} unit, more than e_per = "
-                f"{params.e_per:g}, so smooth runs stay as lines; an e_per of about "
-                f"{0.75 * quantum:g} lets curves be fitted")))
+        # the fit detects each path's grid itself (galvo_core.precision) and bounds its
+        # error beyond the rounding: no warning needed; the quantum is kept for the stats
+        self.quantum = self._fact(drawing, "quantum", lambda: coordinate_quantum(drawing))
         out_msg = check_in_field(fm, self.bbox(work), clamp=params.clamp)
         if out_msg:
             warnings.append(Warning(0, 0, out_msg))
@@ -315,15 +312,10 @@ class _Marks(tuple):  # type: ignore[type-arg]
 
 
 def coordinate_quantum(drawing: Drawing) -> float | None:
-    """1.0 when every coordinate is a whole number (CAD-style integer plotter units), None
-    when the file has fractional coordinates (or no points)."""
-    pts = [p.points for p in drawing.paths if len(p.points)]
-    if not pts:
-        return None
-    allp = np.concatenate(pts)
-    if len(allp) < 3 or not np.array_equal(allp, np.round(allp)):
-        return None
-    return 1.0
+    """The drawing's grid step (input units, :func:`galvo_core.precision.drawing_quantum`),
+    None when its points are exact (off any grid) or it has none."""
+    q, _ = drawing_quantum(drawing.paths)
+    return q if q > 0.0 else None
 
 
 _default = Pipeline()
