@@ -40,6 +40,14 @@ MIN_DISTINCT = 8
 _MAX_STEP_SHARE = 1.0 / 20.0
 #: relative tolerance of "a whole multiple of q"
 _REL_TOL = 1e-6
+#: the drawing's grid is detected on an even sample of at most this many points
+_SAMPLE = 1 << 16
+#: a path's own grid is first looked for on a sample of this many of its points
+_PATH_SAMPLE = 4096
+#: decimal grids tried for paths off the drawing's grid (coarsest first)
+_DECIMAL_STEPS = (1.0, 0.1, 0.01, 0.001)
+#: paths off every decimal grid get their own detection when at most this many are left
+_OWN_GRID_PATHS = 64
 #: at most this many distinct steps go through Euclid's algorithm (then all are verified)
 _GCD_SAMPLE = 64
 
@@ -146,13 +154,18 @@ def drawing_quantum(paths: Sequence[object]) -> tuple[float, tuple[float, float]
     if not arrs:
         return 0.0, (0.0, 0.0)
     allp = np.concatenate(arrs)
-    qx, ox = axis_quantum(allp[:, 0])
-    qy, oy = axis_quantum(allp[:, 1])
-    q = coordinate_quantum(allp)
+    # detected on an even sample of at most _SAMPLE points, then verified on all of them
+    sample = allp[:: max(1, len(allp) // _SAMPLE)]
+    qx, ox = axis_quantum(sample[:, 0])
+    qy, oy = axis_quantum(sample[:, 1])
+    q = coordinate_quantum(sample)
     if q == 0.0:
         return 0.0, (0.0, 0.0)
     # a grid of the larger step: offsets of that axis; the other axis's own offset
-    return q, (ox if qx else 0.0, oy if qy else 0.0)
+    off = (ox if qx == q else 0.0, oy if qy == q else 0.0)
+    if len(sample) < len(allp) and not _on_grid_each(allp, q, off).all():
+        return 0.0, (0.0, 0.0)
+    return q, off
 
 
 def path_quanta(paths: Sequence[object]) -> np.ndarray:
@@ -169,6 +182,26 @@ def path_quanta(paths: Sequence[object]) -> np.ndarray:
         nz = np.flatnonzero(n)
         good[nz] = np.logical_and.reduceat(ok, np.cumsum(n[nz]) - n[nz])
         out[good] = q
-    for i in np.flatnonzero(~good & (n > 0)).tolist():  # off the drawing's grid: its own
-        out[i] = coordinate_quantum(arrs[i])
+    rest = np.flatnonzero(~good & (n >= MIN_DISTINCT))
+    if len(rest) == 0:
+        return out
+    # off the drawing's grid: the coarsest decimal grid a path lies on (one vectorised test
+    # per step for all such paths; exact paths are told by their first 64 points), else its
+    # own grid (detected on a sample, verified on all) when few paths are left
+    m = np.minimum(n[rest], 64)
+    head = np.concatenate([arrs[i][:64] for i in rest.tolist()])
+    hst = np.cumsum(m) - m
+    undecided = np.ones(len(rest), dtype=bool)
+    for step in _DECIMAL_STEPS:
+        cand = undecided & np.logical_and.reduceat(_on_grid_each(head, step, (0.0, 0.0)), hst)
+        for i in np.flatnonzero(cand).tolist():
+            if on_grid(arrs[rest[i]], step):
+                out[rest[i]] = step
+                undecided[i] = False
+    left = rest[undecided]
+    if len(left) <= _OWN_GRID_PATHS:
+        for i in left.tolist():
+            a_ = arrs[i]
+            if coordinate_quantum(a_[:: max(1, len(a_) // _PATH_SAMPLE)]) > 0.0:
+                out[i] = drawing_quantum([a_])[0]
     return out
