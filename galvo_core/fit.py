@@ -71,7 +71,7 @@ from galvo_core.geometry import (
     power_coeffs_into,
     power_coeffs_many,
 )
-from galvo_core.precision import coordinate_quantum, path_quanta
+from galvo_core.precision import path_quanta
 from galvo_core.runs import segmented_cumsum, split_pieces_many
 from galvo_core.thin import check_positive, thin_many
 
@@ -97,6 +97,8 @@ DEFAULT_EPS_SUM = 0.002
 #: the rounding square's half diagonal per unit of side
 _HALF_DIAGONAL = math.sqrt(0.5)
 _BISECT_SAMPLE = 128
+#: rounds of merging adjacent cubics after the fit
+_MERGE_ROUNDS = 3
 _MAX_BISECT = 40
 
 
@@ -509,6 +511,93 @@ class _BatchFitter:
                 k = self._split_points(A[bad], B[bad], dist, starts[bad])
                 todo.append(_halves(A[bad], B[bad], k))
             ab = np.concatenate(todo)
+        for _ in range(_MERGE_ROUNDS):
+            if not self._merge_round():
+                break
+
+    def _try(self, A: np.ndarray, B: np.ndarray):
+        """One cubic per piece A..B (no split): (passed, ctrl, bound) for the pieces whose
+        end tangents meet (the others fail)."""
+        m = len(A)
+        passed = np.zeros(m, dtype=bool)
+        ctrl_all = np.zeros((m, 4, 2))
+        em_all = np.zeros(m)
+        ok, p0, qq, p3, sig = self._triangle(A, B)
+        w = np.flatnonzero(ok)
+        if len(w) == 0:
+            return passed, ctrl_all, em_all
+        a, b = A[w], B[w]
+        i0, i1 = self.kept[a], self.kept[b]
+        ctrl = self._dichotomy(p0[w], qq[w], p3[w], sig[w], i0, i1)
+        # screen on a sample of the points first: the full test only where it can pass
+        lk = self._sample_ok(ctrl, i0, i1, self.e_per[a])
+        if self.quant is not None:
+            lk |= self.quant[a] > 0.0  # (the least-squares cubic may pass where this fails)
+        if not lk.any():
+            return passed, ctrl_all, em_all
+        w, a, b, i0, i1, ctrl = w[lk], a[lk], b[lk], i0[lk], i1[lk], ctrl[lk]
+        good, emax, dist, starts = self._accept(ctrl, i0, i1, self.e_per[a])
+        if self.quant is not None:
+            rq = np.flatnonzero((self.quant[a] > 0.0) & ~good)
+            if len(rq):
+                self._prefer_least_squares(rq, a, b, ctrl, good, emax, dist, starts)
+        passed[w] = good
+        ctrl_all[w] = ctrl
+        em_all[w] = emax
+        return passed, ctrl_all, em_all
+
+    def _sample_ok(self, ctrl, i0, i1, e2) -> np.ndarray:
+        """Per piece: every point of a sample (at most ``_BISECT_SAMPLE`` // 2, evenly
+        strided) within ``e2`` of the cubic (Newton from arc length; a cheap necessary
+        condition of :meth:`_accept`, up to Newton's local minima)."""
+        m = len(ctrl)
+        L = i1 - i0 - 1
+        stride = np.maximum(1, -(-L // (_BISECT_SAMPLE // 2)))
+        cnt = -(-L // stride)
+        pid, off = _ragged(np.zeros(m, dtype=np.intp), cnt)
+        idx = i0[pid] + 1 + stride[pid] * off
+        span = self.arc[i1] - self.arc[i0]
+        u = (self.arc[idx] - self.arc[i0][pid]) / np.where(span > 0, span, 1.0)[pid]
+        cf = gather_coeffs(power_coeffs_many(ctrl), pid)
+        _, d2 = newton_nearest_many(cf, self.work[idx].T, u, 4)
+        worst = np.zeros(m)
+        np.maximum.at(worst, pid, d2)
+        return worst <= e2 * e2
+
+    def _merge_round(self) -> bool:
+        """Two accepted cubics meeting at a smooth vertex (shared tangent) are replaced by
+        one cubic over both pieces where one passes the same test (the split that made them
+        was at the data's crossing, not at a joint of the design). Non-overlapping pairs,
+        one array pass; True when something merged."""
+        if len(self._cubics) == 0:
+            return False
+        A = np.concatenate([c[0] for c in self._cubics])
+        B = np.concatenate([c[1] for c in self._cubics])
+        C = np.concatenate([c[2] for c in self._cubics])
+        E = np.concatenate([c[3] for c in self._cubics])
+        o = np.argsort(A, kind="stable")
+        A, B, C, E = A[o], B[o], C[o], E[o]
+        adj = (B[:-1] == A[1:]) & (self.t_in[B[:-1]] == self.t_out[B[:-1]]).all(axis=1)
+        if not adj.any():
+            self._cubics = [(A, B, C, E)]
+            return False
+        # non-overlapping: in every chain of adjacent pairs, every other pair
+        idx = np.flatnonzero(adj)
+        brk = np.r_[True, idx[1:] != idx[:-1] + 1]
+        chain_start = np.maximum.accumulate(np.where(brk, np.arange(len(idx)), 0))
+        pick = idx[(np.arange(len(idx)) - chain_start) % 2 == 0]
+        ok, ctrl, em = self._try(A[pick], B[pick + 1])
+        if not ok.any():
+            self._cubics = [(A, B, C, E)]
+            return False
+        i = pick[ok]
+        B[i] = B[i + 1]
+        C[i] = ctrl[ok]
+        E[i] = em[ok]
+        keep = np.ones(len(A), dtype=bool)
+        keep[i + 1] = False
+        self._cubics = [(A[keep], B[keep], C[keep], E[keep])]
+        return True
 
     def _least_squares(self, A: np.ndarray, B: np.ndarray, i0: np.ndarray, i1: np.ndarray):
         """Per piece: the cubic with the piece's end points and end tangents whose two
@@ -1233,7 +1322,7 @@ def check_fit(
         out_max = max(out_max, float(point_polyline_distance(samp, loc).max()))
     if not report:
         return float(best.max()), out_max
-    q = coordinate_quantum(pts) if quantum_units is None else float(quantum_units)
+    q = float(path_quanta([pts])[0]) if quantum_units is None else float(quantum_units)
     bound = max(float(e_per), float(eps_line)) + q * _HALF_DIAGONAL
     e_in = float(best.max())
     return {
