@@ -99,6 +99,8 @@ _HALF_DIAGONAL = math.sqrt(0.5)
 _BISECT_SAMPLE = 128
 #: rounds of merging adjacent cubics after the fit
 _MERGE_ROUNDS = 3
+#: points per piece in a merge's dichotomy (a candidate; the full test decides)
+_MERGE_SAMPLE = 32
 _MAX_BISECT = 40
 
 
@@ -343,12 +345,12 @@ class _BatchFitter:
         t = t[:, None]
         return np.stack([p0, p0 + t * (qq - p0), p3 + t * (qq - p3), p3], axis=1)
 
-    def _dichotomy(self, p0, qq, p3, sig, i0, i1) -> np.ndarray:
+    def _dichotomy(self, p0, qq, p3, sig, i0, i1, sample: int = _BISECT_SAMPLE) -> np.ndarray:
         """t per piece: the signed error sum over a sample of each piece's input points
         crosses zero (Illinois false position inside the bracket [0, 1])."""
         m = len(p0)
         L = i1 - i0 - 1
-        stride = np.maximum(1, -(-L // _BISECT_SAMPLE))
+        stride = np.maximum(1, -(-L // sample))
         cnt = -(-L // stride)
         pid, off = _ragged(np.zeros(m, dtype=np.intp), cnt)
         idx = i0[pid] + 1 + stride[pid] * off
@@ -528,7 +530,7 @@ class _BatchFitter:
             return passed, ctrl_all, em_all
         a, b = A[w], B[w]
         i0, i1 = self.kept[a], self.kept[b]
-        ctrl = self._dichotomy(p0[w], qq[w], p3[w], sig[w], i0, i1)
+        ctrl = self._dichotomy(p0[w], qq[w], p3[w], sig[w], i0, i1, _MERGE_SAMPLE)
         # screen on a sample of the points first: the full test only where it can pass
         lk = self._sample_ok(ctrl, i0, i1, self.e_per[a])
         if self.quant is not None:
