@@ -676,12 +676,21 @@ class _BatchFitter:
             return out
         cand, A, B, i0, i1 = cand[bulge], A[bulge], B[bulge], i0[bulge], i1[bulge]
         cl, okl = self._least_squares(A, B, i0, i1)
-        if not okl.any():
-            return out
-        g, e, _, _ = self._accept(cl[okl], i0[okl], i1[okl], self.e_per[A[okl]])
-        sel = np.flatnonzero(okl)[g]
-        self._cubics.append((A[sel], B[sel], cl[sel], e[g]))
-        out[cand[sel]] = True
+        passed = np.zeros(len(A), dtype=bool)
+        if okl.any():
+            g, e, _, _ = self._accept(cl[okl], i0[okl], i1[okl], self.e_per[A[okl]])
+            sel = np.flatnonzero(okl)[g]
+            self._cubics.append((A[sel], B[sel], cl[sel], e[g]))
+            passed[sel] = True
+        # where the least-squares cubic misses (its largest error is not what it minimises),
+        # the dichotomy's balanced cubic may pass
+        rest = np.flatnonzero(~passed)
+        if len(rest):
+            g2, c2, e2 = self._try(A[rest], B[rest])
+            sel2 = rest[g2]
+            self._cubics.append((A[sel2], B[sel2], c2[g2], e2[g2]))
+            passed[sel2] = True
+        out[cand[passed]] = True
         return out
 
     def _prefer_least_squares(self, rq, A, B, ctrl, good, emax, dist, starts) -> None:
