@@ -40,6 +40,19 @@ Any curve parameter gives an upper bound of the true distance, so the acceptance
 too lenient; ``max_error`` is made exact by re-measuring the worst cubics with the seeded
 nearest-point search.
 
+Rounded input (issue 16): points on a grid of step q (whole plotter units, decimal steps,
+an SC/IP grid; :mod:`galvo_core.precision`, detected per path unless ``quantum_units`` is
+given) are the design rounded by up to q/√2. Each point stands for its rounding square: the
+bounds above become ``eps_line + q/√2`` and ``e_per + q/√2`` from the input points and
+polyline, i.e. the user's tolerances beyond the rounding (exactly them when q is 0). Then
+the vertices inside curve runs move, within their rounding squares, onto a local
+least-squares quadratic of the input points (joints on the design, not on the grid) and take
+its tangent; least-squares handle lengths are used where they pass the same test; a single
+thinned segment whose points bulge to one side is tried as a cubic; a line whose moved ends
+would break its bound becomes the thinned line plus connectors inside the rounding squares.
+For every input, after the fit, adjacent cubics meeting at a smooth vertex are refitted as
+one where one cubic passes the same test (up to ``_MERGE_ROUNDS`` rounds).
+
 ``eps_sum`` default: 0.002 input units (one tenth of the paper's e_per). The paper gives no
 value; it only decides when the bisection stops, the acceptance is decided by ``e_per``. A
 bracket on t narrower than 1e-9 also stops it.
@@ -1059,32 +1072,6 @@ def _on_the_design(W, K, Q, arc, t_in, t_out, smooth, quant, tlen) -> None:
     if len(ci):
         _, tan, ok = _local_fits(W, arc, K[ci - 1], K[ci], K[ci])
         t_in[ci[ok]] = tan[ok]
-
-
-def _keep_lines_valid(W, K, Q, eps, tlen) -> None:
-    """Every thinned segment stays a valid line (its input points within ``eps``, the
-    thinning's tolerance, of it) after :func:`_on_the_design` moved vertices: both ends of
-    a segment that fails go back to their input points, until none fails (the unmoved
-    segments are the thinning's own, valid). In place on ``Q``."""
-    n = len(Q)
-    last = np.cumsum(tlen) - 1
-    inner = np.ones(n, dtype=bool)
-    inner[last] = False
-    seg = np.flatnonzero(inner)  # segment k -> k + 1 inside a path
-    orig = W[K]
-    for _ in range(64):
-        moved = (Q != orig).any(axis=1)
-        chk = seg[moved[seg] | moved[seg + 1]]
-        if len(chk) == 0:
-            return
-        pts = np.stack([Q[chk], Q[chk + 1]], axis=1)
-        err = _line_errors(W, pts, K[chk], K[chk + 1])
-        bad = chk[err > eps[chk]]
-        if len(bad) == 0:
-            return
-        Q[bad] = orig[bad]
-        Q[bad + 1] = orig[bad + 1]
-    Q[:] = orig
 
 
 def _arc_per_path(W: np.ndarray, wlen: np.ndarray) -> np.ndarray:
