@@ -37,6 +37,8 @@ STAT_LABELS: dict[str, str] = {
     "estimated_time_s": "Estimated time",
     "max_fit_error_um": "Largest fit error",
     "max_fit_error": "Largest fit error (units)",
+    "quantum_units": "Coordinate grid (units)",
+    "fit_bound_units": "Fit bound in effect (units)",
     "max_deviation_um": "Deviation (overlay)",
     "max_chord_height_um": "Largest chord height",
     "max_chord_height_bits": "Largest chord height (bits)",

@@ -182,6 +182,23 @@ class Drawing:
         """A new drawing with other paths and extra warnings, same file metadata."""
         return replace(self, paths=tuple(paths), warnings=self.warnings + tuple(warnings))
 
+    def quantum(self) -> float:
+        """The grid the coordinates were rounded to (input units; 0 for exact coordinates):
+        :func:`galvo_core.precision.drawing_quantum`."""
+        from galvo_core.precision import drawing_quantum
+
+        return float(drawing_quantum(self.paths)[0])
+
+    def path_quanta(self) -> dict[str, int]:
+        """How many paths have each coordinate grid (``{"1": 370, "0": 12}``; "0": exact),
+        for files whose paths differ (labels and arcs off the grid of the rest)."""
+        from galvo_core.precision import path_quanta
+
+        if not self.paths:
+            return {}
+        q, n = np.unique(path_quanta([p.points for p in self.paths]), return_counts=True)
+        return {f"{float(v):g}": int(c) for v, c in zip(q, n, strict=True)}
+
     def info(self) -> dict[str, object]:
         """A JSON-ready summary (what ``galvo-core info`` prints)."""
         bb = self.bbox()
@@ -195,6 +212,8 @@ class Drawing:
             "bbox": list(bb) if bb is not None else None,
             "size_mm": [w, h],
             "pens": sorted({p.pen for p in self.paths}),
+            "quantum_units": self.quantum(),
+            "path_quanta": self.path_quanta(),
             "commands": dict(sorted(self.commands.items())),
             "warnings": [w_.as_dict() for w_ in self.warnings],
         }

@@ -40,6 +40,19 @@ Any curve parameter gives an upper bound of the true distance, so the acceptance
 too lenient; ``max_error`` is made exact by re-measuring the worst cubics with the seeded
 nearest-point search.
 
+Rounded input (issue 16): points on a grid of step q (whole plotter units, decimal steps,
+an SC/IP grid; :mod:`galvo_core.precision`, detected per path unless ``quantum_units`` is
+given) are the design rounded by up to q/√2. Each point stands for its rounding square: the
+bounds above become ``eps_line + q/√2`` and ``e_per + q/√2`` from the input points and
+polyline, i.e. the user's tolerances beyond the rounding (exactly them when q is 0). Then
+the vertices inside curve runs move, within their rounding squares, onto a local
+least-squares quadratic of the input points (joints on the design, not on the grid) and take
+its tangent; least-squares handle lengths are used where they pass the same test; a single
+thinned segment whose points bulge to one side is tried as a cubic; a line whose moved ends
+would break its bound becomes the thinned line plus connectors inside the rounding squares.
+For every input, after the fit, adjacent cubics meeting at a smooth vertex are refitted as
+one where one cubic passes the same test (up to ``_MERGE_ROUNDS`` rounds).
+
 ``eps_sum`` default: 0.002 input units (one tenth of the paper's e_per). The paper gives no
 value; it only decides when the bisection stops, the acceptance is decided by ``e_per``. A
 bracket on t narrower than 1e-9 also stops it.
@@ -72,6 +85,7 @@ from galvo_core.geometry import (
     power_coeffs_many,
 )
 from galvo_core.job import gc_paused
+from galvo_core.precision import path_quanta
 from galvo_core.runs import segmented_cumsum, split_pieces_many
 from galvo_core.thin import check_positive, thin_many
 
@@ -94,7 +108,13 @@ DEFAULT_EPS_LINE = 0.02
 DEFAULT_E_PER = 0.02
 DEFAULT_EPS_SUM = 0.002
 
+#: the rounding square's half diagonal per unit of side
+_HALF_DIAGONAL = math.sqrt(0.5)
 _BISECT_SAMPLE = 128
+#: rounds of merging adjacent cubics after the fit
+_MERGE_ROUNDS = 3
+#: points per piece in a merge's dichotomy (a candidate; the full test decides)
+_MERGE_SAMPLE = 32
 _MAX_BISECT = 40
 
 
@@ -390,16 +410,20 @@ class _BatchFitter:
         kept: np.ndarray,
         t_in: np.ndarray,
         t_out: np.ndarray,
-        e_per: float,
+        e_per: float | np.ndarray,
         eps_sum: float,
         arc: np.ndarray,
+        q: np.ndarray | None = None,
     ) -> None:
         self.work = work
         self.kept = kept
-        self.q = work[kept]
+        self.q = work[kept] if q is None else q
+        #: per thinned point its path's quantum (None: exact input everywhere)
+        self.quant: np.ndarray | None = None
         self.t_in = t_in
         self.t_out = t_out
-        self.e_per = e_per
+        # the bound of a piece starting at thinned point k (its path's): e_per + rounding
+        self.e_per = np.broadcast_to(np.asarray(e_per, dtype=np.float64), (len(kept),))
         self.eps_sum = eps_sum
         self.arc = arc
         self._cubics: list[tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]] = []
@@ -431,12 +455,12 @@ class _BatchFitter:
         t = t[:, None]
         return np.stack([p0, p0 + t * (qq - p0), p3 + t * (qq - p3), p3], axis=1)
 
-    def _dichotomy(self, p0, qq, p3, sig, i0, i1) -> np.ndarray:
+    def _dichotomy(self, p0, qq, p3, sig, i0, i1, sample: int = _BISECT_SAMPLE) -> np.ndarray:
         """t per piece: the signed error sum over a sample of each piece's input points
         crosses zero (Illinois false position inside the bracket [0, 1])."""
         m = len(p0)
         L = i1 - i0 - 1
-        stride = np.maximum(1, -(-L // _BISECT_SAMPLE))
+        stride = np.maximum(1, -(-L // sample))
         cnt = -(-L // stride)
         pid, off = _ragged(np.zeros(m, dtype=np.intp), cnt)
         idx = i0[pid] + 1 + stride[pid] * off
@@ -523,7 +547,7 @@ class _BatchFitter:
                 done |= stop
         return self._ctrl(p0, qq, p3, t)
 
-    def _accept(self, ctrl: np.ndarray, i0: np.ndarray, i1: np.ndarray):
+    def _accept(self, ctrl: np.ndarray, i0: np.ndarray, i1: np.ndarray, e2: np.ndarray):
         """Per piece: bound of the max input-point error, pass/fail of both sides of the
         guarantee, and the flat per-point errors (with the offsets of each piece)."""
         m = len(ctrl)
@@ -542,12 +566,12 @@ class _BatchFitter:
         u[starts + cnt - 1] = 1.0
         d2[ends] = 0.0
         dist = np.sqrt(d2)
-        e2 = self.e_per
         # Newton may have stopped in a local minimum: seeded search for the points over the
         # bound, in pieces that miss it by little (a piece far off is a bad fit anyway; the
         # check only decides between keeping and splitting, never weakens the guarantee)
         emax0 = np.maximum.reduceat(dist, starts)
-        far = np.flatnonzero((dist > e2) & (emax0[pid] <= 4.0 * e2))
+        e2p = e2[pid]
+        far = np.flatnonzero((dist > e2p) & (emax0[pid] <= 4.0 * e2p))
         if len(far):
             tu, td = nearest_on_cubics(ctrl, pid[far], pts[far])
             better = td < dist[far]
@@ -573,6 +597,10 @@ class _BatchFitter:
         ab = np.asarray(curve_pieces, dtype=np.intp).reshape(-1, 2)
         while len(ab):
             line = ab[:, 1] - ab[:, 0] == 1
+            if self.quant is not None and line.any():
+                as_cubic = self._bulging_segments(ab, line)
+                ab = ab[~as_cubic]
+                line = line[~as_cubic]
             self._lines.append(ab[line, 0])
             ab = ab[~line]
             if len(ab) == 0:
@@ -585,12 +613,213 @@ class _BatchFitter:
             if len(A):
                 i0, i1 = self.kept[A], self.kept[B]
                 ctrl = self._dichotomy(p0[ok], qq[ok], p3[ok], sig[ok], i0, i1)
-                good, emax, dist, starts = self._accept(ctrl, i0, i1)
+                good, emax, dist, starts = self._accept(ctrl, i0, i1, self.e_per[A])
+                if self.quant is not None:
+                    rq = np.flatnonzero(self.quant[A] > 0.0)
+                    if len(rq):
+                        self._prefer_least_squares(rq, A, B, ctrl, good, emax, dist, starts)
                 self._cubics.append((A[good], B[good], ctrl[good], emax[good]))
                 bad = ~good
                 k = self._split_points(A[bad], B[bad], dist, starts[bad])
                 todo.append(_halves(A[bad], B[bad], k))
             ab = np.concatenate(todo)
+        for _ in range(_MERGE_ROUNDS):
+            if not self._merge_round():
+                break
+
+    def _try(self, A: np.ndarray, B: np.ndarray):
+        """One cubic per piece A..B (no split): (passed, ctrl, bound) for the pieces whose
+        end tangents meet (the others fail)."""
+        m = len(A)
+        passed = np.zeros(m, dtype=bool)
+        ctrl_all = np.zeros((m, 4, 2))
+        em_all = np.zeros(m)
+        ok, p0, qq, p3, sig = self._triangle(A, B)
+        w = np.flatnonzero(ok)
+        if len(w) == 0:
+            return passed, ctrl_all, em_all
+        a, b = A[w], B[w]
+        i0, i1 = self.kept[a], self.kept[b]
+        ctrl = self._dichotomy(p0[w], qq[w], p3[w], sig[w], i0, i1, _MERGE_SAMPLE)
+        # screen on a sample of the points first: the full test only where it can pass
+        lk = self._sample_ok(ctrl, i0, i1, self.e_per[a])
+        if self.quant is not None:
+            lk |= self.quant[a] > 0.0  # (the least-squares cubic may pass where this fails)
+        if not lk.any():
+            return passed, ctrl_all, em_all
+        w, a, b, i0, i1, ctrl = w[lk], a[lk], b[lk], i0[lk], i1[lk], ctrl[lk]
+        good, emax, dist, starts = self._accept(ctrl, i0, i1, self.e_per[a])
+        if self.quant is not None:
+            rq = np.flatnonzero((self.quant[a] > 0.0) & ~good)
+            if len(rq):
+                self._prefer_least_squares(rq, a, b, ctrl, good, emax, dist, starts)
+        passed[w] = good
+        ctrl_all[w] = ctrl
+        em_all[w] = emax
+        return passed, ctrl_all, em_all
+
+    def _sample_ok(self, ctrl, i0, i1, e2) -> np.ndarray:
+        """Per piece: every point of a sample (at most ``_BISECT_SAMPLE`` // 2, evenly
+        strided) within ``e2`` of the cubic (Newton from arc length; a cheap necessary
+        condition of :meth:`_accept`, up to Newton's local minima)."""
+        m = len(ctrl)
+        L = i1 - i0 - 1
+        stride = np.maximum(1, -(-L // (_BISECT_SAMPLE // 2)))
+        cnt = -(-L // stride)
+        pid, off = _ragged(np.zeros(m, dtype=np.intp), cnt)
+        idx = i0[pid] + 1 + stride[pid] * off
+        span = self.arc[i1] - self.arc[i0]
+        u = (self.arc[idx] - self.arc[i0][pid]) / np.where(span > 0, span, 1.0)[pid]
+        cf = gather_coeffs(power_coeffs_many(ctrl), pid)
+        _, d2 = newton_nearest_many(cf, self.work[idx].T, u, 4)
+        worst = np.zeros(m)
+        np.maximum.at(worst, pid, d2)
+        return worst <= e2 * e2
+
+    def _merge_round(self) -> bool:
+        """Two accepted cubics meeting at a smooth vertex (shared tangent) are replaced by
+        one cubic over both pieces where one passes the same test (the split that made them
+        was at the data's crossing, not at a joint of the design). Non-overlapping pairs,
+        one array pass; True when something merged."""
+        if len(self._cubics) == 0:
+            return False
+        A = np.concatenate([c[0] for c in self._cubics])
+        B = np.concatenate([c[1] for c in self._cubics])
+        C = np.concatenate([c[2] for c in self._cubics])
+        E = np.concatenate([c[3] for c in self._cubics])
+        o = np.argsort(A, kind="stable")
+        A, B, C, E = A[o], B[o], C[o], E[o]
+        adj = (B[:-1] == A[1:]) & (self.t_in[B[:-1]] == self.t_out[B[:-1]]).all(axis=1)
+        if not adj.any():
+            self._cubics = [(A, B, C, E)]
+            return False
+        # non-overlapping: in every chain of adjacent pairs, every other pair
+        idx = np.flatnonzero(adj)
+        brk = np.r_[True, idx[1:] != idx[:-1] + 1]
+        chain_start = np.maximum.accumulate(np.where(brk, np.arange(len(idx)), 0))
+        pick = idx[(np.arange(len(idx)) - chain_start) % 2 == 0]
+        ok, ctrl, em = self._try(A[pick], B[pick + 1])
+        if not ok.any():
+            self._cubics = [(A, B, C, E)]
+            return False
+        i = pick[ok]
+        B[i] = B[i + 1]
+        C[i] = ctrl[ok]
+        E[i] = em[ok]
+        keep = np.ones(len(A), dtype=bool)
+        keep[i + 1] = False
+        self._cubics = [(A[keep], B[keep], C[keep], E[keep])]
+        return True
+
+    def _least_squares(self, A: np.ndarray, B: np.ndarray, i0: np.ndarray, i1: np.ndarray):
+        """Per piece: the cubic with the piece's end points and end tangents whose two
+        handle lengths minimise the squared distances of (a sample of) its input points at
+        their parameters (chord length, then twice the nearest point's), Schneider's
+        fit; (ctrl (m, 4, 2), ok (m,): positive handles no longer than twice the chord)."""
+        m = len(A)
+        p0, p3 = self.q[A], self.q[B]
+        t0, t3 = self.t_out[A], self.t_in[B]
+        L = i1 - i0 - 1
+        stride = np.maximum(1, -(-L // _BISECT_SAMPLE))
+        cnt = -(-L // stride)
+        pid, off = _ragged(np.zeros(m, dtype=np.intp), cnt)
+        idx = i0[pid] + 1 + stride[pid] * off
+        pts = self.work[idx]
+        span = self.arc[i1] - self.arc[i0]
+        u = (self.arc[idx] - self.arc[i0][pid]) / np.where(span > 0, span, 1.0)[pid]
+        chord = np.hypot(*(p3 - p0).T)
+        ctrl = np.zeros((m, 4, 2))
+        ok = np.zeros(m, dtype=bool)
+        for it in range(3):
+            s = 1.0 - u
+            b0, b1, b2, b3 = s * s * s, 3 * s * s * u, 3 * s * u * u, u * u * u
+            a1 = b1[:, None] * t0[pid]
+            a2 = -b2[:, None] * t3[pid]
+            r = pts - (b0 + b1)[:, None] * p0[pid] - (b2 + b3)[:, None] * p3[pid]
+            c11 = np.bincount(pid, (a1 * a1).sum(1), m)
+            c12 = np.bincount(pid, (a1 * a2).sum(1), m)
+            c22 = np.bincount(pid, (a2 * a2).sum(1), m)
+            x1 = np.bincount(pid, (r * a1).sum(1), m)
+            x2 = np.bincount(pid, (r * a2).sum(1), m)
+            det = c11 * c22 - c12 * c12
+            with np.errstate(divide="ignore", invalid="ignore"):
+                al = (x1 * c22 - x2 * c12) / det
+                be = (c11 * x2 - c12 * x1) / det
+            ok = (np.abs(det) > 1e-12 * (c11 * c22 + 1e-300)) & (al > 0) & (be > 0)
+            ok &= (al < 2.0 * chord) & (be < 2.0 * chord)
+            al = np.where(ok, al, chord / 3.0)
+            be = np.where(ok, be, chord / 3.0)
+            ctrl = np.stack([p0, p0 + al[:, None] * t0, p3 - be[:, None] * t3, p3], axis=1)
+            if it == 2:
+                break
+            cf = gather_coeffs(power_coeffs_many(ctrl), pid)
+            u, _ = newton_nearest_many(cf, pts.T, u, 2)
+        return ctrl, ok
+
+    def _bulging_segments(self, ab: np.ndarray, line: np.ndarray) -> np.ndarray:
+        """Rounded input: the one-segment pieces (``line``) whose input points bulge to one
+        side of the segment (mean signed distance over a fifth of the quantum, at least 4
+        points between: a curve stretch, not a rounded straight line) and that a
+        least-squares cubic with the end tangents fits within the bound; those cubics are
+        accepted here. Returns the mask of such pieces (over ``ab``)."""
+        out = np.zeros(len(ab), dtype=bool)
+        cand = np.flatnonzero(line & (self.quant[ab[:, 0]] > 0.0))
+        if len(cand) == 0:
+            return out
+        A, B = ab[cand, 0], ab[cand, 1]
+        i0, i1 = self.kept[A], self.kept[B]
+        enough = i1 - i0 - 1 >= 4
+        cand, A, B, i0, i1 = cand[enough], A[enough], B[enough], i0[enough], i1[enough]
+        if len(cand) == 0:
+            return out
+        own, off = _ragged(np.zeros(len(A), dtype=np.intp), i1 - i0 - 1)
+        idx = i0[own] + 1 + off
+        p0, p3 = self.q[A], self.q[B]
+        ch = p3 - p0
+        ln = np.hypot(ch[:, 0], ch[:, 1])
+        ln = np.where(ln > 0, ln, 1.0)
+        rel = self.work[idx] - p0[own]
+        sd = (rel[:, 0] * ch[own, 1] - rel[:, 1] * ch[own, 0]) / ln[own]
+        mean = np.bincount(own, sd, len(A)) / np.bincount(own, minlength=len(A))
+        bulge = np.abs(mean) > 0.2 * self.quant[A]
+        if not bulge.any():
+            return out
+        cand, A, B, i0, i1 = cand[bulge], A[bulge], B[bulge], i0[bulge], i1[bulge]
+        cl, okl = self._least_squares(A, B, i0, i1)
+        passed = np.zeros(len(A), dtype=bool)
+        if okl.any():
+            g, e, _, _ = self._accept(cl[okl], i0[okl], i1[okl], self.e_per[A[okl]])
+            sel = np.flatnonzero(okl)[g]
+            self._cubics.append((A[sel], B[sel], cl[sel], e[g]))
+            passed[sel] = True
+        # where the least-squares cubic misses (its largest error is not what it minimises),
+        # the dichotomy's balanced cubic may pass
+        rest = np.flatnonzero(~passed)
+        if len(rest):
+            g2, c2, e2 = self._try(A[rest], B[rest])
+            sel2 = rest[g2]
+            self._cubics.append((A[sel2], B[sel2], c2[g2], e2[g2]))
+            passed[sel2] = True
+        out[cand[passed]] = True
+        return out
+
+    def _prefer_least_squares(self, rq, A, B, ctrl, good, emax, dist, starts) -> None:
+        """Rounded input: where the least-squares cubic (:meth:`_least_squares`) passes the
+        same acceptance test, it replaces the dichotomy's (it follows the middle of the
+        rounding noise, not just its signed balance), in place; a piece the dichotomy
+        failed that the least-squares cubic passes is accepted."""
+        a, b = A[rq], B[rq]
+        i0, i1 = self.kept[a], self.kept[b]
+        cl, okl = self._least_squares(a, b, i0, i1)
+        if not okl.any():
+            return
+        sel = rq[okl]
+        g2, e2, d2, s2 = self._accept(cl[okl], i0[okl], i1[okl], self.e_per[a[okl]])
+        use = sel[g2]
+        ctrl[use] = cl[okl][g2]
+        emax[use] = e2[g2]
+        good[use] = True
+        # the failed pieces keep the dichotomy's errors for choosing their split point
 
     def results(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
         """``(a, b, ctrl, bound, line_a)``: the accepted cubics (thinned index ranges a..b,
@@ -645,6 +874,7 @@ def fit_path(
     eps_sum: float = DEFAULT_EPS_SUM,
     source_index: int = 0,
     pen: int = 1,
+    quantum_units: float | None = None,
 ) -> FittedPath:
     """Fit one path's points (N, 2) (input units) with lines and cubics.
 
@@ -661,6 +891,7 @@ def fit_path(
         eps_sum=eps_sum,
         source_indices=[source_index],
         pens=[pen],
+        quantum_units=None if quantum_units is None else [quantum_units],
     )[0]
 
 
@@ -673,6 +904,7 @@ def fit_paths(
     eps_sum: float = DEFAULT_EPS_SUM,
     source_indices: Sequence[int] | None = None,
     pens: Sequence[int] | None = None,
+    quantum_units: float | Sequence[float] | None = None,
 ) -> list[FittedPath]:
     """:func:`fit_path` for many paths at once (the same result as one call per path).
 
@@ -682,6 +914,11 @@ def fit_paths(
     :class:`_BatchFitter`; pieces never cross a path), the errors of all lines and the exact
     errors of the cubics that decide a path's ``max_error``. The fixed cost per path is a
     few Python operations (building its segments), not a few hundred array calls.
+
+    ``quantum_units``: the grid the points were rounded to (input units; one value for all
+    paths or one per path; 0 for exact input). Default: detected from each path's points
+    (:func:`galvo_core.precision.path_quanta`). The bounds are then ``eps_line`` and
+    ``e_per`` beyond the rounding (see :func:`rounding_slack`).
     """
     eps_line, e_per, eps_sum = _check_params(eps_line, e_per, eps_sum)
     npth = len(paths)
@@ -691,15 +928,17 @@ def fit_paths(
     pen = [1] * npth if pens is None else [int(p) for p in pens]
     cl = [bool(c) for c in closed]
     works, ns = _closed_works(paths, cl)
-    kept_all = thin_many(works, eps_line)
+    slack = rounding_slack(works, quantum_units)
+    kept_all = thin_many(works, eps_line, per_path=eps_line + slack)
     wlen = np.array([len(w) for w in works], dtype=np.intp)
     klen = np.array([len(k) for k in kept_all], dtype=np.intp)
     out: list[FittedPath | None] = [None] * npth
     mk = FittedPath.from_arrays
     todo = np.flatnonzero((wlen > 0) & (klen != 1))
     if len(todo):
+        rounding = np.stack([eps_line + slack[todo], slack[todo] / _HALF_DIAGONAL], axis=1)
         is_cubic, points, first, last, seg_cut, pt_cut, worst = _fit_concatenated(
-            works, kept_all, todo, cl, e_per, eps_sum)
+            works, kept_all, todo, cl, e_per + slack[todo], eps_sum, rounding)
     with gc_paused():  # one object per path (and its array views), no cycles
         for k in np.flatnonzero(klen == 1).tolist():  # a dot: all points equal
             out[k] = mk(src[k], pen[k], cl[k], _DOT_KIND, _read_only(works[k][[0, 0]]),
@@ -713,6 +952,24 @@ def fit_paths(
                 out[k] = mk(src[k], pen[k], cl[k], is_cubic[a:b], points[pt_cut[t]:pt_cut[t + 1]],
                             first[a:b], last[a:b], worst[t], ns[k], int(klen[k]))
     return out  # type: ignore[return-value]
+
+
+def rounding_slack(
+    paths: Sequence[object], quantum_units: float | Sequence[float] | None = None
+) -> np.ndarray:
+    """Per path: how far the design may lie from an input point, ``q / √2`` (the rounding
+    square's half diagonal) for the path's quantum ``q`` (``quantum_units``: one value, one
+    per path, or None to detect each path's from its points). The fit's bounds on a path
+    are ``eps_line + slack`` and ``e_per + slack`` from the input points and polyline, i.e.
+    ``eps_line`` / ``e_per`` beyond the rounding; exactly the user's values when q is 0."""
+    n = len(paths)
+    if quantum_units is None:
+        q = path_quanta(paths)
+    else:
+        q = np.broadcast_to(np.asarray(quantum_units, dtype=np.float64).reshape(-1), (n,))
+        if not (np.isfinite(q) & (q >= 0.0)).all():
+            raise ParamError(f"quantum_units must be finite numbers >= 0, got {quantum_units!r}")
+    return q * _HALF_DIAGONAL
 
 
 def _closed_works(
@@ -741,8 +998,9 @@ def _fit_concatenated(
     kept_all: list[np.ndarray],
     todo: np.ndarray,
     closed: list[bool],
-    e_per: float,
+    e_per: np.ndarray,
     eps_sum: float,
+    rounding: np.ndarray | None = None,
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, list[int], list[int],
            list[float]]:
     """Segments and max_error of the paths ``todo`` (>= 2 thinned points each), all at once
@@ -763,8 +1021,16 @@ def _fit_concatenated(
     Q = W[K]
     is_kend = np.zeros(len(Q), dtype=bool)
     is_kend[kend] = True
-    pa, pb, curve, t_in, t_out = split_pieces_many(Q, tlen, np.asarray(closed)[todo])
-    fitter = _BatchFitter(W, K, t_in, t_out, e_per, eps_sum, _arc_per_path(W, wlen))
+    pa, pb, curve, t_in, t_out, smooth = split_pieces_many(
+        Q, tlen, np.asarray(closed)[todo], rounding=rounding, return_smooth=True
+    )
+    arc = _arc_per_path(W, wlen)
+    if rounding is not None and (rounding[:, 1] > 0.0).any():
+        Q = Q.copy()
+        _on_the_design(W, K, Q, arc, t_in, t_out, smooth, np.repeat(rounding[:, 1], tlen), tlen)
+    fitter = _BatchFitter(W, K, t_in, t_out, np.repeat(e_per, tlen), eps_sum, arc, q=Q)
+    if rounding is not None and (rounding[:, 1] > 0.0).any():
+        fitter.quant = np.repeat(rounding[:, 1], tlen)
     with np.errstate(invalid="ignore", divide="ignore"):
         fitter.fit(np.stack([pa[curve], pb[curve]], axis=1))
     ca, cb, ctrl, bound, fla = fitter.results()
@@ -775,10 +1041,15 @@ def _fit_concatenated(
     end_w = o_w + wlen[todo] - 1  # each path's last input point (trailing repeats included)
     # line points (read-only views of one array) and their true max error
     lpts = np.stack([Q[la], Q[lb]], axis=1)
-    lpts.setflags(write=False)
     lfirst = K[la]
     llast = np.where(is_kend[lb], end_w[owner[lb]], K[lb])
     lerr = _line_errors(W, lpts, lfirst, llast)
+    lkey = 3 * la
+    if rounding is not None:
+        la, lpts, lfirst, llast, lerr, lkey = _valid_lines(
+            W, K, Q, la, lb, lpts, lfirst, llast, lerr, np.repeat(rounding[:, 0], tlen)
+        )
+    lpts.setflags(write=False)
     worst = np.zeros(len(todo))
     np.fmax.at(worst, owner[la], lerr)  # NaN (overflow) ignored, as max() did
     # cubics: a segment ending at the path's last thinned point takes its trailing repeats
@@ -791,7 +1062,7 @@ def _fit_concatenated(
     # all segments in path order, as arrays: kinds, shared control points (each path's
     # start, then per segment its points after the start), replaced input point ranges
     seg_a = np.concatenate([la, ca])
-    order = np.argsort(seg_a, kind="stable")
+    order = np.argsort(np.concatenate([lkey, 3 * ca]), kind="stable")
     nl = len(la)
     is_cubic = order >= nl
     seg_owner = owner[seg_a[order]]
@@ -817,6 +1088,111 @@ def _fit_concatenated(
     for x in (is_cubic, points, first, last):
         x.setflags(write=False)
     return is_cubic, points, first, last, seg_cut.tolist(), pt_cut.tolist(), worst.tolist()
+
+
+def _valid_lines(W, K, Q, la, lb, lpts, lfirst, llast, lerr, eps):
+    """Rounded input: a line between thinned vertices that :func:`_on_the_design` moved may
+    miss its input points by more than the thinning's tolerance ``eps`` (per thinned
+    point); such a line is replaced by the thinned line between the input points (valid by
+    construction of the thinning) and short connectors from the moved vertices to them
+    (inside the rounding square, no input point between). Returns the lines (start thinned
+    index, points, first, last, error, sort key 3 a + 0/1/2) with the replacements."""
+    bad = lerr > eps[la] * (1.0 + 1e-9)
+    if not bad.any():
+        return la, lpts, lfirst, llast, lerr, 3 * la
+    orig = W[K]
+    b = np.flatnonzero(bad)
+    a0, b0 = la[b], lb[b]
+    parts = [(la[~bad], lpts[~bad], lfirst[~bad], llast[~bad], 3 * la[~bad] + 1)]
+    mid = np.stack([orig[a0], orig[b0]], axis=1)
+    parts.append((a0, mid, lfirst[b], llast[b], 3 * a0 + 1))
+    ma = (Q[a0] != orig[a0]).any(axis=1)
+    parts.append((a0[ma], np.stack([Q[a0[ma]], orig[a0[ma]]], axis=1), lfirst[b][ma],
+                  lfirst[b][ma], 3 * a0[ma]))
+    mb = (Q[b0] != orig[b0]).any(axis=1)
+    parts.append((a0[mb], np.stack([orig[b0[mb]], Q[b0[mb]]], axis=1), llast[b][mb],
+                  llast[b][mb], 3 * a0[mb] + 2))
+    la2 = np.concatenate([p[0] for p in parts])
+    pts2 = np.concatenate([p[1] for p in parts])
+    f2 = np.concatenate([p[2] for p in parts])
+    l2 = np.concatenate([p[3] for p in parts])
+    key = np.concatenate([p[4] for p in parts])
+    return la2, pts2, f2, l2, _line_errors(W, pts2, f2, l2), key
+
+
+def _local_fits(
+    W: np.ndarray, arc: np.ndarray, lo: np.ndarray, hi: np.ndarray, at: np.ndarray
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Least-squares quadratics x(s), y(s) in arc length s through the input points lo..hi
+    (inclusive global indices) of each window, evaluated at the point ``at``: (position
+    (V, 2), unit tangent (V, 2) in the path's direction, ok (V,): at least 4 points and a
+    well-conditioned fit)."""
+    cnt = hi - lo + 1
+    v = len(lo)
+    pos = np.zeros((v, 2))
+    tan = np.zeros((v, 2))
+    ok = cnt >= 4
+    if not ok.any():
+        return pos, tan, ok
+    own, off = _ragged(np.zeros(v, dtype=np.intp), np.where(ok, cnt, 0))
+    idx = lo[own] + off
+    scale = np.maximum(arc[hi] - arc[lo], 1e-300)
+    sv = (arc[idx] - arc[at][own]) / scale[own]  # in [-1, 1]: well scaled
+    pw = np.stack([np.ones_like(sv), sv, sv * sv, sv**3, sv**4])
+    starts = np.cumsum(np.where(ok, cnt, 0)) - np.where(ok, cnt, 0)
+    okk = np.flatnonzero(ok)
+    mom = np.add.reduceat(pw, starts[okk], axis=1)  # (5, V')
+    rx = np.add.reduceat(pw[:3] * W[idx, 0], starts[okk], axis=1)
+    ry = np.add.reduceat(pw[:3] * W[idx, 1], starts[okk], axis=1)
+    A = np.stack([mom[0:3], mom[1:4], mom[2:5]]).transpose(2, 0, 1)  # (V', 3, 3)
+    det = np.linalg.det(A)
+    good = np.abs(det) > 1e-9 * np.abs(A).max(axis=(1, 2)) ** 3
+    A[~good] = np.eye(3)
+    cx = np.linalg.solve(A, rx.T[:, :, None])[:, :, 0]
+    cy = np.linalg.solve(A, ry.T[:, :, None])[:, :, 0]
+    pos[okk] = np.stack([cx[:, 0], cy[:, 0]], axis=1)
+    t = np.stack([cx[:, 1], cy[:, 1]], axis=1)
+    ln = np.hypot(t[:, 0], t[:, 1])
+    good &= ln > 0.0
+    tan[okk] = t / np.where(ln > 0.0, ln, 1.0)[:, None]
+    ok[okk] = good
+    return pos, tan, ok
+
+
+def _on_the_design(W, K, Q, arc, t_in, t_out, smooth, quant, tlen) -> None:
+    """Rounded input (per thinned point its path's quantum ``quant``): the smooth thinned
+    vertices (inside curve runs) moved onto a least-squares estimate of the design curve
+    (a quadratic in arc length through the input points between the middles of the two
+    thinned segments around it), kept inside the point's rounding square, with the fit's
+    tangent as both of its tangents; the ends of curve runs keep their place and get
+    one-sided fitted tangents. In place on ``Q``, ``t_in``, ``t_out``."""
+    n = len(Q)
+    last = np.cumsum(tlen) - 1
+    first = last - tlen + 1
+    is_first = np.zeros(n, dtype=bool)
+    is_first[first] = True
+    is_last = np.zeros(n, dtype=bool)
+    is_last[last] = True
+    rnd = quant > 0.0
+    sm = np.flatnonzero(smooth & rnd & ~is_first & ~is_last)
+    if len(sm):
+        lo = (K[sm - 1] + K[sm] + 1) // 2
+        hi = (K[sm] + K[sm + 1]) // 2
+        pos, tan, ok = _local_fits(W, arc, np.minimum(lo, K[sm]), np.maximum(hi, K[sm]), K[sm])
+        k = sm[ok]
+        h = 0.5 * quant[k][:, None]
+        Q[k] = np.clip(pos[ok], W[K[k]] - h, W[K[k]] + h)
+        t_in[k] = tan[ok]
+        t_out[k] = tan[ok]
+    # one-sided tangents at the other vertices (corners, ends of runs)
+    co = np.flatnonzero(~smooth & rnd & ~is_last)
+    if len(co):
+        _, tan, ok = _local_fits(W, arc, K[co], K[co + 1], K[co])
+        t_out[co[ok]] = tan[ok]
+    ci = np.flatnonzero(~smooth & rnd & ~is_first)
+    if len(ci):
+        _, tan, ok = _local_fits(W, arc, K[ci - 1], K[ci], K[ci])
+        t_in[ci[ok]] = tan[ok]
 
 
 def _arc_per_path(W: np.ndarray, wlen: np.ndarray) -> np.ndarray:
@@ -902,12 +1278,20 @@ def fit_drawing(
     eps_sum: float = DEFAULT_EPS_SUM,
     batch: int = 4096,
     cancel: Callable[[], bool] | None = None,
+    quantum_units: float | Sequence[float] | None = None,
 ) -> tuple[FittedPath, ...]:
     """:func:`fit_path` for every path of the drawing, in order (``source_index`` = position),
     fitted ``batch`` paths at a time (:func:`fit_paths`). ``cancel`` is called between
-    batches; when it returns True, :class:`FitCancelled` is raised."""
+    batches; when it returns True, :class:`FitCancelled` is raised. ``quantum_units``: as in
+    :func:`fit_paths`; default: detected on the whole drawing, per path where a path is off
+    the drawing's grid (:func:`galvo_core.precision.path_quanta`)."""
     _check_params(eps_line, e_per, eps_sum)
     paths = drawing.paths
+    if quantum_units is None:
+        qs = path_quanta([p.points for p in paths])
+    else:
+        qs = np.broadcast_to(np.asarray(quantum_units, dtype=np.float64).reshape(-1),
+                             (len(paths),))
     out: list[FittedPath] = []
     for b0 in range(0, len(paths), max(1, int(batch))):
         if cancel is not None and cancel():
@@ -921,6 +1305,7 @@ def fit_drawing(
             eps_sum=eps_sum,
             source_indices=range(b0, b0 + len(chunk)),
             pens=[p.pen for p in chunk],
+            quantum_units=qs[b0 : b0 + len(chunk)],
         )
     return tuple(out)
 
@@ -942,15 +1327,33 @@ def fit_report(
     eps_line: float = DEFAULT_EPS_LINE,
     e_per: float = DEFAULT_E_PER,
     eps_sum: float = DEFAULT_EPS_SUM,
+    quantum_units: float | Sequence[float] | None = None,
+    per_path: bool = False,
 ) -> dict[str, object]:
     """Paper 000 Table 1 row for a drawing: input_points, thinned_points, control_points
     (see :func:`control_points`), lines, cubics, max_error (input units), seconds (wall
-    time of the fit; the one-time load of the compiled thinning is not counted)."""
+    time of the fit; the one-time load of the compiled thinning is not counted), and the
+    precision in effect: quantum_units (the drawing's grid, 0 for exact input; the largest
+    of the paths'), eps_line_in_effect / e_per_in_effect (the bounds from the input points:
+    the user's values plus the rounding, :func:`rounding_slack`).
+
+    With ``per_path``: "paths", one dict per path (index, pen, closed, input_points,
+    segments, lines, cubics, quantum_units, bound, max_error) with the path's own bound
+    (max of the two tolerances in effect) and worst true input-point error."""
     warm_up()
+    pts = [p.points for p in drawing.paths]
+    if quantum_units is None:
+        qs = path_quanta(pts)
+    else:
+        qs = np.broadcast_to(np.asarray(quantum_units, dtype=np.float64).reshape(-1),
+                             (len(pts),))
     t0 = time.perf_counter()
-    fitted = fit_drawing(drawing, eps_line=eps_line, e_per=e_per, eps_sum=eps_sum)
+    fitted = fit_drawing(drawing, eps_line=eps_line, e_per=e_per, eps_sum=eps_sum,
+                         quantum_units=qs)
     secs = time.perf_counter() - t0
-    return {
+    qmax = float(qs.max()) if len(qs) else 0.0
+    slack = qmax * _HALF_DIAGONAL
+    out: dict[str, object] = {
         "input_points": drawing.n_points,
         "thinned_points": sum(f.n_thinned for f in fitted),
         "control_points": sum(control_points(f) for f in fitted),
@@ -958,13 +1361,44 @@ def fit_report(
         "cubics": sum(f.n_cubics for f in fitted),
         "max_error": max((f.max_error for f in fitted), default=0.0),
         "seconds": secs,
+        "quantum_units": qmax,
+        "eps_line_in_effect": float(eps_line) + slack,
+        "e_per_in_effect": float(e_per) + slack,
     }
+    if per_path:
+        out["paths"] = [
+            {
+                "index": f.source_index,
+                "pen": f.pen,
+                "closed": f.closed,
+                "input_points": f.n_input,
+                "segments": len(f.segments),
+                "lines": f.n_lines,
+                "cubics": f.n_cubics,
+                "quantum_units": float(q),
+                "bound": max(float(eps_line), float(e_per)) + float(q) * _HALF_DIAGONAL,
+                "max_error": f.max_error,
+            }
+            for f, q in zip(fitted, qs.tolist(), strict=True)
+        ]
+    return out
 
 
 def check_fit(
-    points: object, fitted: FittedPath, e_per: float, eps_line: float
-) -> tuple[float, float]:
+    points: object,
+    fitted: FittedPath,
+    e_per: float,
+    eps_line: float,
+    *,
+    quantum_units: float | None = None,
+    report: bool = False,
+) -> tuple[float, float] | dict[str, float]:
     """Measure both sides of the fitting guarantee with true distances (input units).
+
+    With ``report``: a dict with those two numbers ("max_in_to_curve",
+    "max_curve_to_polyline"), "segments", "quantum_units" (given, or detected from the
+    points when None) and "bound" (max(e_per, eps_line) + q/√2: the guarantee measured from
+    the points themselves) and "violation" (1.0 when either side exceeds the bound, else 0.0).
 
     Returns ``(max_in_to_curve, max_curve_to_polyline)``:
 
@@ -981,6 +1415,10 @@ def check_fit(
     pts = np.asarray(points, dtype=np.float64).reshape(-1, 2)
     n = len(pts)
     if n == 0 or not fitted.segments:
+        if report:
+            return {"max_in_to_curve": 0.0, "max_curve_to_polyline": 0.0, "segments": 0.0,
+                    "quantum_units": 0.0, "bound": max(float(e_per), float(eps_line)),
+                    "violation": 0.0}
         return 0.0, 0.0
     ext = np.vstack([pts, pts[:1]]) if fitted.segments[-1].last >= n else pts
     h = min(float(e_per), float(eps_line)) / 4.0
@@ -1001,4 +1439,16 @@ def check_fit(
             samp = cubic_eval(s.points, np.linspace(0.0, 1.0, m))
         best[s.first : s.last + 1] = np.minimum(best[s.first : s.last + 1], d)
         out_max = max(out_max, float(point_polyline_distance(samp, loc).max()))
-    return float(best.max()), out_max
+    if not report:
+        return float(best.max()), out_max
+    q = float(path_quanta([pts])[0]) if quantum_units is None else float(quantum_units)
+    bound = max(float(e_per), float(eps_line)) + q * _HALF_DIAGONAL
+    e_in = float(best.max())
+    return {
+        "max_in_to_curve": e_in,
+        "max_curve_to_polyline": out_max,
+        "segments": float(len(fitted.segments)),
+        "quantum_units": q,
+        "bound": bound,
+        "violation": float(max(e_in, out_max) > bound * (1.0 + 1e-9)),
+    }

@@ -19,6 +19,7 @@ and no change of any parameter can return a result computed under other values.
 
 from __future__ import annotations
 
+import math
 import threading
 import time
 from collections import OrderedDict
@@ -37,6 +38,7 @@ from galvo_core.job import Job, Segments, Stroke, gc_paused
 from galvo_core.kerf import compensate_indexed
 from galvo_core.order import order_job_strokes
 from galvo_core.params import UNITS_PER_MM, Params
+from galvo_core.precision import drawing_quantum
 from galvo_core.sample import (
     ROUNDING_BOUND_BITS,
     SampleReport,
@@ -258,13 +260,8 @@ class Pipeline:
         work, origin = self.compensated(drawing, params, fm, run)
         fitted = self.fitted(drawing, params, fm, run)
         warnings: list[Warning] = list(work.warnings)
-        quantum = self._fact(drawing, "quantum", lambda: coordinate_quantum(drawing))
-        if quantum is not None and params.e_per < 0.5 * quantum:
-            warnings.append(Warning(0, 0, (
-                f"the file's coordinates are whole multiples of {quantum:g} unit: its points "
-                f"are rounded by up to {0.5 * quantum:g} unit, more than e_per = "
-                f"{params.e_per:g}, so smooth runs stay as lines; an e_per of about "
-                f"{0.75 * quantum:g} lets curves be fitted")))
+        # the fit detects each path's grid itself (galvo_core.precision) and bounds its
+        # error beyond the rounding: no warning needed; the quantum goes into the stats
         out_msg = check_in_field(fm, self.bbox(work), clamp=params.clamp)
         if out_msg:
             warnings.append(Warning(0, 0, out_msg))
@@ -284,7 +281,9 @@ class Pipeline:
                 f"dwell: {stats['dwell_points']} consecutive marks closer than "
                 f"{params.laser.mark_speed_mm_s * params.laser.point_period_us * 1e-3:.2f} µm "
                 "(mark speed × point period): the beam stands still there and may burn")))
-        job = Job(drawing.name, drawing.sha256, fm, params.processing_dict(),
+        job_params = params.processing_dict()
+        job_params["quantum_units"] = stats["quantum_units"]  # detected, not set
+        job = Job(drawing.name, drawing.sha256, fm, job_params,
                   params.laser.as_dict(), tuple(ordered), stats, tuple(warnings))
         t3 = time.perf_counter()
         run.timings["order"] = t2 - t1
@@ -327,6 +326,7 @@ class Pipeline:
         overrides, marks outside the field (before clamping), dwell points."""
         t, dwell = estimate_with_dwell([s.marks for s in strokes], params.laser, fm.mm_per_bit)
         n_input = self._fact(drawing, "n_points", lambda: drawing.n_points)
+        quantum = self._fact(drawing, "quantum", lambda: coordinate_quantum(drawing)) or 0.0
         fit_err, n_control, n_lines, n_cubics = self._fact(fitted, "counts", lambda: (
             max((f.max_error for f in fitted), default=0.0),
             sum(control_points(f) for f in fitted),
@@ -334,6 +334,10 @@ class Pipeline:
             sum(f.n_cubics for f in fitted)))
         out: dict[str, Any] = {
             "input_points": n_input,
+            # the file's coordinate grid (0: exact) and the fit's bound from the input
+            # points in effect: e_per beyond the rounding (galvo_core.precision)
+            "quantum_units": quantum,
+            "fit_bound_units": params.e_per + quantum / math.sqrt(2.0),
             "control_points": n_control,
             "lines": n_lines,
             "cubics": n_cubics,
@@ -371,15 +375,10 @@ class Pipeline:
 
 
 def coordinate_quantum(drawing: Drawing) -> float | None:
-    """1.0 when every coordinate is a whole number (CAD-style integer plotter units), None
-    when the file has fractional coordinates (or no points)."""
-    pts = [p.points for p in drawing.paths if len(p.points)]
-    if not pts:
-        return None
-    allp = np.concatenate(pts)
-    if len(allp) < 3 or not np.array_equal(allp, np.round(allp)):
-        return None
-    return 1.0
+    """The drawing's grid step (input units, :func:`galvo_core.precision.drawing_quantum`),
+    None when its points are exact (off any grid) or it has none."""
+    q, _ = drawing_quantum(drawing.paths)
+    return q if q > 0.0 else None
 
 
 def process(drawing: Drawing, params: Params | None = None) -> Job:

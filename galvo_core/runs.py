@@ -135,10 +135,13 @@ def _vertex_rules(
     *,
     want_turn: bool = False,
     seg: tuple[np.ndarray, np.ndarray] | None = None,
+    rounding: np.ndarray | None = None,
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Per point of the concatenation: (smooth, turn angle or zeros, cross sign); only a
     path's interior points can be smooth or have a turn (the rules of the module doc).
-    ``seg``: the segment vectors and lengths of ``q`` when already known."""
+    ``seg``: the segment vectors and lengths of ``q`` when already known. ``rounding``: per
+    point (eps, quantum) rows of its path, for rounded input (see :func:`_rounded_rules`).
+    """
     n = len(q)
     smooth = np.zeros(n, dtype=bool)
     turn = np.zeros(n)
@@ -163,7 +166,42 @@ def _vertex_rules(
             turn[1:-1] = np.where(inner, np.arctan2(cr, dot), 0.0)
         # a turn below ~1e-12 rad is numerically straight: no sign
         sign[1:-1] = np.where(inner & (np.abs(cr) > 1e-12 * la * lb), np.sign(cr), 0.0)
+        if rounding is not None:
+            _rounded_rules(smooth, sign, rounding, inner, dot, cr, la, lb, length_ratio)
     return smooth, turn, sign
+
+
+#: a vertex of rounded input turning up to this many times what a thinned circle through
+#: its segments turns is smooth (see :func:`_rounded_rules`)
+_ROUNDED_TURN_MARGIN = 1.5
+#: ... but never more than this (radians)
+_ROUNDED_TURN_CAP = math.radians(50.0)
+
+
+def _rounded_rules(smooth, sign, rounding, inner, dot, cr, la, lb, length_ratio) -> None:
+    """The vertex rules on rounded input (quantum q > 0, thinned with tolerance eps), in
+    place. Thinning a smooth curve of radius R with eps leaves chords of sagitta about eps,
+    so each turns about l / R <= 8 eps / l: on a tight curve the chords turn more than
+    cos_join allows although nothing is a corner. A vertex whose turn is at most
+    ``_ROUNDED_TURN_MARGIN`` times (la + lb) 4 eps / max(la, lb)^2 (and at most
+    ``_ROUNDED_TURN_CAP``) is smooth too, if its segments pass the length rule; a real
+    corner turns more than that. A turn smaller than the rounding can make it (q / the
+    longer segment) has no sign: rounding wiggles are not inflections."""
+    eps = rounding[1:-1, 0]
+    qq = rounding[1:-1, 1]
+    rnd = inner & (qq > 0.0)
+    if not rnd.any():
+        return
+    ang = np.abs(np.arctan2(cr, dot))
+    lmax = np.maximum(la, lb)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        lim = np.minimum(_ROUNDED_TURN_MARGIN * (la + lb) * 4.0 * eps / (lmax * lmax),
+                         _ROUNDED_TURN_CAP)
+        ratio_ok = (lb <= length_ratio * la) & (la <= length_ratio * lb)
+        add = rnd & ratio_ok & (ang <= lim)
+        flat = rnd & (ang < qq / lmax)
+    smooth[1:-1] |= add
+    sign[1:-1][flat] = 0.0
 
 
 def _runs(smooth: np.ndarray, sign: np.ndarray, lay: _Layout) -> tuple[np.ndarray, np.ndarray]:
@@ -366,10 +404,15 @@ def split_pieces_many(
     max_turn_deg: float = 80.0,
     cos_join: float = 0.95,
     length_ratio: float = 3.0,
-) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    rounding: object = None,
+    return_smooth: bool = False,
+) -> tuple[np.ndarray, ...]:
     """:func:`split_pieces` of many thinned paths at once.
 
     ``q`` (N, 2) is the concatenation of the paths, ``lens`` their point counts (sum N),
+    With ``return_smooth`` the per-point smooth flags come sixth.
+    ``rounding``: optional (eps, quantum) per path, the thinning tolerance and the grid of
+    rounded input (:func:`_rounded_rules`; rows with quantum 0 follow the plain rules).
     ``closed`` one flag per path. Returns ``(a, b, curve, t_in, t_out)``: the pieces of
     every path in path order, as inclusive ranges ``a[i]..b[i]`` of indices into ``q``
     (never crossing a path), ``curve[i]`` True for a "curve" piece, False for a line, and
@@ -384,7 +427,14 @@ def split_pieces_many(
     if len(cl) != len(lay.lens):
         raise ValueError("split_pieces_many: one closed flag per path")
     seg = _segments(qq) if len(qq) >= 2 else None
-    smooth, _, sign = _vertex_rules(qq, lay, cos_join, length_ratio, seg=seg)
+    rnd = None
+    if rounding is not None:
+        rr = np.asarray(rounding, dtype=np.float64).reshape(-1, 2)
+        if len(rr) != len(lay.lens):
+            raise ValueError("split_pieces_many: one (eps, quantum) row per path")
+        if (rr[:, 1] > 0.0).any():
+            rnd = np.repeat(rr, lay.lens, axis=0)
+    smooth, _, sign = _vertex_rules(qq, lay, cos_join, length_ratio, seg=seg, rounding=rnd)
     t_in, t_out = _tangents(qq, lay, smooth, cl, cos_join, length_ratio, seg=seg)
     ra, rb = _runs(smooth, sign, lay)
     ca, cb = _split_runs(ra, rb, t_in, t_out, math.radians(max_turn_deg))
@@ -399,6 +449,8 @@ def split_pieces_many(
     b = np.concatenate([la + 1, cb])
     order = np.argsort(a, kind="stable")
     a, b = a[order], b[order]
+    if return_smooth:
+        return a, b, b - a >= 2, t_in, t_out, smooth
     return a, b, b - a >= 2, t_in, t_out
 
 

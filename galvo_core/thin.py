@@ -108,12 +108,23 @@ def thin(points: object, eps_line: float, *, closed: bool = False) -> np.ndarray
     return thin_many([points], eps_line)[0]
 
 
-def thin_many(paths: Sequence[object], eps_line: float) -> list[np.ndarray]:
+def thin_many(
+    paths: Sequence[object], eps_line: float, *, per_path: object = None
+) -> list[np.ndarray]:
     """:func:`thin` for many paths in one go (the same result as one call per path).
 
     All paths are concatenated, then deduplicated and thinned by one compiled call.
+    ``per_path``: optional tolerances (one per path, each finite and > 0) used instead of
+    ``eps_line`` (the fitter's precision-aware tolerance, ``eps_line`` + the path's
+    rounding).
     """
     eps = check_positive("eps_line", eps_line)
+    if per_path is None:
+        eps_arr = np.full(len(paths), eps)
+    else:
+        eps_arr = np.asarray(per_path, dtype=np.float64).reshape(-1)
+        if len(eps_arr) != len(paths) or not (np.isfinite(eps_arr) & (eps_arr > 0)).all():
+            raise ParamError("thin_many: one positive finite tolerance per path")
     arrs = [np.asarray(p, dtype=np.float64).reshape(-1, 2) for p in paths]
     if not arrs:
         return []
@@ -125,7 +136,7 @@ def thin_many(paths: Sequence[object], eps_line: float) -> list[np.ndarray]:
         np.ascontiguousarray(pts[:, 0]),
         np.ascontiguousarray(pts[:, 1]),
         o0,
-        eps,
+        eps_arr,
         _DP_RATIO,
         _DP_WINDOW,
         _SLACK,
@@ -264,8 +275,9 @@ def _reach(x, y, i, end, eps, slack, cand, sure, rr):  # type: ignore[no-untyped
 @njit(cache=True, nogil=True)
 def _thin_paths(x0, y0, o0, eps, dp_ratio, window, slack):  # type: ignore[no-untyped-def]
     """Every path [o0[p], o0[p + 1]) of the points x0, y0: duplicates dropped (a point equal
-    to its predecessor in the same path), thinned. Returns the kept indices into each path's
-    own points, concatenated, and how many each path keeps."""
+    to its predecessor in the same path), thinned (path p with tolerance ``eps[p]``).
+    Returns the kept indices into each path's own points, concatenated, and how many each
+    path keeps."""
     n0 = x0.shape[0]
     n_p = o0.shape[0] - 1
     kidx = np.empty(n0, dtype=np.int64)  # original index of every distinct point
@@ -297,16 +309,18 @@ def _thin_paths(x0, y0, o0, eps, dp_ratio, window, slack):  # type: ignore[no-un
 
 
 @njit(cache=True, nogil=True)
-def _thin_all(x, y, offs, eps, dp_ratio, window, slack):  # type: ignore[no-untyped-def]
-    """Kept-point mask of every path [offs[p], offs[p + 1]) of the distinct points x, y."""
+def _thin_all(x, y, offs, eps_p, dp_ratio, window, slack):  # type: ignore[no-untyped-def]
+    """Kept-point mask of every path [offs[p], offs[p + 1]) of the distinct points x, y
+    (path p thinned with tolerance ``eps_p[p]``)."""
     n = x.shape[0]
     keep = np.zeros(n, dtype=np.bool_)
     cand = np.empty(n + 1, dtype=np.int64)
     sure = np.empty(n + 1, dtype=np.int8)
     rr = np.empty(n + 1, dtype=np.float64)
     chain = np.empty(n + 1, dtype=np.int64)
-    e2 = eps * eps
     for p in range(offs.shape[0] - 1):
+        eps = eps_p[p]
+        e2 = eps * eps
         a = offs[p]
         e = offs[p + 1] - 1
         m = e - a + 1

@@ -94,12 +94,13 @@ def test_out_of_field_refused_unless_clamped():
     assert any("clamped" in w.message for w in job.warnings)
 
 
-def test_integer_coordinates_warn_that_e_per_is_below_their_rounding():
+def test_integer_coordinates_are_fitted_beyond_their_rounding_without_a_warning():
+    """Issue 16: the fit detects the whole-unit grid and bounds its error by e_per beyond
+    the rounding (e_per + 1/sqrt2 from the points): no warning, no hand-tuned e_per."""
     d = read_bytes(b"IN;SP1;PU0,0;PD100,3,200,10,300,24,400,41,500,65;PU;", "int.plt")
     job = Pipeline().run(d, Params()).job
-    assert any("rounded" in w.message and "e_per" in w.message for w in job.warnings)
-    job = Pipeline().run(d, Params(e_per=0.75)).job
     assert not any("rounded" in w.message for w in job.warnings)
+    assert job.stats["max_fit_error"] <= 0.02 + 0.5**0.5 + 1e-9
 
 
 def test_empty_drawing_gives_an_empty_job():

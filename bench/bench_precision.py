@@ -1,0 +1,87 @@
+"""Precision-aware fit on typeface outlines (issue 16): segments against the typeface's own
+count, distance to the true (unrounded) design curve both ways, violations of the bound, time.
+
+Usage: python bench/bench_precision.py [--em 1000] [--styles sans,serif] [--json out.json]
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import sys
+import time
+
+import numpy as np
+
+sys.path.insert(0, os.path.join(os.path.dirname(__file__), ".."))
+sys.path.insert(0, os.path.dirname(__file__))
+
+from fonts import STYLES, curve_distance, glyph_set  # noqa: E402
+
+from galvo_core import fit as fitmod  # noqa: E402
+from galvo_core.geometry import flatten_cubic  # noqa: E402
+
+
+def fitted_dense(fp, h: float = 0.002) -> np.ndarray:
+    parts = []
+    for s in fp.segments:
+        parts.append(flatten_cubic(s.points, h) if s.kind == "cubic" else s.points)
+    return np.vstack([parts[0]] + [p[1:] for p in parts[1:]])
+
+
+def run(style: str, whole: bool, em: float, **kw) -> dict:
+    gs = glyph_set(style, em=em, whole=whole)
+    fitmod.warm_up()
+    t0 = time.process_time()
+    fps = fitmod.fit_paths(gs.points, [True] * len(gs.points), **kw)
+    secs = time.process_time() - t0
+    nseg = sum(len(f.segments) for f in fps)
+    dist = max(curve_distance(fitted_dense(f), t) for f, t in zip(fps, gs.truth, strict=True))
+    viol = 0
+    worst_excess = 0.0
+    for f, p in zip(fps, gs.points, strict=True):
+        rep = fitmod.check_fit(p, f, kw.get("e_per", 0.02), kw.get("eps_line", 0.02),
+                               report=True)
+        if rep["violation"]:
+            viol += 1
+            worst_excess = max(worst_excess, max(rep["max_in_to_curve"],
+                                                 rep["max_curve_to_polyline"]) - rep["bound"])
+    return {
+        "style": style, "whole": whole, "em": em, "points": int(sum(len(p) for p in gs.points)),
+        "own": gs.own_segments, "segments": nseg, "ratio": nseg / gs.own_segments,
+        "dist_true": dist, "violations": viol, "excess": worst_excess, "cpu_s": secs,
+    }
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--em", type=float, default=1000.0)
+    ap.add_argument("--styles", default=",".join(STYLES))
+    ap.add_argument("--json")
+    ap.add_argument("--e-per", type=float)
+    ap.add_argument("--eps-line", type=float)
+    a = ap.parse_args()
+    kw = {}
+    if a.e_per:
+        kw["e_per"] = a.e_per
+    if a.eps_line:
+        kw["eps_line"] = a.eps_line
+    rows = []
+    print("| style | input | points | own | segments | x own | to true curve "
+          "| violations | cpu s |")
+    print("| --- | --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: |")
+    for whole in (True, False):
+        for st in a.styles.split(","):
+            r = run(st, whole, a.em, **kw)
+            rows.append(r)
+            print(f"| {st} | {'whole' if whole else 'exact'} | {r['points']} | {r['own']} | "
+                  f"{r['segments']} | {r['ratio']:.2f} | {r['dist_true']:.3f} | "
+                  f"{r['violations']} | {r['cpu_s']:.2f} |", flush=True)
+    if a.json:
+        with open(a.json, "w") as f:
+            json.dump(rows, f, indent=1)
+
+
+if __name__ == "__main__":
+    main()
