@@ -115,7 +115,8 @@ def cmd_report(a: argparse.Namespace) -> int:
 
     params = _params_from_args(a)
     d = read_file(a.file)
-    row = fit_report(d, eps_line=params.eps_line, e_per=params.e_per, eps_sum=params.eps_sum)
+    row = fit_report(d, eps_line=params.eps_line, e_per=params.e_per, eps_sum=params.eps_sum,
+                     per_path=True)
     out: dict[str, Any] = {
         "file": d.name,
         "eps_line": params.eps_line,
@@ -128,7 +129,11 @@ def cmd_report(a: argparse.Namespace) -> int:
             "cubics": row["cubics"],
             "max_true_error": row["max_error"],
             "time_ms": 1000.0 * float(row["seconds"]),  # type: ignore[arg-type]
+            "quantum_units": row["quantum_units"],
+            "e_per_in_effect": row["e_per_in_effect"],
         },
+        # per path: segments (lines, cubics), the bound in effect and the worst true error
+        "paths": row["paths"],
     }
     mags = a.magnifications or []
     if mags:
@@ -161,6 +166,15 @@ def cmd_report(a: argparse.Namespace) -> int:
         print(f"  lines / cubics         {t['lines']} / {t['cubics']}")
         print(f"  largest true error     {t['max_true_error']:.4f} input units")
         print(f"  time                   {t['time_ms']:.1f} ms")
+        print(f"  coordinate grid        {t['quantum_units']:g} unit (bound from the points: "
+              f"{t['e_per_in_effect']:.4g})")
+        paths = out["paths"]
+        worst = sorted(paths, key=lambda p: -p["max_error"] / max(p["bound"], 1e-300))[:10]
+        if worst:
+            print("  paths nearest their bound (index: segments lines/cubics, worst / bound):")
+        for p in worst:
+            print(f"    {p['index']:>6}: {p['segments']:>5} {p['lines']}/{p['cubics']}, "
+                  f"{p['max_error']:.4f} / {p['bound']:.4f}")
         for r in out.get("magnifications", []):
             print(f"  at {r['magnification']:g}x: raw {r['raw']['mark_points']} marks "
                   f"({r['raw']['estimated_time_s']:.4f} s), adaptive "

@@ -179,3 +179,18 @@ def test_end_to_end_in_a_subprocess(tmp_path):
     bad = run_cli_subprocess("info", str(tmp_path / "missing.plt"))
     assert bad.returncode == 2 and bad.stderr.count("\n") == 1
     assert bad.stderr.startswith("error: ") and "Traceback" not in bad.stderr
+
+
+def test_report_gives_segments_and_worst_error_per_path_within_its_bound():
+    """Issue 16: `report` prints, per path, its segments and its worst true error against
+    the bound in effect (e_per beyond the file's rounding); none above it."""
+    r = run_cli("report", str(SAMPLES / "dense_logo.plt"), "--json")
+    assert r.returncode == 0, r.stderr
+    out = json.loads(r.stdout)
+    assert out["table1"]["quantum_units"] == 1.0  # a whole-unit file
+    paths = out["paths"]
+    assert len(paths) > 10
+    assert sum(p["segments"] for p in paths) == out["table1"]["lines"] + out["table1"]["cubics"]
+    for p in paths:
+        assert p["lines"] + p["cubics"] == p["segments"]
+        assert p["max_error"] <= p["bound"] * (1 + 1e-9)
