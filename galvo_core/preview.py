@@ -21,6 +21,7 @@ tuple's identity (:class:`PreviewCache`), so a change that only re-samples only 
 
 from __future__ import annotations
 
+import math
 from collections import OrderedDict
 from collections.abc import Callable, Iterable, Sequence
 from dataclasses import dataclass, field
@@ -536,7 +537,8 @@ class Preview:
     * ``field_outline`` and ``bounds`` are already in mm.
 
     ``deviation_level`` is each deviation chord's error as a fraction of the fit tolerance
-    (``max(e_per, eps_line)``), clipped to 0..1 (the colour); ``deviation_err`` the error in
+    (``max(e_per, eps_line)`` beyond the file's rounding, ``+ q/√2``), clipped to 0..1 (the
+    colour); ``deviation_err`` the error in
     input units; ``um_per_unit`` converts it to µm on the workpiece.
     """
 
@@ -718,8 +720,12 @@ def build_preview(
     fm = job.field_map
     scale, offset = _units_affine(fm)
     cache = cache if cache is not None else PreviewCache()
+    # the fit's bound in effect from the input points: the tolerances beyond the file's
+    # rounding (its grid's half diagonal; galvo_core.precision), so the overlay colours a
+    # rounded file's points by how far the fit is from their rounding squares' reach
     e_tol = max(float(job.params.get("e_per", 0.0) or 0.0),
-                float(job.params.get("eps_line", 0.0) or 0.0))
+                float(job.params.get("eps_line", 0.0) or 0.0)) + \
+        float(job.params.get("quantum_units", 0.0) or 0.0) / math.sqrt(2.0)
     d_box = cache.get(("bbox", id(drawing)), lambda: (drawing, drawing.bbox()))[1] \
         if drawing is not None else None
     tol_units = display_tolerance(job.params, drawing, d_box)
