@@ -39,7 +39,7 @@ from typing import Any
 
 import numpy as np
 
-from galvo_core.errors import InputError
+from galvo_core.errors import InputError, read_input_bytes
 
 GRID = 65
 CELL = 1024.0  # bits between nodes (65536 / 64)
@@ -223,12 +223,7 @@ def apply_to_job(job: Any, corr: FieldCorrection, tol_bits: float = 0.25) -> Any
 # ---------------------------------------------------------------------------- .cor files
 def read_cor(path: str | os.PathLike[str], x_outer: bool = False) -> FieldCorrection:
     """Read a BJJCZ ``.cor`` file (either layout; module docstring)."""
-    name = os.fspath(path)
-    try:
-        with open(path, "rb") as fh:
-            raw = fh.read()
-    except OSError as exc:
-        raise InputError(name, f"cannot be read ({exc.strerror or exc})") from exc
+    name, raw = read_input_bytes(path)
     label = raw[:0x16].decode("utf-16-le", errors="replace").rstrip("\x00")
     if label.startswith(V1_LABEL):
         if len(raw) < _V1_SIZE:

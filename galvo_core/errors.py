@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import os
+
 
 class GalvoError(Exception):
     """Base of every error galvo_core raises on purpose.
@@ -29,3 +31,14 @@ class ParamError(GalvoError, ValueError):
 
 class Cancelled(Exception):
     """Raised inside a run (fit, sampling, preview) when its ``cancel`` callback says stop."""
+
+
+def read_input_bytes(path: str | os.PathLike[str]) -> tuple[str, bytes]:
+    """The file's name (as given) and bytes; InputError ``<file>: cannot be read (...)``
+    when the system refuses (missing, a folder, no permission)."""
+    name = os.fspath(path)
+    try:
+        with open(path, "rb") as fh:
+            return name, fh.read()
+    except OSError as exc:
+        raise InputError(name, f"cannot be read ({exc.strerror or exc})") from exc

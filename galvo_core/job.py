@@ -41,7 +41,7 @@ import numpy as np
 
 from galvo_core import __version__
 from galvo_core.drawing import Warning
-from galvo_core.errors import GalvoError, InputError
+from galvo_core.errors import GalvoError, InputError, read_input_bytes
 from galvo_core.field import FieldMap
 
 FORMAT = "galvo-job"
@@ -475,12 +475,7 @@ def load_job(path: str | os.PathLike[str]) -> Job:
     """Read and validate a job file written by :func:`write_job` (or by anyone following the
     spec): version 1 (JSON) or version 2 (compact), told apart by the first bytes. Raises
     InputError naming the file and the place of the problem."""
-    name = os.fspath(path)
-    try:
-        with open(path, "rb") as fh:
-            raw = fh.read()
-    except OSError as exc:
-        raise InputError(name, f"cannot be read ({exc.strerror or exc})") from exc
+    name, raw = read_input_bytes(path)
     if raw[:len(MAGIC)] == MAGIC:
         return job_from_compact(raw, name)
     try:

@@ -41,7 +41,7 @@ from collections.abc import Iterable, Mapping
 from dataclasses import dataclass, fields
 from typing import Any
 
-from galvo_core.errors import InputError, ParamError
+from galvo_core.errors import InputError, ParamError, read_input_bytes
 from galvo_core.params import LaserParams
 
 SOURCES = ("fiber", "co2")
@@ -233,12 +233,7 @@ def pen_table_from_dict(doc: Mapping[str, Any], name: str = "<pens>",
 
 def load_pen_table(path: str | os.PathLike[str], base: LaserParams | None = None) -> PenTable:
     """Read a pen table TOML file; InputError (``<file>: <reason>``) if it cannot be used."""
-    name = os.fspath(path)
-    try:
-        with open(path, "rb") as fh:
-            raw = fh.read()
-    except OSError as exc:
-        raise InputError(name, f"cannot be read ({exc.strerror or exc})") from exc
+    name, raw = read_input_bytes(path)
     try:
         doc = tomllib.loads(raw.decode("utf-8"))
     except UnicodeDecodeError as exc:

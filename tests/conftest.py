@@ -31,3 +31,19 @@ def _own_settings_file(tmp_path_factory, monkeypatch):
     settings (a hidden layer, a parameter) must not reach the next one."""
     path = tmp_path_factory.mktemp("settings") / "settings.ini"
     monkeypatch.setenv("GALVO_WORKSTATION_SETTINGS", str(path))
+
+
+@pytest.fixture
+def dialogs(monkeypatch):
+    """The message boxes a GUI test's window opens, answered OK at once (Qt's modal exec
+    would block an offscreen test): the list of boxes shown, for the test to read."""
+    from PySide6.QtWidgets import QMessageBox
+
+    boxes: list = []
+
+    def fake_exec(box):
+        boxes.append(box)
+        return int(QMessageBox.StandardButton.Ok)
+
+    monkeypatch.setattr(QMessageBox, "exec", fake_exec)
+    return boxes

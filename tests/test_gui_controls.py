@@ -24,7 +24,6 @@ pytest.importorskip("pytestqt")
 from _util import SAMPLES, circle_plt  # noqa: E402
 from PySide6.QtCore import QTimer  # noqa: E402
 from PySide6.QtGui import QImage  # noqa: E402
-from PySide6.QtWidgets import QMessageBox  # noqa: E402
 
 from app import views  # noqa: E402
 from app.controls import GROUPS, SLIDER_STEPS, SliderSpec  # noqa: E402
@@ -110,18 +109,6 @@ def circle() -> Drawing:
 @pytest.fixture(scope="module")
 def seal() -> Drawing:
     return read_file(SAMPLES / "seal.plt")
-
-
-@pytest.fixture
-def dialogs(monkeypatch) -> list[QMessageBox]:
-    boxes: list[QMessageBox] = []
-
-    def fake_exec(box):
-        boxes.append(box)
-        return int(QMessageBox.StandardButton.Ok)
-
-    monkeypatch.setattr(QMessageBox, "exec", fake_exec)
-    return boxes
 
 
 def square(side_units: float = 2000.0) -> Drawing:

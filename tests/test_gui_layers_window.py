@@ -12,7 +12,6 @@ import pytest
 
 pytest.importorskip("pytestqt")
 
-from PySide6.QtWidgets import QMessageBox  # noqa: E402
 from test_cli_lmc import two_pen_plt  # noqa: E402
 
 from app.window import MainWindow  # noqa: E402
@@ -30,18 +29,6 @@ from galvo_core.params import LaserParams  # noqa: E402
 pytestmark = pytest.mark.gui
 
 SIZE = (1400, 800)
-
-
-@pytest.fixture
-def dialogs(monkeypatch) -> list[QMessageBox]:
-    boxes: list[QMessageBox] = []
-
-    def fake_exec(box):
-        boxes.append(box)
-        return int(QMessageBox.StandardButton.Ok)
-
-    monkeypatch.setattr(QMessageBox, "exec", fake_exec)
-    return boxes
 
 
 @pytest.fixture

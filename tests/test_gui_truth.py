@@ -17,7 +17,6 @@ pytest.importorskip("pytestqt")
 
 from _util import SAMPLES, circle_plt  # noqa: E402
 from PySide6.QtGui import QImage  # noqa: E402
-from PySide6.QtWidgets import QMessageBox  # noqa: E402
 
 import app.window as window_mod  # noqa: E402
 from app.window import MainWindow, _user_path_message  # noqa: E402
@@ -28,18 +27,6 @@ pytestmark = pytest.mark.gui
 SIZE = (1200, 760)
 SEAL = SAMPLES / "seal.plt"
 LOGO = SAMPLES / "dense_logo.plt"
-
-
-@pytest.fixture
-def dialogs(monkeypatch) -> list[QMessageBox]:
-    boxes: list[QMessageBox] = []
-
-    def fake_exec(box):
-        boxes.append(box)
-        return int(QMessageBox.StandardButton.Ok)
-
-    monkeypatch.setattr(QMessageBox, "exec", fake_exec)
-    return boxes
 
 
 @pytest.fixture
