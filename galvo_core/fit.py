@@ -763,6 +763,7 @@ class _BatchFitter:
         least-squares cubic with the end tangents fits within the bound; those cubics are
         accepted here. Returns the mask of such pieces (over ``ab``)."""
         out = np.zeros(len(ab), dtype=bool)
+        assert self.quant is not None  # only called on rounded input
         cand = np.flatnonzero(line & (self.quant[ab[:, 0]] > 0.0))
         if len(cand) == 0:
             return out
@@ -904,7 +905,7 @@ def fit_paths(
     eps_sum: float = DEFAULT_EPS_SUM,
     source_indices: Sequence[int] | None = None,
     pens: Sequence[int] | None = None,
-    quantum_units: float | Sequence[float] | None = None,
+    quantum_units: float | Sequence[float] | np.ndarray | None = None,
 ) -> list[FittedPath]:
     """:func:`fit_path` for many paths at once (the same result as one call per path).
 
@@ -955,7 +956,7 @@ def fit_paths(
 
 
 def rounding_slack(
-    paths: Sequence[object], quantum_units: float | Sequence[float] | None = None
+    paths: Sequence[object], quantum_units: float | Sequence[float] | np.ndarray | None = None
 ) -> np.ndarray:
     """Per path: how far the design may lie from an input point, ``q / √2`` (the rounding
     square's half diagonal) for the path's quantum ``q`` (``quantum_units``: one value, one
@@ -1278,7 +1279,7 @@ def fit_drawing(
     eps_sum: float = DEFAULT_EPS_SUM,
     batch: int = 4096,
     cancel: Callable[[], bool] | None = None,
-    quantum_units: float | Sequence[float] | None = None,
+    quantum_units: float | Sequence[float] | np.ndarray | None = None,
 ) -> tuple[FittedPath, ...]:
     """:func:`fit_path` for every path of the drawing, in order (``source_index`` = position),
     fitted ``batch`` paths at a time (:func:`fit_paths`). ``cancel`` is called between
@@ -1327,7 +1328,7 @@ def fit_report(
     eps_line: float = DEFAULT_EPS_LINE,
     e_per: float = DEFAULT_E_PER,
     eps_sum: float = DEFAULT_EPS_SUM,
-    quantum_units: float | Sequence[float] | None = None,
+    quantum_units: float | Sequence[float] | np.ndarray | None = None,
     per_path: bool = False,
 ) -> dict[str, object]:
     """Paper 000 Table 1 row for a drawing: input_points, thinned_points, control_points

@@ -302,7 +302,7 @@ def atomic_write_bytes(path: str | os.PathLike[str],
                 fh.write(data)
             else:
                 for part in data:
-                    fh.write(part)
+                    fh.write(part)  # type: ignore[arg-type]  # ndarray: a buffer
             fh.flush()
             os.fsync(fh.fileno())
         os.replace(tmp, target)
@@ -695,9 +695,9 @@ def _strokes_from_arrays(arr: dict[str, np.ndarray], n: int, fm: FieldMap,
     per = cs[sstart[1:]] - cs[sstart[:-1]]
     nseg = np.diff(sstart)
     want = np.where(nseg > 0, per + 1, 0)
-    bad = np.flatnonzero(want != np.diff(pstart))
-    if len(bad):
-        i = int(bad[0])
+    wrong = np.flatnonzero(want != np.diff(pstart))
+    if len(wrong):
+        i = int(wrong[0])
         raise InputError(name, f"strokes[{i}]: {int(np.diff(pstart)[i])} control points for "
                                f"its segments, which need {int(want[i])}")
     ms, ss, ps = mstart.tolist(), sstart.tolist(), pstart.tolist()

@@ -21,6 +21,7 @@ bits).
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
 
 import numpy as np
 import shapely
@@ -142,14 +143,22 @@ class _Rings:
         return cls(owner, xy_c[~last], ring_c[~last])
 
 
+@dataclass(frozen=True)
 class _Runs:
     """Candidate joins: each ring rotated to begin where a run begins (``xy``, ``same``:
     the edge into a vertex is a chord of the run), runs ``r_first..r_last`` (``run_id`` per
-    vertex), each run's centre ``ctr``, signed sweep ``phi`` and whether it is a join
-    (``cand``: on one circle of radius d, turning one way)."""
+    vertex, ``r_len`` per run), each run's centre ``ctr``, signed sweep ``phi`` and whether
+    it is a join (``cand``: on one circle of radius d, turning one way)."""
 
-    def __init__(self, **arrays: np.ndarray) -> None:
-        self.__dict__.update(arrays)
+    xy: np.ndarray
+    same: np.ndarray
+    run_id: np.ndarray
+    r_len: np.ndarray
+    r_first: np.ndarray
+    r_last: np.ndarray
+    ctr: np.ndarray
+    phi: np.ndarray
+    cand: np.ndarray
 
 
 def _join_runs(rings: _Rings, d: float) -> _Runs | None:

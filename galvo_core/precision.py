@@ -143,7 +143,7 @@ def _on_grid_each(p: np.ndarray, q: float, offset: tuple[float, float]) -> np.nd
     scale = float(np.abs(p).max()) if len(p) else 0.0
     tol = _REL_TOL * q + 4e-12 * max(scale, 1.0)
     r = (p - np.asarray(offset, dtype=np.float64)) / q
-    return (np.abs(r - np.round(r)) * q <= tol).all(axis=1)
+    return np.asarray((np.abs(r - np.round(r)) * q <= tol).all(axis=1))
 
 
 def drawing_quantum(paths: Sequence[object]) -> tuple[float, tuple[float, float]]:

@@ -34,7 +34,7 @@ from galvo_core.drawing import Drawing, Warning
 from galvo_core.field import FieldMap
 from galvo_core.fit import FittedPath
 from galvo_core.geometry import flatten_cubic
-from galvo_core.job import Job
+from galvo_core.job import Job, Segments
 from galvo_core.pipeline import Cancelled
 
 __all__ = [
@@ -186,7 +186,8 @@ def original_polylines(drawing: Drawing) -> Polylines:
 
 
 # ------------------------------------------------------------------ fitted geometry
-def flatten_segments(segments: Sequence[tuple[str, np.ndarray]], tol: float) -> np.ndarray:
+def flatten_segments(segments: Sequence[tuple[str, np.ndarray]] | Segments, tol: float
+                     ) -> np.ndarray:
     """One continuous polyline through ``(kind, points)`` segments ("line": (2, 2),
     "cubic": (4, 2)): every cubic flattened within ``tol`` (units of the points), lines as
     their end points. Consecutive segments share their joint (it appears once)."""
