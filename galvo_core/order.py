@@ -224,6 +224,10 @@ class _Problem:
         return self.cpt[cand], self.cpt[cand]
 
 
+#: buckets with more alive points than this are scanned with numpy, not point by point
+_BUCKET_SCAN = 24
+
+
 class _Grid:
     """Points in square buckets; nearest alive point by rings of buckets."""
 
@@ -276,6 +280,23 @@ class _Grid:
             for key in _ring(ci, cj, r):
                 b = self.buckets.get(key)
                 if not b:
+                    continue
+                if len(b) > _BUCKET_SCAN:
+                    # a crowded bucket (clustered ends, e.g. hatch lines along an outline):
+                    # the dead dropped and the same distances taken at once, the first
+                    # nearest kept as the loop below would
+                    ids = np.asarray(b)
+                    keep = alive[ids]
+                    if not keep.all():
+                        ids = ids[keep]
+                        self.buckets[key] = b = ids.tolist()
+                    if not len(ids):
+                        continue
+                    d2a = (pts[ids, 0] - px) ** 2 + (pts[ids, 1] - py) ** 2
+                    j = int(np.argmin(d2a))
+                    if d2a[j] < bd:
+                        bd = float(d2a[j])
+                        best = int(ids[j])
                     continue
                 live = [k for k in b if alive[k]]
                 if len(live) != len(b):
