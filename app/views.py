@@ -336,6 +336,14 @@ class _FastItem(pg.GraphicsObject):
 
     dataBounds = _rect_data_bounds  # noqa: N815 - pyqtgraph API
 
+    def setData(self, xy: np.ndarray) -> None:  # noqa: N802 - like pyqtgraph
+        """Prepare (here, on the calling thread) and show; the worker calls ``prepare`` and
+        the GUI thread only ``setPrepared``."""
+        self.setPrepared(self.prepare(xy))  # type: ignore[attr-defined]
+
+    def getData(self) -> tuple[np.ndarray, np.ndarray]:  # noqa: N802 - like pyqtgraph
+        return self._xy[:, 0], self._xy[:, 1]  # type: ignore[attr-defined]
+
 
 class PointsItem(_FastItem):
     """Round (or square) dots of a fixed pixel size at (N, 2) points: ONE item."""
@@ -365,12 +373,6 @@ class PointsItem(_FastItem):
         self.prepareGeometryChange()
         self._xy, self._poly, self._rect, self._levels = prepared
         self.update()
-
-    def setData(self, xy: np.ndarray) -> None:  # noqa: N802 - like pyqtgraph
-        self.setPrepared(self.prepare(xy))
-
-    def getData(self) -> tuple[np.ndarray, np.ndarray]:  # noqa: N802 - like pyqtgraph
-        return self._xy[:, 0], self._xy[:, 1]
 
     def paint(self, p, *args) -> None:
         if len(self._xy):
@@ -517,12 +519,6 @@ class LinesItem(_FastItem):
         self.prepareGeometryChange()
         self._xy, self._path, self._rect, self._n, self._coarse = prepared
         self.update()
-
-    def setData(self, xy: np.ndarray) -> None:  # noqa: N802 - like pyqtgraph
-        self.setPrepared(self.prepare(xy))
-
-    def getData(self) -> tuple[np.ndarray, np.ndarray]:  # noqa: N802 - like pyqtgraph
-        return self._xy[:, 0], self._xy[:, 1]
 
     def paint(self, p, *args) -> None:
         if not self._n:
