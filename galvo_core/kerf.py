@@ -87,7 +87,7 @@ the vertex nearest to the source ring's first point.
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
+from collections.abc import Iterator, Sequence
 
 import numpy as np
 import shapely
@@ -882,19 +882,7 @@ def _odd_crossings(pts: np.ndarray, a: np.ndarray, b: np.ndarray) -> np.ndarray:
         ids = e_id[s0:s1]
         lo[s0:s1] = p0 + np.searchsorted(col_y, ylo[ids], side="left")
         hi[s0:s1] = p0 + np.searchsorted(col_y, yhi[ids], side="left")
-    cnt = hi - lo
-    sel = np.flatnonzero(cnt > 0)
-    csum = np.cumsum(cnt[sel])
-    chunk = 4_000_000
-    start = 0
-    while start < len(sel):
-        stop = int(np.searchsorted(csum, (csum[start - 1] if start else 0) + chunk,
-                                   side="right"))
-        stop = max(stop, start + 1)
-        rows = sel[start:stop]
-        rc = cnt[rows]
-        row = np.repeat(rows, rc)
-        k = lo[row] + (np.arange(len(row)) - np.repeat(np.cumsum(rc) - rc, rc))
+    for row, k in _pairs_in_chunks(lo, hi - lo):
         pi = porder[k]
         e = e_id[row]
         x = ax[e] + (py[pi] - ay[e]) * (bx[e] - ax[e]) / (by[e] - ay[e])
@@ -902,7 +890,6 @@ def _odd_crossings(pts: np.ndarray, a: np.ndarray, b: np.ndarray) -> np.ndarray:
         hit = (x > px[pi]) & (x < lim)
         cnt_h += np.bincount(pi[hit], minlength=n)
         tie[pi[(x > px[pi]) & (x == lim)]] = True
-        start = stop
     # ---- second leg: up each column's right boundary (edges strictly across it)
     rep = np.maximum(ec1 - ec0, 0)
     crossing = np.flatnonzero(rep)
@@ -945,29 +932,36 @@ def _crossings(pts: np.ndarray, a: np.ndarray, b: np.ndarray) -> np.ndarray:
     yhi = np.maximum(a[:, 1], b[:, 1])
     lo = np.searchsorted(py, ylo, side="left")
     hi = np.searchsorted(py, yhi, side="left")
-    cnt = np.maximum(hi - lo, 0)
     counts = np.zeros(n, dtype=np.int64)
-    chunk = 4_000_000
-    seg_all = np.nonzero(cnt)[0]
-    csum = np.cumsum(cnt[seg_all])
-    start = 0
-    while start < len(seg_all):
-        # take segments until about `chunk` pairs
-        stop = int(np.searchsorted(csum, (csum[start - 1] if start else 0) + chunk,
-                                   side="right"))
-        stop = max(stop, start + 1)
-        segs = seg_all[start:stop]
-        c = cnt[segs]
-        seg = np.repeat(segs, c)
-        off = np.arange(len(seg)) - np.repeat(np.cumsum(c) - c, c)
-        k = lo[seg] + off
+    for seg, k in _pairs_in_chunks(lo, np.maximum(hi - lo, 0)):
         p = pts[order[k]]
         ax, ay, bx, by = a[seg, 0], a[seg, 1], b[seg, 0], b[seg, 1]
         x = ax + (p[:, 1] - ay) * (bx - ax) / (by - ay)
         hit = x > p[:, 0]
         counts += np.bincount(order[k[hit]], minlength=n)
-        start = stop
     return counts
+
+
+#: pairs handled per step of :func:`_pairs_in_chunks` (bounds the temporary arrays)
+PAIR_CHUNK = 4_000_000
+
+
+def _pairs_in_chunks(lo: np.ndarray, cnt: np.ndarray
+                     ) -> Iterator[tuple[np.ndarray, np.ndarray]]:
+    """Every pair (row, k) with ``lo[row] <= k < lo[row] + cnt[row]``, about
+    :data:`PAIR_CHUNK` pairs at a time (whole rows per step): arrays ``row`` and ``k``."""
+    sel = np.flatnonzero(cnt > 0)
+    csum = np.cumsum(cnt[sel])
+    start = 0
+    while start < len(sel):
+        stop = int(np.searchsorted(csum, (csum[start - 1] if start else 0) + PAIR_CHUNK,
+                                   side="right"))
+        stop = max(stop, start + 1)
+        rows = sel[start:stop]
+        rc = cnt[rows]
+        row = np.repeat(rows, rc)
+        yield row, lo[row] + (np.arange(len(row)) - np.repeat(np.cumsum(rc) - rc, rc))
+        start = stop
 
 
 def _polygonal(geom: BaseGeometry) -> BaseGeometry:
