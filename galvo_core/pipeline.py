@@ -38,7 +38,7 @@ from galvo_core.job import Job, Segments, Stroke, gc_paused
 from galvo_core.kerf import compensate_indexed
 from galvo_core.order import order_job_strokes
 from galvo_core.params import UNITS_PER_MM, Params
-from galvo_core.precision import drawing_quantum
+from galvo_core.precision import drawing_quantum, path_quanta
 from galvo_core.sample import (
     ROUNDING_BOUND_BITS,
     SampleReport,
@@ -273,7 +273,7 @@ class Pipeline:
         ordered: list[Stroke] = order_job_strokes(  # type: ignore[assignment]
             strokes, fm, method=params.scan_order, time_budget_s=params.order_time_budget_s)
         t2 = time.perf_counter()
-        stats = self.stats(drawing, params, fitted, fm, ordered, sampled.report)
+        stats = self.stats(drawing, params, fitted, fm, ordered, sampled.report, work)
         if clamped:
             warnings.append(Warning(0, 0, f"{clamped} marks were outside the field and clamped"))
         if stats["dwell_points"]:
@@ -318,8 +318,8 @@ class Pipeline:
         return strokes, clamped
 
     def stats(self, drawing: Drawing, params: Params, fitted: tuple[FittedPath, ...],
-              fm: FieldMap, strokes: list[Stroke], report: SampleReport | None
-              ) -> dict[str, Any]:
+              fm: FieldMap, strokes: list[Stroke], report: SampleReport | None,
+              work: Drawing | None = None) -> dict[str, Any]:
         """Counts, lengths, the time estimate (:mod:`galvo_core.timing`) and what the
         sampler measured: the largest chord height before and after rounding (bits, against
         the true curve; None for raw marks), chords above the tolerance, min-step
@@ -327,6 +327,10 @@ class Pipeline:
         t, dwell = estimate_with_dwell([s.marks for s in strokes], params.laser, fm.mm_per_bit)
         n_input = self._fact(drawing, "n_points", lambda: drawing.n_points)
         quantum = self._fact(drawing, "quantum", lambda: coordinate_quantum(drawing)) or 0.0
+        # the fit detects each path's own grid: its bound is the largest path's
+        fitted_on = work if work is not None else drawing
+        path_q = self._fact(fitted_on, "largest path quantum", lambda: float(
+            path_quanta(fitted_on.paths).max(initial=0.0)))
         fit_err, n_control, n_lines, n_cubics = self._fact(fitted, "counts", lambda: (
             max((f.max_error for f in fitted), default=0.0),
             sum(control_points(f) for f in fitted),
@@ -335,9 +339,10 @@ class Pipeline:
         out: dict[str, Any] = {
             "input_points": n_input,
             # the file's coordinate grid (0: exact) and the fit's bound from the input
-            # points in effect: e_per beyond the rounding (galvo_core.precision)
+            # points in effect: the tolerances beyond each path's rounding
+            # (galvo_core.precision), here the largest over the paths
             "quantum_units": quantum,
-            "fit_bound_units": params.e_per + quantum / math.sqrt(2.0),
+            "fit_bound_units": max(params.e_per, params.eps_line) + path_q / math.sqrt(2.0),
             "control_points": n_control,
             "lines": n_lines,
             "cubics": n_cubics,

@@ -721,12 +721,12 @@ def build_preview(
     fm = job.field_map
     scale, offset = _units_affine(fm)
     cache = cache if cache is not None else PreviewCache()
-    # the fit's bound in effect from the input points: the tolerances beyond the file's
-    # rounding (its grid's half diagonal; galvo_core.precision), so the overlay colours a
-    # rounded file's points by how far the fit is from their rounding squares' reach
-    e_tol = max(float(job.params.get("e_per", 0.0) or 0.0),
-                float(job.params.get("eps_line", 0.0) or 0.0)) + \
-        float(job.params.get("quantum_units", 0.0) or 0.0) / math.sqrt(2.0)
+    # the fit's bound in effect from the input points (the tolerances beyond the paths'
+    # rounding, in the job's stats); jobs without it: the tolerances beyond the file's grid
+    e_tol = float(job.stats.get("fit_bound_units") or 0.0) or (
+        max(float(job.params.get("e_per", 0.0) or 0.0),
+            float(job.params.get("eps_line", 0.0) or 0.0))
+        + float(job.params.get("quantum_units", 0.0) or 0.0) / math.sqrt(2.0))
     d_box = cache.get(("bbox", id(drawing)), lambda: (drawing, drawing.bbox()))[1] \
         if drawing is not None else None
     tol_units = display_tolerance(job.params, drawing, d_box)

@@ -11,7 +11,7 @@ from _util import circle_plt
 from galvo_core.drawing import Drawing, Path
 from galvo_core.errors import ParamError
 from galvo_core.field import FIT_MARGIN_BITS, make_field
-from galvo_core.hpgl import read_bytes
+from galvo_core.hpgl import read_bytes, read_file
 from galvo_core.params import LaserParams, Params
 from galvo_core.pipeline import Cancelled, Pipeline
 
@@ -135,3 +135,15 @@ def test_facts_of_a_drawing_are_computed_once(circle, monkeypatch):
     assert calls == {"quantum": 1, "bbox": 1}
     fresh = Pipeline().run(circle, Params(magnification=12.0, chord_tol_bits=0.5)).job
     assert jobs[-1].stats == fresh.stats and jobs[-1].warnings == fresh.warnings
+
+
+@pytest.mark.parametrize("name", ["seal.plt", "dense_logo.plt", "curve_1181.plt",
+                                  "text_outline.plt", "arcs_circles.plt"])
+def test_the_fit_bound_shown_holds_for_the_largest_fit_error(name):
+    """What the job (and the GUI's job panel) states as the fit bound in effect is never
+    below the largest fit error it reports, whatever grid each path was written on."""
+    from _util import SAMPLES
+
+    stats = Pipeline().run(read_file(SAMPLES / name), Params()).job.stats
+    assert stats["max_fit_error"] <= stats["fit_bound_units"] * (1 + 1e-9)
+    assert stats["fit_bound_units"] >= Params().e_per
