@@ -33,12 +33,12 @@ from galvo_core.drawing import Drawing, Warning
 from galvo_core.errors import Cancelled
 from galvo_core.field import FieldMap, check_in_field, make_field
 from galvo_core.fill import HatchStroke, hatch
-from galvo_core.fit import FitCancelled, FittedPath, control_points, fit_drawing
+from galvo_core.fit import FittedPath, control_points, fit_drawing
 from galvo_core.job import Job, Segments, Stroke, gc_paused
 from galvo_core.kerf import compensate_indexed
 from galvo_core.order import order_job_strokes
 from galvo_core.params import UNITS_PER_MM, Params
-from galvo_core.precision import drawing_quantum, path_quanta
+from galvo_core.precision import path_quanta
 from galvo_core.sample import (
     ROUNDING_BOUND_BITS,
     SampleReport,
@@ -194,11 +194,9 @@ class Pipeline:
 
         def make() -> tuple[FittedPath, ...]:
             # all paths of a batch are thinned and fitted together; cancel() between batches
-            try:
-                return tuple(fit_drawing(work, eps_line=params.eps_line, e_per=params.e_per,
-                                         eps_sum=params.eps_sum, batch=512, cancel=run.cancel))
-            except FitCancelled:
-                raise Cancelled() from None
+            # raises errors.Cancelled
+            return tuple(fit_drawing(work, eps_line=params.eps_line, e_per=params.e_per,
+                                     eps_sum=params.eps_sum, batch=512, cancel=run.cancel))
 
         key = ("fit", self._kerf_key(params, fm), params.group("fit"))
         return self._cache.get(drawing, key, run.stage("fit", make))
@@ -380,9 +378,9 @@ class Pipeline:
 
 
 def coordinate_quantum(drawing: Drawing) -> float | None:
-    """The drawing's grid step (input units, :func:`galvo_core.precision.drawing_quantum`),
-    None when its points are exact (off any grid) or it has none."""
-    q, _ = drawing_quantum(drawing.paths)
+    """The drawing's grid step (input units, :meth:`Drawing.quantum`), None when its points
+    are exact (off any grid) or it has none."""
+    q = drawing.quantum()
     return q if q > 0.0 else None
 
 
