@@ -562,10 +562,6 @@ class Params:
                 out[k] = list(v) if isinstance(v, tuple) else v
         return out
 
-    @property
-    def mm_per_bit(self) -> float:
-        return self.field_size_mm / self.field_bits  # type: ignore[no-any-return]
-
     @classmethod
     def from_mapping(cls, values: Mapping[str, Any], *, base: Params | None = None,
                      ignore_unknown: bool = False) -> Params:
@@ -579,8 +575,3 @@ class Params:
 
 def _rebuild(values: dict[str, Any]) -> Params:
     return Params(**values)
-
-
-def validate(name: str, value: Any) -> Any:
-    """One parameter's value checked on its own (ParamError with a clear message)."""
-    return spec(name).check(value)
