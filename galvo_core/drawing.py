@@ -14,7 +14,8 @@ from __future__ import annotations
 
 import hashlib
 from collections.abc import Iterable, Mapping
-from dataclasses import dataclass, field, replace
+from dataclasses import FrozenInstanceError, dataclass, field, replace
+from itertools import repeat
 from types import MappingProxyType
 
 import numpy as np
@@ -63,7 +64,10 @@ def _frozen_points(points: object) -> np.ndarray:
     return arr
 
 
-@dataclass(frozen=True, slots=True, eq=False)
+_NOWHERE = SourcePos(0, 0)
+_set = object.__setattr__
+
+
 class Path:
     """One pen-down path.
 
@@ -80,15 +84,30 @@ class Path:
         rings and for pen-down runs that return exactly to their start.
     start:
         Where in the file the path began.
+
+    Immutable (assigning an attribute raises ``dataclasses.FrozenInstanceError``); equal
+    only to itself. ``Path(points, pen=1, closed=False, start=SourcePos(0, 0))`` copies
+    ``points``.
+
+    The importer's paths share their storage: :func:`paths_from_store` makes many paths over
+    one points array in one vectorised step; such a path makes its ``points`` view the first
+    time it is read (then keeps it) and its ``start`` when asked for. Nothing else differs.
     """
 
-    points: np.ndarray
-    pen: int = 1
-    closed: bool = False
-    start: SourcePos = field(default_factory=lambda: SourcePos(0, 0))
+    __slots__ = ("_points", "pen", "closed", "_start", "_store", "_k")
+    __match_args__ = ("points", "pen", "closed", "start")
 
-    def __post_init__(self) -> None:
-        object.__setattr__(self, "points", _frozen_points(self.points))
+    def __init__(
+        self,
+        points: object,
+        pen: int = 1,
+        closed: bool = False,
+        start: SourcePos | None = None,
+    ) -> None:
+        _set(self, "_points", _frozen_points(points))
+        _set(self, "pen", pen)
+        _set(self, "closed", closed)
+        _set(self, "_start", _NOWHERE if start is None else start)
 
     @classmethod
     def from_points(
@@ -103,25 +122,103 @@ class Path:
         arr = _frozen_points(points)
         if closed is None:
             closed = len(arr) >= 3 and bool(np.array_equal(arr[0], arr[-1]))
-        return cls(arr, pen=pen, closed=closed, start=start or SourcePos(0, 0))
+        return cls(arr, pen=pen, closed=closed, start=start or _NOWHERE)
+
+    @property
+    def points(self) -> np.ndarray:
+        try:
+            return self._points  # type: ignore[no-any-return]
+        except AttributeError:  # a stored path read for the first time
+            st = self._store
+            k = self._k
+            pts = st.pts[st.starts[k] : st.ends[k]]
+            _set(self, "_points", pts)
+            return pts
+
+    @property
+    def start(self) -> SourcePos:
+        try:
+            return self._start  # type: ignore[no-any-return]
+        except AttributeError:  # a stored path: its position is in the store's arrays
+            st = self._store
+            k = self._k
+            return SourcePos(int(st.lines[k]), int(st.cols[k]))
 
     def __len__(self) -> int:
-        return len(self.points)
+        try:
+            return len(self._points)
+        except AttributeError:
+            st = self._store
+            k = self._k
+            return int(st.ends[k] - st.starts[k])
+
+    def __setattr__(self, name: str, value: object) -> None:
+        raise FrozenInstanceError(f"cannot assign to field {name!r}")
+
+    def __delattr__(self, name: str) -> None:
+        raise FrozenInstanceError(f"cannot delete field {name!r}")
+
+    def __repr__(self) -> str:
+        return (f"Path(points={self.points!r}, pen={self.pen!r}, closed={self.closed!r}, "
+                f"start={self.start!r})")
+
+    def __reduce__(self) -> tuple[object, ...]:
+        return (Path, (self.points, self.pen, self.closed, self.start))
 
     @property
     def length(self) -> float:
         """Polyline length in input units."""
-        if len(self.points) < 2:
+        pts = self.points
+        if len(pts) < 2:
             return 0.0
-        return float(np.hypot(*np.diff(self.points, axis=0).T).sum())
+        return float(np.hypot(*np.diff(pts, axis=0).T).sum())
 
     def with_points(self, points: object, *, closed: bool | None = None) -> Path:
         """A copy with new points (same pen and source position)."""
-        return replace(
-            self,
-            points=_frozen_points(points),
-            closed=self.closed if closed is None else closed,
-        )
+        return Path(points, self.pen, self.closed if closed is None else closed, self.start)
+
+
+class PathStore:
+    """The shared storage of many paths (see :func:`paths_from_store`): path ``k`` is
+    ``pts[starts[k]:ends[k]]`` and began at line ``lines[k]``, column ``cols[k]``."""
+
+    __slots__ = ("pts", "starts", "ends", "lines", "cols")
+
+    def __init__(self, pts: np.ndarray, starts: np.ndarray, ends: np.ndarray,
+                 lines: np.ndarray, cols: np.ndarray) -> None:
+        self.pts = pts
+        self.starts = starts
+        self.ends = ends
+        self.lines = lines
+        self.cols = cols
+
+
+_new_obj = object.__new__
+_P_PEN = Path.__dict__["pen"].__set__
+_P_CLOSED = Path.__dict__["closed"].__set__
+_P_STORE = Path.__dict__["_store"].__set__
+_P_K = Path.__dict__["_k"].__set__
+
+
+def paths_from_store(pts: np.ndarray, starts: np.ndarray, ends: np.ndarray, pens: list[int],
+                     closed: list[bool], lines: np.ndarray, cols: np.ndarray) -> list[Path]:
+    """Paths ``pts[starts[k]:ends[k]]`` (``pts`` a read-only float64 (N, 2) array, not
+    copied), drawn with ``pens[k]``, ``closed[k]``, begun at ``lines[k]``, ``cols[k]``.
+
+    Made in one vectorised step (loops in C: no per-path Python code): each path holds the
+    shared store and its index; its points view and its SourcePos are made when read.
+    """
+    m = len(pens)
+    if m == 0:
+        return []
+    store = PathStore(pts, np.asarray(starts), np.asarray(ends), np.asarray(lines),
+                      np.asarray(cols))
+    objs = list(map(_new_obj, repeat(Path, m)))
+    any(map(_P_PEN, objs, pens))
+    any(map(_P_CLOSED, objs, closed))
+    any(map(_P_STORE, objs, repeat(store, m)))
+    any(map(_P_K, objs, range(m)))
+    return objs
 
 
 @dataclass(frozen=True, eq=False)
@@ -156,7 +253,7 @@ class Drawing:
     # --- derived facts ---------------------------------------------------------------
     @property
     def n_points(self) -> int:
-        return sum(len(p.points) for p in self.paths)
+        return sum(map(len, self.paths))
 
     @property
     def n_closed(self) -> int:

@@ -85,12 +85,11 @@ import re
 import sys
 from collections import Counter
 from collections.abc import Callable
-from itertools import repeat
 from typing import Any
 
 import numpy as np
 
-from galvo_core.drawing import Drawing, Path, SourcePos, Warning, sha256_hex
+from galvo_core.drawing import Drawing, Path, Warning, paths_from_store, sha256_hex
 from galvo_core.errors import InputError
 from galvo_core.hpgl.arcs import arc_points, bezier_points, chord_angle, circle_through
 from galvo_core.hpgl.fastrun import (
@@ -1650,60 +1649,57 @@ def _line_cols(rd: _Reader, offs: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return lines, cols
 
 
-_new_obj = object.__new__
-_set_attr = object.__setattr__
+_GEN_BLOCK = 8192  # general-reader paths per shared points block
 
 
-def _new_path(points: np.ndarray, pen: int, closed: bool, line: int, col: int) -> Path:
-    """A Path without the copy its constructor makes: ``points`` is a read-only float64
-    (N, 2) array already (a view of the scanner's frozen chunk, or the reader's own)."""
-    sp = _new_obj(SourcePos)
-    _set_attr(sp, "line", line)
-    _set_attr(sp, "col", col)
-    p = _new_obj(Path)
-    _set_attr(p, "points", points)
-    _set_attr(p, "pen", pen)
-    _set_attr(p, "closed", closed)
-    _set_attr(p, "start", sp)
-    return p
+def _scanner_paths(rd: _Reader) -> list[Path]:
+    """The paths of the scanner's batches, in order: one vectorised step per chunk, each
+    path a view (made when first read) of the chunk's frozen points."""
+    out: list[Path] = []
+    batches = [p for p in rd.paths if isinstance(p, _Batch)]
+    k = 0
+    while k < len(batches):
+        ch = batches[k].chunk
+        j = k
+        while j < len(batches) and batches[j].chunk is ch:
+            j += 1
+        group = batches[k:j]
+        k = j
+        if len(group) == 1:
+            b = group[0]
+            starts, ends, lines, cols, pens = b.starts, b.ends, b.lines, b.cols, b.pens
+        else:
+            starts, ends, lines, cols, pens = (
+                np.concatenate([getattr(b, f) for b in group])
+                for f in ("starts", "ends", "lines", "cols", "pens"))
+        pts = ch.pts
+        first = pts[starts]
+        last = pts[ends - 1]
+        closed = ((ends - starts >= 4) & (first[:, 0] == last[:, 0])
+                  & (first[:, 1] == last[:, 1]))
+        out.extend(paths_from_store(pts, starts, ends, pens.tolist(), closed.tolist(),
+                                    lines, cols))
+    return out
 
 
-def _batch_paths(b: _Batch, out: list[Path]) -> None:
-    """Append the paths of a scanner batch to ``out``.
-
-    Tens of thousands of paths: the objects are made and filled by ``map`` (loops in C),
-    each path's points a view of the frozen chunk.
-    """
-    pts = b.chunk.pts
-    starts, ends = b.starts, b.ends
-    m = len(starts)
-    first = pts[starts]
-    last = pts[ends - 1]
-    closed = ((ends - starts >= 4) & (first[:, 0] == last[:, 0])
-              & (first[:, 1] == last[:, 1])).tolist()
-    views = list(map(pts.__getitem__, map(slice, starts.tolist(), ends.tolist())))
-    sps = list(map(_new_obj, repeat(SourcePos, m)))
-    any(map(_SP_LINE, sps, b.lines.tolist()))
-    any(map(_SP_COL, sps, b.cols.tolist()))
-    objs = list(map(_new_obj, repeat(Path, m)))
-    any(map(_P_POINTS, objs, views))
-    any(map(_P_PEN, objs, b.pens.tolist()))
-    any(map(_P_CLOSED, objs, closed))
-    any(map(_P_START, objs, sps))
-    out.extend(objs)
-
-
-# slot setters of the frozen dataclasses (member descriptors: no frozen __setattr__)
-def _slot_setter(cls: type, name: str) -> Callable[[object, object], None]:
-    return cls.__dict__[name].__set__  # type: ignore[no-any-return]
-
-
-_SP_LINE = _slot_setter(SourcePos, "line")
-_SP_COL = _slot_setter(SourcePos, "col")
-_P_POINTS = _slot_setter(Path, "points")
-_P_PEN = _slot_setter(Path, "pen")
-_P_CLOSED = _slot_setter(Path, "closed")
-_P_START = _slot_setter(Path, "start")
+def _general_paths(items: list[tuple[np.ndarray, int, bool, int]], lines: np.ndarray,
+                   cols: np.ndarray) -> list[Path]:
+    """The general reader's paths, in order: their points gathered into shared read-only
+    blocks (of _GEN_BLOCK paths), each path a view of its block."""
+    out: list[Path] = []
+    for i0 in range(0, len(items), _GEN_BLOCK):
+        part = items[i0 : i0 + _GEN_BLOCK]
+        pieces = [np.asarray(it[0], dtype=np.float64).reshape(-1, 2) for it in part]
+        lens = np.fromiter(map(len, pieces), dtype=np.int64, count=len(pieces))
+        ends = np.cumsum(lens)
+        starts = ends - lens
+        pts = np.concatenate(pieces) if len(pieces) > 1 else pieces[0].copy()
+        pts.setflags(write=False)
+        del pieces
+        out.extend(paths_from_store(pts, starts, ends, [it[1] for it in part],
+                                    [it[2] for it in part], lines[i0 : i0 + len(part)],
+                                    cols[i0 : i0 + len(part)]))
+    return out
 
 
 def read_bytes(data: bytes, name: str = "<bytes>") -> Drawing:
@@ -1771,25 +1767,33 @@ def _read(data: bytes, name: str) -> Drawing:
     offs = np.array([p[3] for p in rd.paths if not isinstance(p, _Batch)]
                     + [w[0] for w in rd._warn], dtype=np.int64)
     lines, cols = _line_cols(rd, offs)
-    lines_l = lines.tolist()
-    cols_l = cols.tolist()
     for ch in rd.chunks:
         ch.seg_start = ch.seg_off = ch.seg_pen = ch.seg_line = ch.seg_col = _EMPTY_I32
         if len(ch.pts) - ch.npts > max(ch.npts // 4, 4096):
             ch.pts = ch.pts[: ch.npts].copy()  # the drawing keeps only what was used
         ch.pts.setflags(write=False)
-    paths: list[Path] = []
-    k = 0
-    for item in rd.paths:
-        if isinstance(item, _Batch):
-            _batch_paths(item, paths)
-        else:
-            pts, pen, closed, _ = item
-            pts = np.ascontiguousarray(pts, dtype=np.float64)
-            pts.setflags(write=False)
-            paths.append(_new_path(pts, pen, closed, lines_l[k], cols_l[k]))
-            k += 1
-    lc = list(zip(lines_l[k:], cols_l[k:], strict=True))
+    general = [p for p in rd.paths if not isinstance(p, _Batch)]
+    k = len(general)
+    scanned = _scanner_paths(rd) if rd.batched else []
+    gen_paths = _general_paths(general, lines[:k], cols[:k]) if general else []
+    del general
+    if not scanned:
+        paths = gen_paths
+    elif not gen_paths:
+        paths = scanned
+    else:  # in file order
+        paths = []
+        bi = gi = 0
+        for item in rd.paths:
+            if isinstance(item, _Batch):
+                m = len(item.starts)
+                paths.extend(scanned[bi : bi + m])
+                bi += m
+            else:
+                paths.append(gen_paths[gi])
+                gi += 1
+    rd.paths = []
+    lc = list(zip(lines[k:].tolist(), cols[k:].tolist(), strict=True))
     warnings = []
     for (off, msg), (line, col) in zip(rd._warn, lc, strict=True):
         if off < 0:
