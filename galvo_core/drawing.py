@@ -15,7 +15,7 @@ from __future__ import annotations
 import hashlib
 from collections.abc import Iterable, Mapping
 from dataclasses import FrozenInstanceError, dataclass, field, replace
-from itertools import repeat
+from itertools import chain, repeat
 from types import MappingProxyType
 
 import numpy as np
@@ -94,7 +94,10 @@ class Path:
     time it is read (then keeps it) and its ``start`` when asked for. Nothing else differs.
     """
 
-    __slots__ = ("_points", "pen", "closed", "_start", "_store", "_k")
+    # _points: the (N, 2) array; for a stored path unset until first read. _store: the
+    # start (a SourcePos) of a path built by __init__, the PathStore of a stored one, whose
+    # path _k it is (below 256: CPython shares those ints, no int object per path)
+    __slots__ = ("_points", "pen", "closed", "_store", "_k")
     __match_args__ = ("points", "pen", "closed", "start")
 
     def __init__(
@@ -107,7 +110,7 @@ class Path:
         _set(self, "_points", _frozen_points(points))
         _set(self, "pen", pen)
         _set(self, "closed", closed)
-        _set(self, "_start", _NOWHERE if start is None else start)
+        _set(self, "_store", _NOWHERE if start is None else start)
 
     @classmethod
     def from_points(
@@ -137,12 +140,11 @@ class Path:
 
     @property
     def start(self) -> SourcePos:
-        try:
-            return self._start  # type: ignore[no-any-return]
-        except AttributeError:  # a stored path: its position is in the store's arrays
-            st = self._store
-            k = self._k
-            return SourcePos(int(st.lines[k]), int(st.cols[k]))
+        st = self._store
+        if type(st) is SourcePos:
+            return st
+        k = self._k  # a stored path: its position is in the store's arrays
+        return SourcePos(int(st.lines[k]), int(st.cols[k]))
 
     def __len__(self) -> int:
         try:
@@ -179,7 +181,7 @@ class Path:
 
 
 class PathStore:
-    """The shared storage of many paths (see :func:`paths_from_store`): path ``k`` is
+    """The shared storage of up to 256 paths (see :func:`paths_from_store`): path ``k`` is
     ``pts[starts[k]:ends[k]]`` and began at line ``lines[k]``, column ``cols[k]``."""
 
     __slots__ = ("pts", "starts", "ends", "lines", "cols")
@@ -200,24 +202,30 @@ _P_STORE = Path.__dict__["_store"].__set__
 _P_K = Path.__dict__["_k"].__set__
 
 
+_STORE_PATHS = 256  # paths per PathStore: their index is a small int (shared by CPython)
+
+
 def paths_from_store(pts: np.ndarray, starts: np.ndarray, ends: np.ndarray, pens: list[int],
                      closed: list[bool], lines: np.ndarray, cols: np.ndarray) -> list[Path]:
     """Paths ``pts[starts[k]:ends[k]]`` (``pts`` a read-only float64 (N, 2) array, not
     copied), drawn with ``pens[k]``, ``closed[k]``, begun at ``lines[k]``, ``cols[k]``.
 
-    Made in one vectorised step (loops in C: no per-path Python code): each path holds the
-    shared store and its index; its points view and its SourcePos are made when read.
+    Made in one vectorised step (loops in C: no per-path Python code): each path holds a
+    store (one per 256 paths, over views of the arrays given) and its index there; its
+    points view and its SourcePos are made when read.
     """
     m = len(pens)
     if m == 0:
         return []
-    store = PathStore(pts, np.asarray(starts), np.asarray(ends), np.asarray(lines),
-                      np.asarray(cols))
+    starts, ends, lines, cols = (np.asarray(a) for a in (starts, ends, lines, cols))
+    n = _STORE_PATHS
+    stores = [PathStore(pts, starts[i : i + n], ends[i : i + n], lines[i : i + n],
+                        cols[i : i + n]) for i in range(0, m, n)]
     objs = list(map(_new_obj, repeat(Path, m)))
     any(map(_P_PEN, objs, pens))
     any(map(_P_CLOSED, objs, closed))
-    any(map(_P_STORE, objs, repeat(store, m)))
-    any(map(_P_K, objs, range(m)))
+    any(map(_P_STORE, objs, chain.from_iterable(map(repeat, stores, repeat(n)))))
+    any(map(_P_K, objs, chain.from_iterable(repeat(range(n), len(stores)))))
     return objs
 
 

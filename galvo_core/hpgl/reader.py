@@ -136,6 +136,8 @@ _FAST_MIN_BYTES = 256  # shorter runs go command by command
 #: ``process``), so that ``galvo-core info small.plt`` does not pay numba's import
 _COMPILED_MIN_BYTES = 1 << 20
 _CHUNK_POINTS = 1 << 16  # points per output chunk of the compiled scanner
+_BLOCK_POINTS = 1 << 12  # the general reader's paths are gathered into blocks of about
+_BLOCK_PATHS = 1 << 9  # this many points or paths
 _PE_MESSAGES = {  # scan.PE_* problem codes -> the messages of pe.decode_pe
     1: "PE number out of range; clamped",
     2: "PE fractional bits {} out of range 0..26",
@@ -184,6 +186,27 @@ class _Batch:
         self.lines = lines
         self.cols = cols
         self.pens = pens
+class _Block:
+    """General-reader paths gathered: ``pts[starts[k]:ends[k]]`` (read-only), drawn with
+    ``pens[k]``, ``closed[k]``, begun at line ``lines[k]``, column ``cols[k]``."""
+
+    __slots__ = ("pts", "starts", "ends", "pens", "closed", "lines", "cols")
+
+    def __init__(self, part: list[tuple[np.ndarray, int, bool, int]],
+                 where: Callable[[np.ndarray], tuple[np.ndarray, np.ndarray]]) -> None:
+        pieces = [np.asarray(it[0], dtype=np.float64).reshape(-1, 2) for it in part]
+        lens = np.fromiter(map(len, pieces), dtype=np.int64, count=len(pieces))
+        self.ends = np.cumsum(lens).astype(np.int32)
+        self.starts = self.ends - lens.astype(np.int32)
+        self.pts = np.concatenate(pieces) if len(pieces) > 1 else pieces[0].copy()
+        self.pts.setflags(write=False)
+        del pieces
+        self.pens = np.fromiter((it[1] for it in part), dtype=np.int64, count=len(part))
+        self.closed = np.fromiter((it[2] for it in part), dtype=np.bool_, count=len(part))
+        self.lines, self.cols = where(
+            np.fromiter((it[3] for it in part), dtype=np.int64, count=len(part)))
+
+
 _SEP_RE = re.compile(rb"[\x00-\x1a\x1c-\x20;,]*")
 _NUM_RE = re.compile(rb"[-+]?(?:\d+\.?\d*|\.\d+)")
 _JUNK_PARAM_RE = re.compile(rb"[^\s,0-9.+\-\x00]+")
@@ -224,7 +247,14 @@ class _Reader:
         self.name = name
         self.n = len(data)
         # outputs
-        self.paths: list[tuple[np.ndarray, int, bool, int]] = []  # points, pen, closed, offset
+        # the paths in file order: a _Batch (the scanner's) or None (the next general path)
+        self.paths: list[_Batch | None] = []
+        # the general reader's paths: (points, pen, closed, offset) not yet gathered into a
+        # _Block (the first is general path number gen_base), and the blocks before them
+        self.gen: list[tuple[np.ndarray, int, bool, int]] = []
+        self.gen_base = 0
+        self.gen_points = 0
+        self.blocks: list[_Block] = []
         self.commands: Counter[str] = Counter()
         self._warn: list[tuple[int, str]] = []
         self._warn_count: Counter[str] = Counter()
@@ -244,7 +274,9 @@ class _Reader:
         self._chunk: _Chunk | None = None
         self._scan: Any = None  # the compiled scanner's module, imported at its first use
         self._lc = (0, 1, -1)  # scanner position: offset, its line, the newline before it
+        self._blc = (0, 1, -1)  # the same for lines_cols
         self.chunks: list[_Chunk] = []
+        self._next_cap = _CHUNK_POINTS // 16
         self.batched = 0  # paths in _Batch items of self.paths
         self.hpgl_mode = True
         # dialect: HP-GL/2 once the file shows it (PCL/PJL entry, an HP-GL/2-only command)
@@ -286,7 +318,8 @@ class _Reader:
         # sub-polygons: points, pen-down flag of each edge (the closing edge last)
         self.poly_buffer: list[tuple[list[tuple[float, float]], list[bool]]] = []
         self.poly_emitted = True
-        self.poly_edged: tuple[int, int] | None = None  # self.paths range EP emitted
+        # EP's paths: self.paths range and general path numbers (FP may replace them)
+        self.poly_edged: tuple[int, int, int, int] | None = None
         self.poly_fresh = False
         self.poly_offset = 0
         self.tick = (0.5, 0.5)
@@ -407,7 +440,11 @@ class _Reader:
                 if closed is not None
                 else len(piece) >= 4 and piece[0, 0] == piece[-1, 0] and piece[0, 1] == piece[-1, 1]
             )
-            self.paths.append((piece, self.pen, bool(is_closed), offset))
+            self.paths.append(None)
+            self.gen.append((piece, self.pen, bool(is_closed), offset))
+            self.gen_points += len(piece)
+            if self.gen_points >= _BLOCK_POINTS or len(self.gen) >= _BLOCK_PATHS:
+                self.gather()
             if not self.pen_selected:
                 self.unselected_paths += 1
 
@@ -424,6 +461,44 @@ class _Reader:
         elif cur:
             self.emit(np.array(cur, dtype=np.float64).reshape(-1, 2), self.cur_offset)
             self.cur = []
+
+    def gather(self, final: bool = False) -> None:
+        """Move the general paths read so far into a _Block (one shared points array), but
+        not EP's paths that a later FP may replace."""
+        limit = len(self.gen)
+        if self.poly_edged is not None and not final:
+            limit = min(limit, self.poly_edged[2] - self.gen_base)
+        if limit <= 0:
+            return
+        part = self.gen[:limit]
+        del self.gen[:limit]
+        self.gen_base += limit
+        self.gen_points = sum(len(g[0]) for g in self.gen)
+        self.blocks.append(_Block(part, self.lines_cols))
+
+    def lines_cols(self, offs: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """1-based line and column (int32) of the byte offsets ``offs`` (>= 0), counted from
+        the last call's place (the paths of a block are near each other in the file): no
+        pass over the whole file, no temporary larger than the stretch they span."""
+        data = self.data
+        lo = int(offs.min())
+        hi = int(offs.max())
+        pos, line, last_nl = self._blc  # line at pos, the last newline before pos
+        if lo >= pos:
+            cnt = data.count(b"\n", pos, lo)
+            if cnt:
+                line += cnt
+                last_nl = data.rfind(b"\n", pos, lo)
+        else:
+            line -= data.count(b"\n", lo, pos)
+            if last_nl >= lo:
+                last_nl = data.rfind(b"\n", 0, lo)
+        self._blc = (lo, line, last_nl)
+        nl = np.flatnonzero(np.frombuffer(data, dtype=np.uint8, count=hi - lo, offset=lo) == 10)
+        idx = np.searchsorted(nl, offs - lo, side="left")  # newlines in [lo, offset)
+        prev = np.where(idx > 0, nl[np.maximum(idx - 1, 0)] + lo, last_nl) if len(nl) else \
+            np.full(len(offs), last_nl, dtype=np.int64)
+        return (idx + line).astype(np.int32), (offs - prev).astype(np.int32)
 
     def emit_ring(self, ring_pts: np.ndarray, offset: int) -> None:
         """A closed figure (rectangle, circle, wedge): into the polygon buffer in PM."""
@@ -592,10 +667,12 @@ class _Reader:
                 return
             self.poly_emitted = True
             first = len(self.paths)
+            gfirst = self.gen_base + len(self.gen)
+            self.poly_edged = (first, first, gfirst, gfirst)  # (not gathered from gfirst)
             for ring, downs in self.poly_buffer:
                 for run in _pen_down_runs(ring, downs):
                     self.emit(np.array(run, dtype=np.float64), self.poly_offset)
-            self.poly_edged = (first, len(self.paths))
+            self.poly_edged = (first, len(self.paths), gfirst, self.gen_base + len(self.gen))
             return
         if self.poly_emitted and self.poly_edged is None:
             return  # filled already
@@ -604,12 +681,18 @@ class _Reader:
             closed_ring = ring if ring[0] == ring[-1] else ring + [ring[0]]
             rings.append(np.array(closed_ring, dtype=np.float64))
         if self.poly_edged is not None:
-            a, b = self.poly_edged
+            a, b, ga, gb = self.poly_edged
+            self.poly_edged = None
             tail = self.paths[b:]
             del self.paths[a:]
+            gtail = self.gen[gb - self.gen_base :]
+            del self.gen[ga - self.gen_base :]
+            self.gen_points = sum(len(g[0]) for g in self.gen)
             for arr in rings:
                 self.emit(arr, self.poly_offset, closed=len(arr) >= 4)
             self.paths.extend(tail)
+            self.gen.extend(gtail)
+            self.gen_points += sum(len(g[0]) for g in gtail)
         else:
             for arr in rings:
                 self.emit(arr, self.poly_offset, closed=len(arr) >= 4)
@@ -911,12 +994,15 @@ class _Reader:
         elif not self.poly_emitted and self.poly_buffer:
             self.warn(self.poly_offset,
                       "polygon defined with PM but never edged or filled (EP/FP): not drawn")
+        self.gather(final=True)
 
     # ------------------------------------------------------------------ compiled runs
     def _new_chunk(self, need: int, at: int = 0) -> _Chunk:
         # about one point per 16 bytes still to read (real files: 10-50 bytes per point), at
-        # most _CHUNK_POINTS: a small file does not get a large chunk; more come as needed
-        cap = max(need + 2, min(_CHUNK_POINTS, (self.n - at) // 16 + 64))
+        # most _CHUNK_POINTS, and twice the last chunk: a small file, or one the scanner reads
+        # little of, does not get a large chunk; more come as needed
+        cap = max(need + 2, min(self._next_cap, (self.n - at) // 16 + 64))
+        self._next_cap = min(2 * cap, _CHUNK_POINTS)
         ch = _Chunk(cap)
         self._chunk = ch
         self.chunks.append(ch)
@@ -1616,7 +1702,10 @@ def _line_cols_arrays(data: bytes, offs: np.ndarray) -> tuple[np.ndarray, np.nda
     """1-based line and column of each byte offset (one pass over the newlines)."""
     if not len(offs):
         return np.zeros(0, np.int64), np.zeros(0, np.int64)
-    nl = np.flatnonzero(np.frombuffer(data, dtype=np.uint8) == 10)
+    u8 = np.frombuffer(data, dtype=np.uint8)
+    step = 1 << 16  # newlines found 64 kB at a time: no temporary the size of the file
+    nl = np.concatenate([np.flatnonzero(u8[i : i + step] == 10) + i
+                         for i in range(0, len(u8), step)] or [np.zeros(0, np.int64)])
     idx = np.searchsorted(nl, offs, side="left")  # newlines strictly before offset
     if len(nl):
         line_start = np.where(idx > 0, nl[np.maximum(idx - 1, 0)] + 1, 0)
@@ -1649,14 +1738,13 @@ def _line_cols(rd: _Reader, offs: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return lines, cols
 
 
-_GEN_BLOCK = 8192  # general-reader paths per shared points block
 
 
 def _scanner_paths(rd: _Reader) -> list[Path]:
     """The paths of the scanner's batches, in order: one vectorised step per chunk, each
     path a view (made when first read) of the chunk's frozen points."""
     out: list[Path] = []
-    batches = [p for p in rd.paths if isinstance(p, _Batch)]
+    batches = [p for p in rd.paths if p is not None]
     k = 0
     while k < len(batches):
         ch = batches[k].chunk
@@ -1682,23 +1770,12 @@ def _scanner_paths(rd: _Reader) -> list[Path]:
     return out
 
 
-def _general_paths(items: list[tuple[np.ndarray, int, bool, int]], lines: np.ndarray,
-                   cols: np.ndarray) -> list[Path]:
-    """The general reader's paths, in order: their points gathered into shared read-only
-    blocks (of _GEN_BLOCK paths), each path a view of its block."""
+def _general_paths(blocks: list[_Block]) -> list[Path]:
+    """The general reader's paths, in order, each a view of its block's points."""
     out: list[Path] = []
-    for i0 in range(0, len(items), _GEN_BLOCK):
-        part = items[i0 : i0 + _GEN_BLOCK]
-        pieces = [np.asarray(it[0], dtype=np.float64).reshape(-1, 2) for it in part]
-        lens = np.fromiter(map(len, pieces), dtype=np.int64, count=len(pieces))
-        ends = np.cumsum(lens)
-        starts = ends - lens
-        pts = np.concatenate(pieces) if len(pieces) > 1 else pieces[0].copy()
-        pts.setflags(write=False)
-        del pieces
-        out.extend(paths_from_store(pts, starts, ends, [it[1] for it in part],
-                                    [it[2] for it in part], lines[i0 : i0 + len(part)],
-                                    cols[i0 : i0 + len(part)]))
+    for bl in blocks:
+        out.extend(paths_from_store(bl.pts, bl.starts, bl.ends, bl.pens.tolist(),
+                                    bl.closed.tolist(), bl.lines, bl.cols))
     return out
 
 
@@ -1710,6 +1787,7 @@ def read_bytes(data: bytes, name: str = "<bytes>") -> Drawing:
     if data[:1] == b"\x00" and not head:
         head = data.lstrip(b"\x00")[: 1 << 16]
     reason = refusal_reason(head)
+    del head
     if reason is not None:
         raise InputError(name, reason)
     # the reader makes tens of thousands of objects that all live on (paths, positions):
@@ -1753,8 +1831,8 @@ def _read(data: bytes, name: str) -> Drawing:
     if rd.unselected_paths:
         rd.warn(-1, f"{rd.unselected_paths} path(s) drawn before any pen was selected (SP): "
                    "imported with pen 1 (an HP-GL/2 device would not draw them)")
-    pen0 = sum(
-        int((p.pens == 0).sum()) if isinstance(p, _Batch) else int(p[1] == 0) for p in rd.paths)
+    pen0 = sum(int((p.pens == 0).sum()) for p in rd.paths if p is not None)
+    pen0 += sum(int((bl.pens == 0).sum()) for bl in rd.blocks)
     if pen0:
         rd.warn(-1, f"{pen0} path(s) drawn with pen 0 (SP0 puts the pen away: a pen plotter "
                    "would not draw them); imported anyway")
@@ -1764,19 +1842,16 @@ def _read(data: bytes, name: str) -> Drawing:
         if count > _WARN_CAP:
             rd._warn.append((-1, f"... and {count - _WARN_CAP} more warnings like: {key}"))
     # positions: the scanner's paths carry theirs; the others' and the warnings' from offsets
-    offs = np.array([p[3] for p in rd.paths if not isinstance(p, _Batch)]
-                    + [w[0] for w in rd._warn], dtype=np.int64)
+    offs = np.array([w[0] for w in rd._warn], dtype=np.int64)
     lines, cols = _line_cols(rd, offs)
     for ch in rd.chunks:
         ch.seg_start = ch.seg_off = ch.seg_pen = ch.seg_line = ch.seg_col = _EMPTY_I32
         if len(ch.pts) - ch.npts > max(ch.npts // 4, 4096):
             ch.pts = ch.pts[: ch.npts].copy()  # the drawing keeps only what was used
         ch.pts.setflags(write=False)
-    general = [p for p in rd.paths if not isinstance(p, _Batch)]
-    k = len(general)
     scanned = _scanner_paths(rd) if rd.batched else []
-    gen_paths = _general_paths(general, lines[:k], cols[:k]) if general else []
-    del general
+    gen_paths = _general_paths(rd.blocks)
+    rd.blocks = []
     if not scanned:
         paths = gen_paths
     elif not gen_paths:
@@ -1785,15 +1860,15 @@ def _read(data: bytes, name: str) -> Drawing:
         paths = []
         bi = gi = 0
         for item in rd.paths:
-            if isinstance(item, _Batch):
+            if item is None:
+                paths.append(gen_paths[gi])
+                gi += 1
+            else:
                 m = len(item.starts)
                 paths.extend(scanned[bi : bi + m])
                 bi += m
-            else:
-                paths.append(gen_paths[gi])
-                gi += 1
     rd.paths = []
-    lc = list(zip(lines[k:].tolist(), cols[k:].tolist(), strict=True))
+    lc = list(zip(lines.tolist(), cols.tolist(), strict=True))
     warnings = []
     for (off, msg), (line, col) in zip(rd._warn, lc, strict=True):
         if off < 0:
