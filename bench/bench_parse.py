@@ -94,8 +94,9 @@ same classes. Minimal inputs that reproduce each are given so they can be re-che
    starts at (2500,2700) where theirs starts at (4080.4,2700), the end of "RIGHT OF POINT".
    HP-GL does move the pen to the end of the label, so here ezhpgl was right (bug 3 below).
    Since issue 20 we move the pen over the label too (character cell from SI/SR or the
-   default size, CR/LF, DI/DR) but do not apply the label origin LO, so lo.hp still
-   differs (tests/test_hpgl_ezhpgl.py checks it within 10 %).
+   default size, CR/LF, DI/DR) and apply the label origin LO (after LO4-9/14-19 the pen
+   position before LB is restored, PCL5-II 23-65), so lo.hp agrees within 1 % in length
+   and extent (tests/test_hpgl_ezhpgl.py).
    Neither parser draws letters: ezhpgl returns labels as glyph boxes in a substitute font
    (TEXT_APPROXIMATION, "labels" column), and we warn that labels are not drawn.
 5. **IW clipping (input-window.hpgl 4 paths, fill.plt 25, iw.hp 1).** We cut pen-down
@@ -161,7 +162,7 @@ same classes. Minimal inputs that reproduce each are given so they can be re-che
    `(2080,2160),(2480,2160),(2480,2340),(2080,2340),(2080,2160)`. ezhpgl does it this way.
    Check: `python -c "from galvo_core.hpgl import read_file;
    print(read_file('/work/shared/corpus/plt/dgtlrift__hp2xx__pm.hp').paths[1].points)"`.
-3. **LB did not move the current pen position (fixed in issue 20, LO aside)** (class 4
+3. **LB did not move the current pen position (fixed in issue 20, LO included)** (class 4
    above; `lo.hp`). After a label,
    HP-GL leaves the pen at the end of the text, or at the carriage-return point after CR/LF.
    A following PD therefore starts there. We keep the label's start point. Fixing it needs

@@ -307,3 +307,41 @@ def test_arc_chords_follow_the_chord_angle() -> None:
     assert len(pts(d)) == 4
     np.testing.assert_allclose(pts(d)[1], [100 * math.cos(math.radians(30)),
                                            100 * math.sin(math.radians(30))])
+
+
+# ------------------------------------------------------------------ LO with LB
+CELL = 1.5 * 0.187 * 400  # the default character cell along the text (SI defaults)
+
+
+@pytest.mark.parametrize("lo", ["", "LO;", "LO1;", "LO2;", "LO3;", "LO11;", "LO12;", "LO13;",
+                                "LO21;"])
+def test_lo_left_justified_labels_leave_the_pen_at_their_end(lo: str) -> None:
+    """ch. 23, LO (PCL5-II 23-62: positions 1-9, 11-19, 21; none is LO1) and 23-65 (Table
+    23-35): with text path DV0 the label origins 1, 2, 3, 11, 12, 13 and 21 concatenate:
+    "the pen position is updated to give the normal delta X space" to the next label, so
+    PD;PR after a 3-character label draws from 3 cells further on (LO11-13 only offset the
+    letters from the pen, not where the next label starts)."""
+    d = read(f"IN;SP1;PU0,0;{lo}LBABC\x03;PD;PR100,0;")
+    np.testing.assert_allclose(pts(d), [[3 * CELL, 0], [3 * CELL + 100, 0]])
+
+
+@pytest.mark.parametrize("lo", [4, 5, 6, 7, 8, 9, 14, 15, 16, 17, 18, 19])
+def test_lo_centred_or_right_justified_labels_restore_the_pen(lo: int) -> None:
+    """ch. 23, LO (PCL5-II 23-65, rule 2): "If a non-concatenation combination is
+    specified, the pen position that existed immediately prior to the LB command is
+    restored" -- also over CR/LF in the label."""
+    d = read(f"IN;SP1;PU0,0;LO{lo};LBABC\r\nDE\x03;PD;PR100,0;")
+    np.testing.assert_allclose(pts(d), [[0, 0], [100, 0]])
+
+
+def test_lo_lasts_until_in_or_df_and_out_of_range_is_ignored() -> None:
+    """ch. 23, LO (PCL5-II 23-63): "An LO command remains in effect until another LO
+    command is executed, or the printer is initialized or set to default conditions"; a
+    position outside 1-9, 11-19, 21 is not one (ignored, with a warning)."""
+    # LO5 then LO10 (ignored): still LO5, the pen stays at 0,0 after both labels
+    d = read("IN;SP1;PU0,0;LO5;LBAB\x03LO10;LBAB\x03PD;PR100,0;")
+    np.testing.assert_allclose(pts(d), [[0, 0], [100, 0]])
+    assert any("LO10" in w.message for w in d.warnings)
+    for reset in ("IN;SP1;", "DF;"):
+        d = read(f"IN;SP1;LO5;{reset}PU0,0;LBAB\x03;PD;PR100,0;")
+        np.testing.assert_allclose(pts(d)[0], [2 * CELL, 0])

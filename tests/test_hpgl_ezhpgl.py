@@ -73,7 +73,6 @@ NO_PEN = "no SP (or SP0): ezhpgl draws nothing, as HP-GL/2 says; we draw with pe
 TWICE = "EP after FP / RA: ezhpgl gives the polygon once per command; we give one region"
 CLIPPED = "IW: we clip to the window; ezhpgl keeps the whole line and attaches the window"
 ROTATED = "RO: we rotate about the plotter origin; ezhpgl about the page corner"
-LABEL_ORIGIN = "LO: we move the pen over a label as for LO1; ezhpgl applies the label origin"
 DIFFERENT = {
     "dgtlrift__hp2xx__marr.pgl": NO_PEN,
     "drepetto__chiplotle__bird_by_brian_whitman_and_kelly_dobson.hpgl": NO_PEN,
@@ -86,7 +85,6 @@ DIFFERENT = {
     "dgtlrift__hp2xx__iw.hp": CLIPPED,
     "felixfischer__hpgl-viewer__input-window.hpgl": CLIPPED,
     "dgtlrift__hp2xx__286x192.5_qh2.hpg": ROTATED,
-    "dgtlrift__hp2xx__lo.hp": LABEL_ORIGIN,
 }
 FILES = strict_files()
 
@@ -127,5 +125,3 @@ def test_pen_down_length_and_extent_agree_with_ezhpgl(name: str) -> None:
         assert our_len < their_len and "clipped by the input window" in msgs
     elif why is ROTATED:
         assert our_len == pytest.approx(their_len, rel=0.01) and "RO" in d.commands
-    elif why is LABEL_ORIGIN:
-        assert "LO" in d.commands and our_len == pytest.approx(their_len, rel=0.10)

@@ -21,7 +21,9 @@ What it reads
   IR with two numbers moves P1 and keeps the P1-P2 distance (P2 moves along).
 * Recorded, not drawn: LT VS FS PW LA PT FT and the like; labels LB/BL/WD (skipped to their
   terminator, DT honoured; LB moves the pen over the text: SI/SR/default cell, CR/LF/BS,
-  DI/DR; LO is not applied), CO comments, SM symbols, vendor ``!XX`` commands.
+  DI/DR; after a centred or right-justified label, LO4-9 and LO14-19, the pen stays where
+  it was, as the reference restores it; DV, the text path, is taken as DV0), CO comments,
+  SM symbols, vendor ``!XX`` commands.
 * Wrappers: PCL (ESC E, ESC%#A / ESC%#B, parameterised escapes with binary data: ESC...#W
   and ESC&p#X; ESC*p#X is cursor positioning, no data), PJL
   (``@PJL ENTER LANGUAGE=HPGL2``), UEL, HP 7475A device control ESC.( ESC.I…: (also with
@@ -144,6 +146,11 @@ _PE_MESSAGES = {  # scan.PE_* problem codes -> the messages of pe.decode_pe
     3: "PE run ends with half a coordinate pair; it was dropped",
     4: "PE run ends with a flag that has no number",
 }
+#: LO positions (PCL5-II 23-62); those after which a label leaves the pen where the next
+#: label goes on, for text path DV0 (PCL5-II 23-65, Table 23-35): after the others LB
+#: restores the pen position it found
+_LABEL_ORIGINS = frozenset((*range(1, 10), *range(11, 20), 21))
+_LO_CONCATENATE = frozenset((1, 2, 3, 11, 12, 13, 21))
 _SCAN_CMDS = frozenset((b"PU", b"PD", b"PA", b"PR", b"SP"))  # what the scanner reads
 
 
@@ -326,6 +333,7 @@ class _Reader:
         self.char_size: tuple[float, float] | None = None  # SI: width, height (plotter units)
         self.char_rel: tuple[float, float] | None = None  # SR: % of P2-P1
         self.label_dir = (1.0, 0.0)  # DI/DR: unit vector of the text direction
+        self.label_origin = 1  # LO
         self.cur: list[float] = []  # current pen-down path, flat x, y (plotter units)
         self.cur_parts: list[np.ndarray] = []  # its earlier points, read by the scanner
         self.cur_offset = 0
@@ -344,6 +352,7 @@ class _Reader:
         self.char_size = None
         self.char_rel = None
         self.label_dir = (1.0, 0.0)
+        self.label_origin = 1
 
     # ------------------------------------------------------------------ units
     def to_plotter(self, x: float, y: float) -> tuple[float, float]:
@@ -1253,6 +1262,7 @@ class _Reader:
             "SR": self.cmd_sr,
             "DI": self.cmd_di,
             "DR": self.cmd_di,
+            "LO": self.cmd_lo,
         }
 
     def _move(self, mode: bool | None, down: bool | None) -> Callable[[bytes, int, str], None]:
@@ -1351,6 +1361,16 @@ class _Reader:
         r = math.hypot(run, rise)
         self.label_dir = (run / r, rise / r) if r > 0 and math.isfinite(r) else (1.0, 0.0)
 
+    def cmd_lo(self, params: bytes, off: int, mn: str) -> None:
+        """LO [position]: the label origin, 1-9, 11-19 or 21; none is LO1."""
+        v = _nums(params)
+        pos = int(v[0]) if v and math.isfinite(v[0]) else 1
+        if pos not in _LABEL_ORIGINS:
+            self.warn(off, f"LO{pos}: label origin out of range (1-9, 11-19, 21) ignored",
+                      key="lo-range")
+            return
+        self.label_origin = pos
+
     def cmd_pg(self, params: bytes, off: int, mn: str) -> None:
         self.flush()
         self.pages += 1
@@ -1427,7 +1447,9 @@ class _Reader:
     def label_advance(self, text: bytes) -> None:
         """Move the current position over ``text`` as LB does (the pen state is kept: the
         path being drawn ends at the label, the next pen-down move starts at its end)."""
-        if not text:
+        if not text or self.label_origin not in _LO_CONCATENATE:
+            # LO4-9, 14-19 (centred or right-justified labels): the pen position that
+            # existed before LB is restored
             return
         adv, line = self.char_cell()
         ux, uy = self.label_dir
