@@ -79,3 +79,22 @@ def test_memory_per_path_is_small() -> None:
         tracemalloc.stop()
     assert len(d.paths) == n
     assert held / n < 250
+
+
+def test_fp_after_ep_replaces_edges_across_blocks_and_keeps_the_order() -> None:
+    """The general reader gathers its paths into blocks of a few hundred as it reads; FP
+    after EP still replaces all of EP's edges by the rings (one region), and what was drawn
+    between them stays after the rings, in file order."""
+    def square(x: int) -> bytes:
+        return b"PA%d,0;PD%d,0,%d,10,%d,10,%d,0;PU;PM1;" % (x, x + 10, x + 10, x, x)
+
+    n = 1500  # EP's edges: far more than one block
+    data = (b"IN;SP1;PM0;" + b"".join(square(20 * k) for k in range(n))
+            + b"PM2;EP;PA0,100;PD0,200;PU;FP;")
+    d = read_bytes(data, "rings.plt")
+    assert len(d.paths) == n + 1
+    for k in (0, 511, 512, 1023, n - 1):
+        p = d.paths[k]
+        assert p.closed and p.length == pytest.approx(40.0)
+        assert p.points[0].tolist() == [20.0 * k, 0.0]
+    assert d.paths[n].points.tolist() == [[0.0, 100.0], [0.0, 200.0]]
