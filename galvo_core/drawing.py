@@ -66,6 +66,9 @@ def _frozen_points(points: object) -> np.ndarray:
 
 _NOWHERE = SourcePos(0, 0)
 _set = object.__setattr__
+_new_obj = object.__new__
+_SP_LINE = SourcePos.__dict__["line"].__set__
+_SP_COL = SourcePos.__dict__["col"].__set__
 
 
 class Path:
@@ -90,8 +93,9 @@ class Path:
     ``points``.
 
     The importer's paths share their storage: :func:`paths_from_store` makes many paths over
-    one points array in one vectorised step; such a path makes its ``points`` view the first
-    time it is read (then keeps it) and its ``start`` when asked for. Nothing else differs.
+    one points array in one vectorised step; the ``points`` views of a store's 256 paths are
+    made together the first time one of them is read (then kept), a ``start`` when asked
+    for. Nothing else differs.
     """
 
     # _points: the (N, 2) array; for a stored path unset until first read. _store: the
@@ -129,14 +133,13 @@ class Path:
 
     @property
     def points(self) -> np.ndarray:
-        try:
+        st = self._store
+        if type(st) is SourcePos:
             return self._points  # type: ignore[no-any-return]
-        except AttributeError:  # a stored path read for the first time
-            st = self._store
-            k = self._k
-            pts = st.pts[st.starts[k] : st.ends[k]]
-            _set(self, "_points", pts)
-            return pts
+        views = st.views  # a stored path: its store's views, made at the first read
+        if views is None:
+            views = st.make_views()
+        return views[self._k]  # type: ignore[no-any-return]
 
     @property
     def start(self) -> SourcePos:
@@ -144,15 +147,17 @@ class Path:
         if type(st) is SourcePos:
             return st
         k = self._k  # a stored path: its position is in the store's arrays
-        return SourcePos(int(st.lines[k]), int(st.cols[k]))
+        sp = _new_obj(SourcePos)
+        _SP_LINE(sp, st.lines.item(k))
+        _SP_COL(sp, st.cols.item(k))
+        return sp  # type: ignore[no-any-return]
 
     def __len__(self) -> int:
-        try:
+        st = self._store
+        if type(st) is SourcePos:
             return len(self._points)
-        except AttributeError:
-            st = self._store
-            k = self._k
-            return int(st.ends[k] - st.starts[k])
+        k = self._k
+        return st.ends.item(k) - st.starts.item(k)  # type: ignore[no-any-return]
 
     def __setattr__(self, name: str, value: object) -> None:
         raise FrozenInstanceError(f"cannot assign to field {name!r}")
@@ -184,7 +189,7 @@ class PathStore:
     """The shared storage of up to 256 paths (see :func:`paths_from_store`): path ``k`` is
     ``pts[starts[k]:ends[k]]`` and began at line ``lines[k]``, column ``cols[k]``."""
 
-    __slots__ = ("pts", "starts", "ends", "lines", "cols")
+    __slots__ = ("pts", "starts", "ends", "lines", "cols", "views")
 
     def __init__(self, pts: np.ndarray, starts: np.ndarray, ends: np.ndarray,
                  lines: np.ndarray, cols: np.ndarray) -> None:
@@ -193,9 +198,16 @@ class PathStore:
         self.ends = ends
         self.lines = lines
         self.cols = cols
+        self.views: list[np.ndarray] | None = None
+
+    def make_views(self) -> list[np.ndarray]:
+        """The points view of every path of the store (in one go: loops in C), kept."""
+        views = list(map(self.pts.__getitem__,
+                         map(slice, self.starts.tolist(), self.ends.tolist())))
+        self.views = views
+        return views
 
 
-_new_obj = object.__new__
 _P_PEN = Path.__dict__["pen"].__set__
 _P_CLOSED = Path.__dict__["closed"].__set__
 _P_STORE = Path.__dict__["_store"].__set__
