@@ -65,20 +65,27 @@ def test_paths_in_file_order_when_both_readers_take_part() -> None:
                       (50.0, 0.0)]
 
 
-def test_memory_per_path_is_small() -> None:
-    """20,000 two-point paths: the drawing holds well under 250 bytes per path (each path
-    with its own SourcePos and points array needed about 390)."""
+@pytest.mark.parametrize("compiled", [False, True])
+def test_memory_per_path_is_small(compiled: bool, monkeypatch) -> None:
+    """20,000 two-point paths (17 bytes of file each): the drawing holds well under 250
+    bytes per path (each path with its own SourcePos and points array needed about 390),
+    and reading it never needs more than 400 (the numpy reader of small files took 1,085:
+    its per-byte temporaries over the whole run, and re's backtracking state)."""
+    from galvo_core.hpgl import reader
+
+    monkeypatch.setattr(reader, "_use_compiled", lambda size: compiled)
     n = 20_000
     data = _many(n)
     read_bytes(data, "warm.plt")
     tracemalloc.start()
     try:
         d = read_bytes(data, "many.plt")
-        held, _peak = tracemalloc.get_traced_memory()
+        held, peak = tracemalloc.get_traced_memory()
     finally:
         tracemalloc.stop()
     assert len(d.paths) == n
     assert held / n < 250
+    assert peak / n < 400
 
 
 def test_fp_after_ep_replaces_edges_across_blocks_and_keeps_the_order() -> None:

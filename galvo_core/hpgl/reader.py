@@ -129,10 +129,13 @@ HPGL2_ONLY = frozenset("BP BR BZ CR FR LA MC MG NP PC PE PP PS PW QL RF SV TR WU
 
 # one ordinary command with its leading separators: mnemonic, parameters, optional ';'
 _CMD_RE = re.compile(rb"[\x00-\x1a\x1c-\x20;,]*([A-Za-z]{2})([^A-Za-z;\x1b]*)(;?)")
+# possessive (Python 3.11): the same runs, but re keeps no backtracking state per command
+# (the plain ``(...)+`` held about 25 bytes per byte of a run while matching it)
 _RUN_RE = re.compile(
-    rb"(?:[\x00-\x1a\x1c-\x20;,]*[Pp][UuDdAaRr][-+0-9.,;\x00-\x1a\x1c-\x20]*)+"
+    rb"(?:[\x00-\x1a\x1c-\x20;,]*+[Pp][UuDdAaRr][-+0-9.,;\x00-\x1a\x1c-\x20]*+)++"
 )
 _FAST_MIN_BYTES = 256  # shorter runs go command by command
+_FAST_PIECE_BYTES = 1 << 13  # longer runs are read in pieces of at most this size
 #: inputs from this size on are read with the compiled scanner (:mod:`.scan`, numba); smaller
 #: ones with the numpy runs of :mod:`.fastrun` -- unless numba is loaded already (the GUI,
 #: ``process``), so that ``galvo-core info small.plt`` does not pay numba's import
@@ -935,9 +938,11 @@ class _Reader:
                         while k > i and not _is_letter_or_esc(data[k]):
                             k -= 1
                         end = k - 1
-                    if end > i and end - i >= _FAST_MIN_BYTES and self._fast_run(i, end):
-                        i = end
-                        continue
+                    if end > i and end - i >= _FAST_MIN_BYTES:
+                        j = self._fast_pieces(i, end)
+                        if j > i:
+                            i = j
+                            continue
                     slow_until = rm.end()  # read this run command by command
             if m is None:
                 m = cmd_match(data, i)
@@ -1123,6 +1128,25 @@ class _Reader:
             self.pen = p
             self.emit(ch.pts[s:e].copy(), off)
         self.pen = pen
+
+    def _fast_pieces(self, start: int, end: int) -> int:
+        """Read a run with :meth:`_fast_run` in pieces of at most _FAST_PIECE_BYTES, cut
+        before a command (the numpy tokenizer's temporaries take about 60 bytes per byte of
+        what it reads at once); returns where it stopped (``start``: nothing read)."""
+        data = self.data
+        j = start
+        while j < end:
+            cut = end
+            if end - j > _FAST_PIECE_BYTES:
+                # inside a run the only letters are the P of PU/PD/PA/PR and their second
+                cut = max(data.rfind(b"P", j + 1, j + _FAST_PIECE_BYTES),
+                          data.rfind(b"p", j + 1, j + _FAST_PIECE_BYTES))
+                if cut <= j:
+                    cut = end
+            if not self._fast_run(j, cut):
+                break
+            j = cut
+        return j
 
     def _fast_run(self, start: int, end: int) -> bool:
         """Read a run of PU/PD/PA/PR commands in one vectorised step (see fastrun).
