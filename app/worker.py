@@ -132,6 +132,9 @@ def with_prepared(result: RunResult, prepared: PreparedCache | None,
         if cancel():
             raise Cancelled()
         lod = lod_bits if key in ("jumps", "hatch", "marks") else lod_units
+        if key == "kerf" and len(arr[0]) and arr[0] is arrays["fitted"][0]:
+            out[key] = out["fitted"]  # the same outline (preview.build_preview): one path
+            continue
         out[key] = prepared.get(key, arr, lod)
     return replace(result, arrays=arrays, prepared=out)
 

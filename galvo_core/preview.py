@@ -203,15 +203,100 @@ def flatten_segments(segments: Sequence[tuple[str, np.ndarray]] | Segments, tol:
     return np.concatenate(chunks)
 
 
-def _seg_tuples(fp: FittedPath) -> list[tuple[str, np.ndarray]]:
-    return [(s.kind, s.points) for s in fp.segments]
+def _joined_segments(items: Sequence[tuple[np.ndarray, np.ndarray]]
+                     ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """``(ctrl, nseg, is_cubic)`` of paths given as ``(is_cubic, points)`` arrays (the
+    shared-points form of :class:`FittedPath` and :class:`Segments`, each with at least one
+    segment): ``ctrl`` (S, 4, 2) every segment's control points, a line as the cubic with
+    its inner points at thirds (the same straight line: B(t) = P0 + t (P3 - P0)); ``nseg``
+    (P,) the segments of each path; ``is_cubic`` (S,). No Python work per segment."""
+    kinds = [k for k, _ in items]
+    nseg = np.fromiter(map(len, kinds), dtype=np.int64, count=len(items))
+    is_cubic = np.concatenate(kinds).astype(bool)
+    allc = np.asarray(np.concatenate([pt for _, pt in items]), dtype=np.float64)
+    step = np.where(is_cubic, 3, 1)
+    # a path's points: its start, then 1 per line and 3 per cubic; so segment j's first
+    # control point is at (the steps before it) + (one start point per path up to its own)
+    path_of = np.repeat(np.arange(len(nseg)), nseg)
+    o = np.cumsum(step) - step + path_of
+    ctrl = np.empty((len(is_cubic), 4, 2))
+    c = is_cubic
+    if c.any():
+        oc = o[c]
+        ctrl[c] = np.stack([allc[oc], allc[oc + 1], allc[oc + 2], allc[oc + 3]], axis=1)
+    if not c.all():
+        ol = o[~c]
+        p0, p3 = allc[ol], allc[ol + 1]
+        d = p3 - p0
+        ctrl[~c] = np.stack((p0, p0 + d / 3.0, p0 + 2.0 * d / 3.0, p3), axis=1)
+    return ctrl, nseg, is_cubic
+
+
+@njit(cache=True, nogil=True)
+def _flatten_kernel(ctrl: np.ndarray, n: np.ndarray, row0: np.ndarray,
+                    out: np.ndarray) -> None:  # pragma: no cover - jit
+    """Segment ``s``: its points at t = j / n[s], j = 1 .. n[s] (Bernstein form: t = 1 is
+    P3 exactly) into ``out[row0[s] ..]``."""
+    for s in range(ctrl.shape[0]):
+        k = n[s]
+        r = row0[s]
+        for j in range(1, k + 1):
+            t = j / k
+            u = 1.0 - t
+            b0 = u * u * u
+            b1 = 3.0 * u * u * t
+            b2 = 3.0 * u * t * t
+            b3 = t * t * t
+            out[r + j - 1, 0] = (b0 * ctrl[s, 0, 0] + b1 * ctrl[s, 1, 0] + b2 * ctrl[s, 2, 0]
+                                 + b3 * ctrl[s, 3, 0])
+            out[r + j - 1, 1] = (b0 * ctrl[s, 0, 1] + b1 * ctrl[s, 1, 1] + b2 * ctrl[s, 2, 1]
+                                 + b3 * ctrl[s, 3, 1])
+
+
+def flatten_many(items: Sequence[tuple[np.ndarray, np.ndarray]], labels: Sequence[int],
+                 tol: float) -> Polylines:
+    """:func:`flatten_segments` of many paths at once, NaN-joined (:func:`nan_join`):
+    ``items`` the paths as ``(is_cubic, points)`` arrays, ``labels`` their ids. Each cubic
+    gets the uniform steps of :func:`galvo_core.geometry.flatten_cubic` (within ``tol``), a
+    line its end point; vectorised, the points evaluated by one compiled call."""
+    keep = [i for i, (k, _) in enumerate(items) if len(k)]
+    if not keep:
+        return Polylines()
+    items = [items[i] for i in keep]
+    lab = np.asarray([labels[i] for i in keep], dtype=np.int64)
+    ctrl, nseg, is_cubic = _joined_segments(items)
+    c = ctrl
+    d1 = np.hypot(*(c[:, 2] - 2.0 * c[:, 1] + c[:, 0]).T)
+    d2 = np.hypot(*(c[:, 3] - 2.0 * c[:, 2] + c[:, 1]).T)
+    m = 6.0 * np.maximum(d1, d2)
+    with np.errstate(invalid="ignore"):
+        n = np.ceil(np.sqrt(m / (8.0 * tol)))
+    n = np.where(is_cubic & (m > 0.0) & np.isfinite(n), n, 1.0)
+    n = np.clip(n, 1, 1_000_000).astype(np.int64)
+    # rows per path: its start point and every segment's points after the start
+    seg_csum = np.cumsum(n)
+    path_end_seg = np.cumsum(nseg) - 1
+    rows = 1 + np.diff(np.concatenate(([0], seg_csum[path_end_seg])))
+    pstart = np.concatenate(([0], np.cumsum(rows + 1)[:-1]))  # +1: the NaN row after each
+    total = int(rows.sum()) + len(rows) - 1
+    xy = np.full((total, 2), np.nan)
+    ids = np.full(total, -1, dtype=np.int64)
+    first_seg = path_end_seg - nseg + 1
+    xy[pstart] = ctrl[first_seg, 0]
+    before = seg_csum - n - np.repeat(seg_csum[first_seg] - n[first_seg], nseg)
+    row0 = np.repeat(pstart + 1, nseg) + before
+    _flatten_kernel(np.ascontiguousarray(ctrl), n, row0, xy)
+    finite = np.ones(total, dtype=bool)
+    finite[pstart[1:] - 1] = False
+    ids[finite] = np.repeat(lab, rows)
+    return Polylines(xy, ids)
 
 
 def fitted_curve(fitted: Sequence[FittedPath], tol: float) -> Polylines:
     """The fitted lines and cubics of every path as polylines (input units, cubics within
     ``tol``), ids = source_index."""
-    return nan_join((flatten_segments(_seg_tuples(fp), tol) for fp in fitted),
-                    (fp.source_index for fp in fitted))
+    return flatten_many([(fp.is_cubic, fp.points) for fp in fitted],
+                        [fp.source_index for fp in fitted], tol)
 
 
 def control_geometry(fitted: Sequence[FittedPath]) -> tuple[Polylines, np.ndarray, np.ndarray]:
@@ -350,32 +435,12 @@ def deviation_samples(
     plen = np.fromiter((len(p) for p in srcs), dtype=np.int64, count=len(srcs))
     poff = np.concatenate(([0], np.cumsum(plen)[:-1]))
     src = np.ascontiguousarray(np.concatenate(srcs), dtype=np.float64)
-    # the fits' arrays, joined: segment kinds, input ranges, shared control points
-    nseg = np.fromiter((len(fp.is_cubic) for fp in fps), dtype=np.int64, count=len(fps))
-    is_cubic = np.concatenate([fp.is_cubic for fp in fps]).astype(bool)
+    # the fits' arrays, joined: segment kinds, input ranges, control points
     first = np.concatenate([fp.first for fp in fps]).astype(np.int64)
     last = np.concatenate([fp.last for fp in fps]).astype(np.int64)
-    cpts = [np.asarray(fp.points, dtype=np.float64).reshape(-1, 2) for fp in fps]
-    clen = np.fromiter((len(c) for c in cpts), dtype=np.int64, count=len(cpts))
-    allc = np.concatenate(cpts)
-    step = np.where(is_cubic, 3, 1)
-    seg_start = np.cumsum(step) - step  # row within its path's points, per segment
-    path_first_seg = np.concatenate(([0], np.cumsum(nseg)[:-1]))
-    seg_start -= np.repeat(seg_start[path_first_seg], nseg)  # restart at each path
-    o = seg_start + np.repeat(np.concatenate(([0], np.cumsum(clen)[:-1])), nseg)
     if cancel is not None and cancel():
         raise Cancelled()
-    ctrl = np.empty((len(is_cubic), 4, 2))
-    c = is_cubic
-    if c.any():
-        oc = o[c]
-        ctrl[c] = np.stack([allc[oc], allc[oc + 1], allc[oc + 2], allc[oc + 3]], axis=1)
-    if not c.all():
-        # a line as a cubic with its inner points at thirds: B(t) = P0 + t (P3 - P0)
-        ol = o[~c]
-        p0, p3 = allc[ol], allc[ol + 1]
-        d = p3 - p0
-        ctrl[~c] = np.stack((p0, p0 + d / 3.0, p0 + 2.0 * d / 3.0, p3), axis=1)
+    ctrl, nseg, _ = _joined_segments([(fp.is_cubic, fp.points) for fp in fps])
     off = np.repeat(poff, nseg)
     npts = np.repeat(plen, nseg)
     closed = np.repeat(np.fromiter((bool(fp.closed) for fp in fps), dtype=bool,
@@ -401,8 +466,8 @@ def stroke_curves(job: Job, tol: float, kinds: Iterable[str] = ("contour",)) -> 
     within ``tol``; ids = source_index. Strokes without segments contribute nothing."""
     want = set(kinds)
     strokes = [s for s in job.strokes if s.kind in want and s.segments]
-    return nan_join((flatten_segments(s.segments, tol) for s in strokes),
-                    (s.source_index for s in strokes))
+    return flatten_many([(s.segments.is_cubic, s.segments.points) for s in strokes],
+                        [s.source_index for s in strokes], tol)
 
 
 def _all_marks(strokes: Sequence[Any]) -> tuple[np.ndarray, np.ndarray]:
@@ -498,29 +563,34 @@ def control_layer(fitted: Sequence[FittedPath]) -> tuple[np.ndarray, np.ndarray]
     (draw a marker), 0 = an anchor end of a handle line (no marker: the anchor is drawn once
     from the anchor rows), -1 = NaN separator.
     """
-    handles, anchors, _ = control_geometry(fitted)
-    hx = handles.xy
-    h_role = np.where(handles.ids >= 0, 0, -1).astype(np.int8)
-    if len(hx):
-        # pairs are (P0, P1) and (P2, P3): the inner point is the 2nd of an even pair and
-        # the 1st of an odd pair (rows are pair, NaN, pair, NaN, ...)
-        pair = np.arange(len(hx)) // 3
-        pos = np.arange(len(hx)) % 3
-        inner = ((pair % 2 == 0) & (pos == 1)) | ((pair % 2 == 1) & (pos == 0))
-        h_role[inner] = 2
+    items = [(fp.is_cubic, fp.points) for fp in fitted if len(fp.is_cubic)]
+    if not items:
+        return EMPTY, np.empty(0, dtype=np.int8)
+    ctrl, nseg, is_cubic = _joined_segments(items)
+    cub = ctrl[is_cubic]
+    nh = 6 * len(cub) - 1  # P0, P1, NaN, P2, P3, NaN per cubic, without the last NaN
+    hx = np.full((max(nh, 0), 2), np.nan)
+    h_role = np.full(max(nh, 0), -1, dtype=np.int8)
+    if len(cub):
+        for r, (k, role) in enumerate(((0, 0), (1, 2), (2, 2), (3, 0))):
+            rows = np.arange(len(cub)) * 6 + (r if r < 2 else r + 1)
+            hx[rows] = cub[:, k]
+            h_role[rows] = role
+    # anchors: each path's start, then every segment's end (each joint once)
+    last_seg = np.cumsum(nseg) - 1
+    starts = ctrl[last_seg - nseg + 1, 0]
+    pos = np.arange(len(ctrl)) + np.repeat(np.arange(len(nseg)), nseg) + 1
+    anchors = np.empty((len(ctrl) + len(nseg), 2))
+    anchors[pos] = ctrl[:, 3]
+    anchors[np.concatenate(([0], (last_seg + np.arange(len(nseg)) + 2)[:-1]))] = starts
     a = np.full((2 * len(anchors), 2), np.nan)
     a[0::2] = anchors
     a_role = np.full(len(a), -1, dtype=np.int8)
     a_role[0::2] = 1
-    parts = [x for x in (hx, a) if len(x)]
-    if not parts:
-        return EMPTY, np.empty(0, dtype=np.int8)
-    if len(parts) == 2:
-        xy = np.concatenate((hx, np.full((1, 2), np.nan), a))
-        role = np.concatenate((h_role, np.array([-1], dtype=np.int8), a_role))
-    else:
-        xy = parts[0]
-        role = h_role if len(hx) else a_role
+    if not len(hx):
+        return a, a_role
+    xy = np.concatenate((hx, np.full((1, 2), np.nan), a))
+    role = np.concatenate((h_role, np.array([-1], dtype=np.int8), a_role))
     return xy, role
 
 
@@ -779,8 +849,10 @@ def build_preview(
         c_xy, c_role = EMPTY, np.empty(0, dtype=np.int8)
         dev_a, dev_b, dev_e, dev_level = EMPTY, EMPTY, np.empty(0), np.empty(0)
 
+    # the kerf layer: the compensated outline the laser follows, which is the fitted curve
+    # of the compensated drawing (the job's contour segments): the same arrays, drawn again
     kerf_on = float(job.params.get("kerf_mm", 0.0) or 0.0) > 0.0
-    kerf = stroke_curves(job, tol_units) if kerf_on else Polylines()
+    kerf = curve if kerf_on else Polylines()
 
     marks_bits, lens = _all_marks(job.strokes)  # once for the marks and the jumps
     src = np.fromiter((s.source_index for s in job.strokes), dtype=np.int64,
