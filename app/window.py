@@ -710,6 +710,22 @@ class MainWindow(QMainWindow):
         self._update_stale()
         return gen
 
+    def request_layers(self) -> int | None:
+        """Compute the shown layers that the shown result lacks (a layer switched on) from
+        its fit, on the worker, without running the pipeline again; a full run when the
+        result is not the current drawing's with the current parameters and pens."""
+        res = self.result
+        if (res is None or res.fitted is None or res.drawing is not self.drawing
+                or res.params != self.params or not self.layers.is_current(res)
+                or self.runner.active):
+            return self.request_run()
+        from .worker import layer_task
+
+        gen = self.runner.request(layer_task(res, self.wanted_layers(), self.preview_cache,
+                                             self.prepared_cache))
+        self._update_stale()
+        return gen
+
     def gui_message(self, text: str) -> str:
         """A core message in the window's words: command-line flags (``--fit-field``)
         become the names of the controls that do the same."""
@@ -988,7 +1004,7 @@ class MainWindow(QMainWindow):
             self.simulate_at(self.sim_slider.value() / self.SIM_STEPS)
         missing = [k for k in self.wanted_layers() if not pv.has_layer(k)]
         if missing and result.job_path is None and result.fitted is not None:
-            self.request_run()  # a layer turned on while this result was computed
+            self.request_layers()  # a layer turned on while this result was computed
 
     # --- layers ---------------------------------------------------------------------------
     def set_layer_visible(self, key: str, visible: bool) -> None:
@@ -1003,7 +1019,7 @@ class MainWindow(QMainWindow):
         res = self.result
         if (visible and res is not None and not res.preview.has_layer(key)
                 and self.job_path is None and not self.runner.busy):
-            self.request_run()  # its geometry was not computed while hidden: the cache hits
+            self.request_layers()  # its geometry was not computed while hidden
 
     def layer_visible(self, key: str) -> bool:
         return self.layer_boxes[key].isChecked()

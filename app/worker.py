@@ -28,7 +28,7 @@ from galvo_core.fit import FittedPath
 from galvo_core.job import Job
 from galvo_core.params import Params
 from galvo_core.pipeline import Cancelled, Pipeline
-from galvo_core.preview import Preview, PreviewCache, build_preview
+from galvo_core.preview import Preview, PreviewCache, build_preview, with_layers
 
 Task = Callable[[Callable[[], bool]], Any]
 
@@ -183,6 +183,24 @@ def pipeline_task_safe(pipeline: Pipeline, cache: PreviewCache, drawing: Drawing
             res = RunResult(drawing, params, job, None, preview, time.perf_counter() - t0,
                             (), error=str(exc), path=path, layers=layers)
             return with_prepared(res, prepared, cancel)
+
+    return task
+
+
+def layer_task(base: RunResult, layers: frozenset[str], cache: PreviewCache,
+               prepared: PreparedCache | None = None) -> Task:
+    """The work of a layer switched on: the optional layers of ``layers`` that the shown
+    result ``base`` lacks, computed from its fit (no pipeline run); every other layer keeps
+    ``base``'s very arrays and item data, so the views redraw only the new ones."""
+
+    def task(cancel: Callable[[], bool]) -> RunResult:
+        t0 = time.perf_counter()
+        pv = with_layers(base.preview, base.drawing, base.fitted, layers, cache=cache,
+                         cancel=cancel)
+        res = replace(base, preview=pv, layers=frozenset((base.layers or frozenset())
+                                                         | layers), stages_run=("layers",))
+        res = with_prepared(res, prepared, cancel)
+        return replace(res, seconds=time.perf_counter() - t0)
 
     return task
 

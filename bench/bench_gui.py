@@ -208,10 +208,13 @@ def latency(files: list[Path], repeats: int) -> None:
         rows: list[tuple[str, Callable[[int], Callable[[], None]]]] = [
             ("e_per (fit)", lambda i: release(win, "e_per", 0.05 + 0.01 * i)),
             ("eps_line (fit)", lambda i: release(win, "eps_line", 0.06 + 0.01 * i)),
-            ("kerf_mm (kerf + fit)", lambda i: release(win, "kerf_mm", 0.02 + 0.005 * i)),
             ("magnification", lambda i, m=mag: release(win, "magnification",
                                                        round(m * (0.85 - 0.01 * i), 4))),
             ("chord_tol_bits", lambda i: release(win, "chord_tol_bits", 0.6 + 0.1 * i)),
+            ("kerf_mm (kerf + fit)", lambda i: release(win, "kerf_mm", 0.02 + 0.005 * i)),
+            # with a kerf the offset in input units follows the magnification: kerf + refit
+            ("magnification, kerf on", lambda i, m=mag: release(
+                win, "magnification", round(m * (0.80 - 0.01 * i), 4))),
             ("layer: deviation on", lambda i: toggle(win, "deviation", True)),
             ("layer: deviation off", lambda i: toggle(win, "deviation", False)),
             ("layer: control off", lambda i: toggle(win, "control", False)),
@@ -222,6 +225,9 @@ def latency(files: list[Path], repeats: int) -> None:
         print(f"  {'change':26s} {'wall ms':>9s} {'CPU ms':>8s} {'stall ms':>9s}")
         for name, make in rows:
             walls, cpus, stalls = [], [], []
+            if name.startswith("layer:") and win.params.kerf_mm:
+                win.set_param("kerf_mm", 0.0)  # the layer rows without kerf, as the first
+                assert win.wait_idle(600)
             for i in range(repeats):
                 if name.startswith("layer: deviation on"):
                     # a new fit each time, so the overlay is computed, not taken from the cache

@@ -24,7 +24,7 @@ from __future__ import annotations
 import math
 from collections import OrderedDict
 from collections.abc import Callable, Iterable, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Any
 
 import numpy as np
@@ -49,6 +49,7 @@ __all__ = [
     "control_layer",
     "deviation_samples",
     "display_tolerance",
+    "drawing_points",
     "field_outline_mm",
     "fitted_curve",
     "flatten_segments",
@@ -65,6 +66,7 @@ __all__ = [
     "stroke_curves",
     "units_to_mm",
     "warning_path",
+    "with_layers",
 ]
 
 #: Layers whose geometry is computed only when shown (``build_preview(layers=...)``).
@@ -404,6 +406,16 @@ def _deviation_kernel(src: np.ndarray, off: np.ndarray, npts: np.ndarray, closed
             prev_e = e
 
 
+def drawing_points(drawing: Drawing) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """All points of the drawing's paths in one (N, 2) float64 array, each path's point
+    count and its first row (what :func:`deviation_samples` reads; one per drawing)."""
+    pts = [p.points for p in drawing.paths]
+    n = np.fromiter(map(len, pts), dtype=np.int64, count=len(pts))
+    src = np.ascontiguousarray(np.concatenate(pts), dtype=np.float64).reshape(-1, 2) \
+        if len(pts) else EMPTY
+    return src, n, np.cumsum(n) - n
+
+
 def deviation_samples(
     drawing: Drawing,
     fitted: Sequence[FittedPath],
@@ -411,6 +423,7 @@ def deviation_samples(
     min_samples: int = 4,
     max_samples: int = 64,
     cancel: Callable[[], bool] | None = None,
+    points: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None,
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """The true error of the fit, sample by sample along the curve.
 
@@ -423,18 +436,23 @@ def deviation_samples(
 
     Compiled (numba), one call for the whole drawing: a loop over samples and the source
     points each segment replaces, so the work is about ``max_samples`` × the input points
-    at most; Python only gathers each segment's control points once.
+    at most; Python only gathers each segment's control points once. ``points``: the
+    drawing's :func:`drawing_points` when the caller keeps them (they do not change).
     """
-    fps = [fp for fp in fitted if 0 <= fp.source_index < len(drawing.paths)
-           and len(fp.is_cubic) and len(drawing.paths[fp.source_index].points)]
-    if not fps:
-        return EMPTY, EMPTY, np.empty(0)
     if cancel is not None and cancel():
         raise Cancelled()
-    srcs = [drawing.paths[fp.source_index].points for fp in fps]
-    plen = np.fromiter((len(p) for p in srcs), dtype=np.int64, count=len(srcs))
-    poff = np.concatenate(([0], np.cumsum(plen)[:-1]))
-    src = np.ascontiguousarray(np.concatenate(srcs), dtype=np.float64)
+    if points is None:
+        points = drawing_points(drawing)
+    src, all_len, all_off = points
+    si = np.fromiter((fp.source_index for fp in fitted), dtype=np.int64, count=len(fitted))
+    ns = np.fromiter((len(fp.is_cubic) for fp in fitted), dtype=np.int64, count=len(fitted))
+    ok = (si >= 0) & (si < len(all_len)) & (ns > 0)
+    ok[ok] &= all_len[si[ok]] > 0
+    keep = np.flatnonzero(ok)
+    if not len(keep):
+        return EMPTY, EMPTY, np.empty(0)
+    fps = [fitted[i] for i in keep]
+    plen, poff = all_len[si[keep]], all_off[si[keep]]
     # the fits' arrays, joined: segment kinds, input ranges, control points
     first = np.concatenate([fp.first for fp in fps]).astype(np.int64)
     last = np.concatenate([fp.last for fp in fps]).astype(np.int64)
@@ -720,7 +738,8 @@ class PreviewCache:
     """Fit-only geometry (input units) by the identity of the objects it came from (a small
     LRU; each value holds those objects, so an id cannot be reused while cached)."""
 
-    def __init__(self, size: int = 6) -> None:
+    def __init__(self, size: int = 10) -> None:
+        # one run's entries: bbox, original, points, curve, control, deviation, level
         self.size = size
         self._data: OrderedDict[tuple[Any, ...], tuple[Any, ...]] = OrderedDict()
 
@@ -765,6 +784,59 @@ def display_tolerance(job_params: dict[str, Any], drawing: Drawing | None,
     if bb is not None:
         tol = max(tol, float(np.hypot(bb[2] - bb[0], bb[3] - bb[1])) * 1e-6)
     return tol
+
+
+def _optional_layers(drawing: Drawing | None, fit_tuple: tuple[FittedPath, ...],
+                     cache: PreviewCache, cancel: Callable[[], bool] | None, e_tol: float,
+                     control: bool, deviation: bool) -> tuple[np.ndarray, ...]:
+    """``(control_xy, control_role, dev_a, dev_b, dev_err, dev_level)`` of a fit: the
+    control points when ``control``, the deviation overlay when ``deviation`` (and there is
+    a drawing), empty arrays otherwise; cached by the fit's identity."""
+    if control:
+        _, c_xy, c_role = cache.get(("control", id(fit_tuple)),
+                                    lambda: (fit_tuple, *control_layer(fit_tuple)))
+    else:
+        c_xy, c_role = EMPTY, np.empty(0, dtype=np.int8)
+    if deviation and drawing is not None:
+        def make_dev() -> tuple[Any, ...]:
+            pts = cache.get(("points", id(drawing)),
+                            lambda: (drawing, drawing_points(drawing)))[1]
+            return (fit_tuple, drawing, *deviation_samples(drawing, fit_tuple, cancel=cancel,
+                                                           points=pts))
+
+        _, _, dev_a, dev_b, dev_e = cache.get(("deviation", id(fit_tuple), id(drawing)),
+                                              make_dev)
+        (_, dev_level) = cache.get(
+            ("level", id(dev_e), e_tol),
+            lambda: (dev_e, np.clip(dev_e / e_tol, 0.0, 1.0) if e_tol > 0 else dev_e * 0.0))
+    else:
+        dev_a, dev_b, dev_e, dev_level = EMPTY, EMPTY, np.empty(0), np.empty(0)
+    return c_xy, c_role, dev_a, dev_b, dev_e, dev_level
+
+
+def with_layers(pv: Preview, drawing: Drawing | None,
+                fitted: tuple[FittedPath, ...] | None, layers: Iterable[str], *,
+                cache: PreviewCache | None = None,
+                cancel: Callable[[], bool] | None = None) -> Preview:
+    """``pv`` (a preview of ``fitted`` and ``drawing``) with the optional layers of
+    ``layers`` it lacks computed; every other array is ``pv``'s own (the same objects, so
+    the views redraw only the new layers). A layer switched on after the run."""
+    if fitted is None or pv.layers is None:
+        return pv
+    want = frozenset(layers) & OPTIONAL_LAYERS
+    missing = want - pv.layers
+    if not missing:
+        return pv
+    c_xy, c_role, dev_a, dev_b, dev_e, dev_level = _optional_layers(
+        drawing, fitted, cache if cache is not None else PreviewCache(), cancel,
+        pv.tolerance_units, "control" in missing, "deviation" in missing)
+    changes: dict[str, Any] = {"layers": frozenset(pv.layers | missing)}
+    if "control" in missing:
+        changes.update(control_xy=c_xy, control_role=c_role)
+    if "deviation" in missing:
+        changes.update(deviation_a=dev_a, deviation_b=dev_b, deviation_err=dev_e,
+                       deviation_level=dev_level)
+    return replace(pv, **changes)
 
 
 def build_preview(
@@ -825,24 +897,8 @@ def build_preview(
             return fit_tuple, drawing, curve, bbox(curve.xy)
 
         _, _, curve, c_box = cache.get(("curve", *key), make_curve)
-        if shown("control"):
-            _, c_xy, c_role = cache.get(("control", id(fit_tuple)),
-                                        lambda: (fit_tuple, *control_layer(fit_tuple)))
-        else:
-            c_xy, c_role = EMPTY, np.empty(0, dtype=np.int8)
-        if shown("deviation") and drawing is not None:
-            def make_dev() -> tuple[Any, ...]:
-                return (fit_tuple, drawing,
-                        *deviation_samples(drawing, fit_tuple, cancel=cancel))
-
-            _, _, dev_a, dev_b, dev_e = cache.get(("deviation", id(fit_tuple), id(drawing)),
-                                                  make_dev)
-            (_, dev_level) = cache.get(
-                ("level", id(dev_e), e_tol),
-                lambda: (dev_e, np.clip(dev_e / e_tol, 0.0, 1.0) if e_tol > 0
-                         else dev_e * 0.0))
-        else:
-            dev_a, dev_b, dev_e, dev_level = EMPTY, EMPTY, np.empty(0), np.empty(0)
+        c_xy, c_role, dev_a, dev_b, dev_e, dev_level = _optional_layers(
+            drawing, fit_tuple, cache, cancel, e_tol, shown("control"), shown("deviation"))
     else:
         curve = stroke_curves(job, tol_units)
         c_box = bbox(curve.xy)

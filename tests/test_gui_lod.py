@@ -51,3 +51,25 @@ def test_big_lines_get_coarse_levels_coarsest_first(qtbot):
                                                           reverse=True)
     assert levels[0][0] == pytest.approx(0.01 * LOD_FACTORS[0])
     assert LinesItem.prepare(xy[:100], lod=0.01)[-1] is None  # small layers: full only
+
+
+def test_deviation_chords_joined_into_polylines_draw_the_same_chords(qtbot):
+    """The overlay's chords of one colour bin become polylines where they follow one
+    another: the polylines' edges are exactly the chords, none lost, none added."""
+    from app.views import DeviationItem, _chain_chords
+
+    walk = dense_walk(30_001)
+    a, b = walk[:-1].copy(), walk[1:].copy()
+    b[1000] += 0.5  # a gap: the next chord does not start where this one ends
+    level = np.clip(np.abs(np.sin(np.arange(len(a)) / 700.0)), 0, 1)
+    bins = np.minimum((level * 16).astype(int), 15)
+    for k in np.unique(bins):
+        idx = np.flatnonzero(bins == k)
+        xy = _chain_chords(a[idx], b[idx], idx)
+        edges = np.isfinite(xy[:-1, 0]) & np.isfinite(xy[1:, 0])
+        got = np.hstack((xy[:-1][edges], xy[1:][edges]))
+        assert np.array_equal(got, np.hstack((a[idx], b[idx])))
+    paths, _, n, coarse = DeviationItem.prepare(a, b, level, lod=0.01)
+    assert n == len(a) and len(paths) == len(np.unique(bins))
+    assert coarse and [g for g, _ in coarse] == sorted((g for g, _ in coarse), reverse=True)
+    assert DeviationItem.prepare(a[:100], b[:100], level[:100], lod=0.01)[-1] is None

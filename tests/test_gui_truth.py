@@ -255,6 +255,30 @@ def test_deviation_is_computed_only_when_shown(win, qtbot, tmp_path):
     assert win.processed.layers["deviation"].n_chords == len(win.result.preview.deviation_err)
 
 
+def test_a_layer_switched_on_is_added_to_the_shown_result_without_a_new_run(win, qtbot,
+                                                                            tmp_path):
+    """Switching the deviation on computes that layer from the shown fit: the job, the
+    other layers' arrays (so their drawn items) and the stats stay the shown result's; a
+    parameter change after it runs the pipeline as usual."""
+    src = tmp_path / "circle.plt"
+    src.write_bytes(circle_plt())
+    win.layer_boxes["deviation"].setChecked(False)
+    assert win.load_file(src, wait=True)
+    before = win.result
+    win.layer_boxes["deviation"].setChecked(True)
+    assert win.wait_idle(60)
+    after = win.result
+    assert after is not before and after.stages_run == ("layers",)
+    assert after.job is before.job and after.fitted is before.fitted
+    assert after.preview.marks is before.preview.marks
+    assert after.preview.fitted.xy is before.preview.fitted.xy
+    assert after.prepared["marks"] is before.prepared["marks"]
+    assert after.preview.has_layer("deviation") and len(after.preview.deviation_err)
+    assert win.processed.layers["deviation"].n_chords == len(after.preview.deviation_err)
+    assert win.set_param("e_per", 0.07) and win.wait_idle(60)
+    assert "fit" in win.result.stages_run and win.result.preview.has_layer("deviation")
+
+
 def test_export_kinds_can_be_extended(win, qtbot, tmp_path):
     src = tmp_path / "circle.plt"
     src.write_bytes(circle_plt())
