@@ -1033,6 +1033,8 @@ class MainWindow(QMainWindow):
         facts when already known (computed on the worker by :meth:`load_file`)."""
         self._leave_job_mode()
         self._fit_banner = False
+        if drawing is not self.drawing:
+            self._fresh_caches()
         self.drawing = drawing
         self._drawing_bbox = bbox if bbox is not None else self.pipeline.bbox(drawing)
         if size_mm is not None:
@@ -1048,6 +1050,14 @@ class MainWindow(QMainWindow):
         self._update_title()
         self._update_status()
         self._update_stale()
+
+    def _fresh_caches(self) -> None:
+        """Empty caches for a new file: they hold the stages, display geometry and item
+        data of the drawings they were made from, so what the last file left there is
+        freed with its result (memory stays about one file's, not the session's)."""
+        self.pipeline = Pipeline()
+        self.preview_cache = PreviewCache()
+        self.prepared_cache = PreparedCache()
 
     def fit(self) -> None:
         """Zoom both (linked) views to what they show."""
@@ -1183,6 +1193,7 @@ class MainWindow(QMainWindow):
     def _show_job(self, loaded: LoadedJob) -> None:
         source, path = loaded.source, loaded.path
         self.runner.cancel()
+        self._fresh_caches()
         self.drawing = source
         self._drawing_bbox = loaded.bbox
         self.file_path = None

@@ -291,11 +291,14 @@ class _RunThread(QThread):
         self.cancel_event = threading.Event()
 
     def run(self) -> None:  # worker thread
-        # A run creates millions of small, long-lived objects (segments, arrays); a full
-        # garbage collection walking them holds the GIL for 0.3-0.7 s and freezes the GUI
-        # thread. So the collector is paused during the task, and what the task built is
-        # then frozen (gc.freeze: left out of later collections; acyclic objects are still
-        # freed by reference counting when dropped).
+        # A run creates 10^5-10^6 long-lived objects (paths, fits, strokes); a full garbage
+        # collection walking them holds the GIL for 0.2-0.5 s and freezes the GUI thread.
+        # So the collector is paused during the task, and what the task built is then
+        # frozen (gc.freeze: left out of later collections). Frozen objects are still freed
+        # by reference counting when dropped (they build no cycles: a full collection after
+        # ten big files found none of theirs), and the window empties its caches per file
+        # (MainWindow._fresh_caches), so the frozen set stays the live set: bounded by the
+        # file shown (bench/RESULTS.md, "GUI (issue 18)": memory over ten files).
         gc_on = gc.isenabled()
         gc.disable()
         try:

@@ -279,6 +279,25 @@ def test_a_layer_switched_on_is_added_to_the_shown_result_without_a_new_run(win,
     assert "fit" in win.result.stages_run and win.result.preview.has_layer("deviation")
 
 
+def test_the_previous_file_is_freed_when_the_next_one_is_shown(win, qtbot, tmp_path):
+    """Opening another file releases the last one's drawing, job and display geometry
+    (no cache, frozen garbage-collector generation or view keeps them): memory stays about
+    one file's over a session, without a collection."""
+    import gc
+    import weakref
+
+    a, b = tmp_path / "a.plt", tmp_path / "b.plt"
+    a.write_bytes(circle_plt())
+    b.write_bytes(b"IN;SP1;PU0,0;PD400,0,400,400,0,400,0,0;PU;")
+    assert win.load_file(a, wait=True)
+    refs = [weakref.ref(x) for x in (win.drawing, win.result, win.result.job,
+                                     win.result.preview)]
+    assert win.load_file(b, wait=True) and win.drawing.name == "b.plt"
+    qtbot.wait(20)
+    assert gc.isenabled()  # no collection asked for: reference counting frees them
+    assert [r() is None for r in refs] == [True] * len(refs)
+
+
 def test_export_kinds_can_be_extended(win, qtbot, tmp_path):
     src = tmp_path / "circle.plt"
     src.write_bytes(circle_plt())
