@@ -174,7 +174,7 @@ class DeviationItem(pg.GraphicsObject):
         cuts = np.flatnonzero(np.diff(sb)) + 1
         pieces = [(int(bins[idx[0]]), _chain_chords(a[idx], b[idx], idx))
                   for idx in np.split(order, cuts)]
-        paths = [(k, pg.arrayToQPath(xy[:, 0], xy[:, 1], connect="finite"))
+        paths = [(k, _qpath(xy[:, 0], xy[:, 1]))
                  for k, xy in pieces]
         levels: list[tuple[float, list]] = []
         if lod is not None and lod > 0 and len(level) >= MAX_ANTIALIAS_POINTS:
@@ -185,7 +185,7 @@ class DeviationItem(pg.GraphicsObject):
                 n = sum(len(c) for _, c in dec)
                 if n < 0.7 * prev:
                     levels.append((float(lod * f), [
-                        (k, pg.arrayToQPath(c[:, 0], c[:, 1], connect="finite"))
+                        (k, _qpath(c[:, 0], c[:, 1]))
                         for k, c in dec]))
                     prev = n
         lo = np.minimum(a.min(axis=0), b.min(axis=0))
@@ -253,6 +253,27 @@ def _chain_chords(a: np.ndarray, b: np.ndarray, idx: np.ndarray) -> np.ndarray:
     xy[brow] = b
     xy[brow[start] - 1] = a[start]
     return xy
+
+
+#: Rows per call when a big QPainterPath is built (see :func:`_qpath`).
+QPATH_CHUNK = 50_000
+
+
+def _qpath(x: np.ndarray, y: np.ndarray) -> QPainterPath:
+    """NaN-separated polylines as a QPainterPath (pyqtgraph's arrayToQPath, connect
+    "finite"), built in pieces of :data:`QPATH_CHUNK` rows: one call holds the interpreter
+    lock for its whole run (0.2-0.3 s for a million rows, the GUI thread frozen meanwhile
+    when a worker builds it); pieces of 50,000 rows hold it about 10 ms each. Each piece
+    starts with the last row of the one before, so no edge is lost."""
+    n = len(x)
+    if n <= QPATH_CHUNK:
+        return pg.arrayToQPath(x, y, connect="finite")
+    out = QPainterPath()
+    for i in range(0, n, QPATH_CHUNK):
+        lo = max(i - 1, 0)
+        out.addPath(pg.arrayToQPath(x[lo:i + QPATH_CHUNK], y[lo:i + QPATH_CHUNK],
+                                    connect="finite"))
+    return out
 
 
 def _polygon(xy: np.ndarray):
@@ -470,7 +491,7 @@ class ControlItem(_FastItem):
         handles = role[: len(xy)] != 1
         hx = xy.copy()
         hx[~handles] = np.nan
-        lines = pg.arrayToQPath(hx[:, 0], hx[:, 1], connect="finite") if len(xy) \
+        lines = _qpath(hx[:, 0], hx[:, 1]) if len(xy) \
             else QPainterPath()
         anchors, knots = xy[role == 1], xy[role == 2]
         coarse = None
@@ -487,7 +508,7 @@ class ControlItem(_FastItem):
                 if len(long_):
                     px = np.full((3 * len(long_), 2), np.nan)
                     px[0::3], px[1::3] = xy[long_], xy[long_ + 1]
-                    c_lines = pg.arrayToQPath(px[:-1, 0], px[:-1, 1], connect="finite")
+                    c_lines = _qpath(px[:-1, 0], px[:-1, 1])
                 else:
                     c_lines = QPainterPath()
                 coarse.append((float(g), c_lines, _one_per_cell(anchors, g),
@@ -558,15 +579,14 @@ class LinesItem(_FastItem):
         n = int(finite.sum())
         if not n:
             return xy, QPainterPath(), QRectF(), 0, None
-        path = pg.arrayToQPath(xy[:, 0], xy[:, 1], connect="finite")
+        path = _qpath(xy[:, 0], xy[:, 1])
         levels: list[tuple[float, QPainterPath]] = []
         if lod is not None and lod > 0 and n >= MAX_ANTIALIAS_POINTS:
             prev = len(xy)
             for f in LOD_FACTORS[::-1]:  # finest first: each level from the full data
                 c = decimate(xy, lod * f)
                 if len(c) < 0.7 * prev:
-                    levels.append((float(lod * f), pg.arrayToQPath(c[:, 0], c[:, 1],
-                                                                   connect="finite")))
+                    levels.append((float(lod * f), _qpath(c[:, 0], c[:, 1])))
                     prev = len(c)
         return xy, path, _finite_rect(xy[finite]), n, levels[::-1] or None
 

@@ -282,16 +282,17 @@ def flatten_many(items: Sequence[tuple[np.ndarray, np.ndarray]], labels: Sequenc
     pstart = np.concatenate(([0], np.cumsum(rows + 1)[:-1]))  # +1: the NaN row after each
     total = int(rows.sum()) + len(rows) - 1
     xy = np.full((total, 2), np.nan)
-    ids = np.full(total, -1, dtype=np.int64)
     first_seg = path_end_seg - nseg + 1
     xy[pstart] = ctrl[first_seg, 0]
     before = seg_csum - n - np.repeat(seg_csum[first_seg] - n[first_seg], nseg)
     row0 = np.repeat(pstart + 1, nseg) + before
     _flatten_kernel(np.ascontiguousarray(ctrl), n, row0, xy)
-    finite = np.ones(total, dtype=bool)
-    finite[pstart[1:] - 1] = False
-    ids[finite] = np.repeat(lab, rows)
-    return Polylines(xy, ids)
+    # ids: each path's label over its rows, -1 on the NaN row after it (one repeat)
+    vals = np.full(2 * len(rows) - 1, -1, dtype=np.int64)
+    vals[0::2] = lab
+    reps = np.ones(2 * len(rows) - 1, dtype=np.int64)
+    reps[0::2] = rows
+    return Polylines(xy, np.repeat(vals, reps))
 
 
 def fitted_curve(fitted: Sequence[FittedPath], tol: float) -> Polylines:

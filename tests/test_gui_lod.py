@@ -73,3 +73,29 @@ def test_deviation_chords_joined_into_polylines_draw_the_same_chords(qtbot):
     assert n == len(a) and len(paths) == len(np.unique(bins))
     assert coarse and [g for g, _ in coarse] == sorted((g for g, _ in coarse), reverse=True)
     assert DeviationItem.prepare(a[:100], b[:100], level[:100], lod=0.01)[-1] is None
+
+
+def _edges(path) -> set:
+    out, prev = set(), None
+    for i in range(path.elementCount()):
+        e = path.elementAt(i)
+        if e.isLineTo():
+            out.add((prev, (e.x, e.y)))
+        prev = (e.x, e.y)
+    return out
+
+
+def test_big_paths_built_in_pieces_have_the_same_edges(qtbot, monkeypatch):
+    """A big QPainterPath is built in pieces (the worker releases the interpreter lock
+    between them): the same line segments as one call, at every piece boundary too."""
+    import pyqtgraph as pg
+
+    from app import views
+
+    xy = dense_walk(5_000)
+    xy[::37] = np.nan
+    xy[999] = np.nan  # a NaN row at a piece boundary
+    monkeypatch.setattr(views, "QPATH_CHUNK", 500)
+    whole = pg.arrayToQPath(xy[:, 0], xy[:, 1], connect="finite")
+    pieces = views._qpath(xy[:, 0], xy[:, 1])
+    assert _edges(pieces) == _edges(whole) and len(_edges(whole)) > 4000
