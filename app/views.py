@@ -30,6 +30,7 @@ from dataclasses import dataclass
 
 import numpy as np
 import pyqtgraph as pg
+from numba import njit
 from PySide6.QtCore import QPointF, QRectF, Qt
 from PySide6.QtGui import QColor, QImage, QPainterPath, QPen, QPixmapCache, QTransform
 from PySide6.QtWidgets import QGraphicsItem
@@ -631,10 +632,28 @@ def _one_per_cell(pts: np.ndarray, cell: float) -> np.ndarray:
     """One point per grid cell of side ``cell`` (the first of each), order kept."""
     if len(pts) < 2:
         return pts
-    c = np.floor((pts - pts.min(axis=0)) / cell).astype(np.int64)
-    key = c[:, 0] * (int(c[:, 1].max()) + 1) + c[:, 1]
+    lo = pts.min(axis=0)
+    c = np.floor((pts - lo) / cell).astype(np.int64)
+    ny = int(c[:, 1].max()) + 1
+    key = c[:, 0] * ny + c[:, 1]
+    cells = (int(c[:, 0].max()) + 1) * ny
+    if cells <= max(64 * len(pts), 20_000_000):
+        # a bitmap of the cells (20 MB at most): one pass, no sort
+        return pts[_first_in_cell(key, cells)]
     _, first = np.unique(key, return_index=True)
     return pts[np.sort(first)]
+
+
+@njit(cache=True, nogil=True)
+def _first_in_cell(key: np.ndarray, cells: int) -> np.ndarray:  # pragma: no cover - jit
+    seen = np.zeros(cells, dtype=np.bool_)
+    keep = np.zeros(len(key), dtype=np.bool_)
+    for i in range(len(key)):
+        k = key[i]
+        if not seen[k]:
+            seen[k] = True
+            keep[i] = True
+    return keep
 
 
 def decimate(xy: np.ndarray, cell: float) -> np.ndarray:
