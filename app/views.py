@@ -664,15 +664,28 @@ def decimate(xy: np.ndarray, cell: float) -> np.ndarray:
     xy = np.asarray(xy, dtype=np.float64).reshape(-1, 2)
     if len(xy) < 3:
         return xy
-    with np.errstate(invalid="ignore"):
-        c = np.floor(xy / cell)
-    same = (c[1:] == c[:-1]).all(axis=1)  # NaN rows never equal: always kept
-    keep = np.ones(len(xy), dtype=bool)
-    keep[1:] = ~same
-    nan = ~np.isfinite(xy[:, 0])
-    keep[:-1] |= nan[1:]  # the last vertex of each piece
-    keep[-1] = True
-    return xy[keep]
+    return xy[_decimate_keep(xy, float(cell))]
+
+
+@njit(cache=True, nogil=True)
+def _decimate_keep(xy: np.ndarray, cell: float) -> np.ndarray:  # pragma: no cover - jit
+    """The rows :func:`decimate` keeps (one compiled pass)."""
+    n = len(xy)
+    keep = np.ones(n, dtype=np.bool_)
+    px = np.floor(xy[0, 0] / cell)
+    py = np.floor(xy[0, 1] / cell)
+    for i in range(1, n):
+        cx = np.floor(xy[i, 0] / cell)
+        cy = np.floor(xy[i, 1] / cell)
+        if cx == px and cy == py:  # NaN rows never equal: always kept
+            keep[i] = False
+        px = cx
+        py = cy
+    for i in range(n - 1):
+        if not np.isfinite(xy[i + 1, 0]):  # the last vertex of each piece
+            keep[i] = True
+    keep[n - 1] = True
+    return keep
 
 
 def prepare_layer(key: str, *arrays: np.ndarray, lod: float | None = None) -> tuple:
