@@ -39,6 +39,7 @@ from galvo_core.pipeline import Cancelled
 
 __all__ = [
     "EMPTY",
+    "FitArrays",
     "Preview",
     "PreviewCache",
     "Polylines",
@@ -51,6 +52,7 @@ __all__ = [
     "display_tolerance",
     "drawing_points",
     "field_outline_mm",
+    "fit_arrays",
     "fitted_curve",
     "flatten_segments",
     "hatch_polylines",
@@ -234,6 +236,35 @@ def _joined_segments(items: Sequence[tuple[np.ndarray, np.ndarray]]
     return ctrl, nseg, is_cubic
 
 
+@dataclass(frozen=True, eq=False)
+class FitArrays:
+    """A fit's paths with segments, joined once (what the curve, the control points and
+    the deviation overlay all read; cached per fit by :func:`build_preview`): ``index``
+    the positions in the fit of the paths with segments, then :func:`_joined_segments`
+    (``ctrl``, ``nseg``, ``is_cubic``) and every segment's input range (``first``,
+    ``last``)."""
+
+    index: np.ndarray
+    ctrl: np.ndarray
+    nseg: np.ndarray
+    is_cubic: np.ndarray
+    first: np.ndarray
+    last: np.ndarray
+
+
+def fit_arrays(fitted: Sequence[FittedPath]) -> FitArrays | None:
+    """:class:`FitArrays` of ``fitted``, None when no path has a segment."""
+    index = np.asarray([i for i, fp in enumerate(fitted) if len(fp.is_cubic)],
+                       dtype=np.int64)
+    if not len(index):
+        return None
+    fps = [fitted[i] for i in index]
+    ctrl, nseg, is_cubic = _joined_segments([(fp.is_cubic, fp.points) for fp in fps])
+    first = np.concatenate([fp.first for fp in fps]).astype(np.int64)
+    last = np.concatenate([fp.last for fp in fps]).astype(np.int64)
+    return FitArrays(index, ctrl, nseg, is_cubic, first, last)
+
+
 @njit(cache=True, nogil=True)
 def _flatten_kernel(ctrl: np.ndarray, n: np.ndarray, row0: np.ndarray,
                     out: np.ndarray) -> None:  # pragma: no cover - jit
@@ -264,9 +295,15 @@ def flatten_many(items: Sequence[tuple[np.ndarray, np.ndarray]], labels: Sequenc
     keep = [i for i, (k, _) in enumerate(items) if len(k)]
     if not keep:
         return Polylines()
-    items = [items[i] for i in keep]
     lab = np.asarray([labels[i] for i in keep], dtype=np.int64)
-    ctrl, nseg, is_cubic = _joined_segments(items)
+    ctrl, nseg, is_cubic = _joined_segments([items[i] for i in keep])
+    return _flatten_joined(ctrl, nseg, is_cubic, lab, tol)
+
+
+def _flatten_joined(ctrl: np.ndarray, nseg: np.ndarray, is_cubic: np.ndarray,
+                    lab: np.ndarray, tol: float) -> Polylines:
+    """:func:`flatten_many` of joined segments (:func:`_joined_segments`), ``lab`` the
+    paths' ids."""
     c = ctrl
     d1 = np.hypot(*(c[:, 2] - 2.0 * c[:, 1] + c[:, 0]).T)
     d2 = np.hypot(*(c[:, 3] - 2.0 * c[:, 2] + c[:, 1]).T)
@@ -295,11 +332,16 @@ def flatten_many(items: Sequence[tuple[np.ndarray, np.ndarray]], labels: Sequenc
     return Polylines(xy, np.repeat(vals, reps))
 
 
-def fitted_curve(fitted: Sequence[FittedPath], tol: float) -> Polylines:
+def fitted_curve(fitted: Sequence[FittedPath], tol: float,
+                 arrays: FitArrays | None = None) -> Polylines:
     """The fitted lines and cubics of every path as polylines (input units, cubics within
-    ``tol``), ids = source_index."""
-    return flatten_many([(fp.is_cubic, fp.points) for fp in fitted],
-                        [fp.source_index for fp in fitted], tol)
+    ``tol``), ids = source_index. ``arrays``: the fit's :func:`fit_arrays`, when kept."""
+    fa = arrays if arrays is not None else fit_arrays(fitted)
+    if fa is None:
+        return Polylines()
+    lab = np.fromiter((fitted[i].source_index for i in fa.index), dtype=np.int64,
+                      count=len(fa.index))
+    return _flatten_joined(fa.ctrl, fa.nseg, fa.is_cubic, lab, tol)
 
 
 def control_geometry(fitted: Sequence[FittedPath]) -> tuple[Polylines, np.ndarray, np.ndarray]:
@@ -425,6 +467,7 @@ def deviation_samples(
     max_samples: int = 64,
     cancel: Callable[[], bool] | None = None,
     points: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None,
+    arrays: FitArrays | None = None,
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """The true error of the fit, sample by sample along the curve.
 
@@ -438,7 +481,8 @@ def deviation_samples(
     Compiled (numba), one call for the whole drawing: a loop over samples and the source
     points each segment replaces, so the work is about ``max_samples`` × the input points
     at most; Python only gathers each segment's control points once. ``points``: the
-    drawing's :func:`drawing_points` when the caller keeps them (they do not change).
+    drawing's :func:`drawing_points` when the caller keeps them (they do not change);
+    ``arrays`` the fit's :func:`fit_arrays` likewise.
     """
     if cancel is not None and cancel():
         raise Cancelled()
@@ -455,11 +499,12 @@ def deviation_samples(
     fps = [fitted[i] for i in keep]
     plen, poff = all_len[si[keep]], all_off[si[keep]]
     # the fits' arrays, joined: segment kinds, input ranges, control points
-    first = np.concatenate([fp.first for fp in fps]).astype(np.int64)
-    last = np.concatenate([fp.last for fp in fps]).astype(np.int64)
+    if arrays is None or not np.array_equal(arrays.index, keep):
+        arrays = fit_arrays(fps)
+        assert arrays is not None
+    ctrl, nseg, first, last = arrays.ctrl, arrays.nseg, arrays.first, arrays.last
     if cancel is not None and cancel():
         raise Cancelled()
-    ctrl, nseg, _ = _joined_segments([(fp.is_cubic, fp.points) for fp in fps])
     off = np.repeat(poff, nseg)
     npts = np.repeat(plen, nseg)
     closed = np.repeat(np.fromiter((bool(fp.closed) for fp in fps), dtype=bool,
@@ -573,7 +618,8 @@ def path_for_position(drawing: Drawing, line: int, col: int) -> int | None:
 
 
 # ------------------------------------------------------------------ the whole preview
-def control_layer(fitted: Sequence[FittedPath]) -> tuple[np.ndarray, np.ndarray]:
+def control_layer(fitted: Sequence[FittedPath], arrays: FitArrays | None = None
+                  ) -> tuple[np.ndarray, np.ndarray]:
     """The control points and handle lines as ONE NaN-separated array for one plot item.
 
     Returns ``(xy, role)``: rows ``P0, P1, NaN, P2, P3, NaN`` per cubic (the handle lines)
@@ -582,10 +628,10 @@ def control_layer(fitted: Sequence[FittedPath]) -> tuple[np.ndarray, np.ndarray]
     (draw a marker), 0 = an anchor end of a handle line (no marker: the anchor is drawn once
     from the anchor rows), -1 = NaN separator.
     """
-    items = [(fp.is_cubic, fp.points) for fp in fitted if len(fp.is_cubic)]
-    if not items:
+    fa = arrays if arrays is not None else fit_arrays(fitted)
+    if fa is None:
         return EMPTY, np.empty(0, dtype=np.int8)
-    ctrl, nseg, is_cubic = _joined_segments(items)
+    ctrl, nseg, is_cubic = fa.ctrl, fa.nseg, fa.is_cubic
     cub = ctrl[is_cubic]
     nh = 6 * len(cub) - 1  # P0, P1, NaN, P2, P3, NaN per cubic, without the last NaN
     hx = np.full((max(nh, 0), 2), np.nan)
@@ -739,8 +785,9 @@ class PreviewCache:
     """Fit-only geometry (input units) by the identity of the objects it came from (a small
     LRU; each value holds those objects, so an id cannot be reused while cached)."""
 
-    def __init__(self, size: int = 10) -> None:
-        # one run's entries: bbox, original, points, curve, control, deviation, level
+    def __init__(self, size: int = 12) -> None:
+        # one run's entries: bbox, original, points, fit arrays, curve, control, deviation,
+        # level
         self.size = size
         self._data: OrderedDict[tuple[Any, ...], tuple[Any, ...]] = OrderedDict()
 
@@ -793,9 +840,13 @@ def _optional_layers(drawing: Drawing | None, fit_tuple: tuple[FittedPath, ...],
     """``(control_xy, control_role, dev_a, dev_b, dev_err, dev_level)`` of a fit: the
     control points when ``control``, the deviation overlay when ``deviation`` (and there is
     a drawing), empty arrays otherwise; cached by the fit's identity."""
+    def fa() -> FitArrays | None:
+        return cache.get(("fit arrays", id(fit_tuple)),
+                         lambda: (fit_tuple, fit_arrays(fit_tuple)))[1]
+
     if control:
         _, c_xy, c_role = cache.get(("control", id(fit_tuple)),
-                                    lambda: (fit_tuple, *control_layer(fit_tuple)))
+                                    lambda: (fit_tuple, *control_layer(fit_tuple, fa())))
     else:
         c_xy, c_role = EMPTY, np.empty(0, dtype=np.int8)
     if deviation and drawing is not None:
@@ -803,7 +854,7 @@ def _optional_layers(drawing: Drawing | None, fit_tuple: tuple[FittedPath, ...],
             pts = cache.get(("points", id(drawing)),
                             lambda: (drawing, drawing_points(drawing)))[1]
             return (fit_tuple, drawing, *deviation_samples(drawing, fit_tuple, cancel=cancel,
-                                                           points=pts))
+                                                           points=pts, arrays=fa()))
 
         _, _, dev_a, dev_b, dev_e = cache.get(("deviation", id(fit_tuple), id(drawing)),
                                               make_dev)
@@ -894,7 +945,9 @@ def build_preview(
         key = (id(fit_tuple), id(drawing), round(tol_units, 12))
 
         def make_curve() -> tuple[Any, ...]:
-            curve = fitted_curve(fit_tuple, tol_units)
+            fa = cache.get(("fit arrays", id(fit_tuple)),
+                           lambda: (fit_tuple, fit_arrays(fit_tuple)))[1]
+            curve = fitted_curve(fit_tuple, tol_units, fa)
             return fit_tuple, drawing, curve, bbox(curve.xy)
 
         _, _, curve, c_box = cache.get(("curve", *key), make_curve)
