@@ -443,7 +443,7 @@ class PointsItem(_FastItem):
             xy = xy[np.isfinite(xy).all(axis=1)]
         levels = None
         if lod is not None and lod > 0 and len(xy) >= MAX_ANTIALIAS_POINTS:
-            levels = [(float(lod * f), _one_per_cell(xy, lod * f)) for f in LOD_FACTORS]
+            levels = _levels_per_cell(xy, lod)
         return xy, _small_polygon(xy), _finite_rect(xy), levels
 
     def setPrepared(self, prepared: tuple) -> None:  # noqa: N802
@@ -632,8 +632,19 @@ def _one_per_cell(pts: np.ndarray, cell: float) -> np.ndarray:
     """One point per grid cell of side ``cell`` (the first of each), order kept."""
     if len(pts) < 2:
         return pts
-    lo = pts.min(axis=0)
-    c = np.floor((pts - lo) / cell).astype(np.int64)
+    return _first_per_cell(pts, np.floor((pts - pts.min(axis=0)) / cell).astype(np.int64))
+
+
+def _levels_per_cell(pts: np.ndarray, cell: float) -> list[tuple[float, np.ndarray]]:
+    """``(cell * f, _one_per_cell(pts, cell * f))`` for f in :data:`LOD_FACTORS` (whole
+    numbers): the finest grid's cells computed once, a coarser one's by integer division
+    (the same cells: floor(x / (f g)) = floor(floor(x / g) / f) for x >= 0)."""
+    c = np.floor((pts - pts.min(axis=0)) / cell).astype(np.int64)
+    return [(float(cell * f), _first_per_cell(pts, c // int(f))) for f in LOD_FACTORS]
+
+
+def _first_per_cell(pts: np.ndarray, c: np.ndarray) -> np.ndarray:
+    """The first point of ``pts`` in each integer cell ``c`` (N, 2), order kept."""
     ny = int(c[:, 1].max()) + 1
     key = c[:, 0] * ny + c[:, 1]
     cells = (int(c[:, 0].max()) + 1) * ny

@@ -1807,11 +1807,14 @@ class MainWindow(QMainWindow):
                 return f"job file {job_path.name}"
             return "No file — File ▸ Open… or drop an HP-GL file onto the window"
         w, h = self._size_mm(d)
+        memo = getattr(self, "_counts_of", None)
+        if memo is None or memo[0] is not d:  # walks every path: once per drawing
+            memo = self._counts_of = (d, d.n_points, d.n_closed)
         return "   ·   ".join(
             [
                 f"{_fmt_int(len(d.paths))} paths",
-                f"{_fmt_int(d.n_points)} points",
-                f"{_fmt_int(d.n_closed)} closed",
+                f"{_fmt_int(memo[1])} points",
+                f"{_fmt_int(memo[2])} closed",
                 f"{w:.2f} × {h:.2f} mm",
                 (self.shown_name() if res is not None else self.file_name()) or "untitled",
             ]

@@ -99,3 +99,13 @@ def test_big_paths_built_in_pieces_have_the_same_edges(qtbot, monkeypatch):
     whole = pg.arrayToQPath(xy[:, 0], xy[:, 1], connect="finite")
     pieces = views._qpath(xy[:, 0], xy[:, 1])
     assert _edges(pieces) == _edges(whole) and len(_edges(whole)) > 4000
+
+
+def test_marker_levels_from_one_grid_are_one_point_per_cell_of_each():
+    from app.views import _levels_per_cell
+
+    pts = np.random.default_rng(2).uniform(-3, 7, (40_000, 2))
+    levels = _levels_per_cell(pts, 0.05)
+    assert [g for g, _ in levels] == pytest.approx([0.05 * f for f in LOD_FACTORS])
+    for g, kept in levels:
+        assert np.array_equal(kept, _one_per_cell(pts, g))
