@@ -298,6 +298,26 @@ def test_the_previous_file_is_freed_when_the_next_one_is_shown(win, qtbot, tmp_p
     assert [r() is None for r in refs] == [True] * len(refs)
 
 
+def test_stroke_by_stroke_json_of_many_strokes_is_write_jobs(tmp_path):
+    """The big-job writer encodes strokes in groups: over several groups (700 strokes) the
+    bytes are still exactly write_job's."""
+    from app import offload
+    from galvo_core.hpgl import read_bytes
+    from galvo_core.job import write_job
+    from galvo_core.params import Params
+    from galvo_core.pipeline import Pipeline
+
+    body = b"".join(b"PU%d,%d;PD%d,%d,%d,%d;" % (40 * (i % 30), 40 * (i // 30),
+                                                   40 * (i % 30) + 20, 40 * (i // 30),
+                                                   40 * (i % 30) + 20, 40 * (i // 30) + 25)
+                    for i in range(700))
+    job = Pipeline().run(read_bytes(b"IN;SP1;" + body, "many.plt"), Params(fit_field=True)).job
+    assert len(job.strokes) == 700
+    ref = tmp_path / "ref.json"
+    write_job(job, ref)
+    assert offload.job_json_bytes(job) == ref.read_bytes()
+
+
 def test_export_kinds_can_be_extended(win, qtbot, tmp_path):
     src = tmp_path / "circle.plt"
     src.write_bytes(circle_plt())
