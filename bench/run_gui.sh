@@ -18,7 +18,7 @@ TMP=$(mktemp -d)
 .venv/bin/python bench/bench_gui.py latency "$TMP/gen_150k.plt" "${FILES[@]}" "$@"
 .venv/bin/python bench/bench_gui.py stalls --points 1000000
 B="$C/straight-coding__gcode-hpgl-viewer__b_fabric_nesting.plt"
-for s in 1 2 3; do .venv/bin/python bench/gen_plt.py 400000 "$TMP/g400k_$s.plt"; done
+for s in 1 2 3; do .venv/bin/python bench/gen_plt.py 400000 "$TMP/g400k_$s.plt" "$s"; done
 .venv/bin/python bench/gen_plt.py 1000000 "$TMP/g1m.plt"
 MEM=("$TMP/g400k_1.plt" "$TMP/g400k_2.plt" "$TMP/g400k_3.plt")
 [ -f "$B" ] && MEM+=("$B")
