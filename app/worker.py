@@ -299,27 +299,32 @@ class _RunThread(QThread):
         # ten big files found none of theirs), and the window empties its caches per file
         # (MainWindow._fresh_caches), so the frozen set stays the live set: bounded by the
         # file shown (bench/RESULTS.md, "GUI (issue 18)": memory over ten files).
+        # The result is frozen before it is handed over, so the GUI thread never meets
+        # a collection over it.
         gc_on = gc.isenabled()
         gc.disable()
         try:
-            self._run_task()
+            report = self._run_task()
         finally:
             if gc_on:
                 gc.freeze()
                 gc.enable()
+        report()
 
-    def _run_task(self) -> None:
+    def _run_task(self) -> Callable[[], None]:
+        """Run the task; returns the signal emission that reports how it ended."""
+        gen = self.generation
         try:
             result = self.task(self.cancel_event.is_set)
         except Cancelled:
-            self.was_cancelled.emit(self.generation)
+            return lambda: self.was_cancelled.emit(gen)
         except GalvoError as exc:
-            self.failed.emit(self.generation, str(exc), True)
+            msg = str(exc)
+            return lambda: self.failed.emit(gen, msg, True)
         except Exception as exc:  # noqa: BLE001 - reported in the window, never a crash
-            self.failed.emit(self.generation, f"internal error: {type(exc).__name__}: {exc}",
-                             False)
-        else:
-            self.succeeded.emit(self.generation, result)
+            msg = f"internal error: {type(exc).__name__}: {exc}"
+            return lambda: self.failed.emit(gen, msg, False)
+        return lambda: self.succeeded.emit(gen, result)
 
 
 class LatestRunner(QObject):
