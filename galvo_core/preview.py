@@ -223,16 +223,23 @@ def _joined_segments(items: Sequence[tuple[np.ndarray, np.ndarray]]
     # control point is at (the steps before it) + (one start point per path up to its own)
     path_of = np.repeat(np.arange(len(nseg)), nseg)
     o = np.cumsum(step) - step + path_of
+    # one control point at a time (each numpy call short: the GUI thread gets the
+    # interpreter lock between them; one stack of a million segments held it 0.1 s)
     ctrl = np.empty((len(is_cubic), 4, 2))
-    c = is_cubic
-    if c.any():
+    c = np.flatnonzero(is_cubic)
+    if len(c):
         oc = o[c]
-        ctrl[c] = np.stack([allc[oc], allc[oc + 1], allc[oc + 2], allc[oc + 3]], axis=1)
-    if not c.all():
-        ol = o[~c]
+        for k in range(4):
+            ctrl[c, k] = allc[oc + k]
+    line = np.flatnonzero(~is_cubic)
+    if len(line):
+        ol = o[line]
         p0, p3 = allc[ol], allc[ol + 1]
         d = p3 - p0
-        ctrl[~c] = np.stack((p0, p0 + d / 3.0, p0 + 2.0 * d / 3.0, p3), axis=1)
+        ctrl[line, 0] = p0
+        ctrl[line, 1] = p0 + d / 3.0
+        ctrl[line, 2] = p0 + 2.0 * d / 3.0
+        ctrl[line, 3] = p3
     return ctrl, nseg, is_cubic
 
 
