@@ -293,6 +293,29 @@ def _flatten_kernel(ctrl: np.ndarray, n: np.ndarray, row0: np.ndarray,
                                  + b3 * ctrl[s, 3, 1])
 
 
+@njit(cache=True, nogil=True)
+def _flatten_steps(ctrl: np.ndarray, is_cubic: np.ndarray, tol: float
+                   ) -> np.ndarray:  # pragma: no cover - jit
+    """Each segment's uniform steps, as :func:`galvo_core.geometry.flatten_cubic` counts
+    them (|B''| <= 6 max|P_i - 2 P_(i+1) + P_(i+2)|, chord error <= |B''| h^2 / 8 <= tol);
+    a line 1. Compiled without the interpreter lock (a million segments: the GUI thread
+    runs meanwhile)."""
+    out = np.ones(ctrl.shape[0], dtype=np.int64)
+    for s in range(ctrl.shape[0]):
+        if not is_cubic[s]:
+            continue
+        ax = ctrl[s, 2, 0] - 2.0 * ctrl[s, 1, 0] + ctrl[s, 0, 0]
+        ay = ctrl[s, 2, 1] - 2.0 * ctrl[s, 1, 1] + ctrl[s, 0, 1]
+        bx = ctrl[s, 3, 0] - 2.0 * ctrl[s, 2, 0] + ctrl[s, 1, 0]
+        by = ctrl[s, 3, 1] - 2.0 * ctrl[s, 2, 1] + ctrl[s, 1, 1]
+        m = 6.0 * max(np.hypot(ax, ay), np.hypot(bx, by))
+        if m > 0.0:
+            k = np.ceil(np.sqrt(m / (8.0 * tol)))
+            if np.isfinite(k):
+                out[s] = int(min(max(k, 1.0), 1_000_000.0))
+    return out
+
+
 def flatten_many(items: Sequence[tuple[np.ndarray, np.ndarray]], labels: Sequence[int],
                  tol: float) -> Polylines:
     """:func:`flatten_segments` of many paths at once, NaN-joined (:func:`nan_join`):
@@ -311,14 +334,8 @@ def _flatten_joined(ctrl: np.ndarray, nseg: np.ndarray, is_cubic: np.ndarray,
                     lab: np.ndarray, tol: float) -> Polylines:
     """:func:`flatten_many` of joined segments (:func:`_joined_segments`), ``lab`` the
     paths' ids."""
-    c = ctrl
-    d1 = np.hypot(*(c[:, 2] - 2.0 * c[:, 1] + c[:, 0]).T)
-    d2 = np.hypot(*(c[:, 3] - 2.0 * c[:, 2] + c[:, 1]).T)
-    m = 6.0 * np.maximum(d1, d2)
-    with np.errstate(invalid="ignore"):
-        n = np.ceil(np.sqrt(m / (8.0 * tol)))
-    n = np.where(is_cubic & (m > 0.0) & np.isfinite(n), n, 1.0)
-    n = np.clip(n, 1, 1_000_000).astype(np.int64)
+    ctrl = np.ascontiguousarray(ctrl)
+    n = _flatten_steps(ctrl, np.ascontiguousarray(is_cubic), float(tol))
     # rows per path: its start point and every segment's points after the start
     seg_csum = np.cumsum(n)
     path_end_seg = np.cumsum(nseg) - 1
@@ -330,7 +347,7 @@ def _flatten_joined(ctrl: np.ndarray, nseg: np.ndarray, is_cubic: np.ndarray,
     xy[pstart] = ctrl[first_seg, 0]
     before = seg_csum - n - np.repeat(seg_csum[first_seg] - n[first_seg], nseg)
     row0 = np.repeat(pstart + 1, nseg) + before
-    _flatten_kernel(np.ascontiguousarray(ctrl), n, row0, xy)
+    _flatten_kernel(ctrl, n, row0, xy)
     # ids: each path's label over its rows, -1 on the NaN row after it (one repeat)
     vals = np.full(2 * len(rows) - 1, -1, dtype=np.int64)
     vals[0::2] = lab
