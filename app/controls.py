@@ -160,12 +160,12 @@ class ParamSlider(QWidget):
         self.info.setText(text)
 
     def set_position(self, pos: int, final: bool = True) -> None:
-        """Move the slider as a user would (tests, benchmark): emits moved or committed."""
-        self.slider.setSliderDown(not final)
+        """Move the slider as a user drags it (tests, benchmark): pressed, moved to ``pos``
+        (emits moved), and with ``final`` released there (emits committed once)."""
+        self.slider.setSliderDown(True)
         self.slider.setValue(pos)
         if final:
-            self.slider.setSliderDown(False)
-            self._on_released()
+            self.slider.setSliderDown(False)  # sliderReleased -> committed
 
     def _on_slider(self, pos: int) -> None:
         v = self.from_position(pos)

@@ -30,6 +30,7 @@ from dataclasses import dataclass
 
 import numpy as np
 import pyqtgraph as pg
+from numba import njit
 from PySide6.QtCore import QPointF, QRectF, Qt
 from PySide6.QtGui import QColor, QImage, QPainterPath, QPen, QPixmapCache, QTransform
 from PySide6.QtWidgets import QGraphicsItem
@@ -150,33 +151,55 @@ class DeviationItem(pg.GraphicsObject):
             pen.setCapStyle(Qt.PenCapStyle.FlatCap)
             self._pens.append(pen)
         self.n_chords = 0
+        self._coarse: list | None = None
+        #: what the last paint drew: "full" or "coarse" (tests, benchmark)
+        self.last_drawn = ""
 
     @staticmethod
-    def prepare(a: np.ndarray, b: np.ndarray, level: np.ndarray) -> tuple:
-        """The paths per colour bin and the rectangle (any thread: no item touched)."""
+    def prepare(a: np.ndarray, b: np.ndarray, level: np.ndarray,
+                lod: float | None = None) -> tuple:
+        """The paths per colour bin and the rectangle (any thread: no item touched). The
+        chords of a bin that follow one another along the curve (each starting where the
+        one before ended) are joined into polylines, one path per bin; with ``lod`` a big
+        overlay also gets coarse levels (the polylines decimated on grids of ``lod`` times
+        :data:`LOD_FACTORS`, see :func:`decimate`), drawn while a grid cell is at most
+        half a device pixel."""
         if not len(level):
-            return [], QRectF(), 0
-        bins = np.minimum((level * DEVIATION_BINS).astype(np.int64), DEVIATION_BINS - 1)
+            return [], QRectF(), 0, None
+        a = np.asarray(a, dtype=np.float64)
+        b = np.asarray(b, dtype=np.float64)
+        bins = np.minimum((np.asarray(level) * DEVIATION_BINS).astype(np.int64),
+                          DEVIATION_BINS - 1)
         order = np.argsort(bins, kind="stable")
         sb = bins[order]
         cuts = np.flatnonzero(np.diff(sb)) + 1
-        paths = []
-        for idx in np.split(order, cuts):
-            k = int(bins[idx[0]])
-            n = len(idx)
-            x = np.empty(2 * n)
-            y = np.empty(2 * n)
-            x[0::2], x[1::2] = a[idx, 0], b[idx, 0]
-            y[0::2], y[1::2] = a[idx, 1], b[idx, 1]
-            paths.append((k, pg.arrayToQPath(x, y, connect="pairs")))
+        pieces = [(int(bins[idx[0]]), _chain_chords(a[idx], b[idx], idx))
+                  for idx in np.split(order, cuts)]
+        paths = [(k, _qpath(xy[:, 0], xy[:, 1]))
+                 for k, xy in pieces]
+        levels: list[tuple[float, list]] = []
+        if lod is not None and lod > 0 and len(level) >= MAX_ANTIALIAS_POINTS:
+            # like LinesItem: finest first, a level only where it saves 30 % of the rows
+            prev = sum(len(xy) for _, xy in pieces)
+            for f in LOD_FACTORS[::-1]:
+                dec = [(k, decimate(xy, lod * f)) for k, xy in pieces]
+                n = sum(len(c) for _, c in dec)
+                if n < 0.7 * prev:
+                    levels.append((float(lod * f), [
+                        (k, _qpath(c[:, 0], c[:, 1]))
+                        for k, c in dec]))
+                    prev = n
         lo = np.minimum(a.min(axis=0), b.min(axis=0))
         hi = np.maximum(a.max(axis=0), b.max(axis=0))
-        return paths, QRectF(QPointF(lo[0], lo[1]), QPointF(hi[0], hi[1])), len(level)
+        return (paths, QRectF(QPointF(lo[0], lo[1]), QPointF(hi[0], hi[1])), len(level),
+                levels[::-1] or None)
 
     def setPrepared(self, prepared: tuple) -> None:  # noqa: N802
-        paths, rect, n = prepared
+        paths, rect, n, coarse = prepared
         self.prepareGeometryChange()
         self._paths = [(self._pens[k], path) for k, path in paths]
+        self._coarse = [(g, [(self._pens[k], path) for k, path in lv]) for g, lv in coarse] \
+            if coarse else None
         self._rect = rect
         self.n_chords = n
         self.update()
@@ -192,12 +215,66 @@ class DeviationItem(pg.GraphicsObject):
     def paint(self, p, *args) -> None:
         small = self.n_chords < MAX_ANTIALIAS_POINTS
         p.setRenderHint(p.RenderHint.Antialiasing, small)
-        for pen, path in self._paths:
-            if not small:  # a wide pen is stroked in software: thin it on big layers
-                pen = QPen(pen)
-                pen.setWidthF(2.0)
-            p.setPen(pen)
-            p.drawPath(path)
+        paths = self._paths
+        self.last_drawn = "full"
+        level = _pick_level(getattr(self, "_coarse", None), p)
+        if level is not None:
+            paths = level[1]
+            self.last_drawn = "coarse"
+        if small:
+            for pen, path in paths:
+                p.setPen(pen)
+                p.drawPath(path)
+            return
+        # a big overlay: the raster engine strokes a wide pen as polygons (10x the time of
+        # a 1-pixel line): a 2-pixel look from two 1-pixel passes one device pixel apart
+        t = p.transform()
+        thin = [(QPen(pen), path) for pen, path in paths]
+        for pen, _ in thin:
+            pen.setWidthF(1.0)
+        for d in (0.0, 1.0):
+            p.setTransform(t * QTransform.fromTranslate(d, d))
+            for pen, path in thin:
+                p.setPen(pen)
+                p.drawPath(path)
+        p.setTransform(t)
+
+
+def _chain_chords(a: np.ndarray, b: np.ndarray, idx: np.ndarray) -> np.ndarray:
+    """Chords ``a[j] -> b[j]`` (in their order; ``idx`` their rows in the whole overlay) as
+    NaN-separated polylines: a chord that starts where the one before it ended (the next
+    row of the overlay) continues its polyline, any other starts a new one."""
+    n = len(idx)
+    start = np.ones(n, dtype=bool)
+    if n > 1:
+        start[1:] = (np.diff(idx) != 1) | (a[1:] != b[:-1]).any(axis=1)
+    piece = np.cumsum(start)  # 1-based piece of each chord
+    brow = np.arange(n) + 2 * piece - 1  # rows: NaN (not before the first), a, b, b, ...
+    xy = np.full((n + 2 * int(piece[-1]) - 1, 2), np.nan)
+    xy[brow] = b
+    xy[brow[start] - 1] = a[start]
+    return xy
+
+
+#: Rows per call when a big QPainterPath is built (see :func:`_qpath`).
+QPATH_CHUNK = 50_000
+
+
+def _qpath(x: np.ndarray, y: np.ndarray) -> QPainterPath:
+    """NaN-separated polylines as a QPainterPath (pyqtgraph's arrayToQPath, connect
+    "finite"), built in pieces of :data:`QPATH_CHUNK` rows: one call holds the interpreter
+    lock for its whole run (0.2-0.3 s for a million rows, the GUI thread frozen meanwhile
+    when a worker builds it); pieces of 50,000 rows hold it about 10 ms each. Each piece
+    starts with the last row of the one before, so no edge is lost."""
+    n = len(x)
+    if n <= QPATH_CHUNK:
+        return pg.arrayToQPath(x, y, connect="finite")
+    out = QPainterPath()
+    for i in range(0, n, QPATH_CHUNK):
+        lo = max(i - 1, 0)
+        out.addPath(pg.arrayToQPath(x[lo:i + QPATH_CHUNK], y[lo:i + QPATH_CHUNK],
+                                    connect="finite"))
+    return out
 
 
 def _polygon(xy: np.ndarray):
@@ -366,7 +443,7 @@ class PointsItem(_FastItem):
             xy = xy[np.isfinite(xy).all(axis=1)]
         levels = None
         if lod is not None and lod > 0 and len(xy) >= MAX_ANTIALIAS_POINTS:
-            levels = [(float(lod * f), _one_per_cell(xy, lod * f)) for f in LOD_FACTORS]
+            levels = _levels_per_cell(xy, lod)
         return xy, _small_polygon(xy), _finite_rect(xy), levels
 
     def setPrepared(self, prepared: tuple) -> None:  # noqa: N802
@@ -415,7 +492,7 @@ class ControlItem(_FastItem):
         handles = role[: len(xy)] != 1
         hx = xy.copy()
         hx[~handles] = np.nan
-        lines = pg.arrayToQPath(hx[:, 0], hx[:, 1], connect="finite") if len(xy) \
+        lines = _qpath(hx[:, 0], hx[:, 1]) if len(xy) \
             else QPainterPath()
         anchors, knots = xy[role == 1], xy[role == 2]
         coarse = None
@@ -432,7 +509,7 @@ class ControlItem(_FastItem):
                 if len(long_):
                     px = np.full((3 * len(long_), 2), np.nan)
                     px[0::3], px[1::3] = xy[long_], xy[long_ + 1]
-                    c_lines = pg.arrayToQPath(px[:-1, 0], px[:-1, 1], connect="finite")
+                    c_lines = _qpath(px[:-1, 0], px[:-1, 1])
                 else:
                     c_lines = QPainterPath()
                 coarse.append((float(g), c_lines, _one_per_cell(anchors, g),
@@ -503,15 +580,14 @@ class LinesItem(_FastItem):
         n = int(finite.sum())
         if not n:
             return xy, QPainterPath(), QRectF(), 0, None
-        path = pg.arrayToQPath(xy[:, 0], xy[:, 1], connect="finite")
+        path = _qpath(xy[:, 0], xy[:, 1])
         levels: list[tuple[float, QPainterPath]] = []
         if lod is not None and lod > 0 and n >= MAX_ANTIALIAS_POINTS:
             prev = len(xy)
             for f in LOD_FACTORS[::-1]:  # finest first: each level from the full data
                 c = decimate(xy, lod * f)
                 if len(c) < 0.7 * prev:
-                    levels.append((float(lod * f), pg.arrayToQPath(c[:, 0], c[:, 1],
-                                                                   connect="finite")))
+                    levels.append((float(lod * f), _qpath(c[:, 0], c[:, 1])))
                     prev = len(c)
         return xy, path, _finite_rect(xy[finite]), n, levels[::-1] or None
 
@@ -556,10 +632,39 @@ def _one_per_cell(pts: np.ndarray, cell: float) -> np.ndarray:
     """One point per grid cell of side ``cell`` (the first of each), order kept."""
     if len(pts) < 2:
         return pts
+    return _first_per_cell(pts, np.floor((pts - pts.min(axis=0)) / cell).astype(np.int64))
+
+
+def _levels_per_cell(pts: np.ndarray, cell: float) -> list[tuple[float, np.ndarray]]:
+    """``(cell * f, _one_per_cell(pts, cell * f))`` for f in :data:`LOD_FACTORS` (whole
+    numbers): the finest grid's cells computed once, a coarser one's by integer division
+    (the same cells: floor(x / (f g)) = floor(floor(x / g) / f) for x >= 0)."""
     c = np.floor((pts - pts.min(axis=0)) / cell).astype(np.int64)
-    key = c[:, 0] * (int(c[:, 1].max()) + 1) + c[:, 1]
+    return [(float(cell * f), _first_per_cell(pts, c // int(f))) for f in LOD_FACTORS]
+
+
+def _first_per_cell(pts: np.ndarray, c: np.ndarray) -> np.ndarray:
+    """The first point of ``pts`` in each integer cell ``c`` (N, 2), order kept."""
+    ny = int(c[:, 1].max()) + 1
+    key = c[:, 0] * ny + c[:, 1]
+    cells = (int(c[:, 0].max()) + 1) * ny
+    if cells <= max(64 * len(pts), 20_000_000):
+        # a bitmap of the cells (20 MB at most): one pass, no sort
+        return pts[_first_in_cell(key, cells)]
     _, first = np.unique(key, return_index=True)
     return pts[np.sort(first)]
+
+
+@njit(cache=True, nogil=True)
+def _first_in_cell(key: np.ndarray, cells: int) -> np.ndarray:  # pragma: no cover - jit
+    seen = np.zeros(cells, dtype=np.bool_)
+    keep = np.zeros(len(key), dtype=np.bool_)
+    for i in range(len(key)):
+        k = key[i]
+        if not seen[k]:
+            seen[k] = True
+            keep[i] = True
+    return keep
 
 
 def decimate(xy: np.ndarray, cell: float) -> np.ndarray:
@@ -570,15 +675,28 @@ def decimate(xy: np.ndarray, cell: float) -> np.ndarray:
     xy = np.asarray(xy, dtype=np.float64).reshape(-1, 2)
     if len(xy) < 3:
         return xy
-    with np.errstate(invalid="ignore"):
-        c = np.floor(xy / cell)
-    same = (c[1:] == c[:-1]).all(axis=1)  # NaN rows never equal: always kept
-    keep = np.ones(len(xy), dtype=bool)
-    keep[1:] = ~same
-    nan = ~np.isfinite(xy[:, 0])
-    keep[:-1] |= nan[1:]  # the last vertex of each piece
-    keep[-1] = True
-    return xy[keep]
+    return xy[_decimate_keep(xy, float(cell))]
+
+
+@njit(cache=True, nogil=True)
+def _decimate_keep(xy: np.ndarray, cell: float) -> np.ndarray:  # pragma: no cover - jit
+    """The rows :func:`decimate` keeps (one compiled pass)."""
+    n = len(xy)
+    keep = np.ones(n, dtype=np.bool_)
+    px = np.floor(xy[0, 0] / cell)
+    py = np.floor(xy[0, 1] / cell)
+    for i in range(1, n):
+        cx = np.floor(xy[i, 0] / cell)
+        cy = np.floor(xy[i, 1] / cell)
+        if cx == px and cy == py:  # NaN rows never equal: always kept
+            keep[i] = False
+        px = cx
+        py = cy
+    for i in range(n - 1):
+        if not np.isfinite(xy[i + 1, 0]):  # the last vertex of each piece
+            keep[i] = True
+    keep[n - 1] = True
+    return keep
 
 
 def prepare_layer(key: str, *arrays: np.ndarray, lod: float | None = None) -> tuple:
@@ -586,7 +704,7 @@ def prepare_layer(key: str, *arrays: np.ndarray, lod: float | None = None) -> tu
     safe to call on a worker thread, then handed to :meth:`WorkView.set_layer`. ``lod``:
     the coarse grid of line layers, in the layer's units (see :meth:`LinesItem.prepare`)."""
     cls = _LAYER_CLASS[key]
-    if cls in (LinesItem, ControlItem, PointsItem):
+    if cls in (LinesItem, ControlItem, PointsItem, DeviationItem):
         return cls.prepare(*arrays, lod=lod)
     return cls.prepare(*arrays)
 

@@ -710,6 +710,22 @@ class MainWindow(QMainWindow):
         self._update_stale()
         return gen
 
+    def request_layers(self) -> int | None:
+        """Compute the shown layers that the shown result lacks (a layer switched on) from
+        its fit, on the worker, without running the pipeline again; a full run when the
+        result is not the current drawing's with the current parameters and pens."""
+        res = self.result
+        if (res is None or res.fitted is None or res.drawing is not self.drawing
+                or res.params != self.params or not self.layers.is_current(res)
+                or self.runner.active):
+            return self.request_run()
+        from .worker import layer_task
+
+        gen = self.runner.request(layer_task(res, self.wanted_layers(), self.preview_cache,
+                                             self.prepared_cache))
+        self._update_stale()
+        return gen
+
     def gui_message(self, text: str) -> str:
         """A core message in the window's words: command-line flags (``--fit-field``)
         become the names of the controls that do the same."""
@@ -988,7 +1004,7 @@ class MainWindow(QMainWindow):
             self.simulate_at(self.sim_slider.value() / self.SIM_STEPS)
         missing = [k for k in self.wanted_layers() if not pv.has_layer(k)]
         if missing and result.job_path is None and result.fitted is not None:
-            self.request_run()  # a layer turned on while this result was computed
+            self.request_layers()  # a layer turned on while this result was computed
 
     # --- layers ---------------------------------------------------------------------------
     def set_layer_visible(self, key: str, visible: bool) -> None:
@@ -1003,7 +1019,7 @@ class MainWindow(QMainWindow):
         res = self.result
         if (visible and res is not None and not res.preview.has_layer(key)
                 and self.job_path is None and not self.runner.busy):
-            self.request_run()  # its geometry was not computed while hidden: the cache hits
+            self.request_layers()  # its geometry was not computed while hidden
 
     def layer_visible(self, key: str) -> bool:
         return self.layer_boxes[key].isChecked()
@@ -1017,6 +1033,8 @@ class MainWindow(QMainWindow):
         facts when already known (computed on the worker by :meth:`load_file`)."""
         self._leave_job_mode()
         self._fit_banner = False
+        if drawing is not self.drawing:
+            self._fresh_caches()
         self.drawing = drawing
         self._drawing_bbox = bbox if bbox is not None else self.pipeline.bbox(drawing)
         if size_mm is not None:
@@ -1032,6 +1050,14 @@ class MainWindow(QMainWindow):
         self._update_title()
         self._update_status()
         self._update_stale()
+
+    def _fresh_caches(self) -> None:
+        """Empty caches for a new file: they hold the stages, display geometry and item
+        data of the drawings they were made from, so what the last file left there is
+        freed with its result (memory stays about one file's, not the session's)."""
+        self.pipeline = Pipeline()
+        self.preview_cache = PreviewCache()
+        self.prepared_cache = PreparedCache()
 
     def fit(self) -> None:
         """Zoom both (linked) views to what they show."""
@@ -1167,6 +1193,7 @@ class MainWindow(QMainWindow):
     def _show_job(self, loaded: LoadedJob) -> None:
         source, path = loaded.source, loaded.path
         self.runner.cancel()
+        self._fresh_caches()
         self.drawing = source
         self._drawing_bbox = loaded.bbox
         self.file_path = None
@@ -1780,11 +1807,14 @@ class MainWindow(QMainWindow):
                 return f"job file {job_path.name}"
             return "No file — File ▸ Open… or drop an HP-GL file onto the window"
         w, h = self._size_mm(d)
+        memo = getattr(self, "_counts_of", None)
+        if memo is None or memo[0] is not d:  # walks every path: once per drawing
+            memo = self._counts_of = (d, d.n_points, d.n_closed)
         return "   ·   ".join(
             [
                 f"{_fmt_int(len(d.paths))} paths",
-                f"{_fmt_int(d.n_points)} points",
-                f"{_fmt_int(d.n_closed)} closed",
+                f"{_fmt_int(memo[1])} points",
+                f"{_fmt_int(memo[2])} closed",
                 f"{w:.2f} × {h:.2f} mm",
                 (self.shown_name() if res is not None else self.file_name()) or "untitled",
             ]

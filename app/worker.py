@@ -28,7 +28,7 @@ from galvo_core.fit import FittedPath
 from galvo_core.job import Job
 from galvo_core.params import Params
 from galvo_core.pipeline import Cancelled, Pipeline
-from galvo_core.preview import Preview, PreviewCache, build_preview
+from galvo_core.preview import Preview, PreviewCache, build_preview, with_layers
 
 Task = Callable[[Callable[[], bool]], Any]
 
@@ -132,6 +132,9 @@ def with_prepared(result: RunResult, prepared: PreparedCache | None,
         if cancel():
             raise Cancelled()
         lod = lod_bits if key in ("jumps", "hatch", "marks") else lod_units
+        if key == "kerf" and len(arr[0]) and arr[0] is arrays["fitted"][0]:
+            out[key] = out["fitted"]  # the same outline (preview.build_preview): one path
+            continue
         out[key] = prepared.get(key, arr, lod)
     return replace(result, arrays=arrays, prepared=out)
 
@@ -180,6 +183,24 @@ def pipeline_task_safe(pipeline: Pipeline, cache: PreviewCache, drawing: Drawing
             res = RunResult(drawing, params, job, None, preview, time.perf_counter() - t0,
                             (), error=str(exc), path=path, layers=layers)
             return with_prepared(res, prepared, cancel)
+
+    return task
+
+
+def layer_task(base: RunResult, layers: frozenset[str], cache: PreviewCache,
+               prepared: PreparedCache | None = None) -> Task:
+    """The work of a layer switched on: the optional layers of ``layers`` that the shown
+    result ``base`` lacks, computed from its fit (no pipeline run); every other layer keeps
+    ``base``'s very arrays and item data, so the views redraw only the new ones."""
+
+    def task(cancel: Callable[[], bool]) -> RunResult:
+        t0 = time.perf_counter()
+        pv = with_layers(base.preview, base.drawing, base.fitted, layers, cache=cache,
+                         cancel=cancel)
+        res = replace(base, preview=pv, layers=frozenset((base.layers or frozenset())
+                                                         | layers), stages_run=("layers",))
+        res = with_prepared(res, prepared, cancel)
+        return replace(res, seconds=time.perf_counter() - t0)
 
     return task
 
@@ -270,32 +291,40 @@ class _RunThread(QThread):
         self.cancel_event = threading.Event()
 
     def run(self) -> None:  # worker thread
-        # A run creates millions of small, long-lived objects (segments, arrays); a full
-        # garbage collection walking them holds the GIL for 0.3-0.7 s and freezes the GUI
-        # thread. So the collector is paused during the task, and what the task built is
-        # then frozen (gc.freeze: left out of later collections; acyclic objects are still
-        # freed by reference counting when dropped).
+        # A run creates 10^5-10^6 long-lived objects (paths, fits, strokes); a full garbage
+        # collection walking them holds the GIL for 0.2-0.5 s and freezes the GUI thread.
+        # So the collector is paused during the task, and what the task built is then
+        # frozen (gc.freeze: left out of later collections). Frozen objects are still freed
+        # by reference counting when dropped (they build no cycles: a full collection after
+        # ten big files found none of theirs), and the window empties its caches per file
+        # (MainWindow._fresh_caches), so the frozen set stays the live set: bounded by the
+        # file shown (bench/RESULTS.md, "GUI (issue 18)": memory over ten files).
+        # The result is frozen before it is handed over, so the GUI thread never meets
+        # a collection over it.
         gc_on = gc.isenabled()
         gc.disable()
         try:
-            self._run_task()
+            report = self._run_task()
         finally:
             if gc_on:
                 gc.freeze()
                 gc.enable()
+        report()
 
-    def _run_task(self) -> None:
+    def _run_task(self) -> Callable[[], None]:
+        """Run the task; returns the signal emission that reports how it ended."""
+        gen = self.generation
         try:
             result = self.task(self.cancel_event.is_set)
         except Cancelled:
-            self.was_cancelled.emit(self.generation)
+            return lambda: self.was_cancelled.emit(gen)
         except GalvoError as exc:
-            self.failed.emit(self.generation, str(exc), True)
+            msg = str(exc)
+            return lambda: self.failed.emit(gen, msg, True)
         except Exception as exc:  # noqa: BLE001 - reported in the window, never a crash
-            self.failed.emit(self.generation, f"internal error: {type(exc).__name__}: {exc}",
-                             False)
-        else:
-            self.succeeded.emit(self.generation, result)
+            msg = f"internal error: {type(exc).__name__}: {exc}"
+            return lambda: self.failed.emit(gen, msg, False)
+        return lambda: self.succeeded.emit(gen, result)
 
 
 class LatestRunner(QObject):

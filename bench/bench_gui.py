@@ -12,9 +12,13 @@ Driven through the window's scripting surface, offscreen (software rasteriser), 
 * **stalls**: a 5 ms QTimer on the GUI thread records the largest gap between its ticks
   while a file is opened and processed, exported as a job, and the job loaded back; peak
   memory (ru_maxrss) after each phase.
+* **memory**: big files opened one after the other (a session): resident and peak memory
+  and the garbage collector's frozen objects after each, and what a full collection finds
+  at the end (memory must stay about one file's, not grow with each file opened).
 
     .venv/bin/python bench/bench_gui.py latency [FILES...] [--points 150000] [--repeats 5]
     .venv/bin/python bench/bench_gui.py stalls [--points 1000000]
+    .venv/bin/python bench/bench_gui.py memory [FILES...] [--opens 10]
 
 Without FILES, ``latency`` uses a generated ``--points`` file (bench/gen_plt.py); give the
 corpus files (``../shared/corpus/plt/...``) to measure them.
@@ -208,10 +212,13 @@ def latency(files: list[Path], repeats: int) -> None:
         rows: list[tuple[str, Callable[[int], Callable[[], None]]]] = [
             ("e_per (fit)", lambda i: release(win, "e_per", 0.05 + 0.01 * i)),
             ("eps_line (fit)", lambda i: release(win, "eps_line", 0.06 + 0.01 * i)),
-            ("kerf_mm (kerf + fit)", lambda i: release(win, "kerf_mm", 0.02 + 0.005 * i)),
             ("magnification", lambda i, m=mag: release(win, "magnification",
                                                        round(m * (0.85 - 0.01 * i), 4))),
             ("chord_tol_bits", lambda i: release(win, "chord_tol_bits", 0.6 + 0.1 * i)),
+            ("kerf_mm (kerf + fit)", lambda i: release(win, "kerf_mm", 0.02 + 0.005 * i)),
+            # with a kerf the offset in input units follows the magnification: kerf + refit
+            ("magnification, kerf on", lambda i, m=mag: release(
+                win, "magnification", round(m * (0.80 - 0.01 * i), 4))),
             ("layer: deviation on", lambda i: toggle(win, "deviation", True)),
             ("layer: deviation off", lambda i: toggle(win, "deviation", False)),
             ("layer: control off", lambda i: toggle(win, "control", False)),
@@ -222,6 +229,9 @@ def latency(files: list[Path], repeats: int) -> None:
         print(f"  {'change':26s} {'wall ms':>9s} {'CPU ms':>8s} {'stall ms':>9s}")
         for name, make in rows:
             walls, cpus, stalls = [], [], []
+            if name.startswith("layer:") and win.params.kerf_mm:
+                win.set_param("kerf_mm", 0.0)  # the layer rows without kerf, as the first
+                assert win.wait_idle(600)
             for i in range(repeats):
                 if name.startswith("layer: deviation on"):
                     # a new fit each time, so the overlay is computed, not taken from the cache
@@ -291,6 +301,44 @@ def stalls(points: int, big: Path | None) -> None:
     win.close()
 
 
+def rss_mb() -> float:
+    """The resident set size now (MB), from /proc (Linux)."""
+    with open("/proc/self/statm") as fh:
+        return int(fh.read().split()[1]) * os.sysconf("SC_PAGE_SIZE") / 1e6
+
+
+def memory(files: list[Path], opens: int) -> None:
+    """Open ``files`` in turn ``opens`` times (a session): resident and peak memory, the
+    objects in the garbage collector's frozen generation and the GUI thread's longest
+    stall after each; at the end what a full collection still finds."""
+    import gc
+
+    app, win = make_window()
+    probe = StallProbe()
+    print(machine())
+    print(f"{'#':>2s} {'file':30s} {'wall s':>6s} {'RSS MB':>7s} {'peak MB':>8s} "
+          f"{'frozen objs':>11s} {'stall ms':>8s}")
+    print(f"   (start){'':22s} {'':6s} {rss_mb():7.0f} {peak_mb():8.0f} "
+          f"{gc.get_freeze_count():11d}")
+    for i in range(opens):
+        f = files[i % len(files)]
+        probe.start()
+        t0 = time.perf_counter()
+        win.load_file(f)
+        assert win.wait_idle(1200), f
+        for _ in range(3):
+            app.processEvents()
+        gap = probe.stop()
+        print(f"{i + 1:2d} {f.name[:30]:30s} {time.perf_counter() - t0:6.1f} {rss_mb():7.0f} "
+              f"{peak_mb():8.0f} {gc.get_freeze_count():11d} {gap:8.0f}", flush=True)
+    gc.unfreeze()
+    t0 = time.perf_counter()
+    found = gc.collect()
+    print(f"then gc.unfreeze() + gc.collect(): {found} unreachable objects, "
+          f"{(time.perf_counter() - t0) * 1000:.0f} ms; RSS {rss_mb():.0f} MB")
+    win.close()
+
+
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     sub = ap.add_subparsers(dest="cmd", required=True)
@@ -301,8 +349,22 @@ def main(argv: list[str] | None = None) -> int:
     a2 = sub.add_parser("stalls")
     a2.add_argument("--points", type=int, default=1_000_000)
     a2.add_argument("--file", type=Path, default=None)
+    a3 = sub.add_parser("memory")
+    a3.add_argument("files", nargs="*", type=Path)
+    a3.add_argument("--opens", type=int, default=10)
     a = ap.parse_args(argv)
-    if a.cmd == "latency":
+    if a.cmd == "memory":
+        files = list(a.files)
+        if not files:
+            from gen_plt import generate_plt
+
+            tmp = Path(tempfile.mkdtemp(prefix="galvo-bench-"))
+            for seed, n in ((1, 400_000), (2, 400_000), (3, 1_000_000)):
+                f = tmp / f"gen_{n}_{seed}.plt"
+                f.write_bytes(generate_plt(n, seed=seed))
+                files.append(f)
+        memory(files, a.opens)
+    elif a.cmd == "latency":
         files = list(a.files)
         if not files:
             from gen_plt import generate_plt

@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # GUI benchmark (issue 18): control change -> redrawn views on a generated 150k-point file and
 # the three largest corpus files; GUI-thread stalls while a 1M-point file opens, processes,
-# exports and loads back. Prints the tables of bench/RESULTS.md, "GUI (issue 18)".
+# exports and loads back; memory over ten big files opened in a row. Prints the tables of
+# bench/RESULTS.md, "GUI (issue 18)".
 set -euo pipefail
 cd "$(dirname "$0")/.."
 export QT_QPA_PLATFORM=offscreen
@@ -16,4 +17,10 @@ TMP=$(mktemp -d)
 .venv/bin/python bench/gen_plt.py 150000 "$TMP/gen_150k.plt"
 .venv/bin/python bench/bench_gui.py latency "$TMP/gen_150k.plt" "${FILES[@]}" "$@"
 .venv/bin/python bench/bench_gui.py stalls --points 1000000
+B="$C/straight-coding__gcode-hpgl-viewer__b_fabric_nesting.plt"
+for s in 1 2 3; do .venv/bin/python bench/gen_plt.py 400000 "$TMP/g400k_$s.plt" "$s"; done
+.venv/bin/python bench/gen_plt.py 1000000 "$TMP/g1m.plt"
+MEM=("$TMP/g400k_1.plt" "$TMP/g400k_2.plt" "$TMP/g400k_3.plt")
+[ -f "$B" ] && MEM+=("$B")
+.venv/bin/python bench/bench_gui.py memory "${MEM[@]}" "$TMP/g1m.plt" --opens 10
 rm -rf "$TMP"

@@ -24,7 +24,7 @@ from __future__ import annotations
 import math
 from collections import OrderedDict
 from collections.abc import Callable, Iterable, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Any
 
 import numpy as np
@@ -39,6 +39,7 @@ from galvo_core.pipeline import Cancelled
 
 __all__ = [
     "EMPTY",
+    "FitArrays",
     "Preview",
     "PreviewCache",
     "Polylines",
@@ -49,7 +50,9 @@ __all__ = [
     "control_layer",
     "deviation_samples",
     "display_tolerance",
+    "drawing_points",
     "field_outline_mm",
+    "fit_arrays",
     "fitted_curve",
     "flatten_segments",
     "hatch_polylines",
@@ -65,6 +68,7 @@ __all__ = [
     "stroke_curves",
     "units_to_mm",
     "warning_path",
+    "with_layers",
 ]
 
 #: Layers whose geometry is computed only when shown (``build_preview(layers=...)``).
@@ -203,15 +207,165 @@ def flatten_segments(segments: Sequence[tuple[str, np.ndarray]] | Segments, tol:
     return np.concatenate(chunks)
 
 
-def _seg_tuples(fp: FittedPath) -> list[tuple[str, np.ndarray]]:
-    return [(s.kind, s.points) for s in fp.segments]
+def _joined_segments(items: Sequence[tuple[np.ndarray, np.ndarray]]
+                     ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """``(ctrl, nseg, is_cubic)`` of paths given as ``(is_cubic, points)`` arrays (the
+    shared-points form of :class:`FittedPath` and :class:`Segments`, each with at least one
+    segment): ``ctrl`` (S, 4, 2) every segment's control points, a line as the cubic with
+    its inner points at thirds (the same straight line: B(t) = P0 + t (P3 - P0)); ``nseg``
+    (P,) the segments of each path; ``is_cubic`` (S,). No Python work per segment."""
+    kinds = [k for k, _ in items]
+    nseg = np.fromiter(map(len, kinds), dtype=np.int64, count=len(items))
+    is_cubic = np.concatenate(kinds).astype(bool)
+    allc = np.asarray(np.concatenate([pt for _, pt in items]), dtype=np.float64)
+    step = np.where(is_cubic, 3, 1)
+    # a path's points: its start, then 1 per line and 3 per cubic; so segment j's first
+    # control point is at (the steps before it) + (one start point per path up to its own)
+    path_of = np.repeat(np.arange(len(nseg)), nseg)
+    o = np.cumsum(step) - step + path_of
+    # one control point at a time (each numpy call short: the GUI thread gets the
+    # interpreter lock between them; one stack of a million segments held it 0.1 s)
+    ctrl = np.empty((len(is_cubic), 4, 2))
+    c = np.flatnonzero(is_cubic)
+    if len(c):
+        oc = o[c]
+        for k in range(4):
+            ctrl[c, k] = allc[oc + k]
+    line = np.flatnonzero(~is_cubic)
+    if len(line):
+        ol = o[line]
+        p0, p3 = allc[ol], allc[ol + 1]
+        d = p3 - p0
+        ctrl[line, 0] = p0
+        ctrl[line, 1] = p0 + d / 3.0
+        ctrl[line, 2] = p0 + 2.0 * d / 3.0
+        ctrl[line, 3] = p3
+    return ctrl, nseg, is_cubic
 
 
-def fitted_curve(fitted: Sequence[FittedPath], tol: float) -> Polylines:
+@dataclass(frozen=True, eq=False)
+class FitArrays:
+    """A fit's paths with segments, joined once (what the curve, the control points and
+    the deviation overlay all read; cached per fit by :func:`build_preview`): ``index``
+    the positions in the fit of the paths with segments, then :func:`_joined_segments`
+    (``ctrl``, ``nseg``, ``is_cubic``) and every segment's input range (``first``,
+    ``last``)."""
+
+    index: np.ndarray
+    ctrl: np.ndarray
+    nseg: np.ndarray
+    is_cubic: np.ndarray
+    first: np.ndarray
+    last: np.ndarray
+
+
+def fit_arrays(fitted: Sequence[FittedPath]) -> FitArrays | None:
+    """:class:`FitArrays` of ``fitted``, None when no path has a segment."""
+    index = np.asarray([i for i, fp in enumerate(fitted) if len(fp.is_cubic)],
+                       dtype=np.int64)
+    if not len(index):
+        return None
+    fps = [fitted[i] for i in index]
+    ctrl, nseg, is_cubic = _joined_segments([(fp.is_cubic, fp.points) for fp in fps])
+    first = np.concatenate([fp.first for fp in fps]).astype(np.int64)
+    last = np.concatenate([fp.last for fp in fps]).astype(np.int64)
+    return FitArrays(index, ctrl, nseg, is_cubic, first, last)
+
+
+@njit(cache=True, nogil=True)
+def _flatten_kernel(ctrl: np.ndarray, n: np.ndarray, row0: np.ndarray,
+                    out: np.ndarray) -> None:  # pragma: no cover - jit
+    """Segment ``s``: its points at t = j / n[s], j = 1 .. n[s] (Bernstein form: t = 1 is
+    P3 exactly) into ``out[row0[s] ..]``."""
+    for s in range(ctrl.shape[0]):
+        k = n[s]
+        r = row0[s]
+        for j in range(1, k + 1):
+            t = j / k
+            u = 1.0 - t
+            b0 = u * u * u
+            b1 = 3.0 * u * u * t
+            b2 = 3.0 * u * t * t
+            b3 = t * t * t
+            out[r + j - 1, 0] = (b0 * ctrl[s, 0, 0] + b1 * ctrl[s, 1, 0] + b2 * ctrl[s, 2, 0]
+                                 + b3 * ctrl[s, 3, 0])
+            out[r + j - 1, 1] = (b0 * ctrl[s, 0, 1] + b1 * ctrl[s, 1, 1] + b2 * ctrl[s, 2, 1]
+                                 + b3 * ctrl[s, 3, 1])
+
+
+@njit(cache=True, nogil=True)
+def _flatten_steps(ctrl: np.ndarray, is_cubic: np.ndarray, tol: float
+                   ) -> np.ndarray:  # pragma: no cover - jit
+    """Each segment's uniform steps, as :func:`galvo_core.geometry.flatten_cubic` counts
+    them (|B''| <= 6 max|P_i - 2 P_(i+1) + P_(i+2)|, chord error <= |B''| h^2 / 8 <= tol);
+    a line 1. Compiled without the interpreter lock (a million segments: the GUI thread
+    runs meanwhile)."""
+    out = np.ones(ctrl.shape[0], dtype=np.int64)
+    for s in range(ctrl.shape[0]):
+        if not is_cubic[s]:
+            continue
+        ax = ctrl[s, 2, 0] - 2.0 * ctrl[s, 1, 0] + ctrl[s, 0, 0]
+        ay = ctrl[s, 2, 1] - 2.0 * ctrl[s, 1, 1] + ctrl[s, 0, 1]
+        bx = ctrl[s, 3, 0] - 2.0 * ctrl[s, 2, 0] + ctrl[s, 1, 0]
+        by = ctrl[s, 3, 1] - 2.0 * ctrl[s, 2, 1] + ctrl[s, 1, 1]
+        m = 6.0 * max(np.hypot(ax, ay), np.hypot(bx, by))
+        if m > 0.0:
+            k = np.ceil(np.sqrt(m / (8.0 * tol)))
+            if np.isfinite(k):
+                out[s] = int(min(max(k, 1.0), 1_000_000.0))
+    return out
+
+
+def flatten_many(items: Sequence[tuple[np.ndarray, np.ndarray]], labels: Sequence[int],
+                 tol: float) -> Polylines:
+    """:func:`flatten_segments` of many paths at once, NaN-joined (:func:`nan_join`):
+    ``items`` the paths as ``(is_cubic, points)`` arrays, ``labels`` their ids. Each cubic
+    gets the uniform steps of :func:`galvo_core.geometry.flatten_cubic` (within ``tol``), a
+    line its end point; vectorised, the points evaluated by one compiled call."""
+    keep = [i for i, (k, _) in enumerate(items) if len(k)]
+    if not keep:
+        return Polylines()
+    lab = np.asarray([labels[i] for i in keep], dtype=np.int64)
+    ctrl, nseg, is_cubic = _joined_segments([items[i] for i in keep])
+    return _flatten_joined(ctrl, nseg, is_cubic, lab, tol)
+
+
+def _flatten_joined(ctrl: np.ndarray, nseg: np.ndarray, is_cubic: np.ndarray,
+                    lab: np.ndarray, tol: float) -> Polylines:
+    """:func:`flatten_many` of joined segments (:func:`_joined_segments`), ``lab`` the
+    paths' ids."""
+    ctrl = np.ascontiguousarray(ctrl)
+    n = _flatten_steps(ctrl, np.ascontiguousarray(is_cubic), float(tol))
+    # rows per path: its start point and every segment's points after the start
+    seg_csum = np.cumsum(n)
+    path_end_seg = np.cumsum(nseg) - 1
+    rows = 1 + np.diff(np.concatenate(([0], seg_csum[path_end_seg])))
+    pstart = np.concatenate(([0], np.cumsum(rows + 1)[:-1]))  # +1: the NaN row after each
+    total = int(rows.sum()) + len(rows) - 1
+    xy = np.full((total, 2), np.nan)
+    first_seg = path_end_seg - nseg + 1
+    xy[pstart] = ctrl[first_seg, 0]
+    before = seg_csum - n - np.repeat(seg_csum[first_seg] - n[first_seg], nseg)
+    row0 = np.repeat(pstart + 1, nseg) + before
+    _flatten_kernel(ctrl, n, row0, xy)
+    # ids: each path's label over its rows, -1 on the NaN row after it (one repeat)
+    vals = np.full(2 * len(rows) - 1, -1, dtype=np.int64)
+    vals[0::2] = lab
+    reps = np.ones(2 * len(rows) - 1, dtype=np.int64)
+    reps[0::2] = rows
+    return Polylines(xy, np.repeat(vals, reps))
+
+
+def fitted_curve(fitted: Sequence[FittedPath], tol: float,
+                 arrays: FitArrays | None = None) -> Polylines:
     """The fitted lines and cubics of every path as polylines (input units, cubics within
-    ``tol``), ids = source_index."""
-    return nan_join((flatten_segments(_seg_tuples(fp), tol) for fp in fitted),
-                    (fp.source_index for fp in fitted))
+    ``tol``), ids = source_index. ``arrays``: the fit's :func:`fit_arrays`, when kept."""
+    fa = arrays if arrays is not None else fit_arrays(fitted)
+    if fa is None:
+        return Polylines()
+    lab = np.fromiter((fitted[i].source_index for i in fa.index), dtype=np.int64,
+                      count=len(fa.index))
+    return _flatten_joined(fa.ctrl, fa.nseg, fa.is_cubic, lab, tol)
 
 
 def control_geometry(fitted: Sequence[FittedPath]) -> tuple[Polylines, np.ndarray, np.ndarray]:
@@ -319,6 +473,16 @@ def _deviation_kernel(src: np.ndarray, off: np.ndarray, npts: np.ndarray, closed
             prev_e = e
 
 
+def drawing_points(drawing: Drawing) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """All points of the drawing's paths in one (N, 2) float64 array, each path's point
+    count and its first row (what :func:`deviation_samples` reads; one per drawing)."""
+    pts = [p.points for p in drawing.paths]
+    n = np.fromiter(map(len, pts), dtype=np.int64, count=len(pts))
+    src = np.ascontiguousarray(np.concatenate(pts), dtype=np.float64).reshape(-1, 2) \
+        if len(pts) else EMPTY
+    return src, n, np.cumsum(n) - n
+
+
 def deviation_samples(
     drawing: Drawing,
     fitted: Sequence[FittedPath],
@@ -326,6 +490,8 @@ def deviation_samples(
     min_samples: int = 4,
     max_samples: int = 64,
     cancel: Callable[[], bool] | None = None,
+    points: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None,
+    arrays: FitArrays | None = None,
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """The true error of the fit, sample by sample along the curve.
 
@@ -338,44 +504,31 @@ def deviation_samples(
 
     Compiled (numba), one call for the whole drawing: a loop over samples and the source
     points each segment replaces, so the work is about ``max_samples`` × the input points
-    at most; Python only gathers each segment's control points once.
+    at most; Python only gathers each segment's control points once. ``points``: the
+    drawing's :func:`drawing_points` when the caller keeps them (they do not change);
+    ``arrays`` the fit's :func:`fit_arrays` likewise.
     """
-    fps = [fp for fp in fitted if 0 <= fp.source_index < len(drawing.paths)
-           and len(fp.is_cubic) and len(drawing.paths[fp.source_index].points)]
-    if not fps:
+    if cancel is not None and cancel():
+        raise Cancelled()
+    if points is None:
+        points = drawing_points(drawing)
+    src, all_len, all_off = points
+    si = np.fromiter((fp.source_index for fp in fitted), dtype=np.int64, count=len(fitted))
+    ns = np.fromiter((len(fp.is_cubic) for fp in fitted), dtype=np.int64, count=len(fitted))
+    ok = (si >= 0) & (si < len(all_len)) & (ns > 0)
+    ok[ok] &= all_len[si[ok]] > 0
+    keep = np.flatnonzero(ok)
+    if not len(keep):
         return EMPTY, EMPTY, np.empty(0)
+    fps = [fitted[i] for i in keep]
+    plen, poff = all_len[si[keep]], all_off[si[keep]]
+    # the fits' arrays, joined: segment kinds, input ranges, control points
+    if arrays is None or not np.array_equal(arrays.index, keep):
+        arrays = fit_arrays(fps)
+        assert arrays is not None
+    ctrl, nseg, first, last = arrays.ctrl, arrays.nseg, arrays.first, arrays.last
     if cancel is not None and cancel():
         raise Cancelled()
-    srcs = [drawing.paths[fp.source_index].points for fp in fps]
-    plen = np.fromiter((len(p) for p in srcs), dtype=np.int64, count=len(srcs))
-    poff = np.concatenate(([0], np.cumsum(plen)[:-1]))
-    src = np.ascontiguousarray(np.concatenate(srcs), dtype=np.float64)
-    # the fits' arrays, joined: segment kinds, input ranges, shared control points
-    nseg = np.fromiter((len(fp.is_cubic) for fp in fps), dtype=np.int64, count=len(fps))
-    is_cubic = np.concatenate([fp.is_cubic for fp in fps]).astype(bool)
-    first = np.concatenate([fp.first for fp in fps]).astype(np.int64)
-    last = np.concatenate([fp.last for fp in fps]).astype(np.int64)
-    cpts = [np.asarray(fp.points, dtype=np.float64).reshape(-1, 2) for fp in fps]
-    clen = np.fromiter((len(c) for c in cpts), dtype=np.int64, count=len(cpts))
-    allc = np.concatenate(cpts)
-    step = np.where(is_cubic, 3, 1)
-    seg_start = np.cumsum(step) - step  # row within its path's points, per segment
-    path_first_seg = np.concatenate(([0], np.cumsum(nseg)[:-1]))
-    seg_start -= np.repeat(seg_start[path_first_seg], nseg)  # restart at each path
-    o = seg_start + np.repeat(np.concatenate(([0], np.cumsum(clen)[:-1])), nseg)
-    if cancel is not None and cancel():
-        raise Cancelled()
-    ctrl = np.empty((len(is_cubic), 4, 2))
-    c = is_cubic
-    if c.any():
-        oc = o[c]
-        ctrl[c] = np.stack([allc[oc], allc[oc + 1], allc[oc + 2], allc[oc + 3]], axis=1)
-    if not c.all():
-        # a line as a cubic with its inner points at thirds: B(t) = P0 + t (P3 - P0)
-        ol = o[~c]
-        p0, p3 = allc[ol], allc[ol + 1]
-        d = p3 - p0
-        ctrl[~c] = np.stack((p0, p0 + d / 3.0, p0 + 2.0 * d / 3.0, p3), axis=1)
     off = np.repeat(poff, nseg)
     npts = np.repeat(plen, nseg)
     closed = np.repeat(np.fromiter((bool(fp.closed) for fp in fps), dtype=bool,
@@ -401,8 +554,8 @@ def stroke_curves(job: Job, tol: float, kinds: Iterable[str] = ("contour",)) -> 
     within ``tol``; ids = source_index. Strokes without segments contribute nothing."""
     want = set(kinds)
     strokes = [s for s in job.strokes if s.kind in want and s.segments]
-    return nan_join((flatten_segments(s.segments, tol) for s in strokes),
-                    (s.source_index for s in strokes))
+    return flatten_many([(s.segments.is_cubic, s.segments.points) for s in strokes],
+                        [s.source_index for s in strokes], tol)
 
 
 def _all_marks(strokes: Sequence[Any]) -> tuple[np.ndarray, np.ndarray]:
@@ -489,7 +642,8 @@ def path_for_position(drawing: Drawing, line: int, col: int) -> int | None:
 
 
 # ------------------------------------------------------------------ the whole preview
-def control_layer(fitted: Sequence[FittedPath]) -> tuple[np.ndarray, np.ndarray]:
+def control_layer(fitted: Sequence[FittedPath], arrays: FitArrays | None = None
+                  ) -> tuple[np.ndarray, np.ndarray]:
     """The control points and handle lines as ONE NaN-separated array for one plot item.
 
     Returns ``(xy, role)``: rows ``P0, P1, NaN, P2, P3, NaN`` per cubic (the handle lines)
@@ -498,29 +652,34 @@ def control_layer(fitted: Sequence[FittedPath]) -> tuple[np.ndarray, np.ndarray]
     (draw a marker), 0 = an anchor end of a handle line (no marker: the anchor is drawn once
     from the anchor rows), -1 = NaN separator.
     """
-    handles, anchors, _ = control_geometry(fitted)
-    hx = handles.xy
-    h_role = np.where(handles.ids >= 0, 0, -1).astype(np.int8)
-    if len(hx):
-        # pairs are (P0, P1) and (P2, P3): the inner point is the 2nd of an even pair and
-        # the 1st of an odd pair (rows are pair, NaN, pair, NaN, ...)
-        pair = np.arange(len(hx)) // 3
-        pos = np.arange(len(hx)) % 3
-        inner = ((pair % 2 == 0) & (pos == 1)) | ((pair % 2 == 1) & (pos == 0))
-        h_role[inner] = 2
+    fa = arrays if arrays is not None else fit_arrays(fitted)
+    if fa is None:
+        return EMPTY, np.empty(0, dtype=np.int8)
+    ctrl, nseg, is_cubic = fa.ctrl, fa.nseg, fa.is_cubic
+    cub = ctrl[is_cubic]
+    nh = 6 * len(cub) - 1  # P0, P1, NaN, P2, P3, NaN per cubic, without the last NaN
+    hx = np.full((max(nh, 0), 2), np.nan)
+    h_role = np.full(max(nh, 0), -1, dtype=np.int8)
+    if len(cub):
+        for r, (k, role) in enumerate(((0, 0), (1, 2), (2, 2), (3, 0))):
+            rows = np.arange(len(cub)) * 6 + (r if r < 2 else r + 1)
+            hx[rows] = cub[:, k]
+            h_role[rows] = role
+    # anchors: each path's start, then every segment's end (each joint once)
+    last_seg = np.cumsum(nseg) - 1
+    starts = ctrl[last_seg - nseg + 1, 0]
+    pos = np.arange(len(ctrl)) + np.repeat(np.arange(len(nseg)), nseg) + 1
+    anchors = np.empty((len(ctrl) + len(nseg), 2))
+    anchors[pos] = ctrl[:, 3]
+    anchors[np.concatenate(([0], (last_seg + np.arange(len(nseg)) + 2)[:-1]))] = starts
     a = np.full((2 * len(anchors), 2), np.nan)
     a[0::2] = anchors
     a_role = np.full(len(a), -1, dtype=np.int8)
     a_role[0::2] = 1
-    parts = [x for x in (hx, a) if len(x)]
-    if not parts:
-        return EMPTY, np.empty(0, dtype=np.int8)
-    if len(parts) == 2:
-        xy = np.concatenate((hx, np.full((1, 2), np.nan), a))
-        role = np.concatenate((h_role, np.array([-1], dtype=np.int8), a_role))
-    else:
-        xy = parts[0]
-        role = h_role if len(hx) else a_role
+    if not len(hx):
+        return a, a_role
+    xy = np.concatenate((hx, np.full((1, 2), np.nan), a))
+    role = np.concatenate((h_role, np.array([-1], dtype=np.int8), a_role))
     return xy, role
 
 
@@ -650,7 +809,9 @@ class PreviewCache:
     """Fit-only geometry (input units) by the identity of the objects it came from (a small
     LRU; each value holds those objects, so an id cannot be reused while cached)."""
 
-    def __init__(self, size: int = 6) -> None:
+    def __init__(self, size: int = 12) -> None:
+        # one run's entries: bbox, original, points, fit arrays, curve, control, deviation,
+        # level
         self.size = size
         self._data: OrderedDict[tuple[Any, ...], tuple[Any, ...]] = OrderedDict()
 
@@ -695,6 +856,63 @@ def display_tolerance(job_params: dict[str, Any], drawing: Drawing | None,
     if bb is not None:
         tol = max(tol, float(np.hypot(bb[2] - bb[0], bb[3] - bb[1])) * 1e-6)
     return tol
+
+
+def _optional_layers(drawing: Drawing | None, fit_tuple: tuple[FittedPath, ...],
+                     cache: PreviewCache, cancel: Callable[[], bool] | None, e_tol: float,
+                     control: bool, deviation: bool) -> tuple[np.ndarray, ...]:
+    """``(control_xy, control_role, dev_a, dev_b, dev_err, dev_level)`` of a fit: the
+    control points when ``control``, the deviation overlay when ``deviation`` (and there is
+    a drawing), empty arrays otherwise; cached by the fit's identity."""
+    def fa() -> FitArrays | None:
+        return cache.get(("fit arrays", id(fit_tuple)),
+                         lambda: (fit_tuple, fit_arrays(fit_tuple)))[1]
+
+    if control:
+        _, c_xy, c_role = cache.get(("control", id(fit_tuple)),
+                                    lambda: (fit_tuple, *control_layer(fit_tuple, fa())))
+    else:
+        c_xy, c_role = EMPTY, np.empty(0, dtype=np.int8)
+    if deviation and drawing is not None:
+        def make_dev() -> tuple[Any, ...]:
+            pts = cache.get(("points", id(drawing)),
+                            lambda: (drawing, drawing_points(drawing)))[1]
+            return (fit_tuple, drawing, *deviation_samples(drawing, fit_tuple, cancel=cancel,
+                                                           points=pts, arrays=fa()))
+
+        _, _, dev_a, dev_b, dev_e = cache.get(("deviation", id(fit_tuple), id(drawing)),
+                                              make_dev)
+        (_, dev_level) = cache.get(
+            ("level", id(dev_e), e_tol),
+            lambda: (dev_e, np.clip(dev_e / e_tol, 0.0, 1.0) if e_tol > 0 else dev_e * 0.0))
+    else:
+        dev_a, dev_b, dev_e, dev_level = EMPTY, EMPTY, np.empty(0), np.empty(0)
+    return c_xy, c_role, dev_a, dev_b, dev_e, dev_level
+
+
+def with_layers(pv: Preview, drawing: Drawing | None,
+                fitted: tuple[FittedPath, ...] | None, layers: Iterable[str], *,
+                cache: PreviewCache | None = None,
+                cancel: Callable[[], bool] | None = None) -> Preview:
+    """``pv`` (a preview of ``fitted`` and ``drawing``) with the optional layers of
+    ``layers`` it lacks computed; every other array is ``pv``'s own (the same objects, so
+    the views redraw only the new layers). A layer switched on after the run."""
+    if fitted is None or pv.layers is None:
+        return pv
+    want = frozenset(layers) & OPTIONAL_LAYERS
+    missing = want - pv.layers
+    if not missing:
+        return pv
+    c_xy, c_role, dev_a, dev_b, dev_e, dev_level = _optional_layers(
+        drawing, fitted, cache if cache is not None else PreviewCache(), cancel,
+        pv.tolerance_units, "control" in missing, "deviation" in missing)
+    changes: dict[str, Any] = {"layers": frozenset(pv.layers | missing)}
+    if "control" in missing:
+        changes.update(control_xy=c_xy, control_role=c_role)
+    if "deviation" in missing:
+        changes.update(deviation_a=dev_a, deviation_b=dev_b, deviation_err=dev_e,
+                       deviation_level=dev_level)
+    return replace(pv, **changes)
 
 
 def build_preview(
@@ -751,36 +969,24 @@ def build_preview(
         key = (id(fit_tuple), id(drawing), round(tol_units, 12))
 
         def make_curve() -> tuple[Any, ...]:
-            curve = fitted_curve(fit_tuple, tol_units)
+            fa = cache.get(("fit arrays", id(fit_tuple)),
+                           lambda: (fit_tuple, fit_arrays(fit_tuple)))[1]
+            curve = fitted_curve(fit_tuple, tol_units, fa)
             return fit_tuple, drawing, curve, bbox(curve.xy)
 
         _, _, curve, c_box = cache.get(("curve", *key), make_curve)
-        if shown("control"):
-            _, c_xy, c_role = cache.get(("control", id(fit_tuple)),
-                                        lambda: (fit_tuple, *control_layer(fit_tuple)))
-        else:
-            c_xy, c_role = EMPTY, np.empty(0, dtype=np.int8)
-        if shown("deviation") and drawing is not None:
-            def make_dev() -> tuple[Any, ...]:
-                return (fit_tuple, drawing,
-                        *deviation_samples(drawing, fit_tuple, cancel=cancel))
-
-            _, _, dev_a, dev_b, dev_e = cache.get(("deviation", id(fit_tuple), id(drawing)),
-                                                  make_dev)
-            (_, dev_level) = cache.get(
-                ("level", id(dev_e), e_tol),
-                lambda: (dev_e, np.clip(dev_e / e_tol, 0.0, 1.0) if e_tol > 0
-                         else dev_e * 0.0))
-        else:
-            dev_a, dev_b, dev_e, dev_level = EMPTY, EMPTY, np.empty(0), np.empty(0)
+        c_xy, c_role, dev_a, dev_b, dev_e, dev_level = _optional_layers(
+            drawing, fit_tuple, cache, cancel, e_tol, shown("control"), shown("deviation"))
     else:
         curve = stroke_curves(job, tol_units)
         c_box = bbox(curve.xy)
         c_xy, c_role = EMPTY, np.empty(0, dtype=np.int8)
         dev_a, dev_b, dev_e, dev_level = EMPTY, EMPTY, np.empty(0), np.empty(0)
 
+    # the kerf layer: the compensated outline the laser follows, which is the fitted curve
+    # of the compensated drawing (the job's contour segments): the same arrays, drawn again
     kerf_on = float(job.params.get("kerf_mm", 0.0) or 0.0) > 0.0
-    kerf = stroke_curves(job, tol_units) if kerf_on else Polylines()
+    kerf = curve if kerf_on else Polylines()
 
     marks_bits, lens = _all_marks(job.strokes)  # once for the marks and the jumps
     src = np.fromiter((s.source_index for s in job.strokes), dtype=np.int64,

@@ -78,8 +78,11 @@ def estimate_with_dwell(
         return {"mark_length_mm": 0.0, "jump_length_mm": 0.0, "estimated_time_s": 0.0,
                 "corners": 0, "laser_switches": 0, "jumps": 0, "mark_points": 0,
                 "mark_time_s": 0.0, "jump_time_s": 0.0, "delay_time_s": 0.0}, 0
-    allm = np.concatenate([np.asarray(m).reshape(-1, 2) for m in ms]).astype(np.float64)
-    sizes = np.fromiter((len(m) for m in ms), dtype=np.int64, count=n_strokes)
+    try:  # (M, 2) arrays, as the pipeline makes them: no Python work per stroke
+        allm = np.concatenate(ms).astype(np.float64).reshape(-1, 2)
+    except ValueError:
+        allm = np.concatenate([np.asarray(m).reshape(-1, 2) for m in ms]).astype(np.float64)
+    sizes = np.fromiter(map(len, ms), dtype=np.int64, count=n_strokes)
     starts = np.cumsum(sizes) - sizes
     ends = starts + sizes - 1
     dx = allm[1:, 0] - allm[:-1, 0]

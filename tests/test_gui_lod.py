@@ -51,3 +51,61 @@ def test_big_lines_get_coarse_levels_coarsest_first(qtbot):
                                                           reverse=True)
     assert levels[0][0] == pytest.approx(0.01 * LOD_FACTORS[0])
     assert LinesItem.prepare(xy[:100], lod=0.01)[-1] is None  # small layers: full only
+
+
+def test_deviation_chords_joined_into_polylines_draw_the_same_chords(qtbot):
+    """The overlay's chords of one colour bin become polylines where they follow one
+    another: the polylines' edges are exactly the chords, none lost, none added."""
+    from app.views import DeviationItem, _chain_chords
+
+    walk = dense_walk(30_001)
+    a, b = walk[:-1].copy(), walk[1:].copy()
+    b[1000] += 0.5  # a gap: the next chord does not start where this one ends
+    level = np.clip(np.abs(np.sin(np.arange(len(a)) / 700.0)), 0, 1)
+    bins = np.minimum((level * 16).astype(int), 15)
+    for k in np.unique(bins):
+        idx = np.flatnonzero(bins == k)
+        xy = _chain_chords(a[idx], b[idx], idx)
+        edges = np.isfinite(xy[:-1, 0]) & np.isfinite(xy[1:, 0])
+        got = np.hstack((xy[:-1][edges], xy[1:][edges]))
+        assert np.array_equal(got, np.hstack((a[idx], b[idx])))
+    paths, _, n, coarse = DeviationItem.prepare(a, b, level, lod=0.01)
+    assert n == len(a) and len(paths) == len(np.unique(bins))
+    assert coarse and [g for g, _ in coarse] == sorted((g for g, _ in coarse), reverse=True)
+    assert DeviationItem.prepare(a[:100], b[:100], level[:100], lod=0.01)[-1] is None
+
+
+def _edges(path) -> set:
+    out, prev = set(), None
+    for i in range(path.elementCount()):
+        e = path.elementAt(i)
+        if e.isLineTo():
+            out.add((prev, (e.x, e.y)))
+        prev = (e.x, e.y)
+    return out
+
+
+def test_big_paths_built_in_pieces_have_the_same_edges(qtbot, monkeypatch):
+    """A big QPainterPath is built in pieces (the worker releases the interpreter lock
+    between them): the same line segments as one call, at every piece boundary too."""
+    import pyqtgraph as pg
+
+    from app import views
+
+    xy = dense_walk(5_000)
+    xy[::37] = np.nan
+    xy[999] = np.nan  # a NaN row at a piece boundary
+    monkeypatch.setattr(views, "QPATH_CHUNK", 500)
+    whole = pg.arrayToQPath(xy[:, 0], xy[:, 1], connect="finite")
+    pieces = views._qpath(xy[:, 0], xy[:, 1])
+    assert _edges(pieces) == _edges(whole) and len(_edges(whole)) > 4000
+
+
+def test_marker_levels_from_one_grid_are_one_point_per_cell_of_each():
+    from app.views import _levels_per_cell
+
+    pts = np.random.default_rng(2).uniform(-3, 7, (40_000, 2))
+    levels = _levels_per_cell(pts, 0.05)
+    assert [g for g, _ in levels] == pytest.approx([0.05 * f for f in LOD_FACTORS])
+    for g, kept in levels:
+        assert np.array_equal(kept, _one_per_cell(pts, g))

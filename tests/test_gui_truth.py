@@ -255,6 +255,69 @@ def test_deviation_is_computed_only_when_shown(win, qtbot, tmp_path):
     assert win.processed.layers["deviation"].n_chords == len(win.result.preview.deviation_err)
 
 
+def test_a_layer_switched_on_is_added_to_the_shown_result_without_a_new_run(win, qtbot,
+                                                                            tmp_path):
+    """Switching the deviation on computes that layer from the shown fit: the job, the
+    other layers' arrays (so their drawn items) and the stats stay the shown result's; a
+    parameter change after it runs the pipeline as usual."""
+    src = tmp_path / "circle.plt"
+    src.write_bytes(circle_plt())
+    win.layer_boxes["deviation"].setChecked(False)
+    assert win.load_file(src, wait=True)
+    before = win.result
+    win.layer_boxes["deviation"].setChecked(True)
+    assert win.wait_idle(60)
+    after = win.result
+    assert after is not before and after.stages_run == ("layers",)
+    assert after.job is before.job and after.fitted is before.fitted
+    assert after.preview.marks is before.preview.marks
+    assert after.preview.fitted.xy is before.preview.fitted.xy
+    assert after.prepared["marks"] is before.prepared["marks"]
+    assert after.preview.has_layer("deviation") and len(after.preview.deviation_err)
+    assert win.processed.layers["deviation"].n_chords == len(after.preview.deviation_err)
+    assert win.set_param("e_per", 0.07) and win.wait_idle(60)
+    assert "fit" in win.result.stages_run and win.result.preview.has_layer("deviation")
+
+
+def test_the_previous_file_is_freed_when_the_next_one_is_shown(win, qtbot, tmp_path):
+    """Opening another file releases the last one's drawing, job and display geometry
+    (no cache, frozen garbage-collector generation or view keeps them): memory stays about
+    one file's over a session, without a collection."""
+    import gc
+    import weakref
+
+    a, b = tmp_path / "a.plt", tmp_path / "b.plt"
+    a.write_bytes(circle_plt())
+    b.write_bytes(b"IN;SP1;PU0,0;PD400,0,400,400,0,400,0,0;PU;")
+    assert win.load_file(a, wait=True)
+    refs = [weakref.ref(x) for x in (win.drawing, win.result, win.result.job,
+                                     win.result.preview)]
+    assert win.load_file(b, wait=True) and win.drawing.name == "b.plt"
+    qtbot.wait(20)
+    assert gc.isenabled()  # no collection asked for: reference counting frees them
+    assert [r() is None for r in refs] == [True] * len(refs)
+
+
+def test_stroke_by_stroke_json_of_many_strokes_is_write_jobs(tmp_path):
+    """The big-job writer encodes strokes in groups: over several groups (700 strokes) the
+    bytes are still exactly write_job's."""
+    from app import offload
+    from galvo_core.hpgl import read_bytes
+    from galvo_core.job import write_job
+    from galvo_core.params import Params
+    from galvo_core.pipeline import Pipeline
+
+    body = b"".join(b"PU%d,%d;PD%d,%d,%d,%d;" % (40 * (i % 30), 40 * (i // 30),
+                                                   40 * (i % 30) + 20, 40 * (i // 30),
+                                                   40 * (i % 30) + 20, 40 * (i // 30) + 25)
+                    for i in range(700))
+    job = Pipeline().run(read_bytes(b"IN;SP1;" + body, "many.plt"), Params(fit_field=True)).job
+    assert len(job.strokes) == 700
+    ref = tmp_path / "ref.json"
+    write_job(job, ref)
+    assert offload.job_json_bytes(job) == ref.read_bytes()
+
+
 def test_export_kinds_can_be_extended(win, qtbot, tmp_path):
     src = tmp_path / "circle.plt"
     src.write_bytes(circle_plt())

@@ -87,6 +87,45 @@ def test_flatten_segments_stays_within_tolerance():
     assert (np.hypot(*np.diff(poly, axis=0).T) > 0).all()
 
 
+def _random_fit(rng, index: int, n_seg: int) -> FittedPath:
+    """A continuous chain of random lines and cubics (a path of the fit)."""
+    segs, p0 = [], rng.uniform(-50, 50, 2)
+    for _ in range(n_seg):
+        if rng.random() < 0.5:
+            pts = np.vstack([p0, p0 + rng.uniform(-5, 5, (3, 2)).cumsum(axis=0)])
+            segs.append(Segment("cubic", pts, 0, 1))
+        else:
+            pts = np.vstack([p0, p0 + rng.uniform(-5, 5, 2)])
+            segs.append(Segment("line", pts, 0, 1))
+        p0 = pts[-1]
+    return FittedPath(index, 1, False, segs)
+
+
+def test_vectorised_curve_and_control_layer_match_the_per_segment_geometry():
+    """fitted_curve / control_layer work on all paths' arrays at once: path by path they
+    give the vertices flatten_segments gives, and the control rows of each segment."""
+    rng = np.random.default_rng(5)
+    fitted = [_random_fit(rng, i, int(rng.integers(1, 9))) for i in range(40)]
+    fitted.insert(3, FittedPath(99, 1, False, ()))  # a path without segments: nothing drawn
+    tol = 0.003
+    curve = pv.fitted_curve(fitted, tol)
+    want = pv.nan_join((pv.flatten_segments([(s.kind, s.points) for s in fp.segments], tol)
+                        for fp in fitted), (fp.source_index for fp in fitted))
+    assert np.array_equal(curve.ids, want.ids)
+    assert np.array_equal(np.isnan(curve.xy), np.isnan(want.xy))
+    assert np.nanmax(np.abs(curve.xy - want.xy)) < 1e-9
+    assert 99 not in curve.ids
+    xy, role = pv.control_layer(fitted)
+    anchors = np.concatenate([np.vstack([fp.segments[0].points[:1]]
+                                        + [s.points[-1:] for s in fp.segments])
+                              for fp in fitted if fp.segments])
+    assert np.array_equal(xy[role == 1], anchors)
+    handles = [np.vstack([s.points[0:2], s.points[2:4]]) for fp in fitted
+               for s in fp.segments if s.kind == "cubic"]
+    assert np.array_equal(xy[role == 2], np.concatenate([h[1:3] for h in handles]))
+    assert np.array_equal(xy[role == 0], np.concatenate([h[[0, 3]] for h in handles]))
+
+
 def test_control_layer_roles(run):
     _, _, _, fitted = run
     xy, role = pv.control_layer(fitted)
