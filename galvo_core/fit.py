@@ -116,6 +116,10 @@ _MERGE_ROUNDS = 3
 #: points per piece in a merge's dichotomy (a candidate; the full test decides)
 _MERGE_SAMPLE = 32
 _MAX_BISECT = 40
+#: rounds of absorbing lines into cubics on rounded input, and the largest turn (radians)
+#: between the one-sided tangents at the vertex where that may happen
+_ABSORB_ROUNDS = 3
+_ABSORB_TURN = math.radians(30)
 
 
 @dataclass(frozen=True, slots=True, eq=False)
@@ -591,9 +595,13 @@ class _BatchFitter:
             ok &= worst <= e2
         return ok, emax, dist, starts
 
-    def fit(self, curve_pieces: np.ndarray) -> None:
+    def fit(self, curve_pieces: np.ndarray, line_pieces: np.ndarray | None = None) -> None:
         """Fit the curve pieces (P, 2) (inclusive thinned index ranges a, b); the results
-        are in :meth:`results`."""
+        are in :meth:`results`. ``line_pieces``: the starts of the one-segment pieces that
+        are lines already (rounded input may absorb some into cubics, :meth:`_absorb_round`;
+        the others come back among the lines)."""
+        if line_pieces is not None:
+            self._lines.append(np.asarray(line_pieces, dtype=np.intp))
         ab = np.asarray(curve_pieces, dtype=np.intp).reshape(-1, 2)
         while len(ab):
             line = ab[:, 1] - ab[:, 0] == 1
@@ -626,6 +634,58 @@ class _BatchFitter:
         for _ in range(_MERGE_ROUNDS):
             if not self._merge_round():
                 break
+        if self.quant is not None:
+            for _ in range(_ABSORB_ROUNDS):
+                if not (self._absorb_round(0) | self._absorb_round(1)):
+                    break
+
+    def _absorb_round(self, parity: int) -> bool:
+        """Rounded input: a line next to a line or a cubic, at a vertex whose two one-sided
+        tangents differ by less than ``_ABSORB_TURN`` (no corner of the design: the
+        rounding made the thinning leave a short segment or a length jump there), is
+        merged with it into one cubic where one passes the same test. Non-overlapping
+        pairs, one array pass; True when something merged."""
+        assert self.quant is not None
+        la = np.concatenate(self._lines) if self._lines else np.zeros(0, dtype=np.intp)
+        cub = self._cubics
+        nC = sum(len(c[0]) for c in cub)
+        if len(la) == 0:
+            return False
+        A = np.concatenate([la] + [c[0] for c in cub])
+        B = np.concatenate([la + 1] + [c[1] for c in cub])
+        C = np.concatenate([np.zeros((len(la), 4, 2))] + [c[2] for c in cub])
+        E = np.concatenate([np.zeros(len(la))] + [c[3] for c in cub])
+        isl = np.r_[np.ones(len(la), dtype=bool), np.zeros(nC, dtype=bool)]
+        o = np.argsort(A, kind="stable")
+        A, B, C, E, isl = A[o], B[o], C[o], E[o], isl[o]
+        v = B[:-1]
+        ti, to = self.t_in[v], self.t_out[v]
+        cosv = (ti * to).sum(axis=1)
+        adj = ((B[:-1] == A[1:]) & (self.quant[v] > 0.0)
+               & (cosv > math.cos(_ABSORB_TURN)))
+        if not adj.any():
+            return False
+        idx = np.flatnonzero(adj)
+        brk = np.r_[True, idx[1:] != idx[:-1] + 1]
+        chain_start = np.maximum.accumulate(np.where(brk, np.arange(len(idx)), 0))
+        pick = idx[(np.arange(len(idx)) - chain_start) % 2 == parity]
+        if len(pick) == 0:
+            return False
+        ok, ctrl, em = self._try(A[pick], B[pick + 1])
+        if not ok.any():
+            return False
+        i = pick[ok]
+        B[i] = B[i + 1]
+        C[i] = ctrl[ok]
+        E[i] = em[ok]
+        isl[i] = False
+        keep = np.ones(len(A), dtype=bool)
+        keep[i + 1] = False
+        A, B, C, E, isl = A[keep], B[keep], C[keep], E[keep], isl[keep]
+        self._lines = [A[isl]]
+        c = ~isl
+        self._cubics = [(A[c], B[c], C[c], E[c])]
+        return True
 
     def _try(self, A: np.ndarray, B: np.ndarray):
         """One cubic per piece A..B (no split): (passed, ctrl, bound) for the pieces whose
@@ -1033,9 +1093,12 @@ def _fit_concatenated(
     if rounding is not None and (rounding[:, 1] > 0.0).any():
         fitter.quant = np.repeat(rounding[:, 1], tlen)
     with np.errstate(invalid="ignore", divide="ignore"):
-        fitter.fit(np.stack([pa[curve], pb[curve]], axis=1))
+        if fitter.quant is not None:
+            fitter.fit(np.stack([pa[curve], pb[curve]], axis=1), pa[~curve])
+        else:
+            fitter.fit(np.stack([pa[curve], pb[curve]], axis=1))
     ca, cb, ctrl, bound, fla = fitter.results()
-    la = np.concatenate([pa[~curve], fla])
+    la = fla if fitter.quant is not None else np.concatenate([pa[~curve], fla])
     lb = la + 1
     owner = np.repeat(np.arange(len(todo)), tlen)  # thinned index -> position in todo
     o_w = woff[todo]
