@@ -119,6 +119,10 @@ _MAX_BISECT = 40
 #: rounds of absorbing lines into cubics on rounded input, and the largest turn (radians)
 #: between the one-sided tangents at the vertex where that may happen
 _ABSORB_ROUNDS = 3
+#: rounded input: an input segment longer than ``_LONG_SEGMENT`` quanta allows the curve
+#: only that share of the rounding slack beside it (at least ``_LONG_FLOOR``)
+_LONG_SEGMENT = 10.0
+_LONG_FLOOR = 0.5
 _ABSORB_TURN = math.radians(30)
 
 
@@ -551,7 +555,8 @@ class _BatchFitter:
                 done |= stop
         return self._ctrl(p0, qq, p3, t)
 
-    def _accept(self, ctrl: np.ndarray, i0: np.ndarray, i1: np.ndarray, e2: np.ndarray):
+    def _accept(self, ctrl: np.ndarray, i0: np.ndarray, i1: np.ndarray, e2: np.ndarray,
+                A: np.ndarray | None = None):
         """Per piece: bound of the max input-point error, pass/fail of both sides of the
         guarantee, and the flat per-point errors (with the offsets of each piece)."""
         m = len(ctrl)
@@ -590,6 +595,16 @@ class _BatchFitter:
         j = np.flatnonzero(pair)
         if len(j):
             bnd = _curve_to_polyline_bound_many(cf[:, :, j], pts[j], pts[j + 1], u[j], u[j + 1])
+            if self.quant is not None and A is not None:
+                # rounded input: a long input segment is the design up to the rounding of
+                # its ends, so the curve keeps closer to it than the rounding allows
+                qa = self.quant[A][pid[j]]
+                sl = qa * _HALF_DIAGONAL
+                ln = np.hypot(*(pts[j + 1] - pts[j]).T)
+                with np.errstate(divide="ignore", invalid="ignore"):
+                    f = np.clip(_LONG_SEGMENT * qa / ln, _LONG_FLOOR, 1.0)
+                f = np.where(qa > 0.0, f, 1.0)
+                bnd = bnd + sl * (1.0 - f)
             worst = np.zeros(m)
             np.maximum.at(worst, pid[j], bnd)
             ok &= worst <= e2
@@ -621,7 +636,7 @@ class _BatchFitter:
             if len(A):
                 i0, i1 = self.kept[A], self.kept[B]
                 ctrl = self._dichotomy(p0[ok], qq[ok], p3[ok], sig[ok], i0, i1)
-                good, emax, dist, starts = self._accept(ctrl, i0, i1, self.e_per[A])
+                good, emax, dist, starts = self._accept(ctrl, i0, i1, self.e_per[A], A)
                 if self.quant is not None:
                     rq = np.flatnonzero(self.quant[A] > 0.0)
                     if len(rq):
@@ -708,7 +723,7 @@ class _BatchFitter:
         if not lk.any():
             return passed, ctrl_all, em_all
         w, a, b, i0, i1, ctrl = w[lk], a[lk], b[lk], i0[lk], i1[lk], ctrl[lk]
-        good, emax, dist, starts = self._accept(ctrl, i0, i1, self.e_per[a])
+        good, emax, dist, starts = self._accept(ctrl, i0, i1, self.e_per[a], a)
         if self.quant is not None:
             rq = np.flatnonzero((self.quant[a] > 0.0) & ~good)
             if len(rq):
@@ -849,7 +864,7 @@ class _BatchFitter:
         cl, okl = self._least_squares(A, B, i0, i1)
         passed = np.zeros(len(A), dtype=bool)
         if okl.any():
-            g, e, _, _ = self._accept(cl[okl], i0[okl], i1[okl], self.e_per[A[okl]])
+            g, e, _, _ = self._accept(cl[okl], i0[okl], i1[okl], self.e_per[A[okl]], A[okl])
             sel = np.flatnonzero(okl)[g]
             self._cubics.append((A[sel], B[sel], cl[sel], e[g]))
             passed[sel] = True
@@ -875,7 +890,7 @@ class _BatchFitter:
         if not okl.any():
             return
         sel = rq[okl]
-        g2, e2, d2, s2 = self._accept(cl[okl], i0[okl], i1[okl], self.e_per[a[okl]])
+        g2, e2, d2, s2 = self._accept(cl[okl], i0[okl], i1[okl], self.e_per[a[okl]], a[okl])
         use = sel[g2]
         ctrl[use] = cl[okl][g2]
         emax[use] = e2[g2]
