@@ -1103,7 +1103,8 @@ def _fit_concatenated(
     arc = _arc_per_path(W, wlen)
     if rounding is not None and (rounding[:, 1] > 0.0).any():
         Q = Q.copy()
-        _on_the_design(W, K, Q, arc, t_in, t_out, smooth, np.repeat(rounding[:, 1], tlen), tlen)
+        _on_the_design(W, K, Q, arc, t_in, t_out, smooth, np.repeat(rounding[:, 1], tlen), tlen,
+                       np.repeat(rounding[:, 0], tlen))
     fitter = _BatchFitter(W, K, t_in, t_out, np.repeat(e_per, tlen), eps_sum, arc, q=Q)
     if rounding is not None and (rounding[:, 1] > 0.0).any():
         fitter.quant = np.repeat(rounding[:, 1], tlen)
@@ -1238,7 +1239,7 @@ def _local_fits(
     return pos, tan, ok
 
 
-def _on_the_design(W, K, Q, arc, t_in, t_out, smooth, quant, tlen) -> None:
+def _on_the_design(W, K, Q, arc, t_in, t_out, smooth, quant, tlen, eps) -> None:
     """Rounded input (per thinned point its path's quantum ``quant``): the smooth thinned
     vertices (inside curve runs) moved onto a least-squares estimate of the design curve
     (a quadratic in arc length through the input points between the middles of the two
@@ -1264,14 +1265,92 @@ def _on_the_design(W, K, Q, arc, t_in, t_out, smooth, quant, tlen) -> None:
         t_in[k] = tan[ok]
         t_out[k] = tan[ok]
     # one-sided tangents at the other vertices (corners, ends of runs)
+    # (over at least _SIDE_POINTS input points: a short thinned segment is rounding)
+    k_first = np.repeat(K[first], tlen)
+    k_last = np.repeat(K[last], tlen)
     co = np.flatnonzero(~smooth & rnd & ~is_last)
     if len(co):
-        _, tan, ok = _local_fits(W, arc, K[co], K[co + 1], K[co])
+        hi = np.maximum(K[co + 1], np.minimum(K[co] + _SIDE_POINTS - 1, k_last[co]))
+        _, tan, ok = _local_fits(W, arc, K[co], hi, K[co])
         t_out[co[ok]] = tan[ok]
     ci = np.flatnonzero(~smooth & rnd & ~is_first)
     if len(ci):
-        _, tan, ok = _local_fits(W, arc, K[ci - 1], K[ci], K[ci])
+        lo = np.minimum(K[ci - 1], np.maximum(K[ci] - _SIDE_POINTS + 1, k_first[ci]))
+        _, tan, ok = _local_fits(W, arc, lo, K[ci], K[ci])
         t_in[ci[ok]] = tan[ok]
+    _corners_on_the_design(W, K, Q, arc, smooth & ~is_first & ~is_last, rnd & ~is_first
+                           & ~is_last, quant, eps, k_first, k_last)
+
+
+#: one-sided tangents of rounded input are fitted over at least this many input points
+_SIDE_POINTS = 20
+#: a corner's two sides meet at this angle or more (sine): their fitted lines are
+#: intersected; below, the corner is the mean of the two sides' estimates
+_CORNER_SINE = 0.25
+_CORNERS = True
+_CORNER_BOTH = True
+
+
+def _corners_on_the_design(W, K, Q, arc, smooth, rnd, quant, eps, k_first, k_last) -> None:
+    """Rounded input: the interior corners (thinned vertices that are not smooth) move
+    inside their rounding squares onto an estimate of the design's corner: per side a
+    least-squares quadratic of the input points of the thinned segment on that side,
+    evaluated at the corner (position and tangent); the intersection of the two tangent
+    lines where they cross at an angle, else the mean of the two positions; one side's
+    position when only that side has enough points. A corner is kept where a line from it
+    to a neighbouring thinned point would miss its input points by more than ``eps``
+    (per thinned point), so the lines keep their bound. In place on ``Q``."""
+    cv = np.flatnonzero(~smooth & rnd)
+    if len(cv) == 0 or not _CORNERS:
+        return
+    k = K[cv]
+    p_in, t_in, ok_in = _local_fits(W, arc, K[cv - 1], k, k)
+    p_out, t_out, ok_out = _local_fits(W, arc, k, K[cv + 1], k)
+    if _CORNER_BOTH:
+        ok_in &= ok_out
+        ok_out = ok_in
+    est = np.where(ok_in[:, None], p_in, p_out)
+    both = ok_in & ok_out
+    mean = 0.5 * (p_in + p_out)
+    est[both] = mean[both]
+    cr = t_in[:, 0] * t_out[:, 1] - t_in[:, 1] * t_out[:, 0]
+    sharp = both & (np.abs(cr) >= _CORNER_SINE)
+    if sharp.any():
+        d = p_out[sharp] - p_in[sharp]
+        ti, to = t_in[sharp], t_out[sharp]
+        s = (d[:, 0] * to[:, 1] - d[:, 1] * to[:, 0]) / cr[sharp]
+        est[sharp] = p_in[sharp] + s[:, None] * ti
+    has = ok_in | ok_out
+    cv, est = cv[has], est[has]
+    h = 0.5 * quant[cv][:, None]
+    new = np.clip(est, W[K[cv]] - h, W[K[cv]] + h)
+    # an estimate on the input point up to rounding errors is the input point
+    wk = W[K[cv]]
+    same = np.abs(new - wk).max(axis=1) <= 1e-9 * (h[:, 0] + np.abs(wk).max(axis=1))
+    new[same] = W[K[cv[same]]]
+    old = Q[cv].copy()
+    Q[cv] = new
+    moved = np.zeros(len(Q), dtype=bool)
+    moved[cv] = True
+    for _ in range(3):
+        # the thinned segments next to a moved corner, as lines: within eps of their points?
+        seg = np.unique(np.concatenate([cv - 1, cv]))
+        seg = seg[moved[seg] | moved[seg + 1]]
+        if len(seg) == 0:
+            break
+        err = _line_errors(W, np.stack([Q[seg], Q[seg + 1]], axis=1), K[seg], K[seg + 1])
+        bad = seg[err > eps[seg]]
+        if len(bad) == 0:
+            break
+        back = np.unique(np.concatenate([bad, bad + 1]))
+        back = back[moved[back]]
+        if len(back) == 0:
+            break
+        pos = np.searchsorted(cv, back)
+        Q[back] = old[pos]
+        moved[back] = False
+        cv_keep = ~np.isin(cv, back)
+        cv, old = cv[cv_keep], old[cv_keep]
 
 
 def _arc_per_path(W: np.ndarray, wlen: np.ndarray) -> np.ndarray:
