@@ -1239,6 +1239,44 @@ def _local_fits(
     return pos, tan, ok
 
 
+def _local_lines(
+    W: np.ndarray, lo: np.ndarray, hi: np.ndarray, at: np.ndarray
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Least-squares lines (principal axis) through the input points lo..hi (inclusive
+    global indices) of each window: (the point ``at`` projected onto the line (V, 2), unit
+    direction (V, 2) from lo to hi, ok (V,): at least 3 points)."""
+    cnt = hi - lo + 1
+    v = len(lo)
+    ok = cnt >= 3
+    pos = W[at].astype(np.float64, copy=True)
+    tan = np.zeros((v, 2))
+    if not ok.any():
+        return pos, tan, ok
+    c = np.where(ok, cnt, 0)
+    own, off = _ragged(np.zeros(v, dtype=np.intp), c)
+    idx = lo[own] + off
+    ref = W[at]
+    d = W[idx] - ref[own]
+    n = np.maximum(c, 1)
+    mx = np.bincount(own, d[:, 0], v) / n
+    my = np.bincount(own, d[:, 1], v) / n
+    dx = d[:, 0] - mx[own]
+    dy = d[:, 1] - my[own]
+    sxx = np.bincount(own, dx * dx, v)
+    syy = np.bincount(own, dy * dy, v)
+    sxy = np.bincount(own, dx * dy, v)
+    ang = 0.5 * np.arctan2(2.0 * sxy, sxx - syy)
+    tx, ty = np.cos(ang), np.sin(ang)
+    ch = W[hi] - W[lo]
+    flip = tx * ch[:, 0] + ty * ch[:, 1] < 0.0
+    tx = np.where(flip, -tx, tx)
+    ty = np.where(flip, -ty, ty)
+    s = -(mx * tx + my * ty)  # the reference point's coordinate along the line
+    pos[ok] = (ref + np.stack([mx + s * tx, my + s * ty], axis=1))[ok]
+    tan[ok] = np.stack([tx, ty], axis=1)[ok]
+    return pos, tan, ok
+
+
 def _on_the_design(W, K, Q, arc, t_in, t_out, smooth, quant, tlen, eps) -> None:
     """Rounded input (per thinned point its path's quantum ``quant``): the smooth thinned
     vertices (inside curve runs) moved onto a least-squares estimate of the design curve
@@ -1278,8 +1316,7 @@ def _on_the_design(W, K, Q, arc, t_in, t_out, smooth, quant, tlen, eps) -> None:
         lo = np.minimum(K[ci - 1], np.maximum(K[ci] - _SIDE_POINTS + 1, k_first[ci]))
         _, tan, ok = _local_fits(W, arc, lo, K[ci], K[ci])
         t_in[ci[ok]] = tan[ok]
-    _corners_on_the_design(W, K, Q, arc, smooth & ~is_first & ~is_last, rnd & ~is_first
-                           & ~is_last, quant, eps, k_first, k_last)
+    _corners_on_the_design(W, K, Q, arc, smooth, rnd, first, last, quant, eps)
 
 
 #: one-sided tangents of rounded input are fitted over at least this many input points
@@ -1287,32 +1324,47 @@ _SIDE_POINTS = 20
 #: a corner's two sides meet at this angle or more (sine): their fitted lines are
 #: intersected; below, the corner is the mean of the two sides' estimates
 _CORNER_SINE = 0.25
-_CORNERS = True
-_CORNER_BOTH = True
 
 
-def _corners_on_the_design(W, K, Q, arc, smooth, rnd, quant, eps, k_first, k_last) -> None:
-    """Rounded input: the interior corners (thinned vertices that are not smooth) move
-    inside their rounding squares onto an estimate of the design's corner: per side a
-    least-squares quadratic of the input points of the thinned segment on that side,
-    evaluated at the corner (position and tangent); the intersection of the two tangent
-    lines where they cross at an angle, else the mean of the two positions; one side's
-    position when only that side has enough points. A corner is kept where a line from it
-    to a neighbouring thinned point would miss its input points by more than ``eps``
-    (per thinned point), so the lines keep their bound. In place on ``Q``."""
-    cv = np.flatnonzero(~smooth & rnd)
-    if len(cv) == 0 or not _CORNERS:
+def _corners_on_the_design(W, K, Q, arc, smooth, rnd, first, last, quant, eps) -> None:
+    """Rounded input: the corners (thinned vertices that are not smooth; a closed path's
+    seam too) move inside their rounding squares onto an estimate of the design's corner.
+    Per side, the input points of the thinned segment on that side give a position and a
+    tangent at the corner: their least-squares line where the segment is a line (its
+    other end a corner too), else a least-squares quadratic. The corner is the
+    intersection of the two tangent lines where they cross at an angle, else the mean of
+    the two positions. A corner stays where a line from it to a neighbouring thinned point
+    would miss its input points by more than ``eps`` (per thinned point), so the lines
+    keep their bound. In place on ``Q``."""
+    n = len(Q)
+    is_first = np.zeros(n, dtype=bool)
+    is_first[first] = True
+    is_last = np.zeros(n, dtype=bool)
+    is_last[last] = True
+    # vi: the vertex as the end of the segment before it, vo: as the start of the next one
+    vo = np.flatnonzero(~smooth & rnd & ~is_first & ~is_last)
+    vi = vo.copy()
+    seam = (last - first >= 3) & (W[K[first]] == W[K[last]]).all(axis=1) & rnd[first]
+    seam &= ~smooth[first]
+    if seam.any():
+        vi = np.concatenate([vi, last[seam]])
+        vo = np.concatenate([vo, first[seam]])
+    if len(vo) == 0:
         return
-    k = K[cv]
-    p_in, t_in, ok_in = _local_fits(W, arc, K[cv - 1], k, k)
-    p_out, t_out, ok_out = _local_fits(W, arc, k, K[cv + 1], k)
-    if _CORNER_BOTH:
-        ok_in &= ok_out
-        ok_out = ok_in
-    est = np.where(ok_in[:, None], p_in, p_out)
+    k = K[vo]
+    p_in, t_in, ok_in = _local_fits(W, arc, K[vi - 1], K[vi], K[vi])
+    p_out, t_out, ok_out = _local_fits(W, arc, k, K[vo + 1], k)
+    # a side that is a line (its other end a corner too): its least-squares line
+    lin = ~smooth[vi - 1]
+    if lin.any():
+        p, t, ok = _local_lines(W, K[vi - 1][lin], K[vi][lin], K[vi][lin])
+        p_in[lin], t_in[lin], ok_in[lin] = p, t, ok
+    lin = ~smooth[vo + 1]
+    if lin.any():
+        p, t, ok = _local_lines(W, k[lin], K[vo + 1][lin], k[lin])
+        p_out[lin], t_out[lin], ok_out[lin] = p, t, ok
     both = ok_in & ok_out
-    mean = 0.5 * (p_in + p_out)
-    est[both] = mean[both]
+    est = 0.5 * (p_in + p_out)
     cr = t_in[:, 0] * t_out[:, 1] - t_in[:, 1] * t_out[:, 0]
     sharp = both & (np.abs(cr) >= _CORNER_SINE)
     if sharp.any():
@@ -1320,21 +1372,22 @@ def _corners_on_the_design(W, K, Q, arc, smooth, rnd, quant, eps, k_first, k_las
         ti, to = t_in[sharp], t_out[sharp]
         s = (d[:, 0] * to[:, 1] - d[:, 1] * to[:, 0]) / cr[sharp]
         est[sharp] = p_in[sharp] + s[:, None] * ti
-    has = ok_in | ok_out
-    cv, est = cv[has], est[has]
-    h = 0.5 * quant[cv][:, None]
-    new = np.clip(est, W[K[cv]] - h, W[K[cv]] + h)
+    vi, vo, est = vi[both], vo[both], est[both]
+    wk = W[K[vo]]
+    h = 0.5 * quant[vo][:, None]
+    new = np.clip(est, wk - h, wk + h)
     # an estimate on the input point up to rounding errors is the input point
-    wk = W[K[cv]]
     same = np.abs(new - wk).max(axis=1) <= 1e-9 * (h[:, 0] + np.abs(wk).max(axis=1))
-    new[same] = W[K[cv[same]]]
-    old = Q[cv].copy()
-    Q[cv] = new
-    moved = np.zeros(len(Q), dtype=bool)
-    moved[cv] = True
+    new[same] = wk[same]
+    old = Q[vo].copy()
+    Q[vo] = new
+    Q[vi] = new
+    moved = np.zeros(n, dtype=bool)
+    moved[vo] = True
+    moved[vi] = True
     for _ in range(3):
         # the thinned segments next to a moved corner, as lines: within eps of their points?
-        seg = np.unique(np.concatenate([cv - 1, cv]))
+        seg = np.unique(np.concatenate([vi - 1, vo]))
         seg = seg[moved[seg] | moved[seg + 1]]
         if len(seg) == 0:
             break
@@ -1342,15 +1395,18 @@ def _corners_on_the_design(W, K, Q, arc, smooth, rnd, quant, eps, k_first, k_las
         bad = seg[err > eps[seg]]
         if len(bad) == 0:
             break
-        back = np.unique(np.concatenate([bad, bad + 1]))
-        back = back[moved[back]]
-        if len(back) == 0:
+        hit = np.zeros(n, dtype=bool)
+        hit[bad] = True
+        hit[bad + 1] = True
+        back = (hit[vi] | hit[vo]) & moved[vo]
+        if not back.any():
             break
-        pos = np.searchsorted(cv, back)
-        Q[back] = old[pos]
-        moved[back] = False
-        cv_keep = ~np.isin(cv, back)
-        cv, old = cv[cv_keep], old[cv_keep]
+        Q[vo[back]] = old[back]
+        Q[vi[back]] = old[back]
+        moved[vo[back]] = False
+        moved[vi[back]] = False
+        keep = ~back
+        vi, vo, old = vi[keep], vo[keep], old[keep]
 
 
 def _arc_per_path(W: np.ndarray, wlen: np.ndarray) -> np.ndarray:
