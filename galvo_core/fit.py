@@ -51,7 +51,14 @@ its tangent; least-squares handle lengths are used where they pass the same test
 thinned segment whose points bulge to one side is tried as a cubic; a line whose moved ends
 would break its bound becomes the thinned line plus connectors inside the rounding squares.
 For every input, after the fit, adjacent cubics meeting at a smooth vertex are refitted as
-one where one cubic passes the same test (up to ``_MERGE_ROUNDS`` rounds).
+one where one cubic passes the same test (up to ``_MERGE_ROUNDS`` rounds); so are two
+adjacent segments (lines too) at a vertex turning less than ``_ABSORB_TURN``; three
+adjacent cubics become two where two pass, split at another thinned point (the
+dichotomy's splits fall on the data's crossings, not on the design's joints). A merge's
+cubic is screened first (a coarse dichotomy on a few points) and a range that failed is
+not tried again. Rounded input: corners move inside their rounding squares onto the
+intersection of the two sides' least-squares lines (or quadratics), and a long input
+segment (over ``_LONG_SEGMENT`` quanta) leaves a curve only part of the slack beside it.
 
 ``eps_sum`` default: 0.002 input units (one tenth of the paper's e_per). The paper gives no
 value; it only decides when the bisection stops, the acceptance is decided by ``e_per``. A
@@ -68,6 +75,7 @@ from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
 import numpy as np
+from numba import njit
 
 from galvo_core.drawing import Drawing
 from galvo_core.errors import Cancelled, ParamError
@@ -116,9 +124,19 @@ _MERGE_ROUNDS = 3
 #: points per piece in a merge's dichotomy (a candidate; the full test decides)
 _MERGE_SAMPLE = 32
 _MAX_BISECT = 40
+#: a merge's screening cubic: points, dichotomy steps, and how far over the bound a
+#: sample point may be for the real fit to be tried
+_SCREEN_SAMPLE = 12
+_SCREEN_STEPS = 8
+_SCREEN_SLACK = 2.0
 #: rounds of absorbing lines into cubics on rounded input, and the largest turn (radians)
 #: between the one-sided tangents at the vertex where that may happen
 _ABSORB_ROUNDS = 3
+#: rounds of replacing three adjacent cubics by two, and the split points tried per triple
+_RESPLIT_ROUNDS = 1
+_RESPLIT_CANDIDATES = 3
+#: ... in this order (the middle one first)
+_RESPLIT_ORDER = (1, 0, 2)
 #: rounded input: an input segment longer than ``_LONG_SEGMENT`` quanta allows the curve
 #: only that share of the rounding slack beside it (at least ``_LONG_FLOOR``)
 _LONG_SEGMENT = 10.0
@@ -319,11 +337,6 @@ def _make_segment(kind: str, points: np.ndarray, first: int, last: int) -> Segme
     return s
 
 
-#: pairs measured at once by :func:`_curve_to_polyline_bound_many` (its candidates x pairs
-#: tables stay small)
-_BOUND_CHUNK = 1 << 14
-
-
 def _curve_to_polyline_bound_many(
     cf: np.ndarray, a: np.ndarray, b: np.ndarray, u0: np.ndarray, u1: np.ndarray
 ) -> np.ndarray:
@@ -334,58 +347,83 @@ def _curve_to_polyline_bound_many(
 
     |perpendicular| and overshoot beyond the segment's ends are maximised exactly over the
     stretch (end values and roots of their derivatives, quadratics in u): all seven
-    candidate parameters of a pair are evaluated at once, ``_BOUND_CHUNK`` pairs at a time.
+    candidate parameters of a pair are evaluated in one compiled loop (:func:`_bound_kernel`).
     """
-    if len(a) > _BOUND_CHUNK:
-        return np.concatenate(
-            [
-                _curve_to_polyline_bound_many(
-                    cf[:, :, c : c + _BOUND_CHUNK],
-                    a[c : c + _BOUND_CHUNK],
-                    b[c : c + _BOUND_CHUNK],
-                    u0[c : c + _BOUND_CHUNK],
-                    u1[c : c + _BOUND_CHUNK],
-                )
-                for c in range(0, len(a), _BOUND_CHUNK)
-            ]
-        )
-    (ax, ay), (bx, by), (dx, dy), (ex, ey) = cf
-    lo = np.minimum(u0, u1)
-    hi = np.maximum(u0, u1)
-    abx = b[:, 0] - a[:, 0]
-    aby = b[:, 1] - a[:, 1]
-    ln = np.hypot(abx, aby)
-    good = ln > 0.0
-    inv = 1.0 / np.where(good, ln, 1.0)
-    tx, ty = abx * inv, aby * inv  # direction
-    nx, ny = -ty, tx  # normal
-    # B'(u) = 3a u^2 + 2b u + d along the normal (row 0) and the direction (row 1)
-    vx = np.stack([nx, tx])
-    vy = np.stack([ny, ty])
-    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
-        qa = 3.0 * (ax * vx + ay * vy)
-        qb = 2.0 * (bx * vx + by * vy)
-        qc = dx * vx + dy * vy
-        disc = qb * qb - 4.0 * qa * qc
-        sq = np.sqrt(np.maximum(disc, 0.0))
-        lin = np.abs(qa) <= 1e-14 * (np.abs(qb) + np.abs(qc) + 1e-300)
-        sgn = np.array([1.0, -1.0]).reshape(2, 1, 1)
-        r = np.where(lin, -qc / qb, (-qb + sgn * sq) / (2.0 * qa))  # (sign, row, pair)
-        r = np.where((np.isfinite(r) & (disc >= 0.0)) | lin, r, lo)
-    r[np.isnan(r)] = 0.0
-    r.clip(lo, hi, out=r)
-    uu = np.concatenate([lo, hi, 0.5 * (lo + hi), r.reshape(-1)]).reshape(7, -1)
-    px = ((ax * uu + bx) * uu + dx) * uu + ex - a[:, 0]
-    py = ((ay * uu + by) * uu + dy) * uu + ey - a[:, 1]
-    s = px * tx + py * ty
-    p = np.abs(px * nx + py * ny)
-    o = np.maximum(np.maximum(-s, s - ln), 0.0)
-    if not good.all():  # a zero-length segment is its point
-        p = np.where(good, p, np.hypot(px, py))
-        o = np.where(good, o, 0.0)
-    perp = p.max(axis=0)
-    over = o.max(axis=0)
-    return np.sqrt(perp * perp + over * over)
+    out = np.empty(len(a))
+    if len(a):
+        _bound_kernel(cf, np.ascontiguousarray(a, dtype=np.float64),
+                      np.ascontiguousarray(b, dtype=np.float64),
+                      np.ascontiguousarray(u0, dtype=np.float64),
+                      np.ascontiguousarray(u1, dtype=np.float64), out)
+    return out
+
+
+@njit(cache=True, nogil=True, error_model="numpy")
+def _bound_kernel(cf, a, b, u0, u1, out) -> None:  # pragma: no cover (compiled)
+    """:func:`_curve_to_polyline_bound_many`'s maths, one pair at a time (compiled)."""
+    uu = np.empty(7)
+    for k in range(len(out)):
+        ax = cf[0, 0, k]
+        ay = cf[0, 1, k]
+        bx = cf[1, 0, k]
+        by = cf[1, 1, k]
+        dx = cf[2, 0, k]
+        dy = cf[2, 1, k]
+        ex = cf[3, 0, k]
+        ey = cf[3, 1, k]
+        lo = min(u0[k], u1[k])
+        hi = max(u0[k], u1[k])
+        a0 = a[k, 0]
+        a1 = a[k, 1]
+        abx = b[k, 0] - a0
+        aby = b[k, 1] - a1
+        ln = math.hypot(abx, aby)
+        good = ln > 0.0
+        inv = 1.0 / ln if good else 1.0
+        tx = abx * inv
+        ty = aby * inv
+        nx = -ty
+        ny = tx
+        uu[0] = lo
+        uu[1] = hi
+        uu[2] = 0.5 * (lo + hi)
+        j = 3
+        for row in range(2):
+            vx = nx if row == 0 else tx
+            vy = ny if row == 0 else ty
+            qa = 3.0 * (ax * vx + ay * vy)
+            qb = 2.0 * (bx * vx + by * vy)
+            qc = dx * vx + dy * vy
+            disc = qb * qb - 4.0 * qa * qc
+            sq = math.sqrt(max(disc, 0.0))
+            lin = abs(qa) <= 1e-14 * (abs(qb) + abs(qc) + 1e-300)
+            for sg in (1.0, -1.0):
+                if lin:
+                    r = -qc / qb
+                else:
+                    r = (-qb + sg * sq) / (2.0 * qa)
+                    if not (np.isfinite(r) and disc >= 0.0):
+                        r = lo
+                if np.isnan(r):
+                    r = 0.0
+                uu[j] = min(max(r, lo), hi)
+                j += 1
+        perp = 0.0
+        over = 0.0
+        for i in range(7):
+            u = uu[i]
+            px = ((ax * u + bx) * u + dx) * u + ex - a0
+            py = ((ay * u + by) * u + dy) * u + ey - a1
+            if good:
+                sa = px * tx + py * ty
+                pp = abs(px * nx + py * ny)
+                oo = max(max(-sa, sa - ln), 0.0)
+            else:
+                pp = math.hypot(px, py)
+                oo = 0.0
+            perp = max(perp, pp)
+            over = max(over, oo)
+        out[k] = math.sqrt(perp * perp + over * over)
 
 
 def _ragged(starts: np.ndarray, counts: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -436,6 +474,8 @@ class _BatchFitter:
         self.arc = arc
         self._cubics: list[tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]] = []
         self._lines: list[np.ndarray] = []
+        #: keys a (M + 1) + b of the ranges a..b that :meth:`_try` found no cubic for
+        self._failed = np.zeros(0, dtype=np.int64)
 
     # -- the one-parameter family ---------------------------------------------------------
     def _triangle(self, A: np.ndarray, B: np.ndarray):
@@ -463,7 +503,8 @@ class _BatchFitter:
         t = t[:, None]
         return np.stack([p0, p0 + t * (qq - p0), p3 + t * (qq - p3), p3], axis=1)
 
-    def _dichotomy(self, p0, qq, p3, sig, i0, i1, sample: int = _BISECT_SAMPLE) -> np.ndarray:
+    def _dichotomy(self, p0, qq, p3, sig, i0, i1, sample: int = _BISECT_SAMPLE,
+                   max_iter: int = _MAX_BISECT, eps_sum: float | None = None) -> np.ndarray:
         """t per piece: the signed error sum over a sample of each piece's input points
         crosses zero (Illinois false position inside the bracket [0, 1])."""
         m = len(p0)
@@ -530,7 +571,8 @@ class _BatchFitter:
         ustate[:] = u
         side = np.zeros(m)
         with np.errstate(divide="ignore", invalid="ignore"):
-            for _ in range(_MAX_BISECT):
+            eps_s = self.eps_sum if eps_sum is None else eps_sum
+            for _ in range(max_iter):
                 if done.all():
                     break
                 tn = (tl * sh - th * sl) / (sh - sl)
@@ -540,7 +582,7 @@ class _BatchFitter:
                 s = ssum(tn, np.flatnonzero(~done[pid]) if done.any() else None)
                 t = tn
                 going = ~done
-                stop = going & ((np.abs(s) < self.eps_sum) | (th - tl < 1e-9))
+                stop = going & ((np.abs(s) < eps_s) | (th - tl < 1e-9))
                 upd = going ^ stop  # (stop lies within going)
                 pos = upd & (s > 0.0)
                 neg = upd ^ pos
@@ -613,8 +655,10 @@ class _BatchFitter:
     def fit(self, curve_pieces: np.ndarray, line_pieces: np.ndarray | None = None) -> None:
         """Fit the curve pieces (P, 2) (inclusive thinned index ranges a, b); the results
         are in :meth:`results`. ``line_pieces``: the starts of the one-segment pieces that
-        are lines already (rounded input may absorb some into cubics, :meth:`_absorb_round`;
-        the others come back among the lines)."""
+        are lines already (some may be absorbed into cubics, :meth:`_absorb_round`; the
+        others come back among the lines). After the fit: merges of cubics at smooth
+        vertices (:meth:`_merge_round`), of segments at vertices that barely turn
+        (:meth:`_absorb_round`), three cubics into two (:meth:`_resplit_round`)."""
         if line_pieces is not None:
             self._lines.append(np.asarray(line_pieces, dtype=np.intp))
         ab = np.asarray(curve_pieces, dtype=np.intp).reshape(-1, 2)
@@ -649,22 +693,107 @@ class _BatchFitter:
         for _ in range(_MERGE_ROUNDS):
             if not self._merge_round():
                 break
-        if self.quant is not None:
+        if line_pieces is not None:
             for _ in range(_ABSORB_ROUNDS):
                 if not (self._absorb_round(0) | self._absorb_round(1)):
                     break
+        for _ in range(_RESPLIT_ROUNDS):
+            if not (self._resplit_round(0) | self._resplit_round(1) | self._resplit_round(2)):
+                break
+
+    def _resplit_round(self, phase: int) -> bool:
+        """Three adjacent cubics are replaced by two where two pass the same test, split at
+        one of up to ``_RESPLIT_CANDIDATES`` thinned points between them (evenly spread;
+        the first in ``_RESPLIT_ORDER`` where both pass): the dichotomy split a chain of
+        design pieces at the data's crossings, not at its joints. Non-overlapping triples
+        (every third of a chain, from ``phase``); True when something changed."""
+        cub = self._cubics
+        if not cub:
+            return False
+        A = np.concatenate([c[0] for c in cub])
+        B = np.concatenate([c[1] for c in cub])
+        C = np.concatenate([c[2] for c in cub])
+        E = np.concatenate([c[3] for c in cub])
+        o = np.argsort(A, kind="stable")
+        A, B, C, E = A[o], B[o], C[o], E[o]
+        if len(A) < 3:
+            self._cubics = [(A, B, C, E)]
+            return False
+        adj = B[:-1] == A[1:]
+        tri = adj[:-1] & adj[1:]
+        idx = np.flatnonzero(tri)
+        if len(idx) == 0:
+            self._cubics = [(A, B, C, E)]
+            return False
+        brk = np.r_[True, idx[1:] != idx[:-1] + 1]
+        chain_start = np.maximum.accumulate(np.where(brk, np.arange(len(idx)), 0))
+        pick = idx[(np.arange(len(idx)) - chain_start) % 3 == phase]
+        if len(pick) == 0:
+            self._cubics = [(A, B, C, E)]
+            return False
+        a0, d0 = A[pick], B[pick + 2]
+        inner = d0 - a0 - 1  # thinned points strictly inside
+        nc = np.minimum(inner, _RESPLIT_CANDIDATES)
+        # candidates tried in turn (the middle one first), each triple until one passes;
+        # the second cubic only where the first passed
+        found = np.zeros(len(pick), dtype=bool)
+        vv = np.zeros(len(pick), dtype=np.intp)
+        cc1 = np.zeros((len(pick), 4, 2))
+        cc2 = np.zeros((len(pick), 4, 2))
+        ee1 = np.zeros(len(pick))
+        ee2 = np.zeros(len(pick))
+        for j in _RESPLIT_ORDER:
+            g = np.flatnonzero(~found & (j < nc))
+            if len(g) == 0:
+                continue
+            v = a0[g] + 1 + ((j + 0.5) * inner[g] / nc[g]).astype(np.intp)
+            hope = self._screen(a0[g], v) & self._screen(v, d0[g])
+            g, v = g[hope], v[hope]
+            if len(g) == 0:
+                continue
+            ok1, c1, e1 = self._try(a0[g], v)
+            h = np.flatnonzero(ok1)
+            if len(h) == 0:
+                continue
+            ok2, c2, e2 = self._try(v[h], d0[g[h]])
+            h = h[ok2]
+            gh = g[h]
+            found[gh] = True
+            vv[gh] = v[h]
+            cc1[gh] = c1[h]
+            ee1[gh] = e1[h]
+            cc2[gh] = c2[ok2]
+            ee2[gh] = e2[ok2]
+        if not found.any():
+            self._cubics = [(A, B, C, E)]
+            return False
+        grp = np.flatnonzero(found)
+        t = pick[grp]
+        c1, e1, c2, e2, v = cc1[grp], ee1[grp], cc2[grp], ee2[grp], vv[grp]
+        # the triple t, t+1, t+2 becomes: t = a0..v, t+1 = v..d0, t+2 dropped
+        B[t] = v
+        C[t] = c1
+        E[t] = e1
+        A[t + 1] = v
+        B[t + 1] = d0[grp]
+        C[t + 1] = c2
+        E[t + 1] = e2
+        keep = np.ones(len(A), dtype=bool)
+        keep[t + 2] = False
+        self._cubics = [(A[keep], B[keep], C[keep], E[keep])]
+        return True
 
     def _absorb_round(self, parity: int) -> bool:
-        """Rounded input: a line next to a line or a cubic, at a vertex whose two one-sided
-        tangents differ by less than ``_ABSORB_TURN`` (no corner of the design: the
-        rounding made the thinning leave a short segment or a length jump there), is
-        merged with it into one cubic where one passes the same test. Non-overlapping
-        pairs, one array pass; True when something merged."""
-        assert self.quant is not None
+        """Two adjacent segments (lines or cubics) at a vertex whose two tangents differ by
+        less than ``_ABSORB_TURN`` (no corner of the design: rounding made the thinning
+        leave a short segment or a length jump there, or the curve-run rules cut a smooth
+        stretch) are merged into one cubic where one passes the same test. Non-overlapping
+        pairs (every other pair of a chain, from ``parity``), one array pass; True when
+        something merged."""
         la = np.concatenate(self._lines) if self._lines else np.zeros(0, dtype=np.intp)
         cub = self._cubics
         nC = sum(len(c[0]) for c in cub)
-        if len(la) == 0:
+        if len(la) + nC < 2:
             return False
         A = np.concatenate([la] + [c[0] for c in cub])
         B = np.concatenate([la + 1] + [c[1] for c in cub])
@@ -676,7 +805,7 @@ class _BatchFitter:
         v = B[:-1]
         ti, to = self.t_in[v], self.t_out[v]
         cosv = (ti * to).sum(axis=1)
-        adj = ((B[:-1] == A[1:]) & (self.quant[v] > 0.0)
+        adj = ((B[:-1] == A[1:])
                & (cosv > math.cos(_ABSORB_TURN)))
         if not adj.any():
             return False
@@ -709,18 +838,37 @@ class _BatchFitter:
         passed = np.zeros(m, dtype=bool)
         ctrl_all = np.zeros((m, 4, 2))
         em_all = np.zeros(m)
+        # a range that failed before fails again (same ends, tangents and points): skipped
+        key = A.astype(np.int64) * (len(self.kept) + 1) + B
+        fresh = ~np.isin(key, self._failed) if len(self._failed) else np.ones(m, dtype=bool)
         ok, p0, qq, p3, sig = self._triangle(A, B)
+        ok &= fresh
         w = np.flatnonzero(ok)
         if len(w) == 0:
+            self._remember_failed(key[fresh])
             return passed, ctrl_all, em_all
         a, b = A[w], B[w]
         i0, i1 = self.kept[a], self.kept[b]
+        # exact input: a coarse cubic (few points, few steps) screens out the hopeless
+        # pieces (a loose test: over twice the bound on a small sample) before the real one
+        exact = np.ones(len(w), dtype=bool) if self.quant is None else self.quant[a] <= 0.0
+        if exact.any():
+            cc = self._dichotomy(p0[w], qq[w], p3[w], sig[w], i0, i1, _SCREEN_SAMPLE,
+                                 _SCREEN_STEPS, 10.0 * self.eps_sum)
+            hope = self._sample_ok(cc, i0, i1, _SCREEN_SLACK * self.e_per[a], _SCREEN_SAMPLE)
+            hope |= ~exact
+            if not hope.all():
+                w, a, b, i0, i1 = w[hope], a[hope], b[hope], i0[hope], i1[hope]
+                if len(w) == 0:
+                    self._remember_failed(key[fresh])
+                    return passed, ctrl_all, em_all
         ctrl = self._dichotomy(p0[w], qq[w], p3[w], sig[w], i0, i1, _MERGE_SAMPLE)
         # screen on a sample of the points first: the full test only where it can pass
         lk = self._sample_ok(ctrl, i0, i1, self.e_per[a])
         if self.quant is not None:
             lk |= self.quant[a] > 0.0  # (the least-squares cubic may pass where this fails)
         if not lk.any():
+            self._remember_failed(key[fresh])
             return passed, ctrl_all, em_all
         w, a, b, i0, i1, ctrl = w[lk], a[lk], b[lk], i0[lk], i1[lk], ctrl[lk]
         good, emax, dist, starts = self._accept(ctrl, i0, i1, self.e_per[a], a)
@@ -731,15 +879,43 @@ class _BatchFitter:
         passed[w] = good
         ctrl_all[w] = ctrl
         em_all[w] = emax
+        self._remember_failed(key[fresh & ~passed])
         return passed, ctrl_all, em_all
 
-    def _sample_ok(self, ctrl, i0, i1, e2) -> np.ndarray:
+    def _screen(self, A: np.ndarray, B: np.ndarray) -> np.ndarray:
+        """Per piece A..B: False where :meth:`_try` is sure to fail on exact input (the
+        triangle does not exist, the range failed before, or the coarse screening cubic
+        misses); True otherwise (rounded input is not screened)."""
+        key = A.astype(np.int64) * (len(self.kept) + 1) + B
+        hope = ~np.isin(key, self._failed) if len(self._failed) else np.ones(len(A), bool)
+        ok, p0, qq, p3, sig = self._triangle(A, B)
+        hope &= ok
+        w = np.flatnonzero(hope)
+        if len(w) == 0:
+            return hope
+        a = A[w]
+        exact = np.ones(len(w), dtype=bool) if self.quant is None else self.quant[a] <= 0.0
+        e = np.flatnonzero(exact)
+        if len(e):
+            w, a = w[e], a[e]
+            i0, i1 = self.kept[a], self.kept[B[w]]
+            cc = self._dichotomy(p0[w], qq[w], p3[w], sig[w], i0, i1, _SCREEN_SAMPLE,
+                                 _SCREEN_STEPS, 10.0 * self.eps_sum)
+            hope[w] = self._sample_ok(cc, i0, i1, _SCREEN_SLACK * self.e_per[a],
+                                      _SCREEN_SAMPLE)
+        return hope
+
+    def _remember_failed(self, keys: np.ndarray) -> None:
+        if len(keys):
+            self._failed = np.union1d(self._failed, keys)
+
+    def _sample_ok(self, ctrl, i0, i1, e2, sample: int = _BISECT_SAMPLE // 2) -> np.ndarray:
         """Per piece: every point of a sample (at most ``_BISECT_SAMPLE`` // 2, evenly
         strided) within ``e2`` of the cubic (Newton from arc length; a cheap necessary
         condition of :meth:`_accept`, up to Newton's local minima)."""
         m = len(ctrl)
         L = i1 - i0 - 1
-        stride = np.maximum(1, -(-L // (_BISECT_SAMPLE // 2)))
+        stride = np.maximum(1, -(-L // sample))
         cnt = -(-L // stride)
         pid, off = _ragged(np.zeros(m, dtype=np.intp), cnt)
         idx = i0[pid] + 1 + stride[pid] * off
@@ -1109,12 +1285,9 @@ def _fit_concatenated(
     if rounding is not None and (rounding[:, 1] > 0.0).any():
         fitter.quant = np.repeat(rounding[:, 1], tlen)
     with np.errstate(invalid="ignore", divide="ignore"):
-        if fitter.quant is not None:
-            fitter.fit(np.stack([pa[curve], pb[curve]], axis=1), pa[~curve])
-        else:
-            fitter.fit(np.stack([pa[curve], pb[curve]], axis=1))
+        fitter.fit(np.stack([pa[curve], pb[curve]], axis=1), pa[~curve])
     ca, cb, ctrl, bound, fla = fitter.results()
-    la = fla if fitter.quant is not None else np.concatenate([pa[~curve], fla])
+    la = fla
     lb = la + 1
     owner = np.repeat(np.arange(len(todo)), tlen)  # thinned index -> position in todo
     o_w = woff[todo]
