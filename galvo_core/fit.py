@@ -142,6 +142,9 @@ _RESPLIT_ORDER = (1, 0, 2)
 _LONG_SEGMENT = 10.0
 _LONG_FLOOR = 0.5
 _ABSORB_TURN = math.radians(30)
+#: ... but on rounded input a line without input points between its ends, longer than this
+#: many times the bound, is the design's and stays
+_ABSORB_SHORT = 4.0
 
 
 @dataclass(frozen=True, slots=True, eq=False)
@@ -624,7 +627,8 @@ class _BatchFitter:
         e2p = e2[pid]
         far = np.flatnonzero((dist > e2p) & (emax0[pid] <= 4.0 * e2p))
         if len(far):
-            tu, td = nearest_on_cubics(ctrl, pid[far], pts[far])
+            used, inv = np.unique(pid[far], return_inverse=True)  # (only their cubics)
+            tu, td = nearest_on_cubics(ctrl[used], inv, pts[far])
             better = td < dist[far]
             u[far[better]] = tu[better]
             dist[far[better]] = td[better]
@@ -805,7 +809,14 @@ class _BatchFitter:
         v = B[:-1]
         ti, to = self.t_in[v], self.t_out[v]
         cosv = (ti * to).sum(axis=1)
-        adj = ((B[:-1] == A[1:])
+        # rounded input: a line with no input point between its ends, longer than a few
+        # bounds, is a line of the design (a cubic over it could stray by the rounding)
+        fixed = np.zeros(len(A), dtype=bool)
+        if self.quant is not None:
+            ch = self.q[B] - self.q[A]
+            fixed = isl & (self.quant[A] > 0.0) & (self.kept[B] - self.kept[A] < 2) & (
+                np.hypot(ch[:, 0], ch[:, 1]) > _ABSORB_SHORT * self.e_per[A])
+        adj = ((B[:-1] == A[1:]) & ~fixed[:-1] & ~fixed[1:]
                & (cosv > math.cos(_ABSORB_TURN)))
         if not adj.any():
             return False
