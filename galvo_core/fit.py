@@ -120,7 +120,7 @@ DEFAULT_EPS_SUM = 0.002
 _HALF_DIAGONAL = math.sqrt(0.5)
 _BISECT_SAMPLE = 128
 #: rounds of merging adjacent cubics after the fit
-_MERGE_ROUNDS = 3
+_MERGE_ROUNDS = 1
 #: points per piece in a merge's dichotomy (a candidate; the full test decides)
 _MERGE_SAMPLE = 32
 _MAX_BISECT = 40
