@@ -711,29 +711,20 @@ class _BatchFitter:
         the first in ``_RESPLIT_ORDER`` where both pass): the dichotomy split a chain of
         design pieces at the data's crossings, not at its joints. Non-overlapping triples
         (every third of a chain, from ``phase``); True when something changed."""
-        cub = self._cubics
-        if not cub:
-            return False
-        A = np.concatenate([c[0] for c in cub])
-        B = np.concatenate([c[1] for c in cub])
-        C = np.concatenate([c[2] for c in cub])
-        E = np.concatenate([c[3] for c in cub])
-        o = np.argsort(A, kind="stable")
-        A, B, C, E = A[o], B[o], C[o], E[o]
+        A, B, C, E, isl = self._all_segments()
         if len(A) < 3:
-            self._cubics = [(A, B, C, E)]
             return False
         adj = B[:-1] == A[1:]
-        tri = adj[:-1] & adj[1:]
+        fixed = self._fixed_lines(A, B, isl)
+        nl = isl[:-2].astype(np.int8) + isl[1:-1] + isl[2:]
+        tri = (adj[:-1] & adj[1:] & (nl <= 1) & ~fixed[:-2] & ~fixed[1:-1] & ~fixed[2:])
         idx = np.flatnonzero(tri)
         if len(idx) == 0:
-            self._cubics = [(A, B, C, E)]
             return False
         brk = np.r_[True, idx[1:] != idx[:-1] + 1]
         chain_start = np.maximum.accumulate(np.where(brk, np.arange(len(idx)), 0))
         pick = idx[(np.arange(len(idx)) - chain_start) % 3 == phase]
         if len(pick) == 0:
-            self._cubics = [(A, B, C, E)]
             return False
         a0, d0 = A[pick], B[pick + 2]
         inner = d0 - a0 - 1  # thinned points strictly inside
@@ -769,7 +760,6 @@ class _BatchFitter:
             cc2[gh] = c2[ok2]
             ee2[gh] = e2[ok2]
         if not found.any():
-            self._cubics = [(A, B, C, E)]
             return False
         grp = np.flatnonzero(found)
         t = pick[grp]
@@ -782,10 +772,42 @@ class _BatchFitter:
         B[t + 1] = d0[grp]
         C[t + 1] = c2
         E[t + 1] = e2
+        isl[t] = False
+        isl[t + 1] = False
         keep = np.ones(len(A), dtype=bool)
         keep[t + 2] = False
-        self._cubics = [(A[keep], B[keep], C[keep], E[keep])]
+        self._store(A[keep], B[keep], C[keep], E[keep], isl[keep])
         return True
+
+    def _all_segments(self):
+        """All segments so far, lines and cubics, sorted by start: (A, B, C, E, is_line)
+        (a line's C and E are zeros)."""
+        la = np.concatenate(self._lines) if self._lines else np.zeros(0, dtype=np.intp)
+        cub = self._cubics
+        nC = sum(len(c[0]) for c in cub)
+        A = np.concatenate([la] + [c[0] for c in cub])
+        B = np.concatenate([la + 1] + [c[1] for c in cub])
+        C = np.concatenate([np.zeros((len(la), 4, 2))] + [c[2] for c in cub])
+        E = np.concatenate([np.zeros(len(la))] + [c[3] for c in cub])
+        isl = np.r_[np.ones(len(la), dtype=bool), np.zeros(nC, dtype=bool)]
+        o = np.argsort(A, kind="stable")
+        return A[o], B[o], C[o], E[o], isl[o]
+
+    def _store(self, A, B, C, E, isl) -> None:
+        self._lines = [A[isl]]
+        c = ~isl
+        self._cubics = [(A[c], B[c], C[c], E[c])]
+
+    def _fixed_lines(self, A, B, isl) -> np.ndarray:
+        """Rounded input: the lines with no input point between their ends, longer than
+        ``_ABSORB_SHORT`` times the bound: lines of the design (a cubic over one could stray
+        by the rounding), never merged into a cubic."""
+        fixed = np.zeros(len(A), dtype=bool)
+        if self.quant is not None:
+            ch = self.q[B] - self.q[A]
+            fixed = isl & (self.quant[A] > 0.0) & (self.kept[B] - self.kept[A] < 2) & (
+                np.hypot(ch[:, 0], ch[:, 1]) > _ABSORB_SHORT * self.e_per[A])
+        return fixed
 
     def _absorb_round(self, parity: int) -> bool:
         """Two adjacent segments (lines or cubics) at a vertex whose two tangents differ by
@@ -794,28 +816,13 @@ class _BatchFitter:
         stretch) are merged into one cubic where one passes the same test. Non-overlapping
         pairs (every other pair of a chain, from ``parity``), one array pass; True when
         something merged."""
-        la = np.concatenate(self._lines) if self._lines else np.zeros(0, dtype=np.intp)
-        cub = self._cubics
-        nC = sum(len(c[0]) for c in cub)
-        if len(la) + nC < 2:
+        A, B, C, E, isl = self._all_segments()
+        if len(A) < 2:
             return False
-        A = np.concatenate([la] + [c[0] for c in cub])
-        B = np.concatenate([la + 1] + [c[1] for c in cub])
-        C = np.concatenate([np.zeros((len(la), 4, 2))] + [c[2] for c in cub])
-        E = np.concatenate([np.zeros(len(la))] + [c[3] for c in cub])
-        isl = np.r_[np.ones(len(la), dtype=bool), np.zeros(nC, dtype=bool)]
-        o = np.argsort(A, kind="stable")
-        A, B, C, E, isl = A[o], B[o], C[o], E[o], isl[o]
         v = B[:-1]
         ti, to = self.t_in[v], self.t_out[v]
         cosv = (ti * to).sum(axis=1)
-        # rounded input: a line with no input point between its ends, longer than a few
-        # bounds, is a line of the design (a cubic over it could stray by the rounding)
-        fixed = np.zeros(len(A), dtype=bool)
-        if self.quant is not None:
-            ch = self.q[B] - self.q[A]
-            fixed = isl & (self.quant[A] > 0.0) & (self.kept[B] - self.kept[A] < 2) & (
-                np.hypot(ch[:, 0], ch[:, 1]) > _ABSORB_SHORT * self.e_per[A])
+        fixed = self._fixed_lines(A, B, isl)
         adj = ((B[:-1] == A[1:]) & ~fixed[:-1] & ~fixed[1:]
                & (cosv > math.cos(_ABSORB_TURN)))
         if not adj.any():
@@ -836,10 +843,7 @@ class _BatchFitter:
         isl[i] = False
         keep = np.ones(len(A), dtype=bool)
         keep[i + 1] = False
-        A, B, C, E, isl = A[keep], B[keep], C[keep], E[keep], isl[keep]
-        self._lines = [A[isl]]
-        c = ~isl
-        self._cubics = [(A[c], B[c], C[c], E[c])]
+        self._store(A[keep], B[keep], C[keep], E[keep], isl[keep])
         return True
 
     def _try(self, A: np.ndarray, B: np.ndarray):
