@@ -137,6 +137,8 @@ _RESPLIT_ROUNDS = 1
 _RESPLIT_CANDIDATES = 3
 #: ... in this order (the middle one first)
 _RESPLIT_ORDER = (1, 0, 2)
+#: ... and the most lines among the three
+_RESPLIT_LINES = 2
 #: rounded input: an input segment longer than ``_LONG_SEGMENT`` quanta allows the curve
 #: only that share of the rounding slack beside it (at least ``_LONG_FLOOR``)
 _LONG_SEGMENT = 10.0
@@ -706,18 +708,21 @@ class _BatchFitter:
                 break
 
     def _resplit_round(self, phase: int) -> bool:
-        """Three adjacent cubics are replaced by two where two pass the same test, split at
-        one of up to ``_RESPLIT_CANDIDATES`` thinned points between them (evenly spread;
-        the first in ``_RESPLIT_ORDER`` where both pass): the dichotomy split a chain of
-        design pieces at the data's crossings, not at its joints. Non-overlapping triples
-        (every third of a chain, from ``phase``); True when something changed."""
+        """Three adjacent segments (cubics, at most ``_RESPLIT_LINES`` lines, no line of the
+        design: :meth:`_fixed_lines`) are replaced by two cubics where two pass the same
+        test, split at one of up to ``_RESPLIT_CANDIDATES`` thinned points between them
+        (evenly spread; the first in ``_RESPLIT_ORDER`` where both pass): the dichotomy
+        split a chain of design pieces at the data's crossings, not at its joints, and
+        rounding leaves short lines in curves. Non-overlapping triples (every third of a
+        chain, from ``phase``); True when something changed."""
         A, B, C, E, isl = self._all_segments()
         if len(A) < 3:
             return False
         adj = B[:-1] == A[1:]
         fixed = self._fixed_lines(A, B, isl)
         nl = isl[:-2].astype(np.int8) + isl[1:-1] + isl[2:]
-        tri = (adj[:-1] & adj[1:] & (nl <= 1) & ~fixed[:-2] & ~fixed[1:-1] & ~fixed[2:])
+        tri = (adj[:-1] & adj[1:] & (nl <= _RESPLIT_LINES)
+               & ~fixed[:-2] & ~fixed[1:-1] & ~fixed[2:])
         idx = np.flatnonzero(tri)
         if len(idx) == 0:
             return False
