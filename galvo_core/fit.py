@@ -871,7 +871,7 @@ class _BatchFitter:
         i0, i1 = self.kept[a], self.kept[b]
         # exact input: a coarse cubic (few points, few steps) screens out the hopeless
         # pieces (a loose test: over twice the bound on a small sample) before the real one
-        exact = np.ones(len(w), dtype=bool) if self.quant is None else self.quant[a] <= 0.0
+        exact = np.ones(len(w), dtype=bool)
         if exact.any():
             cc = self._dichotomy(p0[w], qq[w], p3[w], sig[w], i0, i1, _SCREEN_SAMPLE,
                                  _SCREEN_STEPS, 10.0 * self.eps_sum)
@@ -914,7 +914,7 @@ class _BatchFitter:
         if len(w) == 0:
             return hope
         a = A[w]
-        exact = np.ones(len(w), dtype=bool) if self.quant is None else self.quant[a] <= 0.0
+        exact = np.ones(len(w), dtype=bool)
         e = np.flatnonzero(exact)
         if len(e):
             w, a = w[e], a[e]
