@@ -869,19 +869,16 @@ class _BatchFitter:
             return passed, ctrl_all, em_all
         a, b = A[w], B[w]
         i0, i1 = self.kept[a], self.kept[b]
-        # exact input: a coarse cubic (few points, few steps) screens out the hopeless
-        # pieces (a loose test: over twice the bound on a small sample) before the real one
-        exact = np.ones(len(w), dtype=bool)
-        if exact.any():
-            cc = self._dichotomy(p0[w], qq[w], p3[w], sig[w], i0, i1, _SCREEN_SAMPLE,
-                                 _SCREEN_STEPS, 10.0 * self.eps_sum)
-            hope = self._sample_ok(cc, i0, i1, _SCREEN_SLACK * self.e_per[a], _SCREEN_SAMPLE)
-            hope |= ~exact
-            if not hope.all():
-                w, a, b, i0, i1 = w[hope], a[hope], b[hope], i0[hope], i1[hope]
-                if len(w) == 0:
-                    self._remember_failed(key[fresh])
-                    return passed, ctrl_all, em_all
+        # a coarse cubic (few points, few steps) screens out the hopeless pieces (a loose
+        # test: over twice the bound on a small sample) before the real one
+        cc = self._dichotomy(p0[w], qq[w], p3[w], sig[w], i0, i1, _SCREEN_SAMPLE,
+                             _SCREEN_STEPS, 10.0 * self.eps_sum)
+        hope = self._sample_ok(cc, i0, i1, _SCREEN_SLACK * self.e_per[a], _SCREEN_SAMPLE)
+        if not hope.all():
+            w, a, b, i0, i1 = w[hope], a[hope], b[hope], i0[hope], i1[hope]
+            if len(w) == 0:
+                self._remember_failed(key[fresh])
+                return passed, ctrl_all, em_all
         ctrl = self._dichotomy(p0[w], qq[w], p3[w], sig[w], i0, i1, _MERGE_SAMPLE)
         # screen on a sample of the points first: the full test only where it can pass
         lk = self._sample_ok(ctrl, i0, i1, self.e_per[a])
@@ -903,9 +900,9 @@ class _BatchFitter:
         return passed, ctrl_all, em_all
 
     def _screen(self, A: np.ndarray, B: np.ndarray) -> np.ndarray:
-        """Per piece A..B: False where :meth:`_try` is sure to fail on exact input (the
+        """Per piece A..B: False where :meth:`_try` will not be tried in earnest (the
         triangle does not exist, the range failed before, or the coarse screening cubic
-        misses); True otherwise (rounded input is not screened)."""
+        misses by over ``_SCREEN_SLACK`` times the bound); True otherwise."""
         key = A.astype(np.int64) * (len(self.kept) + 1) + B
         hope = ~np.isin(key, self._failed) if len(self._failed) else np.ones(len(A), bool)
         ok, p0, qq, p3, sig = self._triangle(A, B)
@@ -914,15 +911,10 @@ class _BatchFitter:
         if len(w) == 0:
             return hope
         a = A[w]
-        exact = np.ones(len(w), dtype=bool)
-        e = np.flatnonzero(exact)
-        if len(e):
-            w, a = w[e], a[e]
-            i0, i1 = self.kept[a], self.kept[B[w]]
-            cc = self._dichotomy(p0[w], qq[w], p3[w], sig[w], i0, i1, _SCREEN_SAMPLE,
-                                 _SCREEN_STEPS, 10.0 * self.eps_sum)
-            hope[w] = self._sample_ok(cc, i0, i1, _SCREEN_SLACK * self.e_per[a],
-                                      _SCREEN_SAMPLE)
+        i0, i1 = self.kept[a], self.kept[B[w]]
+        cc = self._dichotomy(p0[w], qq[w], p3[w], sig[w], i0, i1, _SCREEN_SAMPLE,
+                             _SCREEN_STEPS, 10.0 * self.eps_sum)
+        hope[w] = self._sample_ok(cc, i0, i1, _SCREEN_SLACK * self.e_per[a], _SCREEN_SAMPLE)
         return hope
 
     def _remember_failed(self, keys: np.ndarray) -> None:
