@@ -51,7 +51,14 @@ its tangent; least-squares handle lengths are used where they pass the same test
 thinned segment whose points bulge to one side is tried as a cubic; a line whose moved ends
 would break its bound becomes the thinned line plus connectors inside the rounding squares.
 For every input, after the fit, adjacent cubics meeting at a smooth vertex are refitted as
-one where one cubic passes the same test (up to ``_MERGE_ROUNDS`` rounds).
+one where one cubic passes the same test (up to ``_MERGE_ROUNDS`` rounds); so are two
+adjacent segments (lines too) at a vertex turning less than ``_ABSORB_TURN``; three
+adjacent cubics become two where two pass, split at another thinned point (the
+dichotomy's splits fall on the data's crossings, not on the design's joints). A merge's
+cubic is screened first (a coarse dichotomy on a few points) and a range that failed is
+not tried again. Rounded input: corners move inside their rounding squares onto the
+intersection of the two sides' least-squares lines (or quadratics), and a long input
+segment (over ``_LONG_SEGMENT`` quanta) leaves a curve only part of the slack beside it.
 
 ``eps_sum`` default: 0.002 input units (one tenth of the paper's e_per). The paper gives no
 value; it only decides when the bisection stops, the acceptance is decided by ``e_per``. A
@@ -68,6 +75,7 @@ from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
 import numpy as np
+from numba import njit
 
 from galvo_core.drawing import Drawing
 from galvo_core.errors import Cancelled, ParamError
@@ -112,10 +120,33 @@ DEFAULT_EPS_SUM = 0.002
 _HALF_DIAGONAL = math.sqrt(0.5)
 _BISECT_SAMPLE = 128
 #: rounds of merging adjacent cubics after the fit
-_MERGE_ROUNDS = 3
+_MERGE_ROUNDS = 1
 #: points per piece in a merge's dichotomy (a candidate; the full test decides)
 _MERGE_SAMPLE = 32
 _MAX_BISECT = 40
+#: a merge's screening cubic: points, dichotomy steps, and how far over the bound a
+#: sample point may be for the real fit to be tried
+_SCREEN_SAMPLE = 12
+_SCREEN_STEPS = 8
+_SCREEN_SLACK = 2.0
+#: rounds of absorbing lines into cubics on rounded input, and the largest turn (radians)
+#: between the one-sided tangents at the vertex where that may happen
+_ABSORB_ROUNDS = 3
+#: rounds of replacing three adjacent cubics by two, and the split points tried per triple
+_RESPLIT_ROUNDS = 1
+_RESPLIT_CANDIDATES = 3
+#: ... in this order (the middle one first)
+_RESPLIT_ORDER = (1, 0, 2)
+#: ... and the most lines among the three
+_RESPLIT_LINES = 2
+#: rounded input: an input segment longer than ``_LONG_SEGMENT`` quanta allows the curve
+#: only that share of the rounding slack beside it (at least ``_LONG_FLOOR``)
+_LONG_SEGMENT = 10.0
+_LONG_FLOOR = 0.5
+_ABSORB_TURN = math.radians(30)
+#: ... but on rounded input a line without input points between its ends, longer than this
+#: many times the bound, is the design's and stays
+_ABSORB_SHORT = 4.0
 
 
 @dataclass(frozen=True, slots=True, eq=False)
@@ -311,11 +342,6 @@ def _make_segment(kind: str, points: np.ndarray, first: int, last: int) -> Segme
     return s
 
 
-#: pairs measured at once by :func:`_curve_to_polyline_bound_many` (its candidates x pairs
-#: tables stay small)
-_BOUND_CHUNK = 1 << 14
-
-
 def _curve_to_polyline_bound_many(
     cf: np.ndarray, a: np.ndarray, b: np.ndarray, u0: np.ndarray, u1: np.ndarray
 ) -> np.ndarray:
@@ -326,58 +352,83 @@ def _curve_to_polyline_bound_many(
 
     |perpendicular| and overshoot beyond the segment's ends are maximised exactly over the
     stretch (end values and roots of their derivatives, quadratics in u): all seven
-    candidate parameters of a pair are evaluated at once, ``_BOUND_CHUNK`` pairs at a time.
+    candidate parameters of a pair are evaluated in one compiled loop (:func:`_bound_kernel`).
     """
-    if len(a) > _BOUND_CHUNK:
-        return np.concatenate(
-            [
-                _curve_to_polyline_bound_many(
-                    cf[:, :, c : c + _BOUND_CHUNK],
-                    a[c : c + _BOUND_CHUNK],
-                    b[c : c + _BOUND_CHUNK],
-                    u0[c : c + _BOUND_CHUNK],
-                    u1[c : c + _BOUND_CHUNK],
-                )
-                for c in range(0, len(a), _BOUND_CHUNK)
-            ]
-        )
-    (ax, ay), (bx, by), (dx, dy), (ex, ey) = cf
-    lo = np.minimum(u0, u1)
-    hi = np.maximum(u0, u1)
-    abx = b[:, 0] - a[:, 0]
-    aby = b[:, 1] - a[:, 1]
-    ln = np.hypot(abx, aby)
-    good = ln > 0.0
-    inv = 1.0 / np.where(good, ln, 1.0)
-    tx, ty = abx * inv, aby * inv  # direction
-    nx, ny = -ty, tx  # normal
-    # B'(u) = 3a u^2 + 2b u + d along the normal (row 0) and the direction (row 1)
-    vx = np.stack([nx, tx])
-    vy = np.stack([ny, ty])
-    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
-        qa = 3.0 * (ax * vx + ay * vy)
-        qb = 2.0 * (bx * vx + by * vy)
-        qc = dx * vx + dy * vy
-        disc = qb * qb - 4.0 * qa * qc
-        sq = np.sqrt(np.maximum(disc, 0.0))
-        lin = np.abs(qa) <= 1e-14 * (np.abs(qb) + np.abs(qc) + 1e-300)
-        sgn = np.array([1.0, -1.0]).reshape(2, 1, 1)
-        r = np.where(lin, -qc / qb, (-qb + sgn * sq) / (2.0 * qa))  # (sign, row, pair)
-        r = np.where((np.isfinite(r) & (disc >= 0.0)) | lin, r, lo)
-    r[np.isnan(r)] = 0.0
-    r.clip(lo, hi, out=r)
-    uu = np.concatenate([lo, hi, 0.5 * (lo + hi), r.reshape(-1)]).reshape(7, -1)
-    px = ((ax * uu + bx) * uu + dx) * uu + ex - a[:, 0]
-    py = ((ay * uu + by) * uu + dy) * uu + ey - a[:, 1]
-    s = px * tx + py * ty
-    p = np.abs(px * nx + py * ny)
-    o = np.maximum(np.maximum(-s, s - ln), 0.0)
-    if not good.all():  # a zero-length segment is its point
-        p = np.where(good, p, np.hypot(px, py))
-        o = np.where(good, o, 0.0)
-    perp = p.max(axis=0)
-    over = o.max(axis=0)
-    return np.sqrt(perp * perp + over * over)
+    out = np.empty(len(a))
+    if len(a):
+        _bound_kernel(cf, np.ascontiguousarray(a, dtype=np.float64),
+                      np.ascontiguousarray(b, dtype=np.float64),
+                      np.ascontiguousarray(u0, dtype=np.float64),
+                      np.ascontiguousarray(u1, dtype=np.float64), out)
+    return out
+
+
+@njit(cache=True, nogil=True, error_model="numpy")
+def _bound_kernel(cf, a, b, u0, u1, out) -> None:  # pragma: no cover (compiled)
+    """:func:`_curve_to_polyline_bound_many`'s maths, one pair at a time (compiled)."""
+    uu = np.empty(7)
+    for k in range(len(out)):
+        ax = cf[0, 0, k]
+        ay = cf[0, 1, k]
+        bx = cf[1, 0, k]
+        by = cf[1, 1, k]
+        dx = cf[2, 0, k]
+        dy = cf[2, 1, k]
+        ex = cf[3, 0, k]
+        ey = cf[3, 1, k]
+        lo = min(u0[k], u1[k])
+        hi = max(u0[k], u1[k])
+        a0 = a[k, 0]
+        a1 = a[k, 1]
+        abx = b[k, 0] - a0
+        aby = b[k, 1] - a1
+        ln = math.hypot(abx, aby)
+        good = ln > 0.0
+        inv = 1.0 / ln if good else 1.0
+        tx = abx * inv
+        ty = aby * inv
+        nx = -ty
+        ny = tx
+        uu[0] = lo
+        uu[1] = hi
+        uu[2] = 0.5 * (lo + hi)
+        j = 3
+        for row in range(2):
+            vx = nx if row == 0 else tx
+            vy = ny if row == 0 else ty
+            qa = 3.0 * (ax * vx + ay * vy)
+            qb = 2.0 * (bx * vx + by * vy)
+            qc = dx * vx + dy * vy
+            disc = qb * qb - 4.0 * qa * qc
+            sq = math.sqrt(max(disc, 0.0))
+            lin = abs(qa) <= 1e-14 * (abs(qb) + abs(qc) + 1e-300)
+            for sg in (1.0, -1.0):
+                if lin:
+                    r = -qc / qb
+                else:
+                    r = (-qb + sg * sq) / (2.0 * qa)
+                    if not (np.isfinite(r) and disc >= 0.0):
+                        r = lo
+                if np.isnan(r):
+                    r = 0.0
+                uu[j] = min(max(r, lo), hi)
+                j += 1
+        perp = 0.0
+        over = 0.0
+        for i in range(7):
+            u = uu[i]
+            px = ((ax * u + bx) * u + dx) * u + ex - a0
+            py = ((ay * u + by) * u + dy) * u + ey - a1
+            if good:
+                sa = px * tx + py * ty
+                pp = abs(px * nx + py * ny)
+                oo = max(max(-sa, sa - ln), 0.0)
+            else:
+                pp = math.hypot(px, py)
+                oo = 0.0
+            perp = max(perp, pp)
+            over = max(over, oo)
+        out[k] = math.sqrt(perp * perp + over * over)
 
 
 def _ragged(starts: np.ndarray, counts: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -428,6 +479,8 @@ class _BatchFitter:
         self.arc = arc
         self._cubics: list[tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]] = []
         self._lines: list[np.ndarray] = []
+        #: keys a (M + 1) + b of the ranges a..b that :meth:`_try` found no cubic for
+        self._failed = np.zeros(0, dtype=np.int64)
 
     # -- the one-parameter family ---------------------------------------------------------
     def _triangle(self, A: np.ndarray, B: np.ndarray):
@@ -455,7 +508,8 @@ class _BatchFitter:
         t = t[:, None]
         return np.stack([p0, p0 + t * (qq - p0), p3 + t * (qq - p3), p3], axis=1)
 
-    def _dichotomy(self, p0, qq, p3, sig, i0, i1, sample: int = _BISECT_SAMPLE) -> np.ndarray:
+    def _dichotomy(self, p0, qq, p3, sig, i0, i1, sample: int = _BISECT_SAMPLE,
+                   max_iter: int = _MAX_BISECT, eps_sum: float | None = None) -> np.ndarray:
         """t per piece: the signed error sum over a sample of each piece's input points
         crosses zero (Illinois false position inside the bracket [0, 1])."""
         m = len(p0)
@@ -522,7 +576,8 @@ class _BatchFitter:
         ustate[:] = u
         side = np.zeros(m)
         with np.errstate(divide="ignore", invalid="ignore"):
-            for _ in range(_MAX_BISECT):
+            eps_s = self.eps_sum if eps_sum is None else eps_sum
+            for _ in range(max_iter):
                 if done.all():
                     break
                 tn = (tl * sh - th * sl) / (sh - sl)
@@ -532,7 +587,7 @@ class _BatchFitter:
                 s = ssum(tn, np.flatnonzero(~done[pid]) if done.any() else None)
                 t = tn
                 going = ~done
-                stop = going & ((np.abs(s) < self.eps_sum) | (th - tl < 1e-9))
+                stop = going & ((np.abs(s) < eps_s) | (th - tl < 1e-9))
                 upd = going ^ stop  # (stop lies within going)
                 pos = upd & (s > 0.0)
                 neg = upd ^ pos
@@ -547,7 +602,8 @@ class _BatchFitter:
                 done |= stop
         return self._ctrl(p0, qq, p3, t)
 
-    def _accept(self, ctrl: np.ndarray, i0: np.ndarray, i1: np.ndarray, e2: np.ndarray):
+    def _accept(self, ctrl: np.ndarray, i0: np.ndarray, i1: np.ndarray, e2: np.ndarray,
+                A: np.ndarray | None = None):
         """Per piece: bound of the max input-point error, pass/fail of both sides of the
         guarantee, and the flat per-point errors (with the offsets of each piece)."""
         m = len(ctrl)
@@ -573,7 +629,8 @@ class _BatchFitter:
         e2p = e2[pid]
         far = np.flatnonzero((dist > e2p) & (emax0[pid] <= 4.0 * e2p))
         if len(far):
-            tu, td = nearest_on_cubics(ctrl, pid[far], pts[far])
+            used, inv = np.unique(pid[far], return_inverse=True)  # (only their cubics)
+            tu, td = nearest_on_cubics(ctrl[used], inv, pts[far])
             better = td < dist[far]
             u[far[better]] = tu[better]
             dist[far[better]] = td[better]
@@ -586,14 +643,30 @@ class _BatchFitter:
         j = np.flatnonzero(pair)
         if len(j):
             bnd = _curve_to_polyline_bound_many(cf[:, :, j], pts[j], pts[j + 1], u[j], u[j + 1])
+            if self.quant is not None and A is not None:
+                # rounded input: a long input segment is the design up to the rounding of
+                # its ends, so the curve keeps closer to it than the rounding allows
+                qa = self.quant[A][pid[j]]
+                sl = qa * _HALF_DIAGONAL
+                ln = np.hypot(*(pts[j + 1] - pts[j]).T)
+                with np.errstate(divide="ignore", invalid="ignore"):
+                    f = np.clip(_LONG_SEGMENT * qa / ln, _LONG_FLOOR, 1.0)
+                f = np.where(qa > 0.0, f, 1.0)
+                bnd = bnd + sl * (1.0 - f)
             worst = np.zeros(m)
             np.maximum.at(worst, pid[j], bnd)
             ok &= worst <= e2
         return ok, emax, dist, starts
 
-    def fit(self, curve_pieces: np.ndarray) -> None:
+    def fit(self, curve_pieces: np.ndarray, line_pieces: np.ndarray | None = None) -> None:
         """Fit the curve pieces (P, 2) (inclusive thinned index ranges a, b); the results
-        are in :meth:`results`."""
+        are in :meth:`results`. ``line_pieces``: the starts of the one-segment pieces that
+        are lines already (some may be absorbed into cubics, :meth:`_absorb_round`; the
+        others come back among the lines). After the fit: merges of cubics at smooth
+        vertices (:meth:`_merge_round`), of segments at vertices that barely turn
+        (:meth:`_absorb_round`), three cubics into two (:meth:`_resplit_round`)."""
+        if line_pieces is not None:
+            self._lines.append(np.asarray(line_pieces, dtype=np.intp))
         ab = np.asarray(curve_pieces, dtype=np.intp).reshape(-1, 2)
         while len(ab):
             line = ab[:, 1] - ab[:, 0] == 1
@@ -613,7 +686,7 @@ class _BatchFitter:
             if len(A):
                 i0, i1 = self.kept[A], self.kept[B]
                 ctrl = self._dichotomy(p0[ok], qq[ok], p3[ok], sig[ok], i0, i1)
-                good, emax, dist, starts = self._accept(ctrl, i0, i1, self.e_per[A])
+                good, emax, dist, starts = self._accept(ctrl, i0, i1, self.e_per[A], A)
                 if self.quant is not None:
                     rq = np.flatnonzero(self.quant[A] > 0.0)
                     if len(rq):
@@ -626,6 +699,157 @@ class _BatchFitter:
         for _ in range(_MERGE_ROUNDS):
             if not self._merge_round():
                 break
+        if line_pieces is not None:
+            for _ in range(_ABSORB_ROUNDS):
+                if not (self._absorb_round(0) | self._absorb_round(1)):
+                    break
+        for _ in range(_RESPLIT_ROUNDS):
+            if not (self._resplit_round(0) | self._resplit_round(1) | self._resplit_round(2)):
+                break
+
+    def _resplit_round(self, phase: int) -> bool:
+        """Three adjacent segments (cubics, at most ``_RESPLIT_LINES`` lines, no line of the
+        design: :meth:`_fixed_lines`) are replaced by two cubics where two pass the same
+        test, split at one of up to ``_RESPLIT_CANDIDATES`` thinned points between them
+        (evenly spread; the first in ``_RESPLIT_ORDER`` where both pass): the dichotomy
+        split a chain of design pieces at the data's crossings, not at its joints, and
+        rounding leaves short lines in curves. Non-overlapping triples (every third of a
+        chain, from ``phase``); True when something changed."""
+        A, B, C, E, isl = self._all_segments()
+        if len(A) < 3:
+            return False
+        adj = B[:-1] == A[1:]
+        fixed = self._fixed_lines(A, B, isl)
+        nl = isl[:-2].astype(np.int8) + isl[1:-1] + isl[2:]
+        tri = (adj[:-1] & adj[1:] & (nl <= _RESPLIT_LINES)
+               & ~fixed[:-2] & ~fixed[1:-1] & ~fixed[2:])
+        idx = np.flatnonzero(tri)
+        if len(idx) == 0:
+            return False
+        brk = np.r_[True, idx[1:] != idx[:-1] + 1]
+        chain_start = np.maximum.accumulate(np.where(brk, np.arange(len(idx)), 0))
+        pick = idx[(np.arange(len(idx)) - chain_start) % 3 == phase]
+        if len(pick) == 0:
+            return False
+        a0, d0 = A[pick], B[pick + 2]
+        inner = d0 - a0 - 1  # thinned points strictly inside
+        nc = np.minimum(inner, _RESPLIT_CANDIDATES)
+        # candidates tried in turn (the middle one first), each triple until one passes;
+        # the second cubic only where the first passed
+        found = np.zeros(len(pick), dtype=bool)
+        vv = np.zeros(len(pick), dtype=np.intp)
+        cc1 = np.zeros((len(pick), 4, 2))
+        cc2 = np.zeros((len(pick), 4, 2))
+        ee1 = np.zeros(len(pick))
+        ee2 = np.zeros(len(pick))
+        for j in _RESPLIT_ORDER:
+            g = np.flatnonzero(~found & (j < nc))
+            if len(g) == 0:
+                continue
+            v = a0[g] + 1 + ((j + 0.5) * inner[g] / nc[g]).astype(np.intp)
+            hope = self._screen(a0[g], v) & self._screen(v, d0[g])
+            g, v = g[hope], v[hope]
+            if len(g) == 0:
+                continue
+            ok1, c1, e1 = self._try(a0[g], v)
+            h = np.flatnonzero(ok1)
+            if len(h) == 0:
+                continue
+            ok2, c2, e2 = self._try(v[h], d0[g[h]])
+            h = h[ok2]
+            gh = g[h]
+            found[gh] = True
+            vv[gh] = v[h]
+            cc1[gh] = c1[h]
+            ee1[gh] = e1[h]
+            cc2[gh] = c2[ok2]
+            ee2[gh] = e2[ok2]
+        if not found.any():
+            return False
+        grp = np.flatnonzero(found)
+        t = pick[grp]
+        c1, e1, c2, e2, v = cc1[grp], ee1[grp], cc2[grp], ee2[grp], vv[grp]
+        # the triple t, t+1, t+2 becomes: t = a0..v, t+1 = v..d0, t+2 dropped
+        B[t] = v
+        C[t] = c1
+        E[t] = e1
+        A[t + 1] = v
+        B[t + 1] = d0[grp]
+        C[t + 1] = c2
+        E[t + 1] = e2
+        isl[t] = False
+        isl[t + 1] = False
+        keep = np.ones(len(A), dtype=bool)
+        keep[t + 2] = False
+        self._store(A[keep], B[keep], C[keep], E[keep], isl[keep])
+        return True
+
+    def _all_segments(self):
+        """All segments so far, lines and cubics, sorted by start: (A, B, C, E, is_line)
+        (a line's C and E are zeros)."""
+        la = np.concatenate(self._lines) if self._lines else np.zeros(0, dtype=np.intp)
+        cub = self._cubics
+        nC = sum(len(c[0]) for c in cub)
+        A = np.concatenate([la] + [c[0] for c in cub])
+        B = np.concatenate([la + 1] + [c[1] for c in cub])
+        C = np.concatenate([np.zeros((len(la), 4, 2))] + [c[2] for c in cub])
+        E = np.concatenate([np.zeros(len(la))] + [c[3] for c in cub])
+        isl = np.r_[np.ones(len(la), dtype=bool), np.zeros(nC, dtype=bool)]
+        o = np.argsort(A, kind="stable")
+        return A[o], B[o], C[o], E[o], isl[o]
+
+    def _store(self, A, B, C, E, isl) -> None:
+        self._lines = [A[isl]]
+        c = ~isl
+        self._cubics = [(A[c], B[c], C[c], E[c])]
+
+    def _fixed_lines(self, A, B, isl) -> np.ndarray:
+        """Rounded input: the lines with no input point between their ends, longer than
+        ``_ABSORB_SHORT`` times the bound: lines of the design (a cubic over one could stray
+        by the rounding), never merged into a cubic."""
+        fixed = np.zeros(len(A), dtype=bool)
+        if self.quant is not None:
+            ch = self.q[B] - self.q[A]
+            fixed = isl & (self.quant[A] > 0.0) & (self.kept[B] - self.kept[A] < 2) & (
+                np.hypot(ch[:, 0], ch[:, 1]) > _ABSORB_SHORT * self.e_per[A])
+        return fixed
+
+    def _absorb_round(self, parity: int) -> bool:
+        """Two adjacent segments (lines or cubics) at a vertex whose two tangents differ by
+        less than ``_ABSORB_TURN`` (no corner of the design: rounding made the thinning
+        leave a short segment or a length jump there, or the curve-run rules cut a smooth
+        stretch) are merged into one cubic where one passes the same test. Non-overlapping
+        pairs (every other pair of a chain, from ``parity``), one array pass; True when
+        something merged."""
+        A, B, C, E, isl = self._all_segments()
+        if len(A) < 2:
+            return False
+        v = B[:-1]
+        ti, to = self.t_in[v], self.t_out[v]
+        cosv = (ti * to).sum(axis=1)
+        fixed = self._fixed_lines(A, B, isl)
+        adj = ((B[:-1] == A[1:]) & ~fixed[:-1] & ~fixed[1:]
+               & (cosv > math.cos(_ABSORB_TURN)))
+        if not adj.any():
+            return False
+        idx = np.flatnonzero(adj)
+        brk = np.r_[True, idx[1:] != idx[:-1] + 1]
+        chain_start = np.maximum.accumulate(np.where(brk, np.arange(len(idx)), 0))
+        pick = idx[(np.arange(len(idx)) - chain_start) % 2 == parity]
+        if len(pick) == 0:
+            return False
+        ok, ctrl, em = self._try(A[pick], B[pick + 1])
+        if not ok.any():
+            return False
+        i = pick[ok]
+        B[i] = B[i + 1]
+        C[i] = ctrl[ok]
+        E[i] = em[ok]
+        isl[i] = False
+        keep = np.ones(len(A), dtype=bool)
+        keep[i + 1] = False
+        self._store(A[keep], B[keep], C[keep], E[keep], isl[keep])
+        return True
 
     def _try(self, A: np.ndarray, B: np.ndarray):
         """One cubic per piece A..B (no split): (passed, ctrl, bound) for the pieces whose
@@ -634,21 +858,37 @@ class _BatchFitter:
         passed = np.zeros(m, dtype=bool)
         ctrl_all = np.zeros((m, 4, 2))
         em_all = np.zeros(m)
+        # a range that failed before fails again (same ends, tangents and points): skipped
+        key = A.astype(np.int64) * (len(self.kept) + 1) + B
+        fresh = ~np.isin(key, self._failed) if len(self._failed) else np.ones(m, dtype=bool)
         ok, p0, qq, p3, sig = self._triangle(A, B)
+        ok &= fresh
         w = np.flatnonzero(ok)
         if len(w) == 0:
+            self._remember_failed(key[fresh])
             return passed, ctrl_all, em_all
         a, b = A[w], B[w]
         i0, i1 = self.kept[a], self.kept[b]
+        # a coarse cubic (few points, few steps) screens out the hopeless pieces (a loose
+        # test: over twice the bound on a small sample) before the real one
+        cc = self._dichotomy(p0[w], qq[w], p3[w], sig[w], i0, i1, _SCREEN_SAMPLE,
+                             _SCREEN_STEPS, 10.0 * self.eps_sum)
+        hope = self._sample_ok(cc, i0, i1, _SCREEN_SLACK * self.e_per[a], _SCREEN_SAMPLE)
+        if not hope.all():
+            w, a, b, i0, i1 = w[hope], a[hope], b[hope], i0[hope], i1[hope]
+            if len(w) == 0:
+                self._remember_failed(key[fresh])
+                return passed, ctrl_all, em_all
         ctrl = self._dichotomy(p0[w], qq[w], p3[w], sig[w], i0, i1, _MERGE_SAMPLE)
         # screen on a sample of the points first: the full test only where it can pass
         lk = self._sample_ok(ctrl, i0, i1, self.e_per[a])
         if self.quant is not None:
             lk |= self.quant[a] > 0.0  # (the least-squares cubic may pass where this fails)
         if not lk.any():
+            self._remember_failed(key[fresh])
             return passed, ctrl_all, em_all
         w, a, b, i0, i1, ctrl = w[lk], a[lk], b[lk], i0[lk], i1[lk], ctrl[lk]
-        good, emax, dist, starts = self._accept(ctrl, i0, i1, self.e_per[a])
+        good, emax, dist, starts = self._accept(ctrl, i0, i1, self.e_per[a], a)
         if self.quant is not None:
             rq = np.flatnonzero((self.quant[a] > 0.0) & ~good)
             if len(rq):
@@ -656,15 +896,38 @@ class _BatchFitter:
         passed[w] = good
         ctrl_all[w] = ctrl
         em_all[w] = emax
+        self._remember_failed(key[fresh & ~passed])
         return passed, ctrl_all, em_all
 
-    def _sample_ok(self, ctrl, i0, i1, e2) -> np.ndarray:
+    def _screen(self, A: np.ndarray, B: np.ndarray) -> np.ndarray:
+        """Per piece A..B: False where :meth:`_try` will not be tried in earnest (the
+        triangle does not exist, the range failed before, or the coarse screening cubic
+        misses by over ``_SCREEN_SLACK`` times the bound); True otherwise."""
+        key = A.astype(np.int64) * (len(self.kept) + 1) + B
+        hope = ~np.isin(key, self._failed) if len(self._failed) else np.ones(len(A), bool)
+        ok, p0, qq, p3, sig = self._triangle(A, B)
+        hope &= ok
+        w = np.flatnonzero(hope)
+        if len(w) == 0:
+            return hope
+        a = A[w]
+        i0, i1 = self.kept[a], self.kept[B[w]]
+        cc = self._dichotomy(p0[w], qq[w], p3[w], sig[w], i0, i1, _SCREEN_SAMPLE,
+                             _SCREEN_STEPS, 10.0 * self.eps_sum)
+        hope[w] = self._sample_ok(cc, i0, i1, _SCREEN_SLACK * self.e_per[a], _SCREEN_SAMPLE)
+        return hope
+
+    def _remember_failed(self, keys: np.ndarray) -> None:
+        if len(keys):
+            self._failed = np.union1d(self._failed, keys)
+
+    def _sample_ok(self, ctrl, i0, i1, e2, sample: int = _BISECT_SAMPLE // 2) -> np.ndarray:
         """Per piece: every point of a sample (at most ``_BISECT_SAMPLE`` // 2, evenly
         strided) within ``e2`` of the cubic (Newton from arc length; a cheap necessary
         condition of :meth:`_accept`, up to Newton's local minima)."""
         m = len(ctrl)
         L = i1 - i0 - 1
-        stride = np.maximum(1, -(-L // (_BISECT_SAMPLE // 2)))
+        stride = np.maximum(1, -(-L // sample))
         cnt = -(-L // stride)
         pid, off = _ragged(np.zeros(m, dtype=np.intp), cnt)
         idx = i0[pid] + 1 + stride[pid] * off
@@ -789,7 +1052,7 @@ class _BatchFitter:
         cl, okl = self._least_squares(A, B, i0, i1)
         passed = np.zeros(len(A), dtype=bool)
         if okl.any():
-            g, e, _, _ = self._accept(cl[okl], i0[okl], i1[okl], self.e_per[A[okl]])
+            g, e, _, _ = self._accept(cl[okl], i0[okl], i1[okl], self.e_per[A[okl]], A[okl])
             sel = np.flatnonzero(okl)[g]
             self._cubics.append((A[sel], B[sel], cl[sel], e[g]))
             passed[sel] = True
@@ -815,7 +1078,7 @@ class _BatchFitter:
         if not okl.any():
             return
         sel = rq[okl]
-        g2, e2, d2, s2 = self._accept(cl[okl], i0[okl], i1[okl], self.e_per[a[okl]])
+        g2, e2, d2, s2 = self._accept(cl[okl], i0[okl], i1[okl], self.e_per[a[okl]], a[okl])
         use = sel[g2]
         ctrl[use] = cl[okl][g2]
         emax[use] = e2[g2]
@@ -1028,14 +1291,15 @@ def _fit_concatenated(
     arc = _arc_per_path(W, wlen)
     if rounding is not None and (rounding[:, 1] > 0.0).any():
         Q = Q.copy()
-        _on_the_design(W, K, Q, arc, t_in, t_out, smooth, np.repeat(rounding[:, 1], tlen), tlen)
+        _on_the_design(W, K, Q, arc, t_in, t_out, smooth, np.repeat(rounding[:, 1], tlen), tlen,
+                       np.repeat(rounding[:, 0], tlen))
     fitter = _BatchFitter(W, K, t_in, t_out, np.repeat(e_per, tlen), eps_sum, arc, q=Q)
     if rounding is not None and (rounding[:, 1] > 0.0).any():
         fitter.quant = np.repeat(rounding[:, 1], tlen)
     with np.errstate(invalid="ignore", divide="ignore"):
-        fitter.fit(np.stack([pa[curve], pb[curve]], axis=1))
+        fitter.fit(np.stack([pa[curve], pb[curve]], axis=1), pa[~curve])
     ca, cb, ctrl, bound, fla = fitter.results()
-    la = np.concatenate([pa[~curve], fla])
+    la = fla
     lb = la + 1
     owner = np.repeat(np.arange(len(todo)), tlen)  # thinned index -> position in todo
     o_w = woff[todo]
@@ -1160,7 +1424,45 @@ def _local_fits(
     return pos, tan, ok
 
 
-def _on_the_design(W, K, Q, arc, t_in, t_out, smooth, quant, tlen) -> None:
+def _local_lines(
+    W: np.ndarray, lo: np.ndarray, hi: np.ndarray, at: np.ndarray
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Least-squares lines (principal axis) through the input points lo..hi (inclusive
+    global indices) of each window: (the point ``at`` projected onto the line (V, 2), unit
+    direction (V, 2) from lo to hi, ok (V,): at least 3 points)."""
+    cnt = hi - lo + 1
+    v = len(lo)
+    ok = cnt >= 3
+    pos = W[at].astype(np.float64, copy=True)
+    tan = np.zeros((v, 2))
+    if not ok.any():
+        return pos, tan, ok
+    c = np.where(ok, cnt, 0)
+    own, off = _ragged(np.zeros(v, dtype=np.intp), c)
+    idx = lo[own] + off
+    ref = W[at]
+    d = W[idx] - ref[own]
+    n = np.maximum(c, 1)
+    mx = np.bincount(own, d[:, 0], v) / n
+    my = np.bincount(own, d[:, 1], v) / n
+    dx = d[:, 0] - mx[own]
+    dy = d[:, 1] - my[own]
+    sxx = np.bincount(own, dx * dx, v)
+    syy = np.bincount(own, dy * dy, v)
+    sxy = np.bincount(own, dx * dy, v)
+    ang = 0.5 * np.arctan2(2.0 * sxy, sxx - syy)
+    tx, ty = np.cos(ang), np.sin(ang)
+    ch = W[hi] - W[lo]
+    flip = tx * ch[:, 0] + ty * ch[:, 1] < 0.0
+    tx = np.where(flip, -tx, tx)
+    ty = np.where(flip, -ty, ty)
+    s = -(mx * tx + my * ty)  # the reference point's coordinate along the line
+    pos[ok] = (ref + np.stack([mx + s * tx, my + s * ty], axis=1))[ok]
+    tan[ok] = np.stack([tx, ty], axis=1)[ok]
+    return pos, tan, ok
+
+
+def _on_the_design(W, K, Q, arc, t_in, t_out, smooth, quant, tlen, eps) -> None:
     """Rounded input (per thinned point its path's quantum ``quant``): the smooth thinned
     vertices (inside curve runs) moved onto a least-squares estimate of the design curve
     (a quadratic in arc length through the input points between the middles of the two
@@ -1186,14 +1488,110 @@ def _on_the_design(W, K, Q, arc, t_in, t_out, smooth, quant, tlen) -> None:
         t_in[k] = tan[ok]
         t_out[k] = tan[ok]
     # one-sided tangents at the other vertices (corners, ends of runs)
+    # (over at least _SIDE_POINTS input points: a short thinned segment is rounding)
+    k_first = np.repeat(K[first], tlen)
+    k_last = np.repeat(K[last], tlen)
     co = np.flatnonzero(~smooth & rnd & ~is_last)
     if len(co):
-        _, tan, ok = _local_fits(W, arc, K[co], K[co + 1], K[co])
+        hi = np.maximum(K[co + 1], np.minimum(K[co] + _SIDE_POINTS - 1, k_last[co]))
+        _, tan, ok = _local_fits(W, arc, K[co], hi, K[co])
         t_out[co[ok]] = tan[ok]
     ci = np.flatnonzero(~smooth & rnd & ~is_first)
     if len(ci):
-        _, tan, ok = _local_fits(W, arc, K[ci - 1], K[ci], K[ci])
+        lo = np.minimum(K[ci - 1], np.maximum(K[ci] - _SIDE_POINTS + 1, k_first[ci]))
+        _, tan, ok = _local_fits(W, arc, lo, K[ci], K[ci])
         t_in[ci[ok]] = tan[ok]
+    _corners_on_the_design(W, K, Q, arc, smooth, rnd, first, last, quant, eps)
+
+
+#: one-sided tangents of rounded input are fitted over at least this many input points
+_SIDE_POINTS = 20
+#: a corner's two sides meet at this angle or more (sine): their fitted lines are
+#: intersected; below, the corner is the mean of the two sides' estimates
+_CORNER_SINE = 0.25
+
+
+def _corners_on_the_design(W, K, Q, arc, smooth, rnd, first, last, quant, eps) -> None:
+    """Rounded input: the corners (thinned vertices that are not smooth; a closed path's
+    seam too) move inside their rounding squares onto an estimate of the design's corner.
+    Per side, the input points of the thinned segment on that side give a position and a
+    tangent at the corner: their least-squares line where the segment is a line (its
+    other end a corner too), else a least-squares quadratic. The corner is the
+    intersection of the two tangent lines where they cross at an angle, else the mean of
+    the two positions. A corner stays where a line from it to a neighbouring thinned point
+    would miss its input points by more than ``eps`` (per thinned point), so the lines
+    keep their bound. In place on ``Q``."""
+    n = len(Q)
+    is_first = np.zeros(n, dtype=bool)
+    is_first[first] = True
+    is_last = np.zeros(n, dtype=bool)
+    is_last[last] = True
+    # vi: the vertex as the end of the segment before it, vo: as the start of the next one
+    vo = np.flatnonzero(~smooth & rnd & ~is_first & ~is_last)
+    vi = vo.copy()
+    seam = (last - first >= 3) & (W[K[first]] == W[K[last]]).all(axis=1) & rnd[first]
+    seam &= ~smooth[first]
+    if seam.any():
+        vi = np.concatenate([vi, last[seam]])
+        vo = np.concatenate([vo, first[seam]])
+    if len(vo) == 0:
+        return
+    k = K[vo]
+    p_in, t_in, ok_in = _local_fits(W, arc, K[vi - 1], K[vi], K[vi])
+    p_out, t_out, ok_out = _local_fits(W, arc, k, K[vo + 1], k)
+    # a side that is a line (its other end a corner too): its least-squares line
+    lin = ~smooth[vi - 1]
+    if lin.any():
+        p, t, ok = _local_lines(W, K[vi - 1][lin], K[vi][lin], K[vi][lin])
+        p_in[lin], t_in[lin], ok_in[lin] = p, t, ok
+    lin = ~smooth[vo + 1]
+    if lin.any():
+        p, t, ok = _local_lines(W, k[lin], K[vo + 1][lin], k[lin])
+        p_out[lin], t_out[lin], ok_out[lin] = p, t, ok
+    both = ok_in & ok_out
+    est = 0.5 * (p_in + p_out)
+    cr = t_in[:, 0] * t_out[:, 1] - t_in[:, 1] * t_out[:, 0]
+    sharp = both & (np.abs(cr) >= _CORNER_SINE)
+    if sharp.any():
+        d = p_out[sharp] - p_in[sharp]
+        ti, to = t_in[sharp], t_out[sharp]
+        s = (d[:, 0] * to[:, 1] - d[:, 1] * to[:, 0]) / cr[sharp]
+        est[sharp] = p_in[sharp] + s[:, None] * ti
+    vi, vo, est = vi[both], vo[both], est[both]
+    wk = W[K[vo]]
+    h = 0.5 * quant[vo][:, None]
+    new = np.clip(est, wk - h, wk + h)
+    # an estimate on the input point up to rounding errors is the input point
+    same = np.abs(new - wk).max(axis=1) <= 1e-9 * (h[:, 0] + np.abs(wk).max(axis=1))
+    new[same] = wk[same]
+    old = Q[vo].copy()
+    Q[vo] = new
+    Q[vi] = new
+    moved = np.zeros(n, dtype=bool)
+    moved[vo] = True
+    moved[vi] = True
+    for _ in range(3):
+        # the thinned segments next to a moved corner, as lines: within eps of their points?
+        seg = np.unique(np.concatenate([vi - 1, vo]))
+        seg = seg[moved[seg] | moved[seg + 1]]
+        if len(seg) == 0:
+            break
+        err = _line_errors(W, np.stack([Q[seg], Q[seg + 1]], axis=1), K[seg], K[seg + 1])
+        bad = seg[err > eps[seg]]
+        if len(bad) == 0:
+            break
+        hit = np.zeros(n, dtype=bool)
+        hit[bad] = True
+        hit[bad + 1] = True
+        back = (hit[vi] | hit[vo]) & moved[vo]
+        if not back.any():
+            break
+        Q[vo[back]] = old[back]
+        Q[vi[back]] = old[back]
+        moved[vo[back]] = False
+        moved[vi[back]] = False
+        keep = ~back
+        vi, vo, old = vi[keep], vo[keep], old[keep]
 
 
 def _arc_per_path(W: np.ndarray, wlen: np.ndarray) -> np.ndarray:

@@ -304,6 +304,10 @@ def point_segment_distance(pts: object, a: object, b: object) -> np.ndarray:
     return np.hypot(*(ap - s * ab).reshape(-1, 2).T)
 
 
+#: squared lengths below this are treated as zero (their reciprocal would overflow)
+_TINY_SQUARED = 1e-300
+
+
 def point_polyline_distance(pts: object, poly: object) -> np.ndarray:
     """Distance of each point to the polyline ``poly`` (true Euclidean distance).
 
@@ -321,7 +325,9 @@ def point_polyline_distance(pts: object, poly: object) -> np.ndarray:
     a = q[:-1]
     ab = q[1:] - a
     den = (ab * ab).sum(axis=1)
-    inv = np.where(den > 0.0, 1.0 / np.where(den > 0.0, den, 1.0), 0.0)
+    # (a segment so short that 1 / its squared length overflows is its start point)
+    big = den > _TINY_SQUARED
+    inv = np.where(big, 1.0 / np.where(big, den, 1.0), 0.0)
     out = np.full(len(p), np.inf)
     srows = max(1, min(len(a), _CHUNK_CELLS // max(1, min(len(p), 4096))))
     prow = max(1, _CHUNK_CELLS // srows)

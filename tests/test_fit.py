@@ -12,6 +12,8 @@ from hypothesis import strategies as st
 from galvo_core.drawing import Drawing, Path
 from galvo_core.errors import ParamError
 from galvo_core.fit import (
+    DEFAULT_E_PER,
+    DEFAULT_EPS_LINE,
     FitCancelled,
     FittedPath,
     check_fit,
@@ -20,6 +22,7 @@ from galvo_core.fit import (
     fit_path,
     fit_paths,
     fit_report,
+    segment_point_offsets,
 )
 from galvo_core.geometry import cubic_eval
 from galvo_core.precision import path_quanta
@@ -455,3 +458,24 @@ def test_core_does_not_import_qt():
         "assert not bad, bad"
     )
     subprocess.run([sys.executable, "-c", code], check=True)
+
+
+def test_rounded_polygon_corners_move_onto_the_design():
+    # a polygon at generic slopes, sampled every unit and rounded to whole units: the fit
+    # puts its corners nearer the design's corners than the rounded input points are
+    corners = np.array([[0.3, 0.2], [380.4, 130.45], [300.6, 370.35], [60.25, 400.4],
+                        [-80.45, 200.7]])
+    rc = ring(corners)
+    parts = [rc[i] + np.linspace(0, 1, int(np.hypot(*(rc[i + 1] - rc[i]))),
+                                 endpoint=False)[:, None] * (rc[i + 1] - rc[i])
+             for i in range(5)]
+    pts = np.round(np.vstack(parts + [rc[:1]]))
+    pts = pts[np.r_[True, (np.diff(pts, axis=0) != 0).any(axis=1)]]
+    fp = fit_path(pts, closed=True)
+    joints = fp.points[segment_point_offsets(fp.is_cubic)]
+    ours = np.array([np.hypot(*(joints - c).T).min() for c in corners])
+    rounded = np.hypot(*(np.round(corners) - corners).T)
+    assert (ours <= rounded + 1e-9).all()
+    assert ours.mean() < 0.6 * rounded.mean()
+    rep = check_fit(pts, fp, DEFAULT_E_PER, DEFAULT_EPS_LINE, report=True)
+    assert rep["quantum_units"] == 1.0 and rep["violation"] == 0.0
