@@ -17,6 +17,7 @@ from collections.abc import Iterable, Mapping
 from dataclasses import FrozenInstanceError, dataclass, field, replace
 from itertools import chain, repeat
 from types import MappingProxyType
+from typing import Any
 
 import numpy as np
 
@@ -102,6 +103,11 @@ class Path:
     # start (a SourcePos) of a path built by __init__, the PathStore of a stored one, whose
     # path _k it is (below 256: CPython shares those ints, no int object per path)
     __slots__ = ("_points", "pen", "closed", "_store", "_k")
+    _points: np.ndarray
+    pen: int
+    closed: bool
+    _store: Any  # SourcePos or PathStore (type() checks below, faster than isinstance)
+    _k: int
     __match_args__ = ("points", "pen", "closed", "start")
 
     def __init__(
