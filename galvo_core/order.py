@@ -173,47 +173,53 @@ class _Problem:
                  starts: Sequence[np.ndarray | None] | None) -> None:
         n = len(strokes)
         self.n = n
-        self.closed = np.array([bool(c) for c in closed], dtype=bool)
+        self.closed = np.array([bool(c) for c in closed], dtype=bool).reshape(n)
+        arrs = [np.asarray(s).reshape(-1, 2) for s in strokes]
+        lens = np.array([len(a) for a in arrs], dtype=np.int64).reshape(n)
+        self.empty = lens == 0
         self.first = np.zeros((n, 2))
         self.last = np.zeros((n, 2))
-        self.empty = np.zeros(n, dtype=bool)
+        nz = np.flatnonzero(~self.empty)
+        if len(nz):
+            allp = np.concatenate([arrs[i] for i in nz.tolist()]).astype(np.float64)
+            off = np.cumsum(lens[nz]) - lens[nz]
+            self.first[nz] = allp[off]
+            self.last[nz] = allp[off + lens[nz] - 1]
         # candidate entry points: (point xy, stroke, code) code: 0 start, 1 end (reversed),
-        # >= 2: closed start at point index code - 2
-        cx: list[np.ndarray] = []
-        cs: list[np.ndarray] = []
-        cc: list[np.ndarray] = []
-        for i, s in enumerate(strokes):
-            p = np.asarray(s, dtype=np.float64).reshape(-1, 2)
-            if len(p) == 0:
-                self.empty[i] = True
-                continue
-            self.first[i] = p[0]
-            self.last[i] = p[-1]
-            if self.closed[i] and len(p) >= 3:
-                m = len(p) - 1 if np.array_equal(p[0], p[-1]) else len(p)
-                allowed = None if starts is None else starts[i]
-                idx = np.arange(m) if allowed is None else np.unique(
-                    np.asarray(allowed, dtype=np.int64) % m)
-                if len(idx) == 0:
-                    idx = np.array([0])
-                if len(idx) > MAX_STARTS:
-                    idx = idx[np.linspace(0, len(idx) - 1, MAX_STARTS).astype(np.int64)]
-                cx.append(p[idx])
-                cs.append(np.full(len(idx), i))
-                cc.append(idx + 2)
-            else:
-                self.closed[i] = False
-                cx.append(np.stack([p[0], p[-1]]))
-                cs.append(np.array([i, i]))
-                cc.append(np.array([0, 1]))
-        self.cpt = np.concatenate(cx) if cx else np.zeros((0, 2))
-        self.cstroke = np.concatenate(cs) if cs else np.zeros(0, dtype=np.int64)
-        self.ccode = np.concatenate(cc) if cc else np.zeros(0, dtype=np.int64)
-        self.cand_of: list[np.ndarray] = [np.zeros(0, dtype=np.int64)] * n
-        if len(self.cstroke):
-            order = np.argsort(self.cstroke, kind="stable")
-            bounds = np.searchsorted(self.cstroke[order], np.arange(n + 1))
-            self.cand_of = [order[bounds[i]:bounds[i + 1]] for i in range(n)]
+        # >= 2: closed start at point index code - 2; an open stroke (or a closed one of
+        # fewer than 3 points, then open) has its two ends
+        self.closed &= (lens >= 3) | self.empty
+        ring_idx: dict[int, np.ndarray] = {}
+        for i in np.flatnonzero(self.closed & ~self.empty).tolist():
+            p = arrs[i]
+            m = len(p) - 1 if np.array_equal(p[0], p[-1]) else len(p)
+            allowed = None if starts is None else starts[i]
+            idx = np.arange(m) if allowed is None else np.unique(
+                np.asarray(allowed, dtype=np.int64) % m)
+            if len(idx) == 0:
+                idx = np.array([0])
+            if len(idx) > MAX_STARTS:
+                idx = idx[np.linspace(0, len(idx) - 1, MAX_STARTS).astype(np.int64)]
+            ring_idx[i] = idx
+        count = np.where(self.empty, 0, 2)
+        for i, idx in ring_idx.items():
+            count[i] = len(idx)
+        cstart = np.concatenate([[0], np.cumsum(count)]).astype(np.int64)
+        total = int(cstart[-1])
+        self.cpt = np.zeros((total, 2))
+        self.cstroke = np.repeat(np.arange(n, dtype=np.int64), count)
+        self.ccode = np.zeros(total, dtype=np.int64)
+        op = np.flatnonzero(~self.empty & ~self.closed)
+        self.cpt[cstart[op]] = self.first[op]
+        self.cpt[cstart[op] + 1] = self.last[op]
+        self.ccode[cstart[op] + 1] = 1
+        for i, idx in ring_idx.items():
+            a = int(cstart[i])
+            self.cpt[a:a + len(idx)] = arrs[i][idx]
+            self.ccode[a:a + len(idx)] = idx + 2
+        cands = np.arange(total, dtype=np.int64)
+        bounds = cstart.tolist()
+        self.cand_of: list[np.ndarray] = [cands[bounds[i]:bounds[i + 1]] for i in range(n)]
 
     def entry_exit(self, cand: int) -> tuple[np.ndarray, np.ndarray]:
         i = int(self.cstroke[cand])
@@ -1053,6 +1059,8 @@ def apply_to_strokes(strokes: Sequence[object], placements: Sequence[Placement],
     """Job strokes in the new order, marks and segments reversed / rotated to match."""
     from dataclasses import replace
 
+    from galvo_core.job import Stroke
+
     out = []
     for pl in placements:
         s = strokes[pl.index]
@@ -1072,7 +1080,12 @@ def apply_to_strokes(strokes: Sequence[object], placements: Sequence[Placement],
         if pl.reverse:
             marks = marks[::-1].copy()
             segs = segs.reversed() if arrays else _reverse_segments(segs)
-        out.append(replace(s, marks=marks, segments=segs))  # type: ignore[type-var]
+        if marks is s.marks and segs is s.segments:  # type: ignore[attr-defined]
+            out.append(s)  # as it was (frozen): no copy
+        elif type(s) is Stroke:
+            out.append(Stroke(s.kind, s.source_index, s.closed, marks, segs, s.pen))
+        else:
+            out.append(replace(s, marks=marks, segments=segs))  # type: ignore[type-var]
     return out
 
 
