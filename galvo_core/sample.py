@@ -139,6 +139,10 @@ _CANCEL_EVERY = 64
 _OVER_SAMPLES = 64
 #: the sampler works on whole paths in chunks of about this many segments (bounded temporaries)
 CHUNK_SEGMENTS = 1 << 18
+#: the field-mapped geometry (96 bytes a segment) is kept for a re-sample up to this size;
+#: a larger one is made again when asked (about 0.3 s CPU per million segments): not held
+#: through the rest of a job of millions of points
+FIELDED_KEEP_BYTES = 128 << 20
 #: about how many marks a chain of smoothly joined cubics gathers before it is cut
 _CHAIN_MARKS = 64
 _TINY = 1e-300
@@ -788,10 +792,26 @@ class SampleReport:
 class SampleResult:
     marks: list[np.ndarray]
     report: SampleReport
-    # per stroke, float marks and their (global segment id, t) — for tests and benchmarks
-    float_marks: list[np.ndarray] = field(default_factory=list)
-    params: list[tuple[np.ndarray, np.ndarray]] = field(default_factory=list)
     coef: np.ndarray | None = None
+    # per chunk of paths: float marks, segment ids (of the chunk), parameters, the first
+    # segment of the chunk and each path's span of rows
+    chunks: list[tuple[np.ndarray, np.ndarray, np.ndarray, int, list[tuple[int, int]]]] = (
+        field(default_factory=list))
+
+    @property
+    def float_marks(self) -> list[np.ndarray]:
+        """Per stroke, the float marks (bits, before rounding) — for tests and benchmarks,
+        made when asked (not one array per path while the job is built)."""
+        return [pos[a:b] for pos, _, _, _, spans in self.chunks for a, b in spans]
+
+    @property
+    def params(self) -> list[tuple[np.ndarray, np.ndarray]]:
+        """Per stroke, the marks' (global segment id, t), made when asked."""
+        out = []
+        for _, sid, st, g0, spans in self.chunks:
+            sg = sid + g0
+            out += [(sg[a:b], st[a:b]) for a, b in spans]
+        return out
 
 
 def _round(p: np.ndarray) -> np.ndarray:
@@ -998,7 +1018,8 @@ class _Geometry:
         out = (ends, coef, corner, cf)
         with self._lock:  # only the latest mapping: these arrays are as large as the fit
             self._fielded.clear()
-            self._fielded[key] = out
+            if block.nbytes + ends.nbytes <= FIELDED_KEEP_BYTES:  # else made again if asked
+                self._fielded[key] = out
         return out
 
     def _fielded_chunk(self, fm: FieldMap, a: int, b1: int, b: int, block: np.ndarray,
@@ -1150,9 +1171,7 @@ def sample_paths(
         pc[-1] = len(mk.pid)
         spans = list(zip(pc[:-1], pc[1:], strict=True))
         res.marks += [r[a:b] for a, b in spans]
-        res.float_marks += [mk.pos[a:b] for a, b in spans]
-        sid = mk.sid + g0  # global segment ids
-        res.params += [(sid[a:b], mk.st[a:b]) for a, b in spans]
+        res.chunks.append((mk.pos, mk.sid, mk.st, g0, spans))
     report.chords = chords
     report.max_chord_height_bits = max(hmax, default=0.0)
     report.max_chord_height_int_bits = max(himax, default=0.0)
