@@ -10,7 +10,7 @@ stroke starts at a segment joint). :func:`order_job_strokes` does all of it for 
 Methods:
 
 * ``file``: as given.
-* ``greedy``: nearest next stroke (grid search); open strokes may be reversed, closed ones
+* ``greedy``: nearest next stroke (k-d tree, compiled); open strokes may be reversed, closed ones
   may start at any allowed point. Never longer than the file order (falls back to it).
 * ``optimized``: greedy, then local search over the strokes' ends (2-opt block reversals
   and Or-opt moves of 1-3 strokes, over nearest-neighbour lists), the best direction / start
