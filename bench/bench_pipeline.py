@@ -36,6 +36,7 @@ import resource
 import statistics
 import subprocess
 import sys
+import tempfile
 import time
 from pathlib import Path
 
@@ -129,12 +130,17 @@ def real(n: int) -> Path:
 def _child(cmd: list[str]) -> dict[str, float]:
     """Run ``cmd``; wall, CPU (user + sys) and peak RSS (MB) of that child alone."""
     env = dict(os.environ, PYTHONPATH=str(ROOT), QT_QPA_PLATFORM="offscreen")
-    t0 = time.perf_counter()
-    proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, env=env)
-    _, status, ru = os.wait4(proc.pid, 0)
-    wall = time.perf_counter() - t0
-    out = proc.stdout.read().decode() if proc.stdout else ""
-    err = proc.stderr.read().decode() if proc.stderr else ""
+    # output to files, read after the child ends: a pipe that fills up (the CLI's stats and
+    # warnings of a large job) would block the child while this waits for it
+    with tempfile.TemporaryFile() as fo, tempfile.TemporaryFile() as fe:
+        t0 = time.perf_counter()
+        proc = subprocess.Popen(cmd, stdout=fo, stderr=fe, env=env)
+        _, status, ru = os.wait4(proc.pid, 0)
+        wall = time.perf_counter() - t0
+        fo.seek(0)
+        fe.seek(0)
+        out = fo.read().decode()
+        err = fe.read().decode()
     proc.returncode = os.waitstatus_to_exitcode(status)
     if proc.returncode != 0:
         raise RuntimeError(f"{' '.join(cmd)} failed ({proc.returncode}): {err.strip()[-400:]}")
@@ -169,20 +175,21 @@ def worker(src: str, out: str, fill: bool) -> None:
     from galvo_core.params import Params
 
     warm_up()  # compiled kernels loaded (not counted: the CLI pays it once at import)
-    acc = {s: [0.0, 0.0, 0.0] for s in STAGES}
+    acc = {s: [0.0, 0.0, 0.0, 0.0] for s in STAGES}  # wall, CPU, peak RSS, user CPU
 
     def rss() -> float:
         return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
 
     def timed(stage: str, fn):  # type: ignore[no-untyped-def]
         def wrap(*a, **k):  # type: ignore[no-untyped-def]
-            w, c = time.perf_counter(), time.process_time()
+            w, c, u = time.perf_counter(), time.process_time(), os.times().user
             try:
                 return fn(*a, **k)
             finally:
                 acc[stage][0] += time.perf_counter() - w
                 acc[stage][1] += time.process_time() - c
                 acc[stage][2] = rss()
+                acc[stage][3] += os.times().user - u
         return wrap
 
     names = {"kerf": "compensate_indexed", "fit": "fit_drawing", "sample": "sample_paths",
@@ -192,17 +199,21 @@ def worker(src: str, out: str, fill: bool) -> None:
             setattr(pl, name, timed(stage, getattr(pl, name)))
     params = Params(fit_field=True, **(FILL_PARAMS if fill else {}))
     d = timed("read", read_file)(src)
-    w, c = time.perf_counter(), time.process_time()
+    w, c, u = time.perf_counter(), time.process_time(), os.times().user
     job = pl.Pipeline().run(d, params).job
     run_w, run_c = time.perf_counter() - w, time.process_time() - c
+    run_u = os.times().user - u
     inner = [s for s in names]
     acc["glue"] = [run_w - sum(acc[s][0] for s in inner), run_c - sum(acc[s][1] for s in inner),
-                   rss()]
+                   rss(), run_u - sum(acc[s][3] for s in inner)]
     timed("write", write_job)(job, out)
+    counts = {"points": d.n_points, "paths": len(d.paths), "strokes": len(job.strokes),
+              "marks": int(sum(len(s.marks) for s in job.strokes))}
     del job
     timed("load", load_job)(out)
-    res = {s: {"wall": v[0], "cpu": v[1], "rss_mb": v[2]} for s, v in acc.items()}
-    res["_"] = {"points": d.n_points, "marks": 0}
+    res = {s: {"wall": v[0], "cpu": v[1], "rss_mb": v[2], "user": v[3]}
+           for s, v in acc.items()}
+    res["_"] = counts
     print(json.dumps(res))
 
 
@@ -263,6 +274,8 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--fill-max", type=int, default=1_000_000,
                     help="largest size run with fill on (default 1 M)")
     ap.add_argument("--runs", type=int, default=3)
+    ap.add_argument("--runs-1m", type=int, default=3,
+                    help="runs above 100 k up to 1 M points (5 M: one)")
     ap.add_argument("--no-write", action="store_true")
     ap.add_argument("--io-marks", type=int, default=5_000_000,
                     help="marks of the job-file write/load measurement (0: skip)")
@@ -313,7 +326,7 @@ def main(argv: list[str] | None = None) -> int:
                     continue
                 src = Path(_child([PY, str(Path(__file__).resolve()), "--gen-worker", kind,
                                    str(n)])["stdout"].strip())  # type: ignore[union-attr]
-                runs = a.runs if n <= 100_000 else 1
+                runs = a.runs if n <= 100_000 else (a.runs_1m if n <= 1_000_000 else 1)
                 on = fill == "on"
                 e2e = [cli_run(src, OUT / "job.gjob", on) for _ in range(runs)]
                 # the v1 JSON end to end only without fill (the same stages but the writer)
@@ -325,7 +338,9 @@ def main(argv: list[str] | None = None) -> int:
                     "gjob": {k: med(e2e, k) for k in ("wall", "cpu", "rss_mb")},
                     "json": {k: med(e2e_json, k) for k in ("wall", "cpu", "rss_mb")},
                     "stages": {s: {k: statistics.median(r[s][k] for r in st)
-                                   for k in ("wall", "cpu", "rss_mb")} for s in STAGES},
+                                   for k in ("wall", "cpu", "rss_mb", "user")}
+                               for s in STAGES},
+                    "counts": st[0]["_"],
                     "gjob_bytes": (OUT / "job.gjob").stat().st_size,
                     "json_bytes": (OUT / "job.json").stat().st_size if not on else 0,
                 }
@@ -369,7 +384,7 @@ def report(results: list[dict], io: dict[str, float] | None,  # type: ignore[typ
         "`galvo-core process FILE -o JOB.gjob|JOB.json --fit-field` in a fresh process "
         "(child's wall, user + system CPU, peak RSS); fill on = `" + " ".join(FILL_ARGS) +
         "` (its .json column repeats the .gjob run: not measured separately). Median of the "
-        "runs given (3 up to 100 k points, 1 above).",
+        "runs given (3 up to 1 M points, 1 at 5 M).",
         "",
         "### End to end through the CLI",
         "",
@@ -383,16 +398,24 @@ def report(results: list[dict], io: dict[str, float] | None,  # type: ignore[typ
                      f"| {g['cpu']:.2f} | {g['rss_mb']:.0f} | {j['wall']:.2f} | {j['cpu']:.2f} "
                      f"| {r['gjob_bytes'] / 1e6:.1f} | {r['json_bytes'] / 1e6:.1f} |")
     lines += ["", "### CPU seconds per stage (peak RSS MB at the end of the job)", "",
-              "| drawing | fill | points | " + " | ".join(STAGES) + " | peak MB |",
-              "| --- | --- | ---: |" + " ---: |" * (len(STAGES) + 1)]
+              "| drawing | fill | points | paths | strokes | " + " | ".join(STAGES)
+              + " | peak MB |",
+              "| --- | --- | ---: | ---: | ---: |" + " ---: |" * (len(STAGES) + 1)]
     for r in results:
         st = r["stages"]
-        lines.append(f"| {r['kind']} | {r['fill']} | {r['n']:,} | "
+        c = r.get("counts", {})
+        lines.append(f"| {r['kind']} | {r['fill']} | {r['n']:,} | {c.get('paths', 0):,} | "
+                     f"{c.get('strokes', 0):,} | "
                      + " | ".join(f"{st[s]['cpu']:.3f}" for s in STAGES)
                      + f" | {max(st[s]['rss_mb'] for s in STAGES):.0f} |")
-    lines += ["", "### Growth exponent per stage (CPU, from 100 k points to the largest size; "
-              "— under 20 ms)", "", "| drawing | fill | sizes | " + " | ".join(STAGES)
-              + " | end to end |", "| --- | --- | --- |" + " ---: |" * (len(STAGES) + 1)]
+    lines += ["", "### Growth exponent per stage (from 100 k points to the largest size; — "
+              "under 20 ms)", "",
+              "CPU: user + system time against the points; user: user time alone (without "
+              "the kernel's work, mostly zeroing fresh pages); per stroke: CPU time against "
+              "the job's strokes (the tiled real drawings have many more paths per point at "
+              "large sizes: their later drawings are the ones of many small paths).", "",
+              "| drawing | fill | sizes | measure | " + " | ".join(STAGES) + " | end to end |",
+              "| --- | --- | --- | --- |" + " ---: |" * (len(STAGES) + 1)]
     groups: dict[tuple[str, str], list[dict]] = {}  # type: ignore[type-arg]
     for r in results:
         groups.setdefault((r["kind"], r["fill"]), []).append(r)
@@ -401,13 +424,19 @@ def report(results: list[dict], io: dict[str, float] | None,  # type: ignore[typ
         if len(rows) < 2:
             continue
         a, b = rows[0], rows[-1]
-        cells = []
-        for s in STAGES:
-            e = exponent(a["n"], a["stages"][s]["cpu"], b["n"], b["stages"][s]["cpu"])
-            cells.append("—" if e is None else f"{e:.2f}")
-        e = exponent(a["n"], a["gjob"]["cpu"], b["n"], b["gjob"]["cpu"])
-        lines.append(f"| {kind} | {fill} | {a['n']:,} → {b['n']:,} | " + " | ".join(cells)
-                     + f" | {'—' if e is None else f'{e:.2f}'} |")
+        na, nb = a.get("counts", {}).get("strokes", 0), b.get("counts", {}).get("strokes", 0)
+        measures = [("CPU", "cpu", a["n"], b["n"]), ("user", "user", a["n"], b["n"])]
+        if na and nb and na != nb:
+            measures.append((f"per stroke ({na:,} → {nb:,})", "cpu", na, nb))
+        for label, key, xa, xb in measures:
+            cells = []
+            for s in STAGES:
+                e = exponent(xa, a["stages"][s].get(key, 0.0), xb,
+                             b["stages"][s].get(key, 0.0))
+                cells.append("—" if e is None else f"{e:.2f}")
+            e = exponent(xa, a["gjob"]["cpu"], xb, b["gjob"]["cpu"]) if key == "cpu" else None
+            lines.append(f"| {kind} | {fill} | {a['n']:,} → {b['n']:,} | {label} | "
+                         + " | ".join(cells) + f" | {'—' if e is None else f'{e:.2f}'} |")
     if io:
         lines += ["", f"### Job file: writing and loading {io['marks']:,.0f} marks", "",
                   "A synthetic job (strokes of 400 marks, a line per two marks, a cubic per 40: "

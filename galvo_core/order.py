@@ -10,7 +10,7 @@ stroke starts at a segment joint). :func:`order_job_strokes` does all of it for 
 Methods:
 
 * ``file``: as given.
-* ``greedy``: nearest next stroke (grid search); open strokes may be reversed, closed ones
+* ``greedy``: nearest next stroke (k-d tree, compiled); open strokes may be reversed, closed ones
   may start at any allowed point. Never longer than the file order (falls back to it).
 * ``optimized``: greedy, then local search over the strokes' ends (2-opt block reversals
   and Or-opt moves of 1-3 strokes, over nearest-neighbour lists), the best direction / start
@@ -40,6 +40,7 @@ from typing import Any
 
 import numpy as np
 import shapely
+from numba import njit
 
 ORDER_METHODS = ("file", "greedy", "optimized")
 #: closed strokes offer at most this many start points to the search
@@ -172,47 +173,53 @@ class _Problem:
                  starts: Sequence[np.ndarray | None] | None) -> None:
         n = len(strokes)
         self.n = n
-        self.closed = np.array([bool(c) for c in closed], dtype=bool)
+        self.closed = np.array([bool(c) for c in closed], dtype=bool).reshape(n)
+        arrs = [np.asarray(s).reshape(-1, 2) for s in strokes]
+        lens = np.array([len(a) for a in arrs], dtype=np.int64).reshape(n)
+        self.empty = lens == 0
         self.first = np.zeros((n, 2))
         self.last = np.zeros((n, 2))
-        self.empty = np.zeros(n, dtype=bool)
+        nz = np.flatnonzero(~self.empty)
+        if len(nz):
+            allp = np.concatenate([arrs[i] for i in nz.tolist()]).astype(np.float64)
+            off = np.cumsum(lens[nz]) - lens[nz]
+            self.first[nz] = allp[off]
+            self.last[nz] = allp[off + lens[nz] - 1]
         # candidate entry points: (point xy, stroke, code) code: 0 start, 1 end (reversed),
-        # >= 2: closed start at point index code - 2
-        cx: list[np.ndarray] = []
-        cs: list[np.ndarray] = []
-        cc: list[np.ndarray] = []
-        for i, s in enumerate(strokes):
-            p = np.asarray(s, dtype=np.float64).reshape(-1, 2)
-            if len(p) == 0:
-                self.empty[i] = True
-                continue
-            self.first[i] = p[0]
-            self.last[i] = p[-1]
-            if self.closed[i] and len(p) >= 3:
-                m = len(p) - 1 if np.array_equal(p[0], p[-1]) else len(p)
-                allowed = None if starts is None else starts[i]
-                idx = np.arange(m) if allowed is None else np.unique(
-                    np.asarray(allowed, dtype=np.int64) % m)
-                if len(idx) == 0:
-                    idx = np.array([0])
-                if len(idx) > MAX_STARTS:
-                    idx = idx[np.linspace(0, len(idx) - 1, MAX_STARTS).astype(np.int64)]
-                cx.append(p[idx])
-                cs.append(np.full(len(idx), i))
-                cc.append(idx + 2)
-            else:
-                self.closed[i] = False
-                cx.append(np.stack([p[0], p[-1]]))
-                cs.append(np.array([i, i]))
-                cc.append(np.array([0, 1]))
-        self.cpt = np.concatenate(cx) if cx else np.zeros((0, 2))
-        self.cstroke = np.concatenate(cs) if cs else np.zeros(0, dtype=np.int64)
-        self.ccode = np.concatenate(cc) if cc else np.zeros(0, dtype=np.int64)
-        self.cand_of: list[np.ndarray] = [np.zeros(0, dtype=np.int64)] * n
-        if len(self.cstroke):
-            order = np.argsort(self.cstroke, kind="stable")
-            bounds = np.searchsorted(self.cstroke[order], np.arange(n + 1))
-            self.cand_of = [order[bounds[i]:bounds[i + 1]] for i in range(n)]
+        # >= 2: closed start at point index code - 2; an open stroke (or a closed one of
+        # fewer than 3 points, then open) has its two ends
+        self.closed &= (lens >= 3) | self.empty
+        ring_idx: dict[int, np.ndarray] = {}
+        for i in np.flatnonzero(self.closed & ~self.empty).tolist():
+            p = arrs[i]
+            m = len(p) - 1 if np.array_equal(p[0], p[-1]) else len(p)
+            allowed = None if starts is None else starts[i]
+            idx = np.arange(m) if allowed is None else np.unique(
+                np.asarray(allowed, dtype=np.int64) % m)
+            if len(idx) == 0:
+                idx = np.array([0])
+            if len(idx) > MAX_STARTS:
+                idx = idx[np.linspace(0, len(idx) - 1, MAX_STARTS).astype(np.int64)]
+            ring_idx[i] = idx
+        count = np.where(self.empty, 0, 2)
+        for i, idx in ring_idx.items():
+            count[i] = len(idx)
+        cstart = np.concatenate([[0], np.cumsum(count)]).astype(np.int64)
+        total = int(cstart[-1])
+        self.cpt = np.zeros((total, 2))
+        self.cstroke = np.repeat(np.arange(n, dtype=np.int64), count)
+        self.ccode = np.zeros(total, dtype=np.int64)
+        op = np.flatnonzero(~self.empty & ~self.closed)
+        self.cpt[cstart[op]] = self.first[op]
+        self.cpt[cstart[op] + 1] = self.last[op]
+        self.ccode[cstart[op] + 1] = 1
+        for i, idx in ring_idx.items():
+            a = int(cstart[i])
+            self.cpt[a:a + len(idx)] = arrs[i][idx]
+            self.ccode[a:a + len(idx)] = idx + 2
+        cands = np.arange(total, dtype=np.int64)
+        bounds = cstart.tolist()
+        self.cand_of: list[np.ndarray] = [cands[bounds[i]:bounds[i + 1]] for i in range(n)]
 
     def entry_exit(self, cand: int) -> tuple[np.ndarray, np.ndarray]:
         i = int(self.cstroke[cand])
@@ -224,101 +231,229 @@ class _Problem:
         return self.cpt[cand], self.cpt[cand]
 
 
-#: buckets with more alive points than this are scanned with numpy, not point by point
-_BUCKET_SCAN = 24
+def _grid_cell(pts: np.ndarray) -> float:
+    """Bucket size of the greedy's grid: about two points per bucket where the points are
+    (see :func:`_greedy`)."""
+    if len(pts) == 0:
+        return 1.0
+    span = max(float((pts.max(axis=0) - pts.min(axis=0)).max()), 1e-9)
+    return max(span / max(1.0, math.sqrt(len(pts) / 2.0)), 1e-9)
 
 
-class _Grid:
-    """Points in square buckets; nearest alive point by rings of buckets."""
+#: points per leaf of the greedy's k-d tree
+_LEAF = 8
 
-    def __init__(self, pts: np.ndarray) -> None:
-        self.pts = pts
-        lo = pts.min(axis=0) if len(pts) else np.zeros(2)
-        hi = pts.max(axis=0) if len(pts) else np.ones(2)
-        span = max(float((hi - lo).max()), 1e-9)
-        self.cell = max(span / max(1.0, math.sqrt(len(pts) / 2.0)), 1e-9)
-        self.lo = lo
-        ij = np.floor((pts - lo) / self.cell).astype(np.int64)
-        self.ij = ij
-        self.nx = int(ij[:, 0].max()) + 1 if len(pts) else 1
-        self.ny = int(ij[:, 1].max()) + 1 if len(pts) else 1
-        self.buckets: dict[tuple[int, int], list[int]] = {}
-        self.alive = np.zeros(len(pts), dtype=bool)
-        self.n_alive = 0
 
-    def insert(self, ids: np.ndarray) -> None:
-        for k in ids.tolist():
-            if not self.alive[k]:
-                self.alive[k] = True
-                self.n_alive += 1
-                key = (int(self.ij[k, 0]), int(self.ij[k, 1]))
-                self.buckets.setdefault(key, []).append(k)
+@njit(cache=True, nogil=True)
+def _kd_build(pts: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray,
+                                        np.ndarray]:  # pragma: no cover
+    """A balanced k-d tree over ``pts`` in implicit layout (node k's children 2k+1, 2k+2;
+    node k holds ``perm[start[k]:start[k] + size[k]]``, split at the middle along the longer
+    side of its box): ``perm``, node starts and sizes, boxes (min x, min y, max x, max y)."""
+    C = len(pts)
+    leaves = 1
+    while leaves * _LEAF < C:
+        leaves *= 2
+    m = 2 * leaves - 1
+    start = np.zeros(m, np.int64)
+    size = np.zeros(m, np.int64)
+    box = np.empty((m, 4))
+    perm = np.arange(C)
+    size[0] = C
+    for k in range(m):
+        s, z = start[k], size[k]
+        if z == 0:
+            box[k, 0] = np.inf
+            box[k, 1] = np.inf
+            box[k, 2] = -np.inf
+            box[k, 3] = -np.inf
+        else:
+            idx = perm[s:s + z]
+            box[k, 0] = pts[idx, 0].min()
+            box[k, 1] = pts[idx, 1].min()
+            box[k, 2] = pts[idx, 0].max()
+            box[k, 3] = pts[idx, 1].max()
+        if 2 * k + 1 < m:
+            h = z // 2
+            if z > 1:
+                ax = 0 if box[k, 2] - box[k, 0] >= box[k, 3] - box[k, 1] else 1
+                o = np.argsort(pts[perm[s:s + z], ax], kind="mergesort")
+                perm[s:s + z] = perm[s:s + z][o]
+            start[2 * k + 1], size[2 * k + 1] = s, h
+            start[2 * k + 2], size[2 * k + 2] = s + h, z - h
+    return perm, start, size, box
 
-    def kill(self, ids: np.ndarray) -> None:
-        for k in ids.tolist():
-            if self.alive[k]:
-                self.alive[k] = False
-                self.n_alive -= 1
 
-    def nearest(self, p: np.ndarray) -> int:
-        if self.n_alive == 0:
-            return -1
-        ci = int(math.floor((p[0] - self.lo[0]) / self.cell))
-        cj = int(math.floor((p[1] - self.lo[1]) / self.cell))
+@njit(cache=True, nogil=True)
+def _greedy_walk(pts: np.ndarray, ext: np.ndarray, cstroke: np.ndarray, cstart: np.ndarray,
+                 empty: np.ndarray, succ_start: np.ndarray, succ: np.ndarray,
+                 npred: np.ndarray, first: int, cell: float) -> np.ndarray:  # pragma: no cover
+    """The greedy walk (compiled): from the first candidate of stroke ``first``, always the
+    nearest alive candidate to the current exit (strokes become alive when all their
+    predecessors are done); a k-d tree with alive counts per node finds it.
+
+    Ties (the same squared distance) go the way a search by rings of square buckets of side
+    ``cell`` decides them (the rule this walk had with such a grid): the nearest point first
+    met when the buckets are visited ring by ring around the query's bucket (a ring's
+    buckets: bottom row, top row, left column, right column; a bucket's points in the order
+    they became alive), unless that search would have gone beyond ring 8 (the nearest
+    further than 8 cells): then the lowest index. Returns the candidates in order (fewer
+    than the strokes when a precedence cycle leaves none alive)."""
+    n = len(cstart) - 1
+    C = len(pts)
+    out = np.empty(n, np.int64)
+    if first < 0 or C == 0:
+        return out[:0]
+    lox = pts[:, 0].min()
+    loy = pts[:, 1].min()
+    bi = np.empty(C, np.int64)
+    bj = np.empty(C, np.int64)
+    nx = 1
+    ny = 1
+    for k in range(C):
+        bi[k] = np.int64(math.floor((pts[k, 0] - lox) / cell))
+        bj[k] = np.int64(math.floor((pts[k, 1] - loy) / cell))
+        nx = max(nx, bi[k] + 1)
+        ny = max(ny, bj[k] + 1)
+    perm, nstart, nsize, box = _kd_build(pts)
+    m = len(nstart)
+    first_leaf = m // 2
+    leaf_of = np.empty(C, np.int64)
+    for k in range(first_leaf, m):
+        for q in range(nstart[k], nstart[k] + nsize[k]):
+            leaf_of[perm[q]] = k
+    cnt = np.zeros(m, np.int64)
+    alive = np.zeros(C, np.bool_)
+    seq = np.zeros(C, np.int64)  # when each point became alive
+    n_seq = 0
+    todo = 0
+    for i in range(n):
+        if not empty[i]:
+            todo += 1
+    stack = np.empty(64 * 2, np.int64)
+    n_out = 0
+    i = -1
+    cand = cstart[first]
+    while True:
+        if i < 0:  # the start: every stroke without predecessors becomes alive
+            for j in range(n):
+                if not empty[j] and npred[j] == 0:
+                    for k in range(cstart[j], cstart[j + 1]):
+                        if not alive[k]:
+                            alive[k] = True
+                            seq[k] = n_seq
+                            n_seq += 1
+                            v = leaf_of[k]
+                            while True:
+                                cnt[v] += 1
+                                if v == 0:
+                                    break
+                                v = (v - 1) // 2
+        i = cstroke[cand]
+        out[n_out] = cand
+        n_out += 1
+        for k in range(cstart[i], cstart[i + 1]):
+            if alive[k]:
+                alive[k] = False
+                v = leaf_of[k]
+                while True:
+                    cnt[v] -= 1
+                    if v == 0:
+                        break
+                    v = (v - 1) // 2
+        for q in range(succ_start[i], succ_start[i + 1]):
+            j = succ[q]
+            npred[j] -= 1
+            if npred[j] == 0:
+                for k in range(cstart[j], cstart[j + 1]):
+                    if not alive[k]:
+                        alive[k] = True
+                        seq[k] = n_seq
+                        n_seq += 1
+                        v = leaf_of[k]
+                        while True:
+                            cnt[v] += 1
+                            if v == 0:
+                                break
+                            v = (v - 1) // 2
+        if n_out == todo or cnt[0] == 0:
+            break
+        px = ext[cand, 0]
+        py = ext[cand, 1]
+        ci = np.int64(math.floor((px - lox) / cell))
+        cj = np.int64(math.floor((py - loy) / cell))
+        # nearest alive point; among equals the grid's first (ring, place in ring, seq)
+        # and the lowest index
+        bd = np.inf
         best = -1
-        bd = math.inf
-        px, py = float(p[0]), float(p[1])
-        pts = self.pts
-        alive = self.alive
-        rmax = max(self.nx, self.ny) + abs(ci) + abs(cj) + 1
-        for r in range(rmax + 1):
-            if r > 8:  # far away: look at every alive point at once
-                ids = np.flatnonzero(alive)
-                d = np.hypot(pts[ids, 0] - px, pts[ids, 1] - py)
-                k = int(np.argmin(d))
-                return int(ids[k]) if d[k] < bd else best
-            for key in _ring(ci, cj, r):
-                b = self.buckets.get(key)
-                if not b:
-                    continue
-                if len(b) > _BUCKET_SCAN:
-                    # a crowded bucket (clustered ends, e.g. hatch lines along an outline):
-                    # the dead dropped and the same distances taken at once, the first
-                    # nearest kept as the loop below would
-                    ids = np.asarray(b)
-                    keep = alive[ids]
-                    if not keep.all():
-                        ids = ids[keep]
-                        self.buckets[key] = b = ids.tolist()
-                    if not len(ids):
+        br = 0
+        bt = 0
+        bs = 0
+        low = -1
+        top = 0
+        stack[0] = 0
+        top = 1
+        while top:
+            top -= 1
+            v = stack[top]
+            if cnt[v] == 0:
+                continue
+            dx = max(box[v, 0] - px, 0.0, px - box[v, 2])
+            dy = max(box[v, 1] - py, 0.0, py - box[v, 3])
+            if dx * dx + dy * dy > bd:
+                continue
+            if v >= first_leaf:
+                for q in range(nstart[v], nstart[v] + nsize[v]):
+                    k = perm[q]
+                    if not alive[k]:
                         continue
-                    d2a = (pts[ids, 0] - px) ** 2 + (pts[ids, 1] - py) ** 2
-                    j = int(np.argmin(d2a))
-                    if d2a[j] < bd:
-                        bd = float(d2a[j])
-                        best = int(ids[j])
-                    continue
-                live = [k for k in b if alive[k]]
-                if len(live) != len(b):
-                    self.buckets[key] = live
-                for k in live:
-                    d2 = (pts[k, 0] - px) ** 2 + (pts[k, 1] - py) ** 2
+                    ex = pts[k, 0] - px
+                    ey = pts[k, 1] - py
+                    d2 = ex * ex + ey * ey
+                    if d2 > bd:
+                        continue
+                    a = bi[k] - ci
+                    c = bj[k] - cj
+                    r = max(abs(a), abs(c))
+                    if r == 0:
+                        t = 0
+                    elif c == -r:
+                        t = a + r
+                    elif c == r:
+                        t = 2 * r + 1 + a + r
+                    elif a == -r:
+                        t = 4 * r + 2 + c + r - 1
+                    else:
+                        t = 6 * r + 1 + c + r - 1
                     if d2 < bd:
-                        bd = d2
-                        best = k
-            if best >= 0 and math.sqrt(bd) <= r * self.cell:
-                return best
-        return best
-
-
-def _ring(ci: int, cj: int, r: int) -> list[tuple[int, int]]:
-    if r == 0:
-        return [(ci, cj)]
-    out = [(ci + d, cj - r) for d in range(-r, r + 1)]
-    out += [(ci + d, cj + r) for d in range(-r, r + 1)]
-    out += [(ci - r, cj + d) for d in range(-r + 1, r)]
-    out += [(ci + r, cj + d) for d in range(-r + 1, r)]
-    return out
+                        bd, best, br, bt, bs, low = d2, k, r, t, seq[k], k
+                    else:
+                        if r < br or (r == br and (t < bt or (t == bt and seq[k] < bs))):
+                            best, br, bt, bs = k, r, t, seq[k]
+                        low = min(low, k)
+            else:
+                lc = 2 * v + 1
+                rc = lc + 1
+                # nearer child last (popped first)
+                cl = 0.5 * (box[lc, 0] + box[lc, 2]) - px
+                cr = 0.5 * (box[lc, 1] + box[lc, 3]) - py
+                dl = cl * cl + cr * cr
+                cl = 0.5 * (box[rc, 0] + box[rc, 2]) - px
+                cr = 0.5 * (box[rc, 1] + box[rc, 3]) - py
+                if dl <= cl * cl + cr * cr:
+                    stack[top] = rc
+                    stack[top + 1] = lc
+                else:
+                    stack[top] = lc
+                    stack[top + 1] = rc
+                top += 2
+        # the grid search stops at the first ring r >= br with sqrt(bd) <= r * cell; past
+        # ring 8 it took the lowest index instead
+        rmax = max(nx, ny) + abs(ci) + abs(cj) + 1
+        if rmax >= 9 and (br > 8 or math.sqrt(bd) > 8 * cell):
+            best = low
+        cand = best
+    return out[:n_out]
 
 
 def _placement(prob: _Problem, cand: int) -> Placement:
@@ -330,42 +465,28 @@ def _placement(prob: _Problem, cand: int) -> Placement:
 
 
 def _greedy(prob: _Problem, before: Sequence[tuple[int, int]]) -> list[int]:
-    """Candidate ids in greedy order (one per non-empty stroke)."""
+    """Candidate ids in greedy order (one per non-empty stroke): :func:`_greedy_walk`."""
     n = prob.n
-    succ: list[list[int]] = [[] for _ in range(n)]
-    npred = np.zeros(n, dtype=np.int64)
-    for a, b in before:
-        if a != b and not prob.empty[a] and not prob.empty[b]:
-            succ[a].append(b)
-            npred[b] += 1
-    grid = _Grid(prob.cpt)
-    for i in range(n):
-        if not prob.empty[i] and npred[i] == 0:
-            grid.insert(prob.cand_of[i])
-    out: list[int] = []
-    todo = int((~prob.empty).sum())
+    pairs = np.array([(a, b) for a, b in before
+                      if a != b and not prob.empty[a] and not prob.empty[b]],
+                     dtype=np.int64).reshape(-1, 2)
+    by = np.argsort(pairs[:, 0], kind="stable")
+    succ = np.ascontiguousarray(pairs[by, 1])
+    succ_start = np.searchsorted(pairs[by, 0], np.arange(n + 1)).astype(np.int64)
+    npred = np.bincount(pairs[:, 1], minlength=n).astype(np.int64)
     # start: the first stroke in file order that may go first, as given (or its first start)
-    first = next((i for i in range(n) if not prob.empty[i] and npred[i] == 0), None)
-    if first is None:
-        return out
-    cand = int(prob.cand_of[first][0])
-    while True:
-        i = int(prob.cstroke[cand])
-        out.append(cand)
-        grid.kill(prob.cand_of[i])
-        for j in succ[i]:
-            npred[j] -= 1
-            if npred[j] == 0:
-                grid.insert(prob.cand_of[j])
-        if len(out) == todo:
-            break
-        _, ex = prob.entry_exit(cand)
-        cand = grid.nearest(ex)
-        if cand < 0:  # a precedence cycle: take the rest as they come
-            rest = [int(prob.cand_of[k][0]) for k in range(n)
-                    if not prob.empty[k] and k not in {int(prob.cstroke[c]) for c in out}]
-            out.extend(rest)
-            break
+    free = np.flatnonzero(~prob.empty & (npred == 0))
+    first = int(free[0]) if len(free) else -1
+    cstart = np.searchsorted(prob.cstroke, np.arange(n + 1)).astype(np.int64)
+    _, ext = _cand_xy(prob)
+    pts = np.ascontiguousarray(prob.cpt, dtype=np.float64)
+    out = _greedy_walk(pts, np.ascontiguousarray(ext), prob.cstroke.astype(np.int64), cstart,
+                       prob.empty, succ_start, succ, npred, first, _grid_cell(pts)).tolist()
+    if first >= 0 and len(out) < int((~prob.empty).sum()):
+        # a precedence cycle: take the rest as they come
+        done = set(prob.cstroke[out].tolist())
+        out += [int(prob.cand_of[k][0]) for k in range(n)
+                if not prob.empty[k] and k not in done]
     return out
 
 
@@ -938,6 +1059,8 @@ def apply_to_strokes(strokes: Sequence[object], placements: Sequence[Placement],
     """Job strokes in the new order, marks and segments reversed / rotated to match."""
     from dataclasses import replace
 
+    from galvo_core.job import Stroke
+
     out = []
     for pl in placements:
         s = strokes[pl.index]
@@ -957,7 +1080,12 @@ def apply_to_strokes(strokes: Sequence[object], placements: Sequence[Placement],
         if pl.reverse:
             marks = marks[::-1].copy()
             segs = segs.reversed() if arrays else _reverse_segments(segs)
-        out.append(replace(s, marks=marks, segments=segs))  # type: ignore[type-var]
+        if marks is s.marks and segs is s.segments:  # type: ignore[attr-defined]
+            out.append(s)  # as it was (frozen): no copy
+        elif type(s) is Stroke:
+            out.append(Stroke(s.kind, s.source_index, s.closed, marks, segs, s.pen))
+        else:
+            out.append(replace(s, marks=marks, segments=segs))  # type: ignore[type-var]
     return out
 
 

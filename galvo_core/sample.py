@@ -137,6 +137,12 @@ _MIN_STEP_FIXES, _MIN_STEP_GROWTH = 3, 4.0
 #: the search looks at ``cancel`` every this many rounds
 _CANCEL_EVERY = 64
 _OVER_SAMPLES = 64
+#: the sampler works on whole paths in chunks of about this many segments (bounded temporaries)
+CHUNK_SEGMENTS = 1 << 18
+#: the field-mapped geometry (96 bytes a segment) is kept for a re-sample up to this size;
+#: a larger one is made again when asked (about 0.3 s CPU per million segments): not held
+#: through the rest of a job of millions of points
+FIELDED_KEEP_BYTES = 128 << 20
 #: about how many marks a chain of smoothly joined cubics gathers before it is cut
 _CHAIN_MARKS = 64
 _TINY = 1e-300
@@ -786,10 +792,26 @@ class SampleReport:
 class SampleResult:
     marks: list[np.ndarray]
     report: SampleReport
-    # per stroke, float marks and their (global segment id, t) — for tests and benchmarks
-    float_marks: list[np.ndarray] = field(default_factory=list)
-    params: list[tuple[np.ndarray, np.ndarray]] = field(default_factory=list)
     coef: np.ndarray | None = None
+    # per chunk of paths: float marks, segment ids (of the chunk), parameters, the first
+    # segment of the chunk and each path's span of rows
+    chunks: list[tuple[np.ndarray, np.ndarray, np.ndarray, int, list[tuple[int, int]]]] = (
+        field(default_factory=list))
+
+    @property
+    def float_marks(self) -> list[np.ndarray]:
+        """Per stroke, the float marks (bits, before rounding) — for tests and benchmarks,
+        made when asked (not one array per path while the job is built)."""
+        return [pos[a:b] for pos, _, _, _, spans in self.chunks for a, b in spans]
+
+    @property
+    def params(self) -> list[tuple[np.ndarray, np.ndarray]]:
+        """Per stroke, the marks' (global segment id, t), made when asked."""
+        out = []
+        for _, sid, st, g0, spans in self.chunks:
+            sg = sid + g0
+            out += [(sg[a:b], st[a:b]) for a, b in spans]
+        return out
 
 
 def _round(p: np.ndarray) -> np.ndarray:
@@ -979,18 +1001,42 @@ class _Geometry:
             if hit is not None:
                 self._fielded.move_to_end(key)
                 return hit
+        # in chunks of CHUNK_SEGMENTS segments: the outputs are allocated once, every
+        # temporary is a chunk's (reused from the heap, not mapped afresh at every size)
+        g = len(self.row)
+        block = np.empty((4, 2, g))
+        ends = np.empty((g, 2, 2))
+        corner = np.zeros(g, dtype=bool)
+        for a in range(0, g, CHUNK_SEGMENTS):
+            b = min(a + CHUNK_SEGMENTS, g)
+            # one segment more than the chunk: the corner at the chunk's last joint
+            self._fielded_chunk(fm, a, min(b + 1, g), b, block, ends, corner)
+        coef = block.transpose(2, 0, 1)  # (G, 4, 2) view
+        cf = tuple(block[i, j] for i in range(4) for j in range(2))
+        for x in (ends, coef, corner, *cf):
+            x.setflags(write=False)
+        out = (ends, coef, corner, cf)
+        with self._lock:  # only the latest mapping: these arrays are as large as the fit
+            self._fielded.clear()
+            if block.nbytes + ends.nbytes <= FIELDED_KEEP_BYTES:  # else made again if asked
+                self._fielded[key] = out
+        return out
+
+    def _fielded_chunk(self, fm: FieldMap, a: int, b1: int, b: int, block: np.ndarray,
+                       ends: np.ndarray, corner: np.ndarray) -> None:
+        """Segments a..b-1 of :meth:`fielded`'s arrays, from segments a..b1-1 (b1 = b + 1
+        but at the end: the corner of joint b-1 needs segment b)."""
+        row, is_cubic = self.row[a:b1], self.is_cubic[a:b1]
         # control points in float bits, gathered from the shared points: P0 and P3 of every
         # segment, P1 and P2 of the cubics; a line P0→P1 is the cubic with its inner control
         # points at 1/3 and 2/3 (computed in bits; used for its end tangents)
-        pb = fm.to_bits_float(self.points)
-        row, is_cubic = self.row, self.is_cubic
-        g = len(row)
+        r0 = int(row[0])
+        pb = fm.to_bits_float(self.points[r0:int(row[-1]) + 4])
+        row = row - r0
         p0 = pb[row]
         p3 = pb[row + np.where(is_cubic, 3, 1)]
         ic = np.flatnonzero(is_cubic)
         il = np.flatnonzero(~is_cubic)
-        # inner control points: a cubic's own, a line's at 1/3 and 2/3 (in place: few
-        # temporaries, these arrays are as long as the fit)
         p1 = np.empty_like(p0)
         p2 = np.empty_like(p0)
         if len(ic):
@@ -1007,42 +1053,31 @@ class _Geometry:
             t /= 3.0
             t += c0
             p2[il] = t
-            del c0, d, t
         # power coefficients laid out (4, 2, G): each of a, b, d, e in x and y is one
         # contiguous row, so the eight flat arrays the kernels want are views, not copies;
         # a line exactly a = b = 0, d = P3 − P0, e = P0
-        block = np.empty((4, 2, g))
-        block[0] = 0.0
-        block[1] = 0.0
-        np.subtract(p3.T, p0.T, out=block[2])
-        block[3] = p0.T
-        if len(ic):
-            sub = np.empty((4, 2, len(ic)))
-            power_coeffs_into(sub, p0[ic].T, p1[ic].T, p2[ic].T, p3[ic].T)
-            block[:, :, ic] = sub
-        coef = block.transpose(2, 0, 1)  # (G, 4, 2) view
+        m = b - a
+        out = block[:, :, a:b]
+        out[0] = 0.0
+        out[1] = 0.0
+        np.subtract(p3[:m].T, p0[:m].T, out=out[2])
+        out[3] = p0[:m].T
+        icm = ic[ic < m]
+        if len(icm):
+            sub = np.empty((4, 2, len(icm)))
+            power_coeffs_into(sub, p0[icm].T, p1[icm].T, p2[icm].T, p3[icm].T)
+            out[:, :, icm] = sub
+        ends[a:b, 0] = p0[:m]
+        ends[a:b, 1] = p3[:m]
         # end tangents: the first non-zero control leg at each end
         ts = _first_nonzero(p1 - p0, (lambda z: p2[z] - p0[z], lambda z: p3[z] - p0[z]))
         te = _first_nonzero(p3 - p2, (lambda z: p3[z] - p1[z], lambda z: p3[z] - p0[z]))
-        corner = np.zeros(g, dtype=bool)
-        if g > 1:
-            a, b = te[:-1], ts[1:]
-            ang = turn_deg(a, b)
-            deg = ~((a != 0).any(axis=1) & (b != 0).any(axis=1))
-            corner[:-1] = ((ang > CORNER_DEG) | deg) & (self.seg_path[:-1] ==
-                                                         self.seg_path[1:])
-            del ang, deg
-        del ts, te
-        cf = tuple(block[i, j] for i in range(4) for j in range(2))
-        ends = np.stack((p0, p3), axis=1)  # (G, 2, 2): P0, P3
-        for x in (ends, coef, corner, *cf):
-            x.setflags(write=False)
-        out = (ends, coef, corner, cf)
-        with self._lock:  # only the latest mapping: these arrays are as large as the fit
-            self._fielded.clear()
-            self._fielded[key] = out
-        return out
-
+        if b1 - a > 1:
+            u, v = te[:-1], ts[1:]
+            ang = turn_deg(u, v)
+            deg = ~((u != 0).any(axis=1) & (v != 0).any(axis=1))
+            sp = self.seg_path[a:b1]
+            corner[a:b1 - 1] = ((ang > CORNER_DEG) | deg) & (sp[:-1] == sp[1:])
 
 def sample_geometry(fitted: Sequence[FittedPath]) -> _Geometry:
     """Every segment of ``fitted`` gathered for the sampler (paths, kinds, control points):
@@ -1091,25 +1126,67 @@ def sample_paths(
         res.marks = [np.empty((0, 2), dtype=np.int64) for _ in fitted]
         return res
     ends, coef, corner, cf = geo.fielded(fm)
-    cs = _CubicSet(coef, cf=cf)
     res.coef = coef
-    blocks = _cubic_params(cs, cf, geo, corner, interpolation, tol, min_step, ms_max,
-                           float(fixed_step_bits), float(fixed_slope_tol), report, cancel)
-    blocks.append(_line_params(np.flatnonzero(~geo.is_cubic), ends, ms_max))
-    mk = _merged_marks(cs, geo, ends, corner, blocks)
-    if min_step > 0.0:
-        mk = _min_step_pass(mk, cs, tol, min_step, report)
-    r, mk = _rounded(mk)
-    report.outside_points = int(((r < 0) | (r > fm.max_bit)).any(axis=1).sum())
-    _measure_into(report, mk, r, cs, geo.is_cubic, tol)
-    # one stroke per path
-    cuts = np.searchsorted(mk.pid, np.arange(len(fitted) + 1)).tolist()
-    cuts[-1] = len(mk.pid)
-    spans = list(zip(cuts[:-1], cuts[1:], strict=True))
-    res.marks = [r[a:b] for a, b in spans]
-    res.float_marks = [mk.pos[a:b] for a, b in spans]
-    res.params = [(mk.sid[a:b], mk.st[a:b]) for a, b in spans]
+    # whole paths in chunks of about CHUNK_SEGMENTS segments: each chunk's temporaries stay
+    # a few MB, reused from the heap chunk after chunk instead of mapped (and zeroed by the
+    # kernel) afresh at every size; the paths are independent, so are the chunks
+    seg_end = np.cumsum(geo.path_n)
+    cuts = [0]
+    while cuts[-1] < len(fitted):
+        p0 = cuts[-1]
+        base = int(seg_end[p0] - geo.path_n[p0])
+        cuts.append(max(p0 + 1, int(np.searchsorted(seg_end, base + CHUNK_SEGMENTS,
+                                                     side="right"))))
+    chords = 0
+    hmax: list[float] = []
+    himax: list[float] = []
+    for p0, p1 in zip(cuts[:-1], cuts[1:], strict=True):
+        g0 = int(seg_end[p0] - geo.path_n[p0])
+        g1 = int(seg_end[p1 - 1])
+        sl = slice(g0, g1)
+        view = _GeoView(geo.is_cubic[sl], geo.seg_path[sl] - p0,
+                        geo.path_first[p0:p1] - g0, geo.path_n[p0:p1])
+        cfs = tuple(c[sl] for c in cf)
+        cs = _CubicSet(coef[sl], cf=cfs)
+        part = SampleReport(interpolation, tol)
+        blocks = _cubic_params(cs, cfs, view, corner[sl], interpolation, tol, min_step, ms_max,
+                               float(fixed_step_bits), float(fixed_slope_tol), part, cancel)
+        blocks.append(_line_params(np.flatnonzero(~view.is_cubic), ends[sl], ms_max))
+        mk = _merged_marks(cs, view, ends[sl], corner[sl], blocks)
+        if min_step > 0.0:
+            mk = _min_step_pass(mk, cs, tol, min_step, part)
+        r, mk = _rounded(mk)
+        part.outside_points = int(((r < 0) | (r > fm.max_bit)).any(axis=1).sum())
+        _measure_into(part, mk, r, cs, view.is_cubic, tol)
+        report.min_step_overrides += part.min_step_overrides
+        report.trials += part.trials
+        report.outside_points += part.outside_points
+        report.chord_violations += part.chord_violations
+        if part.chords:
+            chords += part.chords
+            hmax.append(part.max_chord_height_bits)  # type: ignore[arg-type]
+            himax.append(part.max_chord_height_int_bits)  # type: ignore[arg-type]
+        # one stroke per path
+        pc = np.searchsorted(mk.pid, np.arange(p1 - p0 + 1)).tolist()
+        pc[-1] = len(mk.pid)
+        spans = list(zip(pc[:-1], pc[1:], strict=True))
+        res.marks += [r[a:b] for a, b in spans]
+        res.chunks.append((mk.pos, mk.sid, mk.st, g0, spans))
+    report.chords = chords
+    report.max_chord_height_bits = max(hmax, default=0.0)
+    report.max_chord_height_int_bits = max(himax, default=0.0)
     return res
+
+
+@dataclass
+class _GeoView:
+    """The part of a :class:`_Geometry` that a chunk of whole paths needs (its segments
+    and paths numbered from 0)."""
+
+    is_cubic: np.ndarray
+    seg_path: np.ndarray
+    path_first: np.ndarray
+    path_n: np.ndarray
 
 
 def _raw_marks(fitted: Sequence[FittedPath], fm: FieldMap,

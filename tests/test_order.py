@@ -16,8 +16,10 @@ from galvo_core.order import (
     KICKS_PER_STROKE,
     STALL_WINDOW_MIN,
     Placement,
+    _cand_xy,
     _cands_length,
     _greedy,
+    _grid_cell,
     _improve,
     _Problem,
     apply_placement,
@@ -288,3 +290,115 @@ def test_precedence_cycle_and_empty_strokes() -> None:
     pos = {p.index: i for i, p in enumerate(o_pl)}
     assert pos[20] < pos[40]
     assert travel_length(strokes, o_pl, closed) <= travel_length(strokes, g_pl, closed) + 1e-9
+
+
+def _ring_scan_greedy(prob: _Problem, before: list[tuple[int, int]]) -> list[int]:
+    """The greedy walk as a plain search by rings of square buckets (the rule the compiled
+    k-d tree walk keeps, ties included): buckets of side _grid_cell, visited ring by ring
+    (bottom row, top row, left column, right column), a bucket's points in the order they
+    became alive, the first strictly nearest kept, stop after ring r once the best is within
+    r cells; beyond ring 8 every alive point, the lowest index among the nearest."""
+    pts = prob.cpt
+    cell = _grid_cell(pts)
+    lo = pts.min(axis=0)
+    ij = np.floor((pts - lo) / cell).astype(np.int64)
+    nx, ny = int(ij[:, 0].max()) + 1, int(ij[:, 1].max()) + 1
+    buckets: dict[tuple[int, int], list[int]] = {}
+    alive = np.zeros(len(pts), dtype=bool)
+    _, ext = _cand_xy(prob)
+
+    def insert(ids: np.ndarray) -> None:
+        for k in ids.tolist():
+            alive[k] = True
+            buckets.setdefault((int(ij[k, 0]), int(ij[k, 1])), []).append(k)
+
+    def ring(ci: int, cj: int, r: int) -> list[tuple[int, int]]:
+        if r == 0:
+            return [(ci, cj)]
+        return ([(ci + d, cj - r) for d in range(-r, r + 1)]
+                + [(ci + d, cj + r) for d in range(-r, r + 1)]
+                + [(ci - r, cj + d) for d in range(-r + 1, r)]
+                + [(ci + r, cj + d) for d in range(-r + 1, r)])
+
+    def nearest(p: np.ndarray) -> int:
+        ci, cj = (int(v) for v in np.floor((p - lo) / cell))
+        best, bd = -1, np.inf
+        for r in range(max(nx, ny) + abs(ci) + abs(cj) + 2):
+            if r > 8:
+                ids = np.flatnonzero(alive)
+                d2 = ((pts[ids] - p) ** 2).sum(axis=1)
+                return int(ids[np.flatnonzero(d2 == d2.min())[0]])
+            for key in ring(ci, cj, r):
+                for k in buckets.get(key, []):
+                    d2 = float(((pts[k] - p) ** 2).sum())
+                    if alive[k] and d2 < bd:
+                        best, bd = k, d2
+            if best >= 0 and np.sqrt(bd) <= r * cell:
+                return best
+        return best
+
+    n = prob.n
+    succ: list[list[int]] = [[] for _ in range(n)]
+    npred = [0] * n
+    for a, b in before:
+        succ[a].append(b)
+        npred[b] += 1
+    for i in range(n):
+        if npred[i] == 0:
+            insert(prob.cand_of[i])
+    cand = int(prob.cand_of[next(i for i in range(n) if npred[i] == 0)][0])
+    out = []
+    while True:
+        i = int(prob.cstroke[cand])
+        out.append(cand)
+        alive[prob.cand_of[i]] = False
+        for j in succ[i]:
+            npred[j] -= 1
+            if npred[j] == 0:
+                insert(prob.cand_of[j])
+        if len(out) == n:
+            return out
+        cand = nearest(ext[cand])
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_greedy_walk_is_the_bucket_ring_search_ties_included(seed: int) -> None:
+    """The compiled k-d tree walk picks what a ring-by-ring search of square buckets picks,
+    ties too (integer points on a small lattice: many ends at the same distance; crowded
+    clusters; far outliers beyond ring 8; closed strokes with several starts; precedence)."""
+    rng = np.random.default_rng(seed)
+    strokes, closed = [], []
+    for k in range(700):
+        if k % 50 == 0:  # a far outlier
+            p = rng.integers(-4000, 4000, 2).astype(float)
+        elif k % 3 == 0:  # a crowded cluster
+            p = rng.integers(0, 12, 2).astype(float)
+        else:
+            p = rng.integers(0, 300, 2).astype(float)
+        if k % 7 == 0:
+            sq = np.array([(0, 0), (3, 0), (3, 4), (0, 4), (0, 0)], dtype=float) + p
+            strokes.append(sq)
+            closed.append(True)
+        else:
+            strokes.append(np.stack([p, p + rng.integers(-5, 6, 2)]))
+            closed.append(False)
+    before = [(i, i + 1) for i in range(0, 200, 9)] + [(i, i + 300) for i in range(0, 90, 4)]
+    prob = _Problem(strokes, closed, None)
+    want = _ring_scan_greedy(prob, before)
+    got = _greedy(prob, before)
+    assert got == want
+    assert sorted(int(prob.cstroke[c]) for c in got) == list(range(len(strokes)))
+
+
+def test_greedy_walk_tie_beyond_ring_8_takes_the_lowest_index() -> None:
+    """Four ends 1000 units from the start, in four directions, more than 8 buckets away:
+    the bucket search looks at every alive point there and keeps the lowest index (stroke
+    1), not the first of its ring (stroke 4, in the ring's bottom row)."""
+    far = [(1000.0, 0.0), (0.0, 1000.0), (-1000.0, 0.0), (0.0, -1000.0)]
+    strokes = [np.array([(0.0, 0.0), (0.0, 0.0)])] + [np.array([p, p]) for p in far]
+    strokes += [np.array([(800.0 + k % 20, 800.0 + k // 20)] * 2) for k in range(400)]
+    prob = _Problem(strokes, [False] * len(strokes), None)
+    assert 1000.0 > 8 * _grid_cell(prob.cpt)
+    got = _greedy(prob, [])
+    assert got == _ring_scan_greedy(prob, [])
+    assert [int(prob.cstroke[c]) for c in got[:2]] == [0, 1]

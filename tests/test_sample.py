@@ -488,3 +488,27 @@ def test_resampling_a_cached_fit_gives_what_a_fresh_fit_gives():
     for m, c in runs:
         p = Params(magnification=m, chord_tol_bits=c)
         assert pipe.run(d, p).job.stats == Pipeline().run(d, p).job.stats
+
+
+@pytest.mark.parametrize("interpolation", ["adaptive", "fixed"])
+def test_chunks_of_paths_give_what_one_batch_gives(monkeypatch, interpolation):
+    """The sampler works on whole paths in chunks (bounded temporaries): chunks of a few
+    segments give the same marks, parameters and report as one batch of every path."""
+    import galvo_core.sample as sm
+    from galvo_core.fit import fit_drawing
+
+    d = read_file(SAMPLES / "seal.plt")
+    fitted = list(fit_drawing(d))
+    fm = FieldMap(0.2, (0.0, 0.0), 65536, 110.0)  # small: many marks closer than min step
+    kw = dict(interpolation=interpolation, chord_tol_bits=0.5, min_step_bits=3.0)
+    one = sm.sample_paths(fitted, fm, **kw)
+    assert sum(len(fp.is_cubic) for fp in fitted) < sm.CHUNK_SEGMENTS
+    monkeypatch.setattr(sm, "CHUNK_SEGMENTS", 5)
+    many = sm.sample_paths(fitted, fm, **kw)
+    assert len(many.marks) == len(one.marks) == len(fitted)
+    for a, b in zip(one.marks, many.marks, strict=True):
+        assert np.array_equal(a, b)
+    for (sa, ta), (sb, tb) in zip(one.params, many.params, strict=True):
+        assert np.array_equal(sa, sb) and np.array_equal(ta, tb)
+    assert one.report == many.report
+    assert one.report.min_step_overrides > 0 and one.report.chords > 0, one.report
