@@ -294,10 +294,14 @@ def _small_polygon(xy: np.ndarray):
 
 
 def _finite_rect(xy: np.ndarray) -> QRectF:
-    if not len(xy):
+    """The bounding rectangle of the finite rows of ``xy`` (one compiled pass without the
+    interpreter lock: numpy's axis-0 min/max took 7 ms on 170 k rows)."""
+    from galvo_core.preview import bbox
+
+    box = bbox(xy) if len(xy) else None
+    if box is None:
         return QRectF()
-    lo, hi = xy.min(axis=0), xy.max(axis=0)
-    return QRectF(QPointF(lo[0], lo[1]), QPointF(hi[0], hi[1]))
+    return QRectF(QPointF(box[0], box[1]), QPointF(box[2], box[3]))
 
 
 def _footprint(width: float, square: bool, frac: float) -> tuple[np.ndarray, np.ndarray]:
@@ -639,8 +643,46 @@ def _levels_per_cell(pts: np.ndarray, cell: float) -> list[tuple[float, np.ndarr
     """``(cell * f, _one_per_cell(pts, cell * f))`` for f in :data:`LOD_FACTORS` (whole
     numbers): the finest grid's cells computed once, a coarser one's by integer division
     (the same cells: floor(x / (f g)) = floor(floor(x / g) / f) for x >= 0)."""
-    c = np.floor((pts - pts.min(axis=0)) / cell).astype(np.int64)
-    return [(float(cell * f), _first_per_cell(pts, c // int(f))) for f in LOD_FACTORS]
+    from galvo_core.preview import bbox
+
+    box = bbox(pts) if len(pts) >= 2 else None
+    pts = np.ascontiguousarray(pts, dtype=np.float64)
+    if box is None or not np.isfinite(pts).all():
+        c = np.floor((pts - pts.min(axis=0)) / cell).astype(np.int64)
+        return [(float(cell * f), _first_per_cell(pts, c // int(f))) for f in LOD_FACTORS]
+    # one compiled pass per level, the cells computed as above (floor of the finest grid,
+    # then integer division), no (N, 2) temporaries
+    x0, y0 = box[0], box[1]
+    cx_max = int(math.floor((box[2] - x0) / cell))
+    cy_max = int(math.floor((box[3] - y0) / cell))
+    out = []
+    for f in LOD_FACTORS:
+        k = int(f)
+        nx, ny = cx_max // k + 1, cy_max // k + 1
+        if nx * ny <= max(64 * len(pts), 20_000_000):
+            keep = _first_in_grid(pts, x0, y0, float(cell), k, ny, nx * ny)
+            out.append((float(cell * f), pts[keep]))
+        else:
+            c = np.floor((pts - np.array([x0, y0])) / cell).astype(np.int64)
+            out.append((float(cell * f), _first_per_cell(pts, c // k)))
+    return out
+
+
+@njit(cache=True, nogil=True)
+def _first_in_grid(pts: np.ndarray, x0: float, y0: float, cell: float, k: int, ny: int,
+                   cells: int) -> np.ndarray:  # pragma: no cover - jit
+    """The first point in each cell ``floor((p - (x0, y0)) / cell) // k`` (one pass, a
+    bitmap of ``cells`` cells, ``ny`` rows)."""
+    seen = np.zeros(cells, dtype=np.bool_)
+    keep = np.zeros(len(pts), dtype=np.bool_)
+    for i in range(len(pts)):
+        cx = np.int64(np.floor((pts[i, 0] - x0) / cell)) // k
+        cy = np.int64(np.floor((pts[i, 1] - y0) / cell)) // k
+        key = cx * ny + cy
+        if not seen[key]:
+            seen[key] = True
+            keep[i] = True
+    return keep
 
 
 def _first_per_cell(pts: np.ndarray, c: np.ndarray) -> np.ndarray:
