@@ -189,9 +189,9 @@ class DeviationItem(pg.GraphicsObject):
                         (k, _qpath(c[:, 0], c[:, 1]))
                         for k, c in dec]))
                     prev = n
-        lo = np.minimum(a.min(axis=0), b.min(axis=0))
-        hi = np.maximum(a.max(axis=0), b.max(axis=0))
-        return (paths, QRectF(QPointF(lo[0], lo[1]), QPointF(hi[0], hi[1])), len(level),
+        # compiled passes (numpy's axis-0 min/max over 380 k chords took 20-40 ms)
+        ra, rb = _finite_rect(a), _finite_rect(b)
+        return (paths, ra.united(rb) if not ra.isNull() else rb, len(level),
                 levels[::-1] or None)
 
     def setPrepared(self, prepared: tuple) -> None:  # noqa: N802
