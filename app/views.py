@@ -925,11 +925,18 @@ class WorkView(pg.PlotWidget):
         if want == getattr(self, "_legend_keys", None):
             return
         self._legend_keys = want
-        self.legend.clear()
-        for key in want:
-            label = next(s.label for s in LAYERS if s.key == key)
-            self.legend.addItem(self.legend_samples[key], label)
-        self._legend_columns()
+        # pyqtgraph re-lays the legend out (setGeometry, its anchors) after every entry
+        # removed or added: 40-50 ms of the GUI thread for a new set of layers. Once here.
+        self.legend.updateSize = lambda: None
+        try:
+            self.legend.clear()
+            for key in want:
+                label = next(s.label for s in LAYERS if s.key == key)
+                self.legend.addItem(self.legend_samples[key], label)
+            self._legend_columns()
+        finally:
+            del self.legend.updateSize
+        self.legend.updateSize()
         self.legend.setVisible(bool(want))
 
     def _legend_columns(self) -> None:
