@@ -593,7 +593,7 @@ class LinesItem(_FastItem):
                 if len(c) < 0.7 * prev:
                     levels.append((float(lod * f), _qpath(c[:, 0], c[:, 1])))
                     prev = len(c)
-        return xy, path, _finite_rect(xy[finite]), n, levels[::-1] or None
+        return xy, path, _finite_rect(xy), n, levels[::-1] or None  # finite rows only
 
     def setPrepared(self, prepared: tuple) -> None:  # noqa: N802
         self.prepareGeometryChange()

@@ -271,24 +271,33 @@ def _joined_segments(items: Sequence[tuple[np.ndarray, np.ndarray]]
     # control point is at (the steps before it) + (one start point per path up to its own)
     path_of = np.repeat(np.arange(len(nseg)), nseg)
     o = np.cumsum(step) - step + path_of
-    # one control point at a time (each numpy call short: the GUI thread gets the
-    # interpreter lock between them; one stack of a million segments held it 0.1 s)
+    # one compiled pass without the interpreter lock (numpy's masked gathers over a million
+    # segments held it 0.1-0.2 s each while a big job file loaded: GUI-thread stalls)
     ctrl = np.empty((len(is_cubic), 4, 2))
-    c = np.flatnonzero(is_cubic)
-    if len(c):
-        oc = o[c]
-        for k in range(4):
-            ctrl[c, k] = allc[oc + k]
-    line = np.flatnonzero(~is_cubic)
-    if len(line):
-        ol = o[line]
-        p0, p3 = allc[ol], allc[ol + 1]
-        d = p3 - p0
-        ctrl[line, 0] = p0
-        ctrl[line, 1] = p0 + d / 3.0
-        ctrl[line, 2] = p0 + 2.0 * d / 3.0
-        ctrl[line, 3] = p3
+    _gather_ctrl(np.ascontiguousarray(allc), o.astype(np.int64), is_cubic, ctrl)
     return ctrl, nseg, is_cubic
+
+
+@njit(cache=True, nogil=True)
+def _gather_ctrl(allc: np.ndarray, o: np.ndarray, is_cubic: np.ndarray,
+                 ctrl: np.ndarray) -> None:  # pragma: no cover - jit
+    """``ctrl[j]`` = the 4 control points of segment j, whose first point is ``allc[o[j]]``:
+    a cubic's 4 points, a line's ends with its inner points at thirds."""
+    for j in range(len(o)):
+        b = o[j]
+        if is_cubic[j]:
+            for k in range(4):
+                ctrl[j, k, 0] = allc[b + k, 0]
+                ctrl[j, k, 1] = allc[b + k, 1]
+        else:
+            for a in range(2):
+                p0 = allc[b, a]
+                p3 = allc[b + 1, a]
+                d = p3 - p0
+                ctrl[j, 0, a] = p0
+                ctrl[j, 1, a] = p0 + d / 3.0
+                ctrl[j, 2, a] = p0 + 2.0 * d / 3.0
+                ctrl[j, 3, a] = p3
 
 
 @dataclass(frozen=True, eq=False)
