@@ -586,7 +586,10 @@ class LinesItem(_FastItem):
             return xy, QPainterPath(), QRectF(), 0, None
         path = _qpath(xy[:, 0], xy[:, 1])
         levels: list[tuple[float, QPainterPath]] = []
-        if lod is not None and lod > 0 and n >= MAX_ANTIALIAS_POINTS:
+        # pieces of two vertices (the jumps) keep both ends at every grid: no coarse level
+        two_point = (len(xy) % 3 == 2 and n == 2 * (len(xy) // 3 + 1)
+                     and bool(np.isnan(xy[2::3, 0]).all()))
+        if lod is not None and lod > 0 and n >= MAX_ANTIALIAS_POINTS and not two_point:
             prev = len(xy)
             for f in LOD_FACTORS[::-1]:  # finest first: each level from the full data
                 c = decimate(xy, lod * f)
