@@ -76,7 +76,7 @@ class StallProbe:
                 for ident, frame in sys._current_frames().items():  # noqa: SLF001
                     if ident == main:
                         continue
-                    st = traceback.extract_stack(frame)[-2:]
+                    st = traceback.extract_stack(frame)[-4:]
                     where = " <- ".join(f"{x.filename.split('/')[-1]}:{x.lineno} {x.line}"
                                         for x in reversed(st))
                     print(f"    gap {gap:.0f} ms: {where}", file=sys.stderr)
