@@ -172,6 +172,28 @@ class StatsPanel(QWidget):
         rows = ordered_stats(dict(stats or {}))
         rows += list((extra or {}).items())
         per_col = (len(rows) + self.columns - 1) // self.columns
+        layout = (tuple(k for k, _ in rows), per_col, self.columns)
+        if layout == getattr(self, "_layout", None):
+            # the same rows in the same places (a re-run): only the texts that changed are
+            # set (rebuilding the 50-odd items took 6 ms of the GUI thread per result)
+            for r, (key, value) in enumerate(rows):
+                before = self.values.get(key)
+                self.values[key] = value
+                text = format_stat(key, value)
+                old_value = self.shown.get(key)
+                self.shown[key] = text
+                b = self.table.item(r % per_col, 2 * (r // per_col) + 1)
+                if b is None:
+                    continue
+                if text != old_value:
+                    b.setText(text)
+                if key == "dwell_points" and bool(value) != bool(before):
+                    if value:
+                        b.setForeground(QBrush(QColor("#b35c00")))
+                    else:
+                        b.setData(Qt.ItemDataRole.ForegroundRole, None)
+            return
+        self._layout = layout
         self.table.clearContents()
         self.table.setRowCount(per_col)
         self.shown = {}

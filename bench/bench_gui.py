@@ -76,7 +76,7 @@ class StallProbe:
                 for ident, frame in sys._current_frames().items():  # noqa: SLF001
                     if ident == main:
                         continue
-                    st = traceback.extract_stack(frame)[-2:]
+                    st = traceback.extract_stack(frame)[-4:]
                     where = " <- ".join(f"{x.filename.split('/')[-1]}:{x.lineno} {x.line}"
                                         for x in reversed(st))
                     print(f"    gap {gap:.0f} ms: {where}", file=sys.stderr)
@@ -184,7 +184,7 @@ def toggle(win, key: str, on: bool) -> Callable[[], None]:
     return lambda: win.layer_boxes[key].setChecked(on)
 
 
-def latency(files: list[Path], repeats: int) -> None:
+def latency(files: list[Path], repeats: int, only: list[str] | None = None) -> None:
     app, win = make_window()
     probe = StallProbe()
     print(machine())
@@ -226,9 +226,12 @@ def latency(files: list[Path], repeats: int) -> None:
             ("layer: marks off", lambda i: toggle(win, "marks", False)),
             ("layer: marks on", lambda i: toggle(win, "marks", True)),
         ]
-        print(f"  {'change':26s} {'wall ms':>9s} {'CPU ms':>8s} {'stall ms':>9s}")
+        if only:
+            rows = [r for r in rows if any(o in r[0] for o in only)]
+        print(f"  {'change':26s} {'wall ms':>9s} {'CPU ms':>8s} {'stall ms':>9s}"
+              f" {'apply/paint ms':>15s}")
         for name, make in rows:
-            walls, cpus, stalls = [], [], []
+            walls, cpus, stalls, gui = [], [], [], []
             if name.startswith("layer:") and win.params.kerf_mm:
                 win.set_param("kerf_mm", 0.0)  # the layer rows without kerf, as the first
                 assert win.wait_idle(600)
@@ -248,12 +251,16 @@ def latency(files: list[Path], repeats: int) -> None:
                     win.layer_boxes[name.split()[1]].setChecked(True)
                     assert win.wait_idle(600)
                 probe.start()
+                win.gui_work.take()
                 w, c = timed(app, win, make(i))
                 stalls.append(probe.stop())
+                gui.append(win.gui_work.take())
                 walls.append(w * 1000)
                 cpus.append(c * 1000)
+            ap = statistics.median(g[0] for g in gui)
+            pa = statistics.median(g[1] for g in gui)
             print(f"  {name:26s} {statistics.median(walls):9.0f} {statistics.median(cpus):8.0f}"
-                  f" {max(stalls):9.0f}")
+                  f" {max(stalls):9.0f} {ap:7.0f}/{pa:<7.0f}")
         win.set_param("kerf_mm", 0.0)
         win.wait_idle(600)
     win.close()
@@ -346,6 +353,8 @@ def main(argv: list[str] | None = None) -> int:
     a1.add_argument("files", nargs="*", type=Path)
     a1.add_argument("--points", type=int, default=150_000)
     a1.add_argument("--repeats", type=int, default=5)
+    a1.add_argument("--rows", default="", help="only the rows whose name contains one of "
+                    "these comma-separated words (e.g. 'magnification,chord,deviation on')")
     a2 = sub.add_parser("stalls")
     a2.add_argument("--points", type=int, default=1_000_000)
     a2.add_argument("--file", type=Path, default=None)
@@ -372,7 +381,7 @@ def main(argv: list[str] | None = None) -> int:
             f = Path(tempfile.mkdtemp(prefix="galvo-bench-")) / f"gen_{a.points}.plt"
             f.write_bytes(generate_plt(a.points, seed=0))
             files = [f]
-        latency(files, a.repeats)
+        latency(files, a.repeats, [w for w in a.rows.split(",") if w] or None)
     else:
         stalls(a.points, a.file)
     return 0

@@ -19,11 +19,12 @@ and no change of any parameter can return a result computed under other values.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import threading
 import time
 from collections import OrderedDict
-from collections.abc import Callable, Hashable
+from collections.abc import Callable, Hashable, Sequence
 from dataclasses import dataclass, field
 from typing import Any, TypeVar
 
@@ -46,7 +47,7 @@ from galvo_core.sample import (
     sample_geometry,
     sample_paths,
 )
-from galvo_core.timing import estimate_with_dwell
+from galvo_core.timing import estimate_with_dwell, joined_marks
 
 __all__ = ["Cancelled", "Pipeline", "RunResult", "coordinate_quantum", "process"]
 
@@ -215,7 +216,9 @@ class Pipeline:
                 chord_tol_bits=params.chord_tol_bits, min_step_bits=params.min_step_bits,
                 max_step_bits=params.max_step_bits, fixed_step_bits=params.fixed_step_bits,
                 fixed_slope_tol=params.fixed_slope_tol,
-                raw_points=[work.paths[fp.source_index].points for fp in fitted],
+                # the input points are read only by "raw" (a list over 10^4-10^5 paths)
+                raw_points=[work.paths[fp.source_index].points for fp in fitted]
+                if params.interpolation == "raw" else None,
                 cancel=run.cancel,
                 geometry=self._fact(fitted, "sample_geometry", lambda: sample_geometry(fitted)),
             )
@@ -268,8 +271,8 @@ class Pipeline:
         strokes, clamped = self._strokes(work, origin, fitted, sampled, hatched, params, fm)
         run.check()
         t1 = time.perf_counter()
-        ordered: list[Stroke] = order_job_strokes(  # type: ignore[assignment]
-            strokes, fm, method=params.scan_order, time_budget_s=params.order_time_budget_s)
+        ordered: tuple[Stroke, ...] = tuple(order_job_strokes(  # type: ignore[arg-type]
+            strokes, fm, method=params.scan_order, time_budget_s=params.order_time_budget_s))
         t2 = time.perf_counter()
         stats = self.stats(drawing, params, fitted, fm, ordered, sampled.report, work)
         if clamped:
@@ -282,7 +285,7 @@ class Pipeline:
         job_params = params.processing_dict()
         job_params["quantum_units"] = stats["quantum_units"]  # detected, not set
         job = Job(drawing.name, drawing.sha256, fm, job_params,
-                  params.laser.as_dict(), tuple(ordered), stats, tuple(warnings))
+                  params.laser.as_dict(), ordered, stats, tuple(warnings))
         t3 = time.perf_counter()
         run.timings["order"] = t2 - t1
         run.timings["stats"] = t3 - t2
@@ -295,35 +298,42 @@ class Pipeline:
         """The job's strokes in the stages' order (contours, then hatch), clamped when asked;
         and how many marks were clamped."""
         clamped = 0
-        do_clamp = params.clamp  # read once: Params attribute reads cost µs, strokes are 10^4-10^5
-
-        def clamp(m: np.ndarray) -> np.ndarray:
-            nonlocal clamped
-            if not do_clamp:
-                return m
-            c = np.clip(m, 0, fm.max_bit)
-            clamped += int((c != m).any(axis=1).sum())
-            return c
-
+        marks: list[np.ndarray] = list(sampled.marks)
+        keep = [i for i, m in enumerate(marks) if len(m)] if not all(map(len, marks)) \
+            else None
+        hatch_marks = [hm for _, hm in hatched]
+        if params.clamp:  # read once: Params attribute reads cost µs, strokes are 10^4-10^5
+            marks, n1 = _clamped(marks, fm.max_bit)
+            hatch_marks, n2 = _clamped(hatch_marks, fm.max_bit)
+            clamped = n1 + n2
         with gc_paused():  # one object per stroke, no cycles: no collector passes
             segs = self._fact(fitted, "segments", lambda: [
                 Segments(fp.is_cubic, fp.points) for fp in fitted])
-            strokes = [Stroke("contour", origin[fp.source_index], fp.closed, clamp(m), sg,
-                              fp.pen)
-                       for fp, m, sg in zip(fitted, sampled.marks, segs, strict=True) if len(m)]
-            strokes += [Stroke("hatch", origin[h.source_index], False, clamp(hm),
-                               Segments.empty(), work.paths[h.source_index].pen)
-                        for h, hm in hatched]
+            # per fit (a fit belongs to one compensated drawing, so to one ``origin``)
+            src, closed, pens = self._fact(fitted, "stroke columns", lambda: (
+                [origin[fp.source_index] for fp in fitted], [fp.closed for fp in fitted],
+                [fp.pen for fp in fitted]))
+            if keep is not None:  # paths without marks make no stroke
+                marks, segs, src, closed, pens = (
+                    [col[i] for i in keep] for col in (marks, segs, src, closed, pens))
+            strokes = _new_strokes("contour", src, closed, marks, segs, pens)
+            if hatched:
+                strokes += _new_strokes(
+                    "hatch", [origin[h.source_index] for h, _ in hatched],
+                    [False] * len(hatched), hatch_marks, [Segments.empty()] * len(hatched),
+                    [work.paths[h.source_index].pen for h, _ in hatched])
         return strokes, clamped
 
     def stats(self, drawing: Drawing, params: Params, fitted: tuple[FittedPath, ...],
-              fm: FieldMap, strokes: list[Stroke], report: SampleReport | None,
+              fm: FieldMap, strokes: Sequence[Stroke], report: SampleReport | None,
               work: Drawing | None = None) -> dict[str, Any]:
         """Counts, lengths, the time estimate (:mod:`galvo_core.timing`) and what the
         sampler measured: the largest chord height before and after rounding (bits, against
         the true curve; None for raw marks), chords above the tolerance, min-step
         overrides, marks outside the field (before clamping), dwell points."""
-        t, dwell = estimate_with_dwell([s.marks for s in strokes], params.laser, fm.mm_per_bit)
+        # the job's marks joined once (remembered for its strokes tuple: the preview and the
+        # simulation reuse them)
+        t, dwell = estimate_with_dwell(joined_marks(strokes), params.laser, fm.mm_per_bit)
         n_input = self._fact(drawing, "n_points", lambda: drawing.n_points)
         quantum = self._fact(drawing, "quantum", lambda: coordinate_quantum(drawing)) or 0.0
         # the fit detects each path's own grid: its bound is the largest path's
@@ -376,6 +386,58 @@ class Pipeline:
                 "outside_points": report.outside_points,
             })
         return out
+
+
+def _clamped(marks: list[np.ndarray], max_bit: int) -> tuple[list[np.ndarray], int]:
+    """``marks`` clipped to the field (0 .. max_bit) and how many marks moved: one pass over
+    all strokes joined; the strokes that did not move keep their arrays."""
+    if not marks:
+        return marks, 0
+    allm = np.concatenate(marks)
+    moved = ((allm < 0) | (allm > max_bit)).any(axis=1)
+    n = int(moved.sum())
+    if not n:
+        return marks, 0
+    lens = np.fromiter(map(len, marks), dtype=np.int64, count=len(marks))
+    ends = np.cumsum(lens)
+    cs = np.concatenate(([0], np.cumsum(moved)))
+    hit = np.flatnonzero(cs[ends] - cs[ends - lens])
+    out = list(marks)
+    for i in hit.tolist():
+        out[i] = np.clip(marks[i], 0, max_bit)
+    return out, n
+
+
+_STROKE_FIELDS = ("kind", "source_index", "closed", "marks", "segments", "pen")
+# Stroke's own constructor costs ~0.7 µs per field (a frozen dataclass sets each through
+# object.__setattr__) plus __post_init__: 25 ms for 40 k strokes on every re-sample. The
+# fields are written straight into the instance dict instead, when Stroke is still the
+# plain dataclass this expects (else its constructor is used).
+_FAST_STROKES = (tuple(f.name for f in dataclasses.fields(Stroke)) == _STROKE_FIELDS
+                 and not hasattr(Stroke, "__slots__"))
+
+
+def _new_strokes(kind: str, src: list[int], closed: list[bool], marks: list[np.ndarray],
+                 segs: list[Segments], pens: list[int]) -> list[Stroke]:
+    """``Stroke(kind, src[i], closed[i], marks[i], segs[i], pens[i])`` for every i (the
+    segments already :class:`Segments`)."""
+    if not _FAST_STROKES:
+        return [Stroke(kind, s, c, m, sg, p)
+                for s, c, m, sg, p in zip(src, closed, marks, segs, pens, strict=True)]
+    new = object.__new__
+    out = []
+    append = out.append
+    for s, c, m, sg, p in zip(src, closed, marks, segs, pens, strict=True):
+        st = new(Stroke)
+        d = st.__dict__
+        d["kind"] = kind
+        d["source_index"] = s
+        d["closed"] = c
+        d["marks"] = m
+        d["segments"] = sg
+        d["pen"] = p
+        append(st)
+    return out
 
 
 def coordinate_quantum(drawing: Drawing) -> float | None:

@@ -36,6 +36,7 @@ from galvo_core.fit import FittedPath
 from galvo_core.geometry import flatten_cubic
 from galvo_core.job import Job, Segments
 from galvo_core.pipeline import Cancelled
+from galvo_core.timing import joined_marks
 
 __all__ = [
     "EMPTY",
@@ -174,13 +175,60 @@ def field_outline_mm(fm: FieldMap) -> np.ndarray:
 
 
 def bbox(xy: np.ndarray) -> tuple[float, float, float, float] | None:
-    """(xmin, ymin, xmax, ymax) of the finite rows of ``xy``, None when there are none."""
-    a = np.asarray(xy, dtype=np.float64).reshape(-1, 2)
-    a = a[np.isfinite(a).all(axis=1)]
-    if not len(a):
+    """(xmin, ymin, xmax, ymax) of the finite rows of ``xy``, None when there are none.
+
+    One compiled pass without the interpreter lock (numpy's ``min`` over the million rows of
+    a big job held it 0.1-0.2 s on the worker: a stall of the GUI thread)."""
+    a = np.asarray(xy).reshape(-1, 2)
+    if a.dtype.kind in "iu":  # galvo bits: always finite
+        a = np.ascontiguousarray(a, dtype=np.int64)
+        if not len(a):
+            return None
+        box = _bbox_int(a)
+    else:
+        box = _bbox_finite(np.ascontiguousarray(a, dtype=np.float64))
+    if not box[0] <= box[2]:
         return None
-    lo, hi = a.min(axis=0), a.max(axis=0)
-    return float(lo[0]), float(lo[1]), float(hi[0]), float(hi[1])
+    return float(box[0]), float(box[1]), float(box[2]), float(box[3])
+
+
+@njit(cache=True, nogil=True)
+def _bbox_finite(a: np.ndarray) -> np.ndarray:  # pragma: no cover - jit
+    """[xmin, ymin, xmax, ymax] of the rows of ``a`` with both coordinates finite
+    (xmin > xmax when there are none)."""
+    out = np.array([np.inf, np.inf, -np.inf, -np.inf])
+    for i in range(a.shape[0]):
+        x = a[i, 0]
+        y = a[i, 1]
+        if np.isfinite(x) and np.isfinite(y):
+            if x < out[0]:
+                out[0] = x
+            if x > out[2]:
+                out[2] = x
+            if y < out[1]:
+                out[1] = y
+            if y > out[3]:
+                out[3] = y
+    return out
+
+
+@njit(cache=True, nogil=True)
+def _bbox_int(a: np.ndarray) -> np.ndarray:  # pragma: no cover - jit
+    """[xmin, ymin, xmax, ymax] of the (N >= 1, 2) integer rows ``a``."""
+    x0 = x1 = a[0, 0]
+    y0 = y1 = a[0, 1]
+    for i in range(1, a.shape[0]):
+        x = a[i, 0]
+        y = a[i, 1]
+        if x < x0:
+            x0 = x
+        elif x > x1:
+            x1 = x
+        if y < y0:
+            y0 = y
+        elif y > y1:
+            y1 = y
+    return np.array([float(x0), float(y0), float(x1), float(y1)])
 
 
 # ------------------------------------------------------------------ drawing (original)
@@ -223,24 +271,33 @@ def _joined_segments(items: Sequence[tuple[np.ndarray, np.ndarray]]
     # control point is at (the steps before it) + (one start point per path up to its own)
     path_of = np.repeat(np.arange(len(nseg)), nseg)
     o = np.cumsum(step) - step + path_of
-    # one control point at a time (each numpy call short: the GUI thread gets the
-    # interpreter lock between them; one stack of a million segments held it 0.1 s)
+    # one compiled pass without the interpreter lock (numpy's masked gathers over a million
+    # segments held it 0.1-0.2 s each while a big job file loaded: GUI-thread stalls)
     ctrl = np.empty((len(is_cubic), 4, 2))
-    c = np.flatnonzero(is_cubic)
-    if len(c):
-        oc = o[c]
-        for k in range(4):
-            ctrl[c, k] = allc[oc + k]
-    line = np.flatnonzero(~is_cubic)
-    if len(line):
-        ol = o[line]
-        p0, p3 = allc[ol], allc[ol + 1]
-        d = p3 - p0
-        ctrl[line, 0] = p0
-        ctrl[line, 1] = p0 + d / 3.0
-        ctrl[line, 2] = p0 + 2.0 * d / 3.0
-        ctrl[line, 3] = p3
+    _gather_ctrl(np.ascontiguousarray(allc), o.astype(np.int64), is_cubic, ctrl)
     return ctrl, nseg, is_cubic
+
+
+@njit(cache=True, nogil=True)
+def _gather_ctrl(allc: np.ndarray, o: np.ndarray, is_cubic: np.ndarray,
+                 ctrl: np.ndarray) -> None:  # pragma: no cover - jit
+    """``ctrl[j]`` = the 4 control points of segment j, whose first point is ``allc[o[j]]``:
+    a cubic's 4 points, a line's ends with its inner points at thirds."""
+    for j in range(len(o)):
+        b = o[j]
+        if is_cubic[j]:
+            for k in range(4):
+                ctrl[j, k, 0] = allc[b + k, 0]
+                ctrl[j, k, 1] = allc[b + k, 1]
+        else:
+            for a in range(2):
+                p0 = allc[b, a]
+                p3 = allc[b + 1, a]
+                d = p3 - p0
+                ctrl[j, 0, a] = p0
+                ctrl[j, 1, a] = p0 + d / 3.0
+                ctrl[j, 2, a] = p0 + 2.0 * d / 3.0
+                ctrl[j, 3, a] = p3
 
 
 @dataclass(frozen=True, eq=False)
@@ -560,14 +617,10 @@ def stroke_curves(job: Job, tol: float, kinds: Iterable[str] = ("contour",)) -> 
 
 def _all_marks(strokes: Sequence[Any]) -> tuple[np.ndarray, np.ndarray]:
     """Every mark of ``strokes`` in order as one (M, 2) int64 array, and each stroke's mark
-    count (one concatenation, no Python work per mark)."""
-    if not strokes:
-        return np.empty((0, 2), dtype=np.int64), np.empty(0, dtype=np.int64)
-    lens = np.fromiter((len(s.marks) for s in strokes), dtype=np.int64, count=len(strokes))
-    if not lens.sum():
-        return np.empty((0, 2), dtype=np.int64), lens
-    allm = np.concatenate([s.marks for s in strokes if len(s.marks)])
-    return np.asarray(allm, dtype=np.int64).reshape(-1, 2), lens
+    count (one concatenation, no Python work per mark; a job's strokes tuple is joined once:
+    :func:`galvo_core.timing.joined_marks`)."""
+    j = joined_marks(strokes)
+    return j.marks, j.lens
 
 
 def mark_points(job: Job, kinds: Iterable[str] | None = None) -> tuple[np.ndarray, np.ndarray]:
@@ -606,6 +659,8 @@ def _jumps_from(marks: np.ndarray, lens: np.ndarray) -> np.ndarray:
 
 def hatch_polylines(job: Job) -> Polylines:
     """The marks of the job's hatch strokes as polylines (galvo bits), ids = source_index."""
+    if not joined_marks(job.strokes).hatch.any():
+        return Polylines()
     strokes = [s for s in job.strokes if s.kind == "hatch"]
     return nan_join((np.asarray(s.marks, dtype=np.float64) for s in strokes),
                     (s.source_index for s in strokes))
@@ -988,16 +1043,15 @@ def build_preview(
     kerf_on = float(job.params.get("kerf_mm", 0.0) or 0.0) > 0.0
     kerf = curve if kerf_on else Polylines()
 
-    marks_bits, lens = _all_marks(job.strokes)  # once for the marks and the jumps
-    src = np.fromiter((s.source_index for s in job.strokes), dtype=np.int64,
-                      count=len(job.strokes))
-    mark_ids = np.repeat(src, lens)
+    joined = joined_marks(job.strokes)  # once for the marks, the jumps and the stats
+    marks_bits, lens = joined.marks, joined.lens
+    mark_ids = np.repeat(joined.source, lens)
     marks = marks_bits.astype(np.float64)
     jumps = _jumps_from(marks_bits, lens)
     hatch = hatch_polylines(job)
 
     bounds = _union(_affine_box(_union(o_box, c_box, bbox(kerf.xy)), scale, offset),
-                    _affine_box(_union(bbox(marks), bbox(hatch.xy)), fm.mm_per_bit, (0, 0)))
+                    _affine_box(_union(bbox(marks_bits), bbox(hatch.xy)), fm.mm_per_bit, (0, 0)))
     return Preview(
         field_map=fm,
         units_scale=scale,

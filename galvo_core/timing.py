@@ -23,7 +23,12 @@ not model acceleration (sky-writing, the galvo's own lag); the delays stand in f
 
 from __future__ import annotations
 
+import threading
+from collections import OrderedDict
 from collections.abc import Sequence
+from dataclasses import dataclass
+from operator import attrgetter
+from typing import Any
 
 import numpy as np
 
@@ -65,24 +70,91 @@ def estimate(
     return estimate_with_dwell(strokes, laser, mm_per_bit)[0]
 
 
+@dataclass(frozen=True, eq=False)
+class JoinedMarks:
+    """Every mark of a job's strokes in marking order as one array, with the stroke table
+    beside it: made once per job (:func:`joined_marks`) and shared by the time estimate,
+    the stats and the display geometry, so none of them loops over 10^4-10^5 strokes."""
+
+    #: (M, 2) int64 galvo bits, every stroke's marks in order
+    marks: np.ndarray
+    #: (S,) int64 each stroke's mark count (0 for an empty stroke)
+    lens: np.ndarray
+    #: (S,) int64 each stroke's ``source_index``
+    source: np.ndarray
+    #: (S,) bool: the stroke is a hatch stroke
+    hatch: np.ndarray
+
+
+_EMPTY_MARKS = np.empty((0, 2), dtype=np.int64)
+_JOINED: OrderedDict[int, tuple[object, JoinedMarks]] = OrderedDict()
+_JOINED_LOCK = threading.Lock()
+
+
+def joined_marks(strokes: Sequence[Any]) -> JoinedMarks:
+    """The :class:`JoinedMarks` of ``strokes`` (job strokes: ``marks``, ``source_index``,
+    ``kind``). The last few tuples are remembered by identity (the entry holds the tuple,
+    so its id cannot be reused meanwhile; other sequences are joined each time): a job's
+    strokes are joined once, whoever asks first (the stats, the preview, the simulation)."""
+    key = id(strokes)
+    keep = isinstance(strokes, tuple)  # only an immutable sequence is remembered
+    with _JOINED_LOCK:
+        hit = _JOINED.get(key) if keep else None
+        if hit is not None and hit[0] is strokes:
+            _JOINED.move_to_end(key)
+            return hit[1]
+    n = len(strokes)
+    lens = np.fromiter(map(len, map(attrgetter("marks"), strokes)), dtype=np.int64, count=n)
+    if lens.sum():
+        try:  # (M, 2) arrays, as the pipeline makes them
+            allm = np.concatenate([s.marks for s in strokes])
+        except ValueError:
+            allm = np.concatenate([np.asarray(s.marks).reshape(-1, 2) for s in strokes])
+        allm = np.asarray(allm, dtype=np.int64).reshape(-1, 2)
+    else:
+        allm = _EMPTY_MARKS
+    src = np.fromiter(map(attrgetter("source_index"), strokes), dtype=np.int64, count=n)
+    kinds = set(map(attrgetter("kind"), strokes))
+    if "hatch" in kinds:
+        hatch = np.fromiter((s.kind == "hatch" for s in strokes), dtype=bool, count=n)
+    else:
+        hatch = np.zeros(n, dtype=bool)
+    out = JoinedMarks(allm, lens, src, hatch)
+    if not keep:
+        return out
+    with _JOINED_LOCK:
+        _JOINED[key] = (strokes, out)
+        while len(_JOINED) > 4:
+            _JOINED.popitem(last=False)
+    return out
+
+
 def estimate_with_dwell(
-    strokes: Sequence[np.ndarray], laser: LaserParams, mm_per_bit: float
+    strokes: Sequence[np.ndarray] | JoinedMarks, laser: LaserParams, mm_per_bit: float
 ) -> tuple[dict[str, float | int], int]:
     """:func:`estimate` and :func:`dwell_count` in one pass over all strokes at once (one
-    concatenated array; stroke boundaries by offsets, no loop per stroke)."""
+    concatenated array; stroke boundaries by offsets, no loop per stroke). ``strokes``: the
+    strokes' marks, or a job's :class:`JoinedMarks` (already concatenated)."""
     us = 1e-6
     period = laser.point_period_us * us
-    ms = [m for m in strokes if len(m)]
-    n_strokes = len(ms)
-    if not n_strokes:
+    if isinstance(strokes, JoinedMarks):
+        sizes = strokes.lens[strokes.lens > 0]
+        n_strokes = len(sizes)
+        allm = strokes.marks.astype(np.float64) if n_strokes else None
+    else:
+        ms = [m for m in strokes if len(m)]
+        n_strokes = len(ms)
+        if n_strokes:
+            try:  # (M, 2) arrays: no Python work per stroke
+                allm = np.concatenate(ms).astype(np.float64).reshape(-1, 2)
+            except ValueError:
+                allm = np.concatenate([np.asarray(m).reshape(-1, 2)
+                                       for m in ms]).astype(np.float64)
+            sizes = np.fromiter(map(len, ms), dtype=np.int64, count=n_strokes)
+    if not n_strokes or allm is None:
         return {"mark_length_mm": 0.0, "jump_length_mm": 0.0, "estimated_time_s": 0.0,
                 "corners": 0, "laser_switches": 0, "jumps": 0, "mark_points": 0,
                 "mark_time_s": 0.0, "jump_time_s": 0.0, "delay_time_s": 0.0}, 0
-    try:  # (M, 2) arrays, as the pipeline makes them: no Python work per stroke
-        allm = np.concatenate(ms).astype(np.float64).reshape(-1, 2)
-    except ValueError:
-        allm = np.concatenate([np.asarray(m).reshape(-1, 2) for m in ms]).astype(np.float64)
-    sizes = np.fromiter(map(len, ms), dtype=np.int64, count=n_strokes)
     starts = np.cumsum(sizes) - sizes
     ends = starts + sizes - 1
     dx = allm[1:, 0] - allm[:-1, 0]

@@ -109,3 +109,17 @@ def test_marker_levels_from_one_grid_are_one_point_per_cell_of_each():
     assert [g for g, _ in levels] == pytest.approx([0.05 * f for f in LOD_FACTORS])
     for g, kept in levels:
         assert np.array_equal(kept, _one_per_cell(pts, g))
+
+
+def test_two_point_pieces_get_no_coarse_level_but_longer_pieces_do():
+    # jumps (pairs) keep both ends at any grid: no level is built for them; a layer whose
+    # pieces are longer is still decimated
+    rng = np.random.default_rng(7)
+    n = 30_000
+    pairs = np.full((3 * n - 1, 2), np.nan)
+    pairs[0::3] = rng.random((n, 2)) * 1000
+    pairs[1::3] = pairs[0::3] + 0.01
+    assert LinesItem.prepare(pairs, lod=1.0)[4] is None
+    line = np.cumsum(rng.random((3 * n - 1, 2)) * 0.01, axis=0)
+    line[2::7] = np.nan
+    assert LinesItem.prepare(line, lod=1.0)[4] is not None

@@ -220,3 +220,28 @@ def test_screenshot_of_a_drawing_bigger_than_the_field_uses_fit_field(qtbot, dia
     assert win.wait_idle(60)
     assert win.params.fit_field and win.run_error is None and win.banner.isVisible()
     assert win.current_job().strokes and not dialogs
+
+
+def test_stats_table_cells_follow_each_new_result(qtbot):
+    # a re-run updates the cells in place (same rows): every cell must show the new job's
+    win = make(qtbot)
+    assert win.load_file(SAMPLES / "seal.plt", wait=True)
+    table = win.stats_panel.table
+
+    def cells() -> dict[str, str]:
+        out = {}
+        for r in range(table.rowCount()):
+            for c in range(0, table.columnCount(), 2):
+                a, b = table.item(r, c), table.item(r, c + 1)
+                if a is not None and b is not None:
+                    out[a.toolTip()] = b.text()
+        return out
+
+    first = cells()
+    for value in (0.5, 3.0):
+        assert win.set_param("chord_tol_bits", value) and win.wait_idle(60)
+        stats = win.result.job.stats
+        shown = cells()
+        for key in ("mark_points", "chord_tol_bits", "estimated_time_s", "mark_length_mm"):
+            assert shown[key] == format_stat(key, stats[key]), key
+    assert shown["mark_points"] != first["mark_points"]
