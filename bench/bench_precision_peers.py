@@ -1,58 +1,251 @@
-"""Peers on the typeface outlines of bench_precision.py (issue 16): Paper.js
-``Path.simplify`` and fit-curve (Schneider) at a grid of tolerances, each result's segment
-count against the typeface's own and its distance to the true design curve (both ways, as
-bench_precision measures ours), and the peer's own time (node, ms). Peers installed by
-bench/run_fit.sh into bench/node_modules. Whole contours are handed to fit-curve (it is not
-split at corners here).
+"""Peers side by side with the project's fit (issue 16), on the typeface outlines of
+bench_precision.py (six styles, whole-unit and exact) and on the corpus files with curves.
 
-Usage: python bench/bench_precision_peers.py [--styles sans,serif-italic] [--em 1000]
+Peers (each given the same points; the curve fitters are given corner-to-corner runs, the
+corners being the typeface's own, see bench/peers_tools.py):
+* Paper.js ``Path.simplify`` and fit-curve (Schneider), node, bench/js/peers.js;
+* FontForge ``layer.simplify`` (flags mergelines, ignoreslopes, ignoreextrema,
+  smoothcurves), Debian python3-fontforge;
+* Inkscape ``path-simplify`` (batch ``--actions``; threshold = tolerance / selection
+  diagonal);
+* Potrace (CLI, defaults but ``-O``): the even-odd fill of each glyph's outline rendered at
+  ``s`` pixels per unit, traced, scaled back (it traces bitmaps: no corners handed over).
+
+Each peer runs at a grid of tolerances including our stated bound (e_per + q/sqrt 2:
+0.727 on whole units, 0.02 on exact). Measured per row: segments, x the typeface's own
+count, distance to the true design curve both ways (``fonts.curve_distance`` per contour,
+as bench_precision; per glyph for Potrace, whose contours are its own), and time (CPU s of
+the peer's own process or call; node: its own wall-clock ms of the fits, the box is loaded).
+
+Corpus (``--corpus``): every file of ../shared/corpus/plt where our fit at the defaults
+gives at least one cubic: detected quantum, input points, our segments, our worst error
+(check_fit, both sides) against the stated bound, and the peers' segments at a tolerance
+equal to that bound with their worst distance to the input polyline (both ways, per path;
+no true curve there). Corners there: the turn-angle rule of peers_tools.turn_corners.
+
+Usage: python bench/bench_precision_peers.py [--styles sans,serif] [--json out.json]
+       [--corpus] [--no-fonts] [--peers paper,fit-curve,fontforge,inkscape,potrace]
 """
 
 from __future__ import annotations
 
 import argparse
+import glob
+import json
+import math
 import os
 import sys
+import time
 
 import numpy as np
 
-sys.path.insert(0, os.path.join(os.path.dirname(__file__), ".."))
-sys.path.insert(0, os.path.dirname(__file__))
+HERE = os.path.dirname(os.path.abspath(__file__))
+sys.path.insert(0, os.path.join(HERE, ".."))
+sys.path.insert(0, HERE)
 
+import peers_tools as pt  # noqa: E402
 from bench_fit import SCALE, run_peer  # noqa: E402
-from fonts import curve_distance, glyph_set  # noqa: E402
+from bench_precision import fitted_dense  # noqa: E402
+from bench_precision import run as run_ours  # noqa: E402
+from fonts import STYLES, curve_distance  # noqa: E402
 
-from galvo_core.geometry import flatten_cubic  # noqa: E402
+from galvo_core import fit as fitmod  # noqa: E402
+from galvo_core.errors import GalvoError  # noqa: E402
+from galvo_core.hpgl import read_file  # noqa: E402
+from galvo_core.precision import path_quanta  # noqa: E402
 
-DISTS = (0.05, 0.1, 0.25, 0.5, 0.75, 1.0)
+HALF_DIAG = math.sqrt(0.5)
+E_PER = 0.02
+#: tolerances (units) handed to the curve-fitting peers; the stated bound is added
+TOLS = {True: (0.25, 0.5, 1.0, 2.0), False: (0.01, 0.05)}
+#: Potrace: (pixels per unit, -O opttolerance in pixels)
+POTRACE = ((1.0, 0.2), (2.0, 0.2), (4.0, 0.2))
+PEERS = ("paper", "fit-curve", "fontforge", "inkscape", "potrace")
+CORPUS = os.environ.get("GALVO_CORPUS",
+                        os.path.join(HERE, "..", "..", "shared", "corpus", "plt"))
 
 
-def dense(cubics) -> np.ndarray:
-    parts = [flatten_cubic(np.asarray(c, float), 0.002) for c in cubics]
-    return np.vstack([parts[0]] + [p[1:] for p in parts[1:]])
+def node_tols(lib: str, tols) -> list[float]:
+    # both compare squared distances with the number handed over (Paper.js too: PathFitter
+    # findMaxError returns a squared distance); coordinates are scaled by SCALE (bench_fit)
+    return [(t * SCALE) ** 2 for t in tols]
+
+
+def runs_of(paths, corners, closed):
+    """Flat list of (run, closed) handed to a peer and, per path, its slice."""
+    flat, where = [], []
+    for p, c, cl in zip(paths, corners, closed, strict=True):
+        runs, whole_closed = pt.split_runs(p, c, cl)
+        where.append((len(flat), len(flat) + len(runs)))
+        flat += [(r, whole_closed) for r in runs]
+    return flat, where
+
+
+def regroup(per_run, where):
+    return [[s for k in range(a, b) for s in per_run[k]] for a, b in where]
+
+
+def run_fitters(peers, paths, corners, closed, tols):
+    """Each curve-fitting peer at each tolerance: yields (peer, version, tol, per-path
+    segments, seconds)."""
+    flat, where = runs_of(paths, corners, closed)
+    for lib in ("paper", "fit-curve"):
+        if lib not in peers:
+            continue
+        res = run_peer(lib, flat, node_tols(lib, tols))
+        for t, r in zip(tols, res["results"], strict=True):
+            per_run = [[np.asarray(c, float) for c in cs] for cs in r["paths"]]
+            yield lib, res["version"], t, regroup(per_run, where), r["ms"] / 1e3
+    if "fontforge" in peers:
+        res = pt.fontforge_simplify(flat, list(tols))
+        for t, r in zip(tols, res["results"], strict=True):
+            yield "fontforge", res["version"], t, regroup(r["paths"], where), r["cpu_s"]
+    if "inkscape" in peers:
+        groups = [[r for r, _ in flat[a:b]] for a, b in where]
+        gclosed = [bool(flat[a][1]) if b - a == 1 else False for a, b in where]
+        ver = pt.inkscape_version()
+        for t in tols:
+            segs, secs = pt.inkscape_simplify(groups, gclosed, t)
+            yield "inkscape", ver, t, segs, secs
+
+
+def font_rows(style: str, whole: bool, peers, em: float) -> list[dict]:
+    fc = pt.font_case(style, whole, em)
+    bound = E_PER + (HALF_DIAG if whole else 0.0)
+    ours = run_ours(style, whole, em)
+    base = {"style": style, "input": "whole" if whole else "exact", "own": fc.own_segments,
+            "points": ours["points"]}
+    rows = [dict(base, peer="ours (defaults)", tol=bound, segments=ours["segments"],
+                 dist_true=ours["dist_true"], secs=ours["cpu_s"])]
+    tols = sorted(set(TOLS[whole]) | {round(bound, 3)})
+    for lib, ver, t, segs, secs in run_fitters(peers, fc.points, fc.corners,
+                                               [True] * len(fc.points), tols):
+        dist = max((curve_distance(pt.seg_dense(s), tr) if s else math.inf)
+                   for s, tr in zip(segs, fc.truth, strict=True))
+        rows.append(dict(base, peer=f"{lib} {ver}", tol=t, segments=sum(map(len, segs)),
+                         dist_true=dist, secs=secs))
+    if "potrace" in peers:
+        ver = pt.potrace_version()
+        for scale, opt in POTRACE:
+            n, dist, secs = 0, 0.0, 0.0
+            for g in sorted(set(fc.glyph)):
+                ks = [k for k, gg in enumerate(fc.glyph) if gg == g]
+                out, s = pt.potrace_glyph([fc.points[k] for k in ks], scale, opt)
+                secs += s
+                n += sum(map(len, out))
+                dist = max(dist, pt.set_distance([pt.seg_dense(o) for o in out],
+                                                 [fc.truth[k] for k in ks]))
+            rows.append(dict(base, peer=f"potrace {ver} ({scale:g} px/unit, -O {opt})",
+                             tol=opt / scale, segments=n, dist_true=dist, secs=secs))
+    for r in rows:
+        r["ratio"] = r["segments"] / r["own"]
+        r["at_bound"] = abs(r["tol"] - bound) < 1e-6
+    return rows
+
+
+# --- corpus -----------------------------------------------------------------------------------
+
+
+def corpus_files() -> list[str]:
+    fs = sorted(glob.glob(os.path.join(CORPUS, "*")))
+    return [f for f in fs if os.path.isfile(f) and "__expected" not in os.path.basename(f)
+            and not f.endswith((".tsv", ".md", ".svg", ".png"))]
+
+
+def corpus_row(path: str, peers) -> dict | None:
+    try:
+        dr = read_file(path)
+    except GalvoError:
+        return None
+    paths = [p for p in dr.paths if len(p.points) >= 2]
+    if not paths:
+        return None
+    pts = [np.asarray(p.points, float) for p in paths]
+    closed = [bool(p.closed) for p in paths]
+    qs = path_quanta(pts)
+    t0 = time.process_time()
+    fps = fitmod.fit_paths(pts, closed, quantum_units=qs)
+    secs = time.process_time() - t0
+    ncubic = sum(f.n_cubics for f in fps)
+    if not ncubic:
+        return None
+    worst, excess, bound_max = 0.0, -math.inf, 0.0
+    for p, f, q in zip(pts, fps, qs.tolist(), strict=True):
+        rep = fitmod.check_fit(p, f, E_PER, E_PER, quantum_units=q, report=True)
+        w = max(rep["max_in_to_curve"], rep["max_curve_to_polyline"])
+        worst = max(worst, w)
+        excess = max(excess, w - rep["bound"])
+        bound_max = max(bound_max, rep["bound"])
+    row = {"file": os.path.basename(path), "quantum": float(qs.max()),
+           "points": int(sum(map(len, pts))), "paths": len(pts),
+           "segments": sum(len(f.segments) for f in fps), "cubics": ncubic,
+           "worst": worst, "bound": bound_max, "excess": excess, "secs": secs, "peers": {}}
+    # peers at the stated bound; closed paths' polylines closed for them
+    work = [np.vstack([p, p[:1]]) if c and not np.array_equal(p[0], p[-1]) else p
+            for p, c in zip(pts, closed, strict=True)]
+    corners = [pt.turn_corners(p, c, reach=4.0 * bound_max) for p, c in zip(work, closed,
+                                                                            strict=True)]
+    row["corners"] = int(sum(map(len, corners)))
+    for lib, ver, _t, segs, s in run_fitters(peers, work, corners, closed, [bound_max]):
+        dist = max((curve_distance(pt.seg_dense(sg), p) if sg else math.inf)
+                   for sg, p in zip(segs, work, strict=True))
+        row["peers"][lib] = {"version": ver, "segments": sum(map(len, segs)),
+                             "dist_input": dist, "secs": s}
+    return row
+
+
+# --- output -------------------------------------------------------------------------------------
+
+
+def print_font(rows):
+    print("| style | input | peer | tolerance | segments | x own | to true curve | s |")
+    print("| --- | --- | --- | ---: | ---: | ---: | ---: | ---: |")
+    for r in rows:
+        b = " (bound)" if r["at_bound"] else ""
+        print(f"| {r['style']} | {r['input']} | {r['peer']} | {r['tol']:.3g}{b} | "
+              f"{r['segments']} | {r['ratio']:.2f} | {r['dist_true']:.3f} | "
+              f"{r['secs']:.2f} |", flush=True)
+
+
+def print_corpus_row(r, peers):
+    ps = " | ".join(f"{r['peers'][p]['segments']} / {r['peers'][p]['dist_input']:.3f}"
+                    if p in r["peers"] else "–" for p in peers)
+    print(f"| {r['file']} | {r['quantum']:g} | {r['points']} | {r['segments']} | "
+          f"{r['worst']:.3f} / {r['bound']:.3f} | {r['corners']} | {ps} |", flush=True)
 
 
 def main() -> None:
     ap = argparse.ArgumentParser()
-    ap.add_argument("--styles", default="sans,serif-italic,sans-light")
+    ap.add_argument("--styles", default=",".join(STYLES))
     ap.add_argument("--em", type=float, default=1000.0)
+    ap.add_argument("--peers", default=",".join(PEERS))
+    ap.add_argument("--corpus", action="store_true", help="also the corpus table")
+    ap.add_argument("--no-fonts", action="store_true")
+    ap.add_argument("--json")
     a = ap.parse_args()
-    print("| style | input | peer | tolerance (units) | segments | x own | to true curve | ms |")
-    print("| --- | --- | --- | ---: | ---: | ---: | ---: | ---: |")
-    for whole in (True, False):
-        for st in a.styles.split(","):
-            gs = glyph_set(st, em=a.em, whole=whole)
-            paths = [(p, True) for p in gs.points]
-            for lib in ("paper", "fit-curve"):
-                tols = [(d * SCALE) ** 2 if lib == "fit-curve" else d * SCALE for d in DISTS]
-                res = run_peer(lib, paths, tols)
-                for d, r in zip(DISTS, res["results"], strict=True):
-                    n = sum(len(cs) for cs in r["paths"])
-                    dist = max(curve_distance(dense(cs), t)
-                               for cs, t in zip(r["paths"], gs.truth, strict=True) if cs)
-                    print(f"| {st} | {'whole' if whole else 'exact'} | {lib} {res['version']} | "
-                          f"{d} | {n} | {n / gs.own_segments:.2f} | {dist:.3f} | "
-                          f"{r['ms']:.0f} |", flush=True)
+    peers = a.peers.split(",")
+    fitmod.warm_up()
+    out = {"fonts": [], "corpus": []}
+    if not a.no_fonts:
+        for whole in (True, False):
+            for st in a.styles.split(","):
+                rows = font_rows(st, whole, peers, a.em)
+                out["fonts"] += rows
+                print_font(rows)
+    if a.corpus:
+        cp = [p for p in peers if p != "potrace"]
+        print("\n| file | q | points | segments | worst / bound | corners | "
+              + " | ".join(f"{p} segs / dist" for p in cp) + " |")
+        print("| --- | ---: | ---: | ---: | ---: | ---: | " + " | ".join("---:" for _ in cp)
+              + " |")
+        for f in corpus_files():
+            r = corpus_row(f, cp)
+            if r is not None:
+                out["corpus"].append(r)
+                print_corpus_row(r, cp)
+    if a.json:
+        with open(a.json, "w") as f:
+            json.dump(out, f, indent=1, default=float)
 
 
 if __name__ == "__main__":
