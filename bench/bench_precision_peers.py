@@ -45,7 +45,6 @@ sys.path.insert(0, HERE)
 
 import peers_tools as pt  # noqa: E402
 from bench_fit import SCALE, run_peer  # noqa: E402
-from bench_precision import fitted_dense  # noqa: E402
 from bench_precision import run as run_ours  # noqa: E402
 from fonts import STYLES, curve_distance  # noqa: E402
 
@@ -92,7 +91,9 @@ def run_fitters(peers, paths, corners, closed, tols):
     for lib in ("paper", "fit-curve"):
         if lib not in peers:
             continue
-        res = run_peer(lib, flat, node_tols(lib, tols))
+        # every run open, a corner-less closed contour too (from its first point round to
+        # it): Paper.js's own closed mode leaves an excursion at the closing point
+        res = run_peer(lib, [(r, False) for r, _ in flat], node_tols(lib, tols))
         for t, r in zip(tols, res["results"], strict=True):
             per_run = [[np.asarray(c, float) for c in cs] for cs in r["paths"]]
             yield lib, res["version"], t, regroup(per_run, where), r["ms"] / 1e3
@@ -180,14 +181,19 @@ def corpus_row(path: str, peers) -> dict | None:
            "points": int(sum(map(len, pts))), "paths": len(pts),
            "segments": sum(len(f.segments) for f in fps), "cubics": ncubic,
            "worst": worst, "bound": bound_max, "excess": excess, "secs": secs, "peers": {}}
-    # peers at the stated bound; closed paths' polylines closed for them
+    # peers at the stated bound; closed paths' polylines closed for them; dots (all points
+    # equal) left out
+    keep = [k for k, p in enumerate(pts) if (p != p[0]).any()]
+    closed = [closed[k] for k in keep]
     work = [np.vstack([p, p[:1]]) if c and not np.array_equal(p[0], p[-1]) else p
-            for p, c in zip(pts, closed, strict=True)]
+            for p, c in zip((pts[k] for k in keep), closed, strict=True)]
+    row["dots"] = len(pts) - len(keep)
     corners = [pt.turn_corners(p, c, reach=4.0 * bound_max) for p, c in zip(work, closed,
                                                                             strict=True)]
     row["corners"] = int(sum(map(len, corners)))
     for lib, ver, _t, segs, s in run_fitters(peers, work, corners, closed, [bound_max]):
-        dist = max((curve_distance(pt.seg_dense(sg), p) if sg else math.inf)
+        h = max(1e-3, bound_max / 20.0)
+        dist = max((pt.both_ways(pt.seg_dense(sg, h), p) if sg else math.inf)
                    for sg, p in zip(segs, work, strict=True))
         row["peers"][lib] = {"version": ver, "segments": sum(map(len, segs)),
                              "dist_input": dist, "secs": s}

@@ -38,6 +38,8 @@ from galvo_core.geometry import flatten_cubic, point_polyline_distance  # noqa: 
 FONT_CORNER_DEG = 7.0
 #: turn-angle rule for paths without a typeface: turn over +-L arc length > this
 TURN_CORNER_DEG = 45.0
+#: ... and, next to an edge at least the reach long, an edge turn over this
+EDGE_CORNER_DEG = 30.0
 SYSTEM_PY = "/usr/bin/python3"  # Debian's python, where python3-fontforge lives
 
 
@@ -116,8 +118,10 @@ def turn_corners(p: np.ndarray, closed: bool, reach: float,
                  deg: float = TURN_CORNER_DEG) -> np.ndarray:
     """Corner indices of a polyline: vertices where the direction from the point ``reach``
     (arc length) behind to the vertex and from the vertex to the point ``reach`` ahead turn
-    by more than ``deg`` degrees, the largest turn of each cluster (candidates closer than
-    ``reach``). A closed path (last point = first) is taken cyclically."""
+    by more than ``deg`` degrees (the largest turn of each cluster of candidates closer than
+    ``reach``), and every vertex where the polyline turns by more than ``EDGE_CORNER_DEG``
+    next to an edge at least ``reach`` long (a polygon's corners, chamfers included). A
+    closed path (last point = first) is taken cyclically."""
     n = len(p)
     if n < 3:
         return np.zeros(0, np.intp)
@@ -136,11 +140,18 @@ def turn_corners(p: np.ndarray, closed: bool, reach: float,
     ang = np.degrees(np.abs(np.arctan2(u[:, 0] * v[:, 1] - u[:, 1] * v[:, 0],
                                        (u * v).sum(axis=1))))
     ang[~(u.any(axis=1) & v.any(axis=1))] = 0.0
+    # joints of two long edges (a polygon's vertices, not a dense curve's): the edge turn
+    e_in, e_out = ext[i] - ext[i - 1], ext[(i + 1) % len(ext)] - ext[i]
+    long = (np.hypot(*e_in.T) >= reach) | (np.hypot(*e_out.T) >= reach)
+    turn1 = np.degrees(np.abs(np.arctan2(e_in[:, 0] * e_out[:, 1] - e_in[:, 1] * e_out[:, 0],
+                                         (e_in * e_out).sum(axis=1))))
+    sharp = np.flatnonzero(long & (turn1 > EDGE_CORNER_DEG))
     cand = np.flatnonzero(ang > deg)
     if not closed:
         cand = cand[(cand > 0) & (cand < n - 1)]
+        sharp = sharp[(sharp > 0) & (sharp < n - 1)]
     if not len(cand):
-        return cand
+        return sharp.astype(np.intp)
     out = []
     grp = [cand[0]]
     for c in cand[1:]:
@@ -150,7 +161,7 @@ def turn_corners(p: np.ndarray, closed: bool, reach: float,
             out.append(grp[int(np.argmax(ang[grp]))])
             grp = [c]
     out.append(grp[int(np.argmax(ang[grp]))])
-    return np.array(sorted(set(out)), dtype=np.intp)
+    return np.array(sorted(set(out) | set(sharp.tolist())), dtype=np.intp)
 
 
 def split_runs(p: np.ndarray, corners: np.ndarray, closed: bool) -> tuple[list[np.ndarray], bool]:
@@ -186,6 +197,19 @@ def directed(a: np.ndarray, polys: list[np.ndarray]) -> float:
     for q in polys:
         d = np.minimum(d, point_polyline_distance(a, q))
     return float(d.max())
+
+
+def both_ways(a: np.ndarray, b: np.ndarray) -> float:
+    """fonts.curve_distance's measure (each vertex of one polyline to the other polyline,
+    the larger of the two maxima) computed by GEOS (for the long corpus paths)."""
+    import shapely
+
+    def one(p, q):
+        if len(q) < 2:
+            return float(np.hypot(*(p - q[0]).T).max())
+        return float(shapely.distance(shapely.points(p), shapely.LineString(q)).max())
+
+    return max(one(a, b), one(b, a))
 
 
 def set_distance(fitted: list[np.ndarray], truth: list[np.ndarray]) -> float:
@@ -296,8 +320,7 @@ def rasterize(polys: list[np.ndarray], scale: float, margin: int = 4):
         rhi = np.ceil((yhi - y0) * scale - 0.5).astype(np.int64)
         cnt = np.maximum(rhi - rlo, 0)
         e = np.repeat(np.arange(len(a)), cnt)
-        r = np.concatenate([np.arange(lo, hi) for lo, hi in zip(rlo, rhi) if hi > lo]) \
-            if cnt.sum() else np.zeros(0, np.int64)
+        r = np.repeat(rlo, cnt) + np.arange(int(cnt.sum())) - np.repeat(np.cumsum(cnt) - cnt, cnt)
         yc = y0 + (r + 0.5) / scale
         t = (yc - a[e, 1]) / (b[e, 1] - a[e, 1])
         xc = a[e, 0] + t * (b[e, 0] - a[e, 0])
