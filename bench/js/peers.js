@@ -1,5 +1,5 @@
-// Fit peers for bench/bench_fit.py and bench/bench_precision_peers.py. stdin: JSON {lib, scale, tols: [...], paths: [{closed,
-// points: [[x, y], ...]}]}; stdout: JSON {version, results: [{tol, ms, paths: [[[x0, y0],
+// Fit peers for bench/bench_fit.py and bench/bench_precision_peers.py. stdin: JSON {lib,
+// scale, tols: [...], paths: [{closed, points: [[x, y], ...]}]}; stdout: JSON {version, results: [{tol, ms, paths: [[[x0, y0],
 // [x1, y1], [x2, y2], [x3, y3]], ...]]}]} (cubics in the input's units).
 // Coordinates are multiplied by `scale` before fitting and divided after: Paper.js skips its
 // refinement when tolerance^2 < 1, so the tolerances handed over must be >= 1 after scaling.
