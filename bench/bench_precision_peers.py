@@ -193,10 +193,13 @@ def corpus_row(path: str, peers) -> dict | None:
     row["corners"] = int(sum(map(len, corners)))
     for lib, ver, _t, segs, s in run_fitters(peers, work, corners, closed, [bound_max]):
         h = max(1e-3, bound_max / 20.0)
-        dist = max((pt.both_ways(pt.seg_dense(sg, h), p) if sg else math.inf)
-                   for sg, p in zip(segs, work, strict=True))
+        ds = [(pt.both_ways(pt.seg_dense(sg, h), p) if sg else math.inf)
+              for sg, p in zip(segs, work, strict=True)]
+        # paths farther than the bound from their input polyline (the input vertices'
+        # distances to the flattened curve may read up to h too high: h of slack)
+        over = sum(d > bound_max + h for d in ds)
         row["peers"][lib] = {"version": ver, "segments": sum(map(len, segs)),
-                             "dist_input": dist, "secs": s}
+                             "dist_input": max(ds), "over": int(over), "secs": s}
     return row
 
 
@@ -214,8 +217,8 @@ def print_font(rows):
 
 
 def print_corpus_row(r, peers):
-    ps = " | ".join(f"{r['peers'][p]['segments']} / {r['peers'][p]['dist_input']:.3f}"
-                    if p in r["peers"] else "–" for p in peers)
+    ps = " | ".join(f"{r['peers'][p]['segments']} / {r['peers'][p]['dist_input']:.3f} / "
+                    f"{r['peers'][p]['over']}" if p in r["peers"] else "–" for p in peers)
     print(f"| {r['file']} | {r['quantum']:g} | {r['points']} | {r['segments']} | "
           f"{r['worst']:.3f} / {r['bound']:.3f} | {r['corners']} | {ps} |", flush=True)
 
@@ -302,7 +305,7 @@ def main() -> None:
     if a.corpus:
         cp = [p for p in peers if p != "potrace"]
         print("\n| file | q | points | segments | worst / bound | corners | "
-              + " | ".join(f"{p} segs / dist" for p in cp) + " |")
+              + " | ".join(f"{p} segs / dist / paths over" for p in cp) + " |")
         print("| --- | ---: | ---: | ---: | ---: | ---: | " + " | ".join("---:" for _ in cp)
               + " |")
         for f in corpus_files():
