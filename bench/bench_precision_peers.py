@@ -57,6 +57,8 @@ HALF_DIAG = math.sqrt(0.5)
 E_PER = 0.02
 #: tolerances (units) handed to the curve-fitting peers; the stated bound is added
 TOLS = {True: (0.25, 0.5, 1.0, 2.0), False: (0.01, 0.05)}
+#: the node peers take seconds to a minute per tolerance on a loaded box: fewer there
+NODE_TOLS = {True: (1.0, 2.0), False: (0.01, 0.05)}
 #: Potrace: (pixels per unit, -O opttolerance in pixels)
 POTRACE = ((1.0, 0.2), (2.0, 0.2), (4.0, 0.2))
 PEERS = ("paper", "fit-curve", "fontforge", "inkscape", "potrace")
@@ -84,19 +86,21 @@ def regroup(per_run, where):
     return [[s for k in range(a, b) for s in per_run[k]] for a, b in where]
 
 
-def run_fitters(peers, paths, corners, closed, tols):
-    """Each curve-fitting peer at each tolerance: yields (peer, version, tol, per-path
-    segments, seconds)."""
+def run_fitters(peers, paths, corners, closed, tols, node_tols=None):
+    """Each curve-fitting peer at each tolerance (``node_tols`` for Paper.js and
+    fit-curve, default ``tols``): yields (peer, version, tol, per-path segments, seconds)."""
     flat, where = runs_of(paths, corners, closed)
     for lib in ("paper", "fit-curve"):
         if lib not in peers:
             continue
+        tols_all, tols = tols, (tols if node_tols is None else node_tols)
         # every run open, a corner-less closed contour too (from its first point round to
         # it): Paper.js's own closed mode leaves an excursion at the closing point
         res = run_peer(lib, [(r, False) for r, _ in flat], node_tols(lib, tols))
         for t, r in zip(tols, res["results"], strict=True):
             per_run = [[np.asarray(c, float) for c in cs] for cs in r["paths"]]
             yield lib, res["version"], t, regroup(per_run, where), r["ms"] / 1e3
+        tols = tols_all
     if "fontforge" in peers:
         res = pt.fontforge_simplify(flat, list(tols))
         for t, r in zip(tols, res["results"], strict=True):
@@ -119,8 +123,9 @@ def font_rows(style: str, whole: bool, peers, em: float) -> list[dict]:
     rows = [dict(base, peer="ours (defaults)", tol=bound, segments=ours["segments"],
                  dist_true=ours["dist_true"], secs=ours["cpu_s"])]
     tols = sorted(set(TOLS[whole]) | {bound})
+    ntols = sorted(set(NODE_TOLS[whole]) | {bound})
     for lib, ver, t, segs, secs in run_fitters(peers, fc.points, fc.corners,
-                                               [True] * len(fc.points), tols):
+                                               [True] * len(fc.points), tols, ntols):
         dist = max((curve_distance(pt.seg_dense(s), tr) if s else math.inf)
                    for s, tr in zip(segs, fc.truth, strict=True))
         rows.append(dict(base, peer=f"{lib} {ver}", tol=t, segments=sum(map(len, segs)),
@@ -284,6 +289,7 @@ def main() -> None:
     ap.add_argument("--peers", default=",".join(PEERS))
     ap.add_argument("--corpus", action="store_true", help="also the corpus table")
     ap.add_argument("--no-fonts", action="store_true")
+    ap.add_argument("--inputs", default="whole,exact")
     ap.add_argument("--json")
     ap.add_argument("--summary", metavar="JSON", help="only print the summary of a run's JSON")
     a = ap.parse_args()
@@ -295,7 +301,7 @@ def main() -> None:
     fitmod.warm_up()
     out = {"fonts": [], "corpus": []}
     if not a.no_fonts:
-        for whole in (True, False):
+        for whole in [i == "whole" for i in a.inputs.split(",")]:
             for st in a.styles.split(","):
                 rows = font_rows(st, whole, peers, a.em)
                 out["fonts"] += rows
