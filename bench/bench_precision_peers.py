@@ -291,11 +291,15 @@ def main() -> None:
     ap.add_argument("--no-fonts", action="store_true")
     ap.add_argument("--inputs", default="whole,exact")
     ap.add_argument("--json")
-    ap.add_argument("--summary", metavar="JSON", help="only print the summary of a run's JSON")
+    ap.add_argument("--summary", metavar="JSON", nargs="+",
+                    help="only print the summary of the font rows of these runs' JSON")
     a = ap.parse_args()
     if a.summary:
-        with open(a.summary) as f:
-            summary(json.load(f)["fonts"])
+        rows = []
+        for fn in a.summary:
+            with open(fn) as f:
+                rows += json.load(f)["fonts"]
+        summary(rows)
         return
     peers = a.peers.split(",")
     fitmod.warm_up()
