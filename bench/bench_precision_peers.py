@@ -86,14 +86,14 @@ def regroup(per_run, where):
     return [[s for k in range(a, b) for s in per_run[k]] for a, b in where]
 
 
-def run_fitters(peers, paths, corners, closed, tols, node_tols=None):
-    """Each curve-fitting peer at each tolerance (``node_tols`` for Paper.js and
+def run_fitters(peers, paths, corners, closed, tols, tols_node=None):
+    """Each curve-fitting peer at each tolerance (``tols_node`` for Paper.js and
     fit-curve, default ``tols``): yields (peer, version, tol, per-path segments, seconds)."""
     flat, where = runs_of(paths, corners, closed)
     for lib in ("paper", "fit-curve"):
         if lib not in peers:
             continue
-        tols_all, tols = tols, (tols if node_tols is None else node_tols)
+        tols_all, tols = tols, (tols if tols_node is None else tols_node)
         # every run open, a corner-less closed contour too (from its first point round to
         # it): Paper.js's own closed mode leaves an excursion at the closing point
         res = run_peer(lib, [(r, False) for r, _ in flat], node_tols(lib, tols))
@@ -110,8 +110,11 @@ def run_fitters(peers, paths, corners, closed, tols, node_tols=None):
         gclosed = [bool(flat[a][1]) if b - a == 1 else False for a, b in where]
         ver = pt.inkscape_version()
         for t in tols:
-            segs, secs = pt.inkscape_simplify(groups, gclosed, t)
-            yield "inkscape", ver, t, segs, secs
+            got = pt.inkscape_simplify(groups, gclosed, t)
+            if got is None:  # over pt.INKSCAPE_TIMEOUT s
+                yield "inkscape", ver, t, None, pt.INKSCAPE_TIMEOUT
+            else:
+                yield "inkscape", ver, t, got[0], got[1]
 
 
 def font_rows(style: str, whole: bool, peers, em: float) -> list[dict]:
@@ -126,6 +129,8 @@ def font_rows(style: str, whole: bool, peers, em: float) -> list[dict]:
     ntols = sorted(set(NODE_TOLS[whole]) | {bound})
     for lib, ver, t, segs, secs in run_fitters(peers, fc.points, fc.corners,
                                                [True] * len(fc.points), tols, ntols):
+        if segs is None:
+            continue
         dist = max((curve_distance(pt.seg_dense(s), tr) if s else math.inf)
                    for s, tr in zip(segs, fc.truth, strict=True))
         rows.append(dict(base, peer=f"{lib} {ver}", tol=t, segments=sum(map(len, segs)),
@@ -197,6 +202,9 @@ def corpus_row(path: str, peers) -> dict | None:
                                                                             strict=True)]
     row["corners"] = int(sum(map(len, corners)))
     for lib, ver, _t, segs, s in run_fitters(peers, work, corners, closed, [bound_max]):
+        if segs is None:
+            row["peers"][lib] = {"version": ver, "timeout": s}
+            continue
         h = max(1e-3, bound_max / 20.0)
         ds = [(pt.both_ways(pt.seg_dense(sg, h), p) if sg else math.inf)
               for sg, p in zip(segs, work, strict=True)]
@@ -222,8 +230,15 @@ def print_font(rows):
 
 
 def print_corpus_row(r, peers):
-    ps = " | ".join(f"{r['peers'][p]['segments']} / {r['peers'][p]['dist_input']:.3f} / "
-                    f"{r['peers'][p]['over']}" if p in r["peers"] else "–" for p in peers)
+    def cell(p):
+        q = r["peers"].get(p)
+        if q is None:
+            return "–"
+        if "segments" not in q:
+            return f"over {q['timeout']:g} s"
+        return f"{q['segments']} / {q['dist_input']:.3f} / {q['over']}"
+
+    ps = " | ".join(cell(p) for p in peers)
     print(f"| {r['file']} | {r['quantum']:g} | {r['points']} | {r['segments']} | "
           f"{r['worst']:.3f} / {r['bound']:.3f} | {r['corners']} | {ps} |", flush=True)
 
@@ -310,6 +325,7 @@ def main() -> None:
                 rows = font_rows(st, whole, peers, a.em)
                 out["fonts"] += rows
                 print_font(rows)
+                dump(out, a.json)
     if out["fonts"]:
         summary(out["fonts"])
     if a.corpus:
@@ -323,9 +339,15 @@ def main() -> None:
             if r is not None:
                 out["corpus"].append(r)
                 print_corpus_row(r, cp)
-    if a.json:
-        with open(a.json, "w") as f:
+                dump(out, a.json)
+    dump(out, a.json)
+
+
+def dump(out, fn) -> None:
+    if fn:
+        with open(fn + ".tmp", "w") as f:
             json.dump(out, f, indent=1, default=float)
+        os.replace(fn + ".tmp", fn)
 
 
 if __name__ == "__main__":

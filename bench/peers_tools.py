@@ -40,7 +40,8 @@ FONT_CORNER_DEG = 7.0
 TURN_CORNER_DEG = 45.0
 #: ... and, next to an edge at least the reach long, an edge turn over this
 EDGE_CORNER_DEG = 30.0
-SYSTEM_PY = "/usr/bin/python3"  # Debian's python, where python3-fontforge lives
+SYSTEM_PY = "/usr/bin/python3"
+INKSCAPE_TIMEOUT = 120.0  # Debian's python, where python3-fontforge lives
 
 
 def child_cpu() -> float:
@@ -463,7 +464,9 @@ def _svg_doc(groups: list[list[np.ndarray]], closed: list[bool]) -> tuple[str, f
 
 def inkscape_simplify(groups: list[list[np.ndarray]], closed: list[bool], tol: float):
     """Inkscape ``path-simplify`` of all paths at once (each path: its runs as subpaths;
-    a one-run closed path closed with Z). Inkscape's threshold is relative to the
+    a one-run closed path closed with Z); None when it runs over ``INKSCAPE_TIMEOUT``
+    seconds (it first resamples every path at the tolerance).
+    Inkscape's threshold is relative to the
     selection's bounding-box diagonal: it is set to ``tol`` / diagonal so that the distance
     it works with is ``tol`` units. Returns per path its segments and the CPU seconds of
     the inkscape process (start-up included)."""
@@ -478,10 +481,13 @@ def inkscape_simplify(groups: list[list[np.ndarray]], closed: list[bool], tol: f
         env = dict(os.environ, INKSCAPE_PROFILE_DIR=prof, HOME=d)
         env.pop("DISPLAY", None)
         c0 = child_cpu()
-        subprocess.run(["inkscape", src, "--actions",
-                        f"select-all:all;path-simplify;export-filename:{dst};"
-                        "export-plain-svg;export-do"],
-                       check=True, env=env, capture_output=True)
+        try:
+            subprocess.run(["inkscape", src, "--actions",
+                            f"select-all:all;path-simplify;export-filename:{dst};"
+                            "export-plain-svg;export-do"],
+                           check=True, env=env, capture_output=True, timeout=INKSCAPE_TIMEOUT)
+        except subprocess.TimeoutExpired:
+            return None
         secs = child_cpu() - c0
         txt = open(dst).read()
         out: list[list[np.ndarray]] = [[] for _ in groups]
