@@ -297,6 +297,62 @@ def summary(rows) -> None:
                       f"{sum(r['secs'] for r in sub):.2f} |")
 
 
+def per_style_table(rows) -> None:
+    """One line per style and input: ours, each peer at our stated bound, Potrace at 1 and
+    4 px per unit; cells "segments (x own) / distance to the true curve"."""
+    kinds = ["paper", "fit-curve", "fontforge", "inkscape"]
+    print("| style | input | ours | " + " | ".join(f"{k} at the bound" for k in kinds)
+          + " | potrace 1 px/unit | potrace 4 px/unit |")
+    print("| --- | --- | " + " | ".join("---:" for _ in range(len(kinds) + 3)) + " |")
+
+    def cell(r):
+        return "–" if r is None else f"{r['segments']} ({r['ratio']:.2f}) / {r['dist_true']:.3f}"
+
+    keys = []
+    for r in rows:
+        if (r["input"], r["style"]) not in keys:
+            keys.append((r["input"], r["style"]))
+    for inp, st in sorted(keys, key=lambda k: (k[0] != "whole", list(STYLES).index(k[1]))):
+        rs = [r for r in rows if r["style"] == st and r["input"] == inp]
+        bound = E_PER + (HALF_DIAG if inp == "whole" else 0.0)
+
+        def pick(pred, rs=rs):
+            return next((r for r in rs if pred(r)), None)
+
+        cells = [cell(pick(lambda r: r["peer"].startswith("ours")))]
+        for k in kinds:
+            cells.append(cell(pick(lambda r, k=k, bound=bound: r["peer"].split(" ")[0] == k
+                                   and abs(r["tol"] - bound) < 1e-3)))
+        for sc in ("(1 px", "(4 px"):
+            cells.append(cell(pick(lambda r, sc=sc: r["peer"].startswith("potrace")
+                                   and sc in r["peer"])))
+        print(f"| {st} | {inp} | " + " | ".join(cells) + " |")
+
+
+def corpus_table(rows, peers=("paper", "fit-curve", "fontforge", "inkscape")) -> None:
+    print("| file | q | points | ours: segments | ours: worst / bound | "
+          + " | ".join(f"{p}: segments / dist / paths over" for p in peers) + " |")
+    print("| --- | ---: | ---: | ---: | ---: | " + " | ".join("---:" for _ in peers) + " |")
+    for r in rows:
+        def cell(p, r=r):
+            q = r["peers"].get(p)
+            if q is None:
+                return "–"
+            if "segments" not in q:
+                return f"over {q['timeout']:g} s"
+            return f"{q['segments']} / {q['dist_input']:.3f} / {q['over']}"
+        print(f"| {r['file']} | {r['quantum']:g} | {r['points']} | {r['segments']} | "
+              f"{r['worst']:.3f} / {r['bound']:.3f} | " + " | ".join(map(cell, peers)) + " |")
+    tot = [str(sum(r["segments"] for r in rows))]
+    for p in peers:
+        ok = [r for r in rows if "segments" in r["peers"].get(p, {})]
+        tot.append(f"{sum(r['peers'][p]['segments'] for r in ok)} on {len(ok)} files; "
+                   f"{sum(r['peers'][p]['over'] > 0 for r in ok)} files with paths over")
+    over_ours = sum(r["worst"] > r["bound"] * (1 + 1e-9) for r in rows)
+    print(f"| **{len(rows)} files** | | {sum(r['points'] for r in rows)} | {tot[0]} | "
+          f"{over_ours} files over | " + " | ".join(tot[1:]) + " |")
+
+
 def main() -> None:
     ap = argparse.ArgumentParser()
     ap.add_argument("--styles", default=",".join(STYLES))
@@ -306,6 +362,8 @@ def main() -> None:
     ap.add_argument("--no-fonts", action="store_true")
     ap.add_argument("--inputs", default="whole,exact")
     ap.add_argument("--json")
+    ap.add_argument("--tables", action="store_true", help="with --summary: per style too")
+    ap.add_argument("--corpus-table", metavar="JSON", help="only print a run's corpus table")
     ap.add_argument("--summary", metavar="JSON", nargs="+",
                     help="only print the summary of the font rows of these runs' JSON")
     a = ap.parse_args()
@@ -315,6 +373,13 @@ def main() -> None:
             with open(fn) as f:
                 rows += json.load(f)["fonts"]
         summary(rows)
+        if a.tables:
+            print()
+            per_style_table(rows)
+        return
+    if a.corpus_table:
+        with open(a.corpus_table) as f:
+            corpus_table(json.load(f)["corpus"])
         return
     peers = a.peers.split(",")
     fitmod.warm_up()
