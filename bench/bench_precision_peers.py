@@ -368,10 +368,14 @@ def main() -> None:
                     help="only print the summary of the font rows of these runs' JSON")
     a = ap.parse_args()
     if a.summary:
-        rows = []
+        rows, seen = [], set()
         for fn in a.summary:
             with open(fn) as f:
-                rows += json.load(f)["fonts"]
+                for r in json.load(f)["fonts"]:  # a style run twice: its first run kept
+                    k = (r["style"], r["input"], r["peer"], r["tol"])
+                    if k not in seen:
+                        seen.add(k)
+                        rows.append(r)
         summary(rows)
         if a.tables:
             print()
