@@ -59,6 +59,8 @@ E_PER = 0.02
 TOLS = {True: (0.25, 0.5, 1.0, 2.0), False: (0.01, 0.05)}
 #: the node peers take seconds to a minute per tolerance on a loaded box: fewer there
 NODE_TOLS = {True: (1.0, 2.0), False: (0.01, 0.05)}
+#: Inkscape's threshold is no distance bound (it stays close at 2 units): larger ones too
+INK_TOLS = {True: (3.0, 4.0, 6.0, 8.0), False: (0.1, 0.2, 0.4)}
 #: Potrace: (pixels per unit, -O opttolerance in pixels)
 POTRACE = ((1.0, 0.2), (2.0, 0.2), (4.0, 0.2))
 PEERS = ("paper", "fit-curve", "fontforge", "inkscape", "potrace")
@@ -86,7 +88,7 @@ def regroup(per_run, where):
     return [[s for k in range(a, b) for s in per_run[k]] for a, b in where]
 
 
-def run_fitters(peers, paths, corners, closed, tols, tols_node=None):
+def run_fitters(peers, paths, corners, closed, tols, tols_node=None, tols_ink=()):
     """Each curve-fitting peer at each tolerance (``tols_node`` for Paper.js and
     fit-curve, default ``tols``): yields (peer, version, tol, per-path segments, seconds)."""
     flat, where = runs_of(paths, corners, closed)
@@ -109,7 +111,7 @@ def run_fitters(peers, paths, corners, closed, tols, tols_node=None):
         groups = [[r for r, _ in flat[a:b]] for a, b in where]
         gclosed = [bool(flat[a][1]) if b - a == 1 else False for a, b in where]
         ver = pt.inkscape_version()
-        for t in tols:
+        for t in sorted(set(tols) | set(tols_ink)):
             got = pt.inkscape_simplify(groups, gclosed, t)
             if got is None:  # over pt.INKSCAPE_TIMEOUT s
                 yield "inkscape", ver, t, None, pt.INKSCAPE_TIMEOUT
@@ -128,7 +130,8 @@ def font_rows(style: str, whole: bool, peers, em: float) -> list[dict]:
     tols = sorted(set(TOLS[whole]) | {bound})
     ntols = sorted(set(NODE_TOLS[whole]) | {bound})
     for lib, ver, t, segs, secs in run_fitters(peers, fc.points, fc.corners,
-                                               [True] * len(fc.points), tols, ntols):
+                                               [True] * len(fc.points), tols, ntols,
+                                               INK_TOLS[whole]):
         if segs is None:
             continue
         dist = max((curve_distance(pt.seg_dense(s), tr) if s else math.inf)

@@ -367,7 +367,7 @@ def potrace_glyph(polys: list[np.ndarray], scale: float, opttol: float = 0.2,
 
 def potrace_version() -> str:
     r = subprocess.run(["potrace", "--version"], capture_output=True, text=True)
-    return r.stdout.split()[1] if r.returncode == 0 else "missing"
+    return r.stdout.split()[1].rstrip(".") if r.returncode == 0 else "missing"
 
 
 # --- FontForge's simplify (Debian python3-fontforge, run by Debian's python) -----------------
