@@ -280,7 +280,7 @@ def summary(rows) -> None:
                 if at_b:
                     sel["the bound"] = at_b
                 best = []
-                for st in styles:
+                for st in sorted({r["style"] for r in mine} & set(ours)):
                     ok = [r for r in mine if r["style"] == st
                           and r["dist_true"] <= ours[st]["dist_true"] + 1e-9]
                     if ok:
