@@ -349,8 +349,10 @@ def corpus_table(rows, peers=("paper", "fit-curve", "fontforge", "inkscape")) ->
     tot = [str(sum(r["segments"] for r in rows))]
     for p in peers:
         ok = [r for r in rows if "segments" in r["peers"].get(p, {})]
-        tot.append(f"{sum(r['peers'][p]['segments'] for r in ok)} on {len(ok)} files; "
-                   f"{sum(r['peers'][p]['over'] > 0 for r in ok)} files with paths over")
+        tot.append(f"{sum(r['peers'][p]['segments'] for r in ok)} (ours on these "
+                   f"{len(ok)} files: {sum(r['segments'] for r in ok)}); "
+                   f"{sum(r['peers'][p]['over'] > 0 for r in ok)} files with paths over, "
+                   f"{sum(r['peers'][p]['over'] for r in ok)} paths")
     over_ours = sum(r["worst"] > r["bound"] * (1 + 1e-9) for r in rows)
     print(f"| **{len(rows)} files** | | {sum(r['points'] for r in rows)} | {tot[0]} | "
           f"{over_ours} files over | " + " | ".join(tot[1:]) + " |")
