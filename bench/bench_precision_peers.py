@@ -332,6 +332,24 @@ def per_style_table(rows) -> None:
         print(f"| {st} | {inp} | " + " | ".join(cells) + " |")
 
 
+def grid_table(rows) -> None:
+    """Every peer at every tolerance tried: ranges over the styles."""
+    print("| input | peer | tolerance | styles | x own | to true curve | s (mean) |")
+    print("| --- | --- | ---: | ---: | ---: | ---: | ---: |")
+    keys = []
+    for r in rows:
+        k = (r["input"], r["peer"], round(r["tol"], 3))
+        if k not in keys:
+            keys.append(k)
+    keys.sort(key=lambda k: (k[0] != "whole", k[1] != "ours (defaults)", k[1], k[2]))
+    for inp, peer, tol in keys:
+        sub = [r for r in rows if (r["input"], r["peer"], round(r["tol"], 3)) == (inp, peer, tol)]
+        print(f"| {inp} | {peer} | {tol:g} | {len(sub)} | "
+              f"{_rng([r['ratio'] for r in sub], '{:.2f}')} | "
+              f"{_rng([r['dist_true'] for r in sub], '{:.3f}')} | "
+              f"{sum(r['secs'] for r in sub) / len(sub):.2f} |")
+
+
 def corpus_table(rows, peers=("paper", "fit-curve", "fontforge", "inkscape")) -> None:
     print("| file | q | points | ours: segments | ours: worst / bound | "
           + " | ".join(f"{p}: segments / dist / paths over" for p in peers) + " |")
@@ -385,6 +403,8 @@ def main() -> None:
         if a.tables:
             print()
             per_style_table(rows)
+            print()
+            grid_table(rows)
         return
     if a.corpus_table:
         with open(a.corpus_table) as f:
