@@ -1,58 +1,447 @@
-"""Peers on the typeface outlines of bench_precision.py (issue 16): Paper.js
-``Path.simplify`` and fit-curve (Schneider) at a grid of tolerances, each result's segment
-count against the typeface's own and its distance to the true design curve (both ways, as
-bench_precision measures ours), and the peer's own time (node, ms). Peers installed by
-bench/run_fit.sh into bench/node_modules. Whole contours are handed to fit-curve (it is not
-split at corners here).
+"""Peers side by side with the project's fit (issue 16), on the typeface outlines of
+bench_precision.py (six styles, whole-unit and exact) and on the corpus files with curves.
 
-Usage: python bench/bench_precision_peers.py [--styles sans,serif-italic] [--em 1000]
+Peers (each given the same points; the curve fitters are given corner-to-corner runs, the
+corners being the typeface's own, see bench/peers_tools.py):
+* Paper.js ``Path.simplify`` and fit-curve (Schneider), node, bench/js/peers.js;
+* FontForge ``layer.simplify`` (flags mergelines, ignoreslopes, ignoreextrema,
+  smoothcurves), Debian python3-fontforge;
+* Inkscape ``path-simplify`` (batch ``--actions``; threshold = tolerance / selection
+  diagonal);
+* Potrace (CLI, defaults but ``-O``): the even-odd fill of each glyph's outline rendered at
+  ``s`` pixels per unit, traced, scaled back (it traces bitmaps: no corners handed over).
+
+Each peer runs at a grid of tolerances including our stated bound (e_per + q/sqrt 2:
+0.727 on whole units, 0.02 on exact). Measured per row: segments, x the typeface's own
+count, distance to the true design curve both ways (``fonts.curve_distance`` per contour,
+as bench_precision; per glyph for Potrace, whose contours are its own), and time (CPU s of
+the peer's own process or call; node: its own wall-clock ms of the fits, the box is loaded).
+
+Corpus (``--corpus``): every file of ../shared/corpus/plt where our fit at the defaults
+gives at least one cubic: detected quantum, input points, our segments, our worst error
+(check_fit, both sides) against the stated bound, and the peers' segments at a tolerance
+equal to that bound with their worst distance to the input polyline (both ways, per path;
+no true curve there). Corners there: the turn-angle rule of peers_tools.turn_corners.
+
+Usage: python bench/bench_precision_peers.py [--styles sans,serif] [--json out.json]
+       [--corpus] [--no-fonts] [--peers paper,fit-curve,fontforge,inkscape,potrace]
 """
 
 from __future__ import annotations
 
 import argparse
+import glob
+import json
+import math
 import os
 import sys
+import time
 
 import numpy as np
 
-sys.path.insert(0, os.path.join(os.path.dirname(__file__), ".."))
-sys.path.insert(0, os.path.dirname(__file__))
+HERE = os.path.dirname(os.path.abspath(__file__))
+sys.path.insert(0, os.path.join(HERE, ".."))
+sys.path.insert(0, HERE)
 
+import peers_tools as pt  # noqa: E402
 from bench_fit import SCALE, run_peer  # noqa: E402
-from fonts import curve_distance, glyph_set  # noqa: E402
+from bench_precision import run as run_ours  # noqa: E402
+from fonts import STYLES, curve_distance  # noqa: E402
 
-from galvo_core.geometry import flatten_cubic  # noqa: E402
+from galvo_core import fit as fitmod  # noqa: E402
+from galvo_core.errors import GalvoError  # noqa: E402
+from galvo_core.hpgl import read_file  # noqa: E402
+from galvo_core.precision import path_quanta  # noqa: E402
 
-DISTS = (0.05, 0.1, 0.25, 0.5, 0.75, 1.0)
+HALF_DIAG = math.sqrt(0.5)
+E_PER = 0.02
+#: tolerances (units) handed to the curve-fitting peers; the stated bound is added
+TOLS = {True: (0.25, 0.5, 1.0, 2.0), False: (0.01, 0.05)}
+#: the node peers take seconds to a minute per tolerance on a loaded box: fewer there
+NODE_TOLS = {True: (1.0, 2.0), False: (0.01, 0.05)}
+#: Inkscape's threshold is no distance bound (it stays close at 2 units): larger ones too
+INK_TOLS = {True: (3.0, 4.0, 6.0, 8.0), False: (0.1, 0.2, 0.4)}
+#: Potrace: (pixels per unit, -O opttolerance in pixels)
+POTRACE = ((1.0, 0.2), (2.0, 0.2), (4.0, 0.2))
+PEERS = ("paper", "fit-curve", "fontforge", "inkscape", "potrace")
+CORPUS = os.environ.get("GALVO_CORPUS",
+                        os.path.join(HERE, "..", "..", "shared", "corpus", "plt"))
 
 
-def dense(cubics) -> np.ndarray:
-    parts = [flatten_cubic(np.asarray(c, float), 0.002) for c in cubics]
-    return np.vstack([parts[0]] + [p[1:] for p in parts[1:]])
+def node_tols(lib: str, tols) -> list[float]:
+    # both compare squared distances with the number handed over (Paper.js too: PathFitter
+    # findMaxError returns a squared distance); coordinates are scaled by SCALE (bench_fit)
+    return [(t * SCALE) ** 2 for t in tols]
+
+
+def runs_of(paths, corners, closed):
+    """Flat list of (run, closed) handed to a peer and, per path, its slice."""
+    flat, where = [], []
+    for p, c, cl in zip(paths, corners, closed, strict=True):
+        runs, whole_closed = pt.split_runs(p, c, cl)
+        where.append((len(flat), len(flat) + len(runs)))
+        flat += [(r, whole_closed) for r in runs]
+    return flat, where
+
+
+def regroup(per_run, where):
+    return [[s for k in range(a, b) for s in per_run[k]] for a, b in where]
+
+
+def run_fitters(peers, paths, corners, closed, tols, tols_node=None, tols_ink=()):
+    """Each curve-fitting peer at each tolerance (``tols_node`` for Paper.js and
+    fit-curve, default ``tols``): yields (peer, version, tol, per-path segments, seconds)."""
+    flat, where = runs_of(paths, corners, closed)
+    for lib in ("paper", "fit-curve"):
+        if lib not in peers:
+            continue
+        tols_all, tols = tols, (tols if tols_node is None else tols_node)
+        # every run open, a corner-less closed contour too (from its first point round to
+        # it): Paper.js's own closed mode leaves an excursion at the closing point
+        res = run_peer(lib, [(r, False) for r, _ in flat], node_tols(lib, tols))
+        for t, r in zip(tols, res["results"], strict=True):
+            per_run = [[np.asarray(c, float) for c in cs] for cs in r["paths"]]
+            yield lib, res["version"], t, regroup(per_run, where), r["ms"] / 1e3
+        tols = tols_all
+    if "fontforge" in peers:
+        res = pt.fontforge_simplify(flat, list(tols))
+        for t, r in zip(tols, res["results"], strict=True):
+            yield "fontforge", res["version"], t, regroup(r["paths"], where), r["cpu_s"]
+    if "inkscape" in peers:
+        groups = [[r for r, _ in flat[a:b]] for a, b in where]
+        gclosed = [bool(flat[a][1]) if b - a == 1 else False for a, b in where]
+        ver = pt.inkscape_version()
+        for t in sorted(set(tols) | set(tols_ink)):
+            got = pt.inkscape_simplify(groups, gclosed, t)
+            if got is None:  # over pt.INKSCAPE_TIMEOUT s
+                yield "inkscape", ver, t, None, pt.INKSCAPE_TIMEOUT
+            else:
+                yield "inkscape", ver, t, got[0], got[1]
+
+
+def font_rows(style: str, whole: bool, peers, em: float) -> list[dict]:
+    fc = pt.font_case(style, whole, em)
+    bound = E_PER + (HALF_DIAG if whole else 0.0)
+    ours = run_ours(style, whole, em)
+    base = {"style": style, "input": "whole" if whole else "exact", "own": fc.own_segments,
+            "points": ours["points"]}
+    rows = [dict(base, peer="ours (defaults)", tol=bound, segments=ours["segments"],
+                 dist_true=ours["dist_true"], secs=ours["cpu_s"])]
+    tols = sorted(set(TOLS[whole]) | {bound})
+    ntols = sorted(set(NODE_TOLS[whole]) | {bound})
+    for lib, ver, t, segs, secs in run_fitters(peers, fc.points, fc.corners,
+                                               [True] * len(fc.points), tols, ntols,
+                                               INK_TOLS[whole]):
+        if segs is None:
+            continue
+        dist = max((curve_distance(pt.seg_dense(s), tr) if s else math.inf)
+                   for s, tr in zip(segs, fc.truth, strict=True))
+        rows.append(dict(base, peer=f"{lib} {ver}", tol=t, segments=sum(map(len, segs)),
+                         dist_true=dist, secs=secs))
+    if "potrace" in peers:
+        ver = pt.potrace_version()
+        for scale, opt in POTRACE:
+            n, dist, secs = 0, 0.0, 0.0
+            for g in sorted(set(fc.glyph)):
+                ks = [k for k, gg in enumerate(fc.glyph) if gg == g]
+                out, s = pt.potrace_glyph([fc.points[k] for k in ks], scale, opt)
+                secs += s
+                n += sum(map(len, out))
+                dist = max(dist, pt.set_distance([pt.seg_dense(o) for o in out],
+                                                 [fc.truth[k] for k in ks]))
+            rows.append(dict(base, peer=f"potrace {ver} ({scale:g} px/unit, -O {opt})",
+                             tol=opt / scale, segments=n, dist_true=dist, secs=secs))
+    for r in rows:
+        r["ratio"] = r["segments"] / r["own"]
+        r["at_bound"] = abs(r["tol"] - bound) < 1e-3
+    return rows
+
+
+# --- corpus -----------------------------------------------------------------------------------
+
+
+def corpus_files() -> list[str]:
+    fs = sorted(glob.glob(os.path.join(CORPUS, "*")))
+    return [f for f in fs if os.path.isfile(f) and "__expected" not in os.path.basename(f)
+            and not f.endswith((".tsv", ".md", ".svg", ".png"))]
+
+
+def corpus_row(path: str, peers) -> dict | None:
+    try:
+        dr = read_file(path)
+    except GalvoError:
+        return None
+    paths = [p for p in dr.paths if len(p.points) >= 2]
+    if not paths:
+        return None
+    pts = [np.asarray(p.points, float) for p in paths]
+    closed = [bool(p.closed) for p in paths]
+    qs = path_quanta(pts)
+    t0 = time.process_time()
+    fps = fitmod.fit_paths(pts, closed, quantum_units=qs)
+    secs = time.process_time() - t0
+    ncubic = sum(f.n_cubics for f in fps)
+    if not ncubic:
+        return None
+    worst, excess, bound_max = 0.0, -math.inf, 0.0
+    for p, f, q in zip(pts, fps, qs.tolist(), strict=True):
+        rep = fitmod.check_fit(p, f, E_PER, E_PER, quantum_units=q, report=True)
+        w = max(rep["max_in_to_curve"], rep["max_curve_to_polyline"])
+        worst = max(worst, w)
+        excess = max(excess, w - rep["bound"])
+        bound_max = max(bound_max, rep["bound"])
+    row = {"file": os.path.basename(path), "quantum": float(qs.max()),
+           "points": int(sum(map(len, pts))), "paths": len(pts),
+           "segments": sum(len(f.segments) for f in fps), "cubics": ncubic,
+           "worst": worst, "bound": bound_max, "excess": excess, "secs": secs, "peers": {}}
+    # peers at the stated bound; closed paths' polylines closed for them; dots (all points
+    # equal) left out
+    keep = [k for k, p in enumerate(pts) if (p != p[0]).any()]
+    closed = [closed[k] for k in keep]
+    work = [np.vstack([p, p[:1]]) if c and not np.array_equal(p[0], p[-1]) else p
+            for p, c in zip((pts[k] for k in keep), closed, strict=True)]
+    row["dots"] = len(pts) - len(keep)
+    corners = [pt.turn_corners(p, c, reach=4.0 * bound_max) for p, c in zip(work, closed,
+                                                                            strict=True)]
+    row["corners"] = int(sum(map(len, corners)))
+    for lib, ver, _t, segs, s in run_fitters(peers, work, corners, closed, [bound_max]):
+        if segs is None:
+            row["peers"][lib] = {"version": ver, "timeout": s}
+            continue
+        h = max(1e-3, bound_max / 20.0)
+        ds = [(pt.both_ways(pt.seg_dense(sg, h), p) if sg else math.inf)
+              for sg, p in zip(segs, work, strict=True)]
+        # paths farther than the bound from their input polyline (the input vertices'
+        # distances to the flattened curve may read up to h too high: h of slack)
+        over = sum(d > bound_max + h for d in ds)
+        row["peers"][lib] = {"version": ver, "segments": sum(map(len, segs)),
+                             "dist_input": max(ds), "over": int(over), "secs": s}
+    return row
+
+
+# --- output -------------------------------------------------------------------------------------
+
+
+def print_font(rows):
+    print("| style | input | peer | tolerance | segments | x own | to true curve | s |")
+    print("| --- | --- | --- | ---: | ---: | ---: | ---: | ---: |")
+    for r in rows:
+        b = " (bound)" if r["at_bound"] else ""
+        print(f"| {r['style']} | {r['input']} | {r['peer']} | {r['tol']:.3g}{b} | "
+              f"{r['segments']} | {r['ratio']:.2f} | {r['dist_true']:.3f} | "
+              f"{r['secs']:.2f} |", flush=True)
+
+
+def print_corpus_row(r, peers):
+    def cell(p):
+        q = r["peers"].get(p)
+        if q is None:
+            return "–"
+        if "segments" not in q:
+            return f"over {q['timeout']:g} s"
+        return f"{q['segments']} / {q['dist_input']:.3f} / {q['over']}"
+
+    ps = " | ".join(cell(p) for p in peers)
+    print(f"| {r['file']} | {r['quantum']:g} | {r['points']} | {r['segments']} | "
+          f"{r['worst']:.3f} / {r['bound']:.3f} | {r['corners']} | {ps} |", flush=True)
+
+
+def _rng(v, fmt):
+    a, b = fmt.format(min(v)), fmt.format(max(v))
+    return a if a == b else f"{a}–{b}"
+
+
+def summary(rows) -> None:
+    """Over the styles, per input and peer: the peer at our stated bound, and its fewest
+    segments among the tolerances tried whose distance to the true curve is no larger
+    than ours on the same style (ranges over the styles; time summed)."""
+    styles = sorted({r["style"] for r in rows})
+    print(f"\n({len(styles)} styles)\n")
+    print("| input | peer | at | x own | to true curve | s (sum) |")
+    print("| --- | --- | --- | ---: | ---: | ---: |")
+    for inp in ("whole", "exact"):
+        rs = [r for r in rows if r["input"] == inp]
+        ours = {r["style"]: r for r in rs if r["peer"].startswith("ours")}
+        kinds = []
+        for r in rs:
+            k = r["peer"].split(" (")[0] if not r["peer"].startswith("potrace") else "potrace"
+            if k not in kinds:
+                kinds.append(k)
+        for k in kinds:
+            mine = [r for r in rs if (r["peer"].split(" (")[0] if k != "potrace"
+                                      else r["peer"].split(" ")[0]) == k]
+            for r in mine:  # (tolerance written rounded to 0.001 in older runs' JSON)
+                r["at_bound"] = abs(r["tol"] - E_PER - (HALF_DIAG if inp == "whole" else 0)) < 1e-3
+            if k.startswith("ours"):
+                sel = {"defaults": mine}
+            else:
+                sel = {}
+                at_b = [r for r in mine if r["at_bound"]]
+                if at_b:
+                    sel["the bound"] = at_b
+                best = []
+                for st in sorted({r["style"] for r in mine} & set(ours)):
+                    ok = [r for r in mine if r["style"] == st
+                          and r["dist_true"] <= ours[st]["dist_true"] + 1e-9]
+                    if ok:
+                        best.append(min(ok, key=lambda r: r["segments"]))
+                    else:
+                        best.append(min((r for r in mine if r["style"] == st),
+                                        key=lambda r: r["dist_true"]))
+                sel["ours' distance (else its closest)"] = best
+            for what, sub in sel.items():
+                tol = _rng([r["tol"] for r in sub], "{:.3g}")
+                reach = sum(r["dist_true"] <= ours[r["style"]]["dist_true"] + 1e-9 for r in sub)
+                extra = ("" if what in ("defaults", "the bound")
+                         else f" (tol {tol}; {reach}/{len(sub)} reach it)")
+                print(f"| {inp} | {k} | {what}{extra} | "
+                      f"{_rng([r['ratio'] for r in sub], '{:.2f}')} | "
+                      f"{_rng([r['dist_true'] for r in sub], '{:.3f}')} | "
+                      f"{sum(r['secs'] for r in sub):.2f} |")
+
+
+def per_style_table(rows) -> None:
+    """One line per style and input: ours, each peer at our stated bound, Potrace at 1 and
+    4 px per unit; cells "segments (x own) / distance to the true curve"."""
+    kinds = ["paper", "fit-curve", "fontforge", "inkscape"]
+    print("| style | input | ours | " + " | ".join(f"{k} at the bound" for k in kinds)
+          + " | potrace 1 px/unit | potrace 4 px/unit |")
+    print("| --- | --- | " + " | ".join("---:" for _ in range(len(kinds) + 3)) + " |")
+
+    def cell(r):
+        return "–" if r is None else f"{r['segments']} ({r['ratio']:.2f}) / {r['dist_true']:.3f}"
+
+    keys = []
+    for r in rows:
+        if (r["input"], r["style"]) not in keys:
+            keys.append((r["input"], r["style"]))
+    for inp, st in sorted(keys, key=lambda k: (k[0] != "whole", list(STYLES).index(k[1]))):
+        rs = [r for r in rows if r["style"] == st and r["input"] == inp]
+        bound = E_PER + (HALF_DIAG if inp == "whole" else 0.0)
+
+        def pick(pred, rs=rs):
+            return next((r for r in rs if pred(r)), None)
+
+        cells = [cell(pick(lambda r: r["peer"].startswith("ours")))]
+        for k in kinds:
+            cells.append(cell(pick(lambda r, k=k, bound=bound: r["peer"].split(" ")[0] == k
+                                   and abs(r["tol"] - bound) < 1e-3)))
+        for sc in ("(1 px", "(4 px"):
+            cells.append(cell(pick(lambda r, sc=sc: r["peer"].startswith("potrace")
+                                   and sc in r["peer"])))
+        print(f"| {st} | {inp} | " + " | ".join(cells) + " |")
+
+
+def grid_table(rows) -> None:
+    """Every peer at every tolerance tried: ranges over the styles."""
+    print("| input | peer | tolerance | styles | x own | to true curve | s (mean) |")
+    print("| --- | --- | ---: | ---: | ---: | ---: | ---: |")
+    keys = []
+    for r in rows:
+        k = (r["input"], r["peer"], round(r["tol"], 3))
+        if k not in keys:
+            keys.append(k)
+    keys.sort(key=lambda k: (k[0] != "whole", k[1] != "ours (defaults)", k[1], k[2]))
+    for inp, peer, tol in keys:
+        sub = [r for r in rows if (r["input"], r["peer"], round(r["tol"], 3)) == (inp, peer, tol)]
+        print(f"| {inp} | {peer} | {tol:g} | {len(sub)} | "
+              f"{_rng([r['ratio'] for r in sub], '{:.2f}')} | "
+              f"{_rng([r['dist_true'] for r in sub], '{:.3f}')} | "
+              f"{sum(r['secs'] for r in sub) / len(sub):.2f} |")
+
+
+def corpus_table(rows, peers=("paper", "fit-curve", "fontforge", "inkscape")) -> None:
+    print("| file | q | points | ours: segments | ours: worst / bound | "
+          + " | ".join(f"{p}: segments / dist / paths over" for p in peers) + " |")
+    print("| --- | ---: | ---: | ---: | ---: | " + " | ".join("---:" for _ in peers) + " |")
+    for r in rows:
+        def cell(p, r=r):
+            q = r["peers"].get(p)
+            if q is None:
+                return "–"
+            if "segments" not in q:
+                return f"over {q['timeout']:g} s"
+            return f"{q['segments']} / {q['dist_input']:.3f} / {q['over']}"
+        print(f"| {r['file']} | {r['quantum']:g} | {r['points']} | {r['segments']} | "
+              f"{r['worst']:.3f} / {r['bound']:.3f} | " + " | ".join(map(cell, peers)) + " |")
+    tot = [str(sum(r["segments"] for r in rows))]
+    for p in peers:
+        ok = [r for r in rows if "segments" in r["peers"].get(p, {})]
+        tot.append(f"{sum(r['peers'][p]['segments'] for r in ok)} (ours on these "
+                   f"{len(ok)} files: {sum(r['segments'] for r in ok)}); "
+                   f"{sum(r['peers'][p]['over'] > 0 for r in ok)} files with paths over, "
+                   f"{sum(r['peers'][p]['over'] for r in ok)} paths")
+    over_ours = sum(r["worst"] > r["bound"] * (1 + 1e-9) for r in rows)
+    print(f"| **{len(rows)} files** | | {sum(r['points'] for r in rows)} | {tot[0]} | "
+          f"{over_ours} files over | " + " | ".join(tot[1:]) + " |")
 
 
 def main() -> None:
     ap = argparse.ArgumentParser()
-    ap.add_argument("--styles", default="sans,serif-italic,sans-light")
+    ap.add_argument("--styles", default=",".join(STYLES))
     ap.add_argument("--em", type=float, default=1000.0)
+    ap.add_argument("--peers", default=",".join(PEERS))
+    ap.add_argument("--corpus", action="store_true", help="also the corpus table")
+    ap.add_argument("--no-fonts", action="store_true")
+    ap.add_argument("--inputs", default="whole,exact")
+    ap.add_argument("--json")
+    ap.add_argument("--tables", action="store_true", help="with --summary: per style too")
+    ap.add_argument("--corpus-table", metavar="JSON", help="only print a run's corpus table")
+    ap.add_argument("--summary", metavar="JSON", nargs="+",
+                    help="only print the summary of the font rows of these runs' JSON")
     a = ap.parse_args()
-    print("| style | input | peer | tolerance (units) | segments | x own | to true curve | ms |")
-    print("| --- | --- | --- | ---: | ---: | ---: | ---: | ---: |")
-    for whole in (True, False):
-        for st in a.styles.split(","):
-            gs = glyph_set(st, em=a.em, whole=whole)
-            paths = [(p, True) for p in gs.points]
-            for lib in ("paper", "fit-curve"):
-                tols = [(d * SCALE) ** 2 if lib == "fit-curve" else d * SCALE for d in DISTS]
-                res = run_peer(lib, paths, tols)
-                for d, r in zip(DISTS, res["results"], strict=True):
-                    n = sum(len(cs) for cs in r["paths"])
-                    dist = max(curve_distance(dense(cs), t)
-                               for cs, t in zip(r["paths"], gs.truth, strict=True) if cs)
-                    print(f"| {st} | {'whole' if whole else 'exact'} | {lib} {res['version']} | "
-                          f"{d} | {n} | {n / gs.own_segments:.2f} | {dist:.3f} | "
-                          f"{r['ms']:.0f} |", flush=True)
+    if a.summary:
+        rows, seen = [], set()
+        for fn in a.summary:
+            with open(fn) as f:
+                for r in json.load(f)["fonts"]:  # a style run twice: its first run kept
+                    k = (r["style"], r["input"], r["peer"], r["tol"])
+                    if k not in seen:
+                        seen.add(k)
+                        rows.append(r)
+        summary(rows)
+        if a.tables:
+            print()
+            per_style_table(rows)
+            print()
+            grid_table(rows)
+        return
+    if a.corpus_table:
+        with open(a.corpus_table) as f:
+            corpus_table(json.load(f)["corpus"])
+        return
+    peers = a.peers.split(",")
+    fitmod.warm_up()
+    out = {"fonts": [], "corpus": []}
+    if not a.no_fonts:
+        for whole in [i == "whole" for i in a.inputs.split(",")]:
+            for st in a.styles.split(","):
+                rows = font_rows(st, whole, peers, a.em)
+                out["fonts"] += rows
+                print_font(rows)
+                dump(out, a.json)
+    if out["fonts"]:
+        summary(out["fonts"])
+    if a.corpus:
+        cp = [p for p in peers if p != "potrace"]
+        print("\n| file | q | points | segments | worst / bound | corners | "
+              + " | ".join(f"{p} segs / dist / paths over" for p in cp) + " |")
+        print("| --- | ---: | ---: | ---: | ---: | ---: | " + " | ".join("---:" for _ in cp)
+              + " |")
+        for f in corpus_files():
+            r = corpus_row(f, cp)
+            if r is not None:
+                out["corpus"].append(r)
+                print_corpus_row(r, cp)
+                dump(out, a.json)
+    dump(out, a.json)
+
+
+def dump(out, fn) -> None:
+    if fn:
+        with open(fn + ".tmp", "w") as f:
+            json.dump(out, f, indent=1, default=float)
+        os.replace(fn + ".tmp", fn)
 
 
 if __name__ == "__main__":

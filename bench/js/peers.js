@@ -1,8 +1,12 @@
-// Fit peers for bench/bench_fit.py. stdin: JSON {lib, scale, tols: [...], paths: [{closed,
-// points: [[x, y], ...]}]}; stdout: JSON {version, results: [{tol, ms, paths: [[[x0, y0],
+// Fit peers for bench/bench_fit.py and bench/bench_precision_peers.py. stdin: JSON {lib,
+// scale, tols: [...], paths: [{closed, points: [[x, y], ...]}]}; stdout: JSON {version, results: [{tol, ms, paths: [[[x0, y0],
 // [x1, y1], [x2, y2], [x3, y3]], ...]]}]} (cubics in the input's units).
 // Coordinates are multiplied by `scale` before fitting and divided after: Paper.js skips its
 // refinement when tolerance^2 < 1, so the tolerances handed over must be >= 1 after scaling.
+// Both peers compare the number handed over with SQUARED distances (fit-curve's maxError;
+// Paper.js's PathFitter.findMaxError returns a squared distance and fitCubic compares it with
+// the tolerance as given): a distance d is handed over as (d * scale)^2
+// (bench_precision_peers.py; bench_fit.py searches the tolerance, whatever its meaning).
 'use strict';
 const fs = require('fs');
 const inp = JSON.parse(fs.readFileSync(0, 'utf8'));
