@@ -80,6 +80,7 @@ from numba import njit
 from galvo_core.drawing import Drawing
 from galvo_core.errors import Cancelled, ParamError
 from galvo_core.geometry import (
+    _newton_step,
     cubic_eval,
     cubic_length,
     gather_coeffs,
@@ -431,6 +432,80 @@ def _bound_kernel(cf, a, b, u0, u1, out) -> None:  # pragma: no cover (compiled)
         out[k] = math.sqrt(perp * perp + over * over)
 
 
+#: an empty index array (:func:`_ssum_kernel` on every point)
+_NO_POINTS = np.zeros(0, dtype=np.intp)
+#: points per chunk of :func:`_ssum_kernel`
+_SSUM_CHUNK = 512
+
+
+@njit(cache=True, nogil=True)
+def _ssum_kernel(cfm, pid, sel, every, pxy, ustate, tiny, chxy, sg, out):  # pragma: no cover
+    """The dichotomy's signed error sums (compiled): for each sample point i (all, or those
+    in ``sel``) of piece pid[i], 3 Newton steps from ustate[i] on the piece's cubic (``cfm``
+    (4, 2, m) power coefficients), ustate[i] updated; its distance signed by the side of the
+    curve it lies on (the chord's direction where the tangent vanishes) times the piece's
+    orientation sg[i], summed per piece into ``out`` in the order of the points (the
+    numbers of the former numpy version, bit for bit)."""
+    n = pid.shape[0] if every else sel.shape[0]
+    ch = _SSUM_CHUNK
+    cf = np.empty((4, 2, ch))
+    p = np.empty((2, ch))
+    u = np.empty(ch)
+    w = np.empty(ch)
+    lo = np.zeros(1)
+    hi = np.ones(1)
+    for c0 in range(0, n, ch):
+        ln = min(n, c0 + ch) - c0
+        for j in range(ln):
+            i = c0 + j if every else sel[c0 + j]
+            r = pid[i]
+            for a in range(4):
+                cf[a, 0, j] = cfm[a, 0, r]
+                cf[a, 1, j] = cfm[a, 1, r]
+            p[0, j] = pxy[0, i]
+            p[1, j] = pxy[1, i]
+            u[j] = ustate[i]
+        for _ in range(3):
+            _newton_step(cf, p, u, 0, ln, lo, hi, True, True, False)
+        for j in range(ln):
+            i = c0 + j if every else sel[c0 + j]
+            uk = u[j]
+            ustate[i] = uk
+            ax = cf[0, 0, j]
+            ay = cf[0, 1, j]
+            bx = cf[1, 0, j]
+            by = cf[1, 1, j]
+            dx = cf[2, 0, j]
+            dy = cf[2, 1, j]
+            ex = cf[3, 0, j]
+            ey = cf[3, 1, j]
+            px = p[0, j]
+            py = p[1, j]
+            nx = ((ax * uk + bx) * uk + dx) * uk - (px - ex)  # (Newton's squared distance)
+            ny = ((ay * uk + by) * uk + dy) * uk - (py - ey)
+            d2 = nx * nx + ny * ny
+            tgx = (3.0 * ax * uk + 2.0 * bx) * uk + dx
+            tgy = (3.0 * ay * uk + 2.0 * by) * uk + dy
+            if tgx * tgx + tgy * tgy <= tiny[i]:
+                tgx = chxy[0, i]
+                tgy = chxy[1, i]
+            rx = px - (((ax * uk + bx) * uk + dx) * uk + ex)
+            ry = py - (((ay * uk + by) * uk + dy) * uk + ey)
+            cr = tgx * ry - tgy * rx
+            if cr > 0.0:
+                side = 1.0
+            elif cr < 0.0:
+                side = -1.0
+            elif cr == 0.0:
+                side = 0.0
+            else:
+                side = cr  # (NaN)
+            w[j] = sg[i] * side * math.sqrt(d2)
+        for j in range(ln):
+            i = c0 + j if every else sel[c0 + j]
+            out[pid[i]] += w[j]
+
+
 def _ragged(starts: np.ndarray, counts: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """(owner, offset) of the flattened ranges: item j of range r -> (r, j)."""
     total = int(counts.sum())
@@ -539,29 +614,11 @@ class _BatchFitter:
             are evaluated, the others come back 0)."""
             if pm is not None and len(pm) == len(pid):
                 pm = None  # (every point: no copies)
-            pp = pid if pm is None else pid[pm]
             power_coeffs_into(cfm, p0t, p0t + t * q0, p3t + t * q3, p3t)
-            cf = np.take(cfm, pp, axis=2)
-            q = pxy if pm is None else pxy[:, pm]
-            u0 = ustate if pm is None else ustate[pm]
-            uu, d2 = newton_nearest_many(cf, q, u0, 3)
-            if pm is None:
-                ustate[:] = uu
-            else:
-                ustate[pm] = uu
-            # (x and y as the rows of (2, K) arrays, u in both rows)
-            a, b, d, e = cf
-            u2 = np.empty(q.shape)
-            u2[:] = uu
-            tg = (3.0 * a * u2 + 2.0 * b) * u2 + d
-            t2 = tg * tg
-            bad = t2[0] + t2[1] <= (tiny if pm is None else tiny[pm])
-            if bad.any():
-                tg = np.where(bad, chxy if pm is None else chxy[:, pm], tg)
-            r = q - (((a * u2 + b) * u2 + d) * u2 + e)
-            side = np.sign(tg[0] * r[1] - tg[1] * r[0])
-            w = (sg if pm is None else sg[pm]) * side * np.sqrt(d2)
-            return -np.bincount(pp, weights=w, minlength=m)
+            out = np.zeros(m)
+            _ssum_kernel(cfm, pid, _NO_POINTS if pm is None else pm, pm is None, pxy, ustate,
+                         tiny, chxy, sg, out)
+            return -out
 
         tl = np.zeros(m)
         th = np.ones(m)
