@@ -293,6 +293,7 @@ class FittedPath:
 _KINDS = ("line", "cubic")
 _DOT_KIND = _read_only(np.zeros(1, dtype=bool))
 _ZERO_FIRST = _read_only(np.zeros(1, dtype=np.int64))
+_ONE_LAST = _read_only(np.ones(1, dtype=np.int64))
 _fp_setters = [FittedPath.__dict__[f].__set__ for f in (
     "source_index", "pen", "closed", "is_cubic", "points", "first", "last", "max_error",
     "n_input", "n_thinned", "_segments")]
@@ -1255,7 +1256,10 @@ def fit_paths(
     klen = np.array([len(k) for k in kept_all], dtype=np.intp)
     out: list[FittedPath | None] = [None] * npth
     mk = FittedPath.from_arrays
-    todo = np.flatnonzero((wlen > 0) & (klen != 1))
+    # a path of two distinct points (most paths of a nesting file) is its line, with no
+    # error: built directly, not through the fit's stages (the same result)
+    two = (wlen == 2) & (klen == 2)
+    todo = np.flatnonzero((wlen > 0) & (klen != 1) & ~two)
     if len(todo):
         rounding = np.stack([eps_line + slack[todo], slack[todo] / _HALF_DIAGONAL], axis=1)
         is_cubic, points, first, last, seg_cut, pt_cut, worst = _fit_concatenated(
@@ -1267,6 +1271,12 @@ def fit_paths(
                         0.0, ns[k], 1)
         for k in np.flatnonzero(wlen == 0).tolist():
             out[k] = FittedPath(src[k], pen[k], cl[k], (), 0.0, 0, 0)
+        k2 = np.flatnonzero(two)
+        if len(k2):
+            pts2 = _read_only(np.stack([works[k] for k in k2.tolist()]))
+            for t, k in enumerate(k2.tolist()):
+                out[k] = mk(src[k], pen[k], cl[k], _DOT_KIND, pts2[t], _ZERO_FIRST, _ONE_LAST,
+                            0.0, ns[k], 2)
         if len(todo):
             for t, k in enumerate(todo.tolist()):
                 a, b = seg_cut[t], seg_cut[t + 1]
