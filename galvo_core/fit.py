@@ -300,9 +300,41 @@ _fp_setters = [FittedPath.__dict__[f].__set__ for f in (
 _set_fp_segments = _fp_setters[-1]
 
 
-def _init_fitted(fp: FittedPath, *values: object) -> None:
-    for setter, v in zip(_fp_setters, (*values, None), strict=True):
-        setter(fp, v)
+(_s_src, _s_pen, _s_closed, _s_kinds, _s_points, _s_first, _s_last, _s_err, _s_nin, _s_nth,
+ _s_segs) = _fp_setters
+
+
+def _init_fitted(fp: FittedPath, source_index, pen, closed, is_cubic, points, first, last,
+                 max_error, n_input, n_thinned) -> None:  # type: ignore[no-untyped-def]
+    _s_src(fp, source_index)
+    _s_pen(fp, pen)
+    _s_closed(fp, closed)
+    _s_kinds(fp, is_cubic)
+    _s_points(fp, points)
+    _s_first(fp, first)
+    _s_last(fp, last)
+    _s_err(fp, max_error)
+    _s_nin(fp, n_input)
+    _s_nth(fp, n_thinned)
+    _s_segs(fp, None)
+
+
+def _new_fitted(source_index, pen, closed, is_cubic, points, first, last, max_error, n_input,
+                n_thinned) -> FittedPath:  # type: ignore[no-untyped-def]
+    """:meth:`FittedPath.from_arrays` (the fitter's loop over paths calls this)."""
+    fp = _new(FittedPath)
+    _s_src(fp, source_index)
+    _s_pen(fp, pen)
+    _s_closed(fp, closed)
+    _s_kinds(fp, is_cubic)
+    _s_points(fp, points)
+    _s_first(fp, first)
+    _s_last(fp, last)
+    _s_err(fp, max_error)
+    _s_nin(fp, n_input)
+    _s_nth(fp, n_thinned)
+    _s_segs(fp, None)
+    return fp
 
 
 def control_points(fp: FittedPath) -> int:
@@ -1275,13 +1307,15 @@ def fit_paths(
         if len(k2):
             pts2 = _read_only(np.stack([works[k] for k in k2.tolist()]))
             for t, k in enumerate(k2.tolist()):
-                out[k] = mk(src[k], pen[k], cl[k], _DOT_KIND, pts2[t], _ZERO_FIRST, _ONE_LAST,
-                            0.0, ns[k], 2)
+                out[k] = _new_fitted(src[k], pen[k], cl[k], _DOT_KIND, pts2[t], _ZERO_FIRST,
+                                     _ONE_LAST, 0.0, ns[k], 2)
         if len(todo):
+            kl = klen.tolist()
             for t, k in enumerate(todo.tolist()):
                 a, b = seg_cut[t], seg_cut[t + 1]
-                out[k] = mk(src[k], pen[k], cl[k], is_cubic[a:b], points[pt_cut[t]:pt_cut[t + 1]],
-                            first[a:b], last[a:b], worst[t], ns[k], int(klen[k]))
+                out[k] = _new_fitted(src[k], pen[k], cl[k], is_cubic[a:b],
+                                     points[pt_cut[t]:pt_cut[t + 1]], first[a:b], last[a:b],
+                                     worst[t], ns[k], kl[k])
     return out  # type: ignore[return-value]
 
 
