@@ -294,6 +294,7 @@ _KINDS = ("line", "cubic")
 _DOT_KIND = _read_only(np.zeros(1, dtype=bool))
 _ZERO_FIRST = _read_only(np.zeros(1, dtype=np.int64))
 _ONE_LAST = _read_only(np.ones(1, dtype=np.int64))
+_KEPT_TWO = _read_only(np.array([0, 1], dtype=np.int64))
 _fp_setters = [FittedPath.__dict__[f].__set__ for f in (
     "source_index", "pen", "closed", "is_cubic", "points", "first", "last", "max_error",
     "n_input", "n_thinned", "_segments")]
@@ -1283,14 +1284,28 @@ def fit_paths(
     cl = [bool(c) for c in closed]
     works, ns = _closed_works(paths, cl)
     slack = rounding_slack(works, quantum_units)
-    kept_all = thin_many(works, eps_line, per_path=eps_line + slack)
-    wlen = np.array([len(w) for w in works], dtype=np.intp)
-    klen = np.array([len(k) for k in kept_all], dtype=np.intp)
+    wlen = np.fromiter(map(len, works), dtype=np.intp, count=npth)
+    # a path of two distinct points (most paths of a nesting file) is its line, with no
+    # error: built directly, not thinned nor fitted (the same result)
+    two = np.zeros(npth, dtype=bool)
+    i2 = np.flatnonzero(wlen == 2)
+    if len(i2):
+        p2 = np.stack([works[k] for k in i2.tolist()])
+        d2 = (p2[:, 0] != p2[:, 1]).any(axis=1)
+        two[i2[d2]] = True
+        pts2 = _read_only(p2[d2])
+    if two.any():
+        rest = np.flatnonzero(~two).tolist()
+        kept_rest = thin_many([works[k] for k in rest], eps_line,
+                              per_path=(eps_line + slack)[rest])
+        kept_all = [_KEPT_TWO] * npth
+        for j, k in enumerate(rest):
+            kept_all[k] = kept_rest[j]
+    else:
+        kept_all = thin_many(works, eps_line, per_path=eps_line + slack)
+    klen = np.fromiter(map(len, kept_all), dtype=np.intp, count=npth)
     out: list[FittedPath | None] = [None] * npth
     mk = FittedPath.from_arrays
-    # a path of two distinct points (most paths of a nesting file) is its line, with no
-    # error: built directly, not through the fit's stages (the same result)
-    two = (wlen == 2) & (klen == 2)
     todo = np.flatnonzero((wlen > 0) & (klen != 1) & ~two)
     if len(todo):
         rounding = np.stack([eps_line + slack[todo], slack[todo] / _HALF_DIAGONAL], axis=1)
@@ -1305,7 +1320,6 @@ def fit_paths(
             out[k] = FittedPath(src[k], pen[k], cl[k], (), 0.0, 0, 0)
         k2 = np.flatnonzero(two)
         if len(k2):
-            pts2 = _read_only(np.stack([works[k] for k in k2.tolist()]))
             for t, k in enumerate(k2.tolist()):
                 out[k] = _new_fitted(src[k], pen[k], cl[k], _DOT_KIND, pts2[t], _ZERO_FIRST,
                                      _ONE_LAST, 0.0, ns[k], 2)
