@@ -1500,6 +1500,127 @@ def _valid_lines(W, K, Q, la, lb, lpts, lfirst, llast, lerr, eps):
     return la2, pts2, f2, l2, _line_errors(W, pts2, f2, l2), key
 
 
+@njit(cache=True, nogil=True)
+def _pairwise_block(a, s, n):  # pragma: no cover (compiled)
+    """numpy's pairwise sum of a[s : s + n] for n <= 128 (one unrolled block)."""
+    if n < 8:
+        res = 0.0
+        for i in range(s, s + n):
+            res += a[i]
+        return res
+    r0 = a[s]
+    r1 = a[s + 1]
+    r2 = a[s + 2]
+    r3 = a[s + 3]
+    r4 = a[s + 4]
+    r5 = a[s + 5]
+    r6 = a[s + 6]
+    r7 = a[s + 7]
+    i = 8
+    m = n - n % 8
+    while i < m:
+        r0 += a[s + i]
+        r1 += a[s + i + 1]
+        r2 += a[s + i + 2]
+        r3 += a[s + i + 3]
+        r4 += a[s + i + 4]
+        r5 += a[s + i + 5]
+        r6 += a[s + i + 6]
+        r7 += a[s + i + 7]
+        i += 8
+    res = ((r0 + r1) + (r2 + r3)) + ((r4 + r5) + (r6 + r7))
+    while i < n:
+        res += a[s + i]
+        i += 1
+    return res
+
+
+@njit(cache=True, nogil=True)
+def _pairwise_sum(a, s, n):  # pragma: no cover (compiled)
+    """numpy's pairwise sum of a[s : s + n] (its float64 add reduction), bit for bit: blocks
+    of <= 128 terms, a longer range the sum of its two halves (split at a multiple of 8),
+    evaluated with an explicit stack (a recursive compiled function does not load from
+    numba's cache)."""
+    if n <= 128:
+        return _pairwise_block(a, s, n)
+    st_s = np.empty(64, dtype=np.int64)
+    st_n = np.empty(64, dtype=np.int64)
+    st_k = np.empty(64, dtype=np.int64)  # 0: left half next, 1: right half next, 2: add
+    vals = np.empty(64)
+    top = 0
+    nv = 0
+    st_s[0] = s
+    st_n[0] = n
+    st_k[0] = 0
+    while top >= 0:
+        cs = st_s[top]
+        cn = st_n[top]
+        if cn <= 128:
+            vals[nv] = _pairwise_block(a, cs, cn)
+            nv += 1
+            top -= 1
+            continue
+        h = cn // 2
+        h -= h % 8
+        k = st_k[top]
+        st_k[top] = k + 1
+        if k == 0:
+            top += 1
+            st_s[top] = cs
+            st_n[top] = h
+            st_k[top] = 0
+        elif k == 1:
+            top += 1
+            st_s[top] = cs + h
+            st_n[top] = cn - h
+            st_k[top] = 0
+        else:
+            nv -= 1
+            vals[nv - 1] = vals[nv - 1] + vals[nv]
+            top -= 1
+    return vals[0]
+
+
+@njit(cache=True, nogil=True)
+def _window_sums(sv, sv3, sv4, W, idx, starts, mom, rx, ry):  # pragma: no cover (compiled)
+    """:func:`_local_fits`'s sums per window j (points starts[j] .. starts[j + 1] - 1 of
+    the flat ``sv``, the last to the end): mom[r] of sv^r (r = 0 .. 4; sv3, sv4 given),
+    rx[r], ry[r] of sv^r times the x, y of input point idx; each as np.add.reduceat sums
+    them (the first term plus numpy's pairwise sum of the rest)."""
+    n_all = sv.shape[0]
+    v = starts.shape[0]
+    big = 0
+    for j in range(v):
+        e = starts[j + 1] if j + 1 < v else n_all
+        big = max(big, e - starts[j])
+    buf = np.empty((10, big))
+    for j in range(v):
+        s = starts[j]
+        e = starts[j + 1] if j + 1 < v else n_all
+        n = e - s
+        for k in range(n):
+            u = sv[s + k]
+            u2 = u * u
+            x = W[idx[s + k], 0]
+            y = W[idx[s + k], 1]
+            buf[0, k] = u
+            buf[1, k] = u2
+            buf[2, k] = sv3[s + k]
+            buf[3, k] = sv4[s + k]
+            buf[4, k] = x
+            buf[5, k] = u * x
+            buf[6, k] = u2 * x
+            buf[7, k] = y
+            buf[8, k] = u * y
+            buf[9, k] = u2 * y
+        mom[0, j] = float(n)  # (a sum of ones is exact)
+        for r in range(4):
+            mom[r + 1, j] = buf[r, 0] + _pairwise_sum(buf[r], 1, n - 1)
+        for r in range(3):
+            rx[r, j] = buf[4 + r, 0] + _pairwise_sum(buf[4 + r], 1, n - 1)
+            ry[r, j] = buf[7 + r, 0] + _pairwise_sum(buf[7 + r], 1, n - 1)
+
+
 def _local_fits(
     W: np.ndarray, arc: np.ndarray, lo: np.ndarray, hi: np.ndarray, at: np.ndarray
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -1518,12 +1639,14 @@ def _local_fits(
     idx = lo[own] + off
     scale = np.maximum(arc[hi] - arc[lo], 1e-300)
     sv = (arc[idx] - arc[at][own]) / scale[own]  # in [-1, 1]: well scaled
-    pw = np.stack([np.ones_like(sv), sv, sv * sv, sv**3, sv**4])
     starts = np.cumsum(np.where(ok, cnt, 0)) - np.where(ok, cnt, 0)
     okk = np.flatnonzero(ok)
-    mom = np.add.reduceat(pw, starts[okk], axis=1)  # (5, V')
-    rx = np.add.reduceat(pw[:3] * W[idx, 0], starts[okk], axis=1)
-    ry = np.add.reduceat(pw[:3] * W[idx, 1], starts[okk], axis=1)
+    # the sums of 1, s .. s^4 and of x, y times 1, s, s^2 per window (the numbers of
+    # np.add.reduceat over their stacked rows, bit for bit, without the (5, N) arrays)
+    mom = np.empty((5, len(okk)))
+    rx = np.empty((3, len(okk)))
+    ry = np.empty((3, len(okk)))
+    _window_sums(sv, sv**3, sv**4, W, idx, starts[okk], mom, rx, ry)
     A = np.stack([mom[0:3], mom[1:4], mom[2:5]]).transpose(2, 0, 1)  # (V', 3, 3)
     det = np.linalg.det(A)
     good = np.abs(det) > 1e-9 * np.abs(A).max(axis=(1, 2)) ** 3
