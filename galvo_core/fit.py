@@ -1582,11 +1582,14 @@ def _pairwise_sum(a, s, n):  # pragma: no cover (compiled)
 
 
 @njit(cache=True, nogil=True)
-def _window_sums(sv, sv3, sv4, W, idx, starts, mom, rx, ry):  # pragma: no cover (compiled)
+def _window_sums(sv, W, idx, starts, mom, rx, ry):  # pragma: no cover (compiled)
     """:func:`_local_fits`'s sums per window j (points starts[j] .. starts[j + 1] - 1 of
-    the flat ``sv``, the last to the end): mom[r] of sv^r (r = 0 .. 4; sv3, sv4 given),
-    rx[r], ry[r] of sv^r times the x, y of input point idx; each as np.add.reduceat sums
-    them (the first term plus numpy's pairwise sum of the rest)."""
+    the flat ``sv``, the last to the end): mom[r] of sv^r (r = 0 .. 4), rx[r], ry[r] of
+    sv^r times the x, y of input point idx; each as np.add.reduceat sums them (the first
+    term plus numpy's pairwise sum of the rest). The powers are products (s^3 = s^2 s,
+    s^4 = s^2 s^2), the same on every machine (numpy's ``**`` takes a vector path on
+    AVX-512 machines and a 28x slower scalar one for negative bases, with different last
+    bits)."""
     n_all = sv.shape[0]
     v = starts.shape[0]
     big = 0
@@ -1605,8 +1608,8 @@ def _window_sums(sv, sv3, sv4, W, idx, starts, mom, rx, ry):  # pragma: no cover
             y = W[idx[s + k], 1]
             buf[0, k] = u
             buf[1, k] = u2
-            buf[2, k] = sv3[s + k]
-            buf[3, k] = sv4[s + k]
+            buf[2, k] = u2 * u
+            buf[3, k] = u2 * u2
             buf[4, k] = x
             buf[5, k] = u * x
             buf[6, k] = u2 * x
@@ -1641,12 +1644,12 @@ def _local_fits(
     sv = (arc[idx] - arc[at][own]) / scale[own]  # in [-1, 1]: well scaled
     starts = np.cumsum(np.where(ok, cnt, 0)) - np.where(ok, cnt, 0)
     okk = np.flatnonzero(ok)
-    # the sums of 1, s .. s^4 and of x, y times 1, s, s^2 per window (the numbers of
-    # np.add.reduceat over their stacked rows, bit for bit, without the (5, N) arrays)
+    # the sums of 1, s .. s^4 and of x, y times 1, s, s^2 per window (compiled, in
+    # np.add.reduceat's order, without the (5, N) arrays)
     mom = np.empty((5, len(okk)))
     rx = np.empty((3, len(okk)))
     ry = np.empty((3, len(okk)))
-    _window_sums(sv, sv**3, sv**4, W, idx, starts[okk], mom, rx, ry)
+    _window_sums(sv, W, idx, starts[okk], mom, rx, ry)
     A = np.stack([mom[0:3], mom[1:4], mom[2:5]]).transpose(2, 0, 1)  # (V', 3, 3)
     det = np.linalg.det(A)
     good = np.abs(det) > 1e-9 * np.abs(A).max(axis=(1, 2)) ** 3
