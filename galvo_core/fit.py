@@ -1956,9 +1956,11 @@ FitCancelled = Cancelled
 
 def warm_up() -> None:
     """Load (or, the first time on a machine, compile) the fitter's compiled kernels (the
-    thinning, the Newton refinement) now, so that a timed first fit does not pay for it."""
+    thinning, the Newton refinement, the local fits of rounded input) now, so that a timed
+    first fit does not pay for it."""
     t = np.linspace(0.0, 2.0 * np.pi, 97)
-    fit_paths([np.c_[40.0 * np.cos(t), 25.0 * np.sin(t)]], [True])
+    e = np.c_[40.0 * np.cos(t), 25.0 * np.sin(t)]
+    fit_paths([e, np.round(8.0 * e)], [True, True])
 
 
 def fit_report(
