@@ -1916,13 +1916,15 @@ def fit_drawing(
     eps_line: float = DEFAULT_EPS_LINE,
     e_per: float = DEFAULT_E_PER,
     eps_sum: float = DEFAULT_EPS_SUM,
-    batch: int = 4096,
+    batch: int = 16384,
     cancel: Callable[[], bool] | None = None,
     quantum_units: float | Sequence[float] | np.ndarray | None = None,
 ) -> tuple[FittedPath, ...]:
     """:func:`fit_path` for every path of the drawing, in order (``source_index`` = position),
-    fitted ``batch`` paths at a time (:func:`fit_paths`). ``cancel`` is called between
-    batches; when it returns True, :class:`FitCancelled` is raised. ``quantum_units``: as in
+    fitted ``batch`` paths at a time (:func:`fit_paths`; the fixed cost per batch is a few
+    hundred array calls: 512 paths per batch fit the 40,705 paths of a nesting file in 2x
+    the time of 16,384). ``cancel`` is called between batches; when it returns True,
+    :class:`FitCancelled` is raised. ``quantum_units``: as in
     :func:`fit_paths`; default: detected on the whole drawing, per path where a path is off
     the drawing's grid (:func:`galvo_core.precision.path_quanta`)."""
     _check_params(eps_line, e_per, eps_sum)
