@@ -80,6 +80,7 @@ from numba import njit
 from galvo_core.drawing import Drawing
 from galvo_core.errors import Cancelled, ParamError
 from galvo_core.geometry import (
+    _newton_step,
     cubic_eval,
     cubic_length,
     gather_coeffs,
@@ -292,15 +293,49 @@ class FittedPath:
 _KINDS = ("line", "cubic")
 _DOT_KIND = _read_only(np.zeros(1, dtype=bool))
 _ZERO_FIRST = _read_only(np.zeros(1, dtype=np.int64))
+_ONE_LAST = _read_only(np.ones(1, dtype=np.int64))
+_KEPT_TWO = _read_only(np.array([0, 1], dtype=np.int64))
 _fp_setters = [FittedPath.__dict__[f].__set__ for f in (
     "source_index", "pen", "closed", "is_cubic", "points", "first", "last", "max_error",
     "n_input", "n_thinned", "_segments")]
 _set_fp_segments = _fp_setters[-1]
 
 
-def _init_fitted(fp: FittedPath, *values: object) -> None:
-    for setter, v in zip(_fp_setters, (*values, None), strict=True):
-        setter(fp, v)
+(_s_src, _s_pen, _s_closed, _s_kinds, _s_points, _s_first, _s_last, _s_err, _s_nin, _s_nth,
+ _s_segs) = _fp_setters
+
+
+def _init_fitted(fp: FittedPath, source_index, pen, closed, is_cubic, points, first, last,
+                 max_error, n_input, n_thinned) -> None:  # type: ignore[no-untyped-def]
+    _s_src(fp, source_index)
+    _s_pen(fp, pen)
+    _s_closed(fp, closed)
+    _s_kinds(fp, is_cubic)
+    _s_points(fp, points)
+    _s_first(fp, first)
+    _s_last(fp, last)
+    _s_err(fp, max_error)
+    _s_nin(fp, n_input)
+    _s_nth(fp, n_thinned)
+    _s_segs(fp, None)
+
+
+def _new_fitted(source_index, pen, closed, is_cubic, points, first, last, max_error, n_input,
+                n_thinned) -> FittedPath:  # type: ignore[no-untyped-def]
+    """:meth:`FittedPath.from_arrays` (the fitter's loop over paths calls this)."""
+    fp = _new(FittedPath)
+    _s_src(fp, source_index)
+    _s_pen(fp, pen)
+    _s_closed(fp, closed)
+    _s_kinds(fp, is_cubic)
+    _s_points(fp, points)
+    _s_first(fp, first)
+    _s_last(fp, last)
+    _s_err(fp, max_error)
+    _s_nin(fp, n_input)
+    _s_nth(fp, n_thinned)
+    _s_segs(fp, None)
+    return fp
 
 
 def control_points(fp: FittedPath) -> int:
@@ -431,6 +466,80 @@ def _bound_kernel(cf, a, b, u0, u1, out) -> None:  # pragma: no cover (compiled)
         out[k] = math.sqrt(perp * perp + over * over)
 
 
+#: an empty index array (:func:`_ssum_kernel` on every point)
+_NO_POINTS = np.zeros(0, dtype=np.intp)
+#: points per chunk of :func:`_ssum_kernel`
+_SSUM_CHUNK = 512
+
+
+@njit(cache=True, nogil=True)
+def _ssum_kernel(cfm, pid, sel, every, pxy, ustate, tiny, chxy, sg, out):  # pragma: no cover
+    """The dichotomy's signed error sums (compiled): for each sample point i (all, or those
+    in ``sel``) of piece pid[i], 3 Newton steps from ustate[i] on the piece's cubic (``cfm``
+    (4, 2, m) power coefficients), ustate[i] updated; its distance signed by the side of the
+    curve it lies on (the chord's direction where the tangent vanishes) times the piece's
+    orientation sg[i], summed per piece into ``out`` in the order of the points (the
+    numbers of the former numpy version, bit for bit)."""
+    n = pid.shape[0] if every else sel.shape[0]
+    ch = _SSUM_CHUNK
+    cf = np.empty((4, 2, ch))
+    p = np.empty((2, ch))
+    u = np.empty(ch)
+    w = np.empty(ch)
+    lo = np.zeros(1)
+    hi = np.ones(1)
+    for c0 in range(0, n, ch):
+        ln = min(n, c0 + ch) - c0
+        for j in range(ln):
+            i = c0 + j if every else sel[c0 + j]
+            r = pid[i]
+            for a in range(4):
+                cf[a, 0, j] = cfm[a, 0, r]
+                cf[a, 1, j] = cfm[a, 1, r]
+            p[0, j] = pxy[0, i]
+            p[1, j] = pxy[1, i]
+            u[j] = ustate[i]
+        for _ in range(3):
+            _newton_step(cf, p, u, 0, ln, lo, hi, True, True, False)
+        for j in range(ln):
+            i = c0 + j if every else sel[c0 + j]
+            uk = u[j]
+            ustate[i] = uk
+            ax = cf[0, 0, j]
+            ay = cf[0, 1, j]
+            bx = cf[1, 0, j]
+            by = cf[1, 1, j]
+            dx = cf[2, 0, j]
+            dy = cf[2, 1, j]
+            ex = cf[3, 0, j]
+            ey = cf[3, 1, j]
+            px = p[0, j]
+            py = p[1, j]
+            nx = ((ax * uk + bx) * uk + dx) * uk - (px - ex)  # (Newton's squared distance)
+            ny = ((ay * uk + by) * uk + dy) * uk - (py - ey)
+            d2 = nx * nx + ny * ny
+            tgx = (3.0 * ax * uk + 2.0 * bx) * uk + dx
+            tgy = (3.0 * ay * uk + 2.0 * by) * uk + dy
+            if tgx * tgx + tgy * tgy <= tiny[i]:
+                tgx = chxy[0, i]
+                tgy = chxy[1, i]
+            rx = px - (((ax * uk + bx) * uk + dx) * uk + ex)
+            ry = py - (((ay * uk + by) * uk + dy) * uk + ey)
+            cr = tgx * ry - tgy * rx
+            if cr > 0.0:
+                side = 1.0
+            elif cr < 0.0:
+                side = -1.0
+            elif cr == 0.0:
+                side = 0.0
+            else:
+                side = cr  # (NaN)
+            w[j] = sg[i] * side * math.sqrt(d2)
+        for j in range(ln):
+            i = c0 + j if every else sel[c0 + j]
+            out[pid[i]] += w[j]
+
+
 def _ragged(starts: np.ndarray, counts: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """(owner, offset) of the flattened ranges: item j of range r -> (r, j)."""
     total = int(counts.sum())
@@ -539,29 +648,11 @@ class _BatchFitter:
             are evaluated, the others come back 0)."""
             if pm is not None and len(pm) == len(pid):
                 pm = None  # (every point: no copies)
-            pp = pid if pm is None else pid[pm]
             power_coeffs_into(cfm, p0t, p0t + t * q0, p3t + t * q3, p3t)
-            cf = np.take(cfm, pp, axis=2)
-            q = pxy if pm is None else pxy[:, pm]
-            u0 = ustate if pm is None else ustate[pm]
-            uu, d2 = newton_nearest_many(cf, q, u0, 3)
-            if pm is None:
-                ustate[:] = uu
-            else:
-                ustate[pm] = uu
-            # (x and y as the rows of (2, K) arrays, u in both rows)
-            a, b, d, e = cf
-            u2 = np.empty(q.shape)
-            u2[:] = uu
-            tg = (3.0 * a * u2 + 2.0 * b) * u2 + d
-            t2 = tg * tg
-            bad = t2[0] + t2[1] <= (tiny if pm is None else tiny[pm])
-            if bad.any():
-                tg = np.where(bad, chxy if pm is None else chxy[:, pm], tg)
-            r = q - (((a * u2 + b) * u2 + d) * u2 + e)
-            side = np.sign(tg[0] * r[1] - tg[1] * r[0])
-            w = (sg if pm is None else sg[pm]) * side * np.sqrt(d2)
-            return -np.bincount(pp, weights=w, minlength=m)
+            out = np.zeros(m)
+            _ssum_kernel(cfm, pid, _NO_POINTS if pm is None else pm, pm is None, pxy, ustate,
+                         tiny, chxy, sg, out)
+            return -out
 
         tl = np.zeros(m)
         th = np.ones(m)
@@ -1193,12 +1284,29 @@ def fit_paths(
     cl = [bool(c) for c in closed]
     works, ns = _closed_works(paths, cl)
     slack = rounding_slack(works, quantum_units)
-    kept_all = thin_many(works, eps_line, per_path=eps_line + slack)
-    wlen = np.array([len(w) for w in works], dtype=np.intp)
-    klen = np.array([len(k) for k in kept_all], dtype=np.intp)
+    wlen = np.fromiter(map(len, works), dtype=np.intp, count=npth)
+    # a path of two distinct points (most paths of a nesting file) is its line, with no
+    # error: built directly, not thinned nor fitted (the same result)
+    two = np.zeros(npth, dtype=bool)
+    i2 = np.flatnonzero(wlen == 2)
+    if len(i2):
+        p2 = np.stack([works[k] for k in i2.tolist()])
+        d2 = (p2[:, 0] != p2[:, 1]).any(axis=1)
+        two[i2[d2]] = True
+        pts2 = _read_only(p2[d2])
+    if two.any():
+        rest = np.flatnonzero(~two).tolist()
+        kept_rest = thin_many([works[k] for k in rest], eps_line,
+                              per_path=(eps_line + slack)[rest])
+        kept_all = [_KEPT_TWO] * npth
+        for j, k in enumerate(rest):
+            kept_all[k] = kept_rest[j]
+    else:
+        kept_all = thin_many(works, eps_line, per_path=eps_line + slack)
+    klen = np.fromiter(map(len, kept_all), dtype=np.intp, count=npth)
     out: list[FittedPath | None] = [None] * npth
     mk = FittedPath.from_arrays
-    todo = np.flatnonzero((wlen > 0) & (klen != 1))
+    todo = np.flatnonzero((wlen > 0) & (klen != 1) & ~two)
     if len(todo):
         rounding = np.stack([eps_line + slack[todo], slack[todo] / _HALF_DIAGONAL], axis=1)
         is_cubic, points, first, last, seg_cut, pt_cut, worst = _fit_concatenated(
@@ -1210,11 +1318,18 @@ def fit_paths(
                         0.0, ns[k], 1)
         for k in np.flatnonzero(wlen == 0).tolist():
             out[k] = FittedPath(src[k], pen[k], cl[k], (), 0.0, 0, 0)
+        k2 = np.flatnonzero(two)
+        if len(k2):
+            for t, k in enumerate(k2.tolist()):
+                out[k] = _new_fitted(src[k], pen[k], cl[k], _DOT_KIND, pts2[t], _ZERO_FIRST,
+                                     _ONE_LAST, 0.0, ns[k], 2)
         if len(todo):
+            kl = klen.tolist()
             for t, k in enumerate(todo.tolist()):
                 a, b = seg_cut[t], seg_cut[t + 1]
-                out[k] = mk(src[k], pen[k], cl[k], is_cubic[a:b], points[pt_cut[t]:pt_cut[t + 1]],
-                            first[a:b], last[a:b], worst[t], ns[k], int(klen[k]))
+                out[k] = _new_fitted(src[k], pen[k], cl[k], is_cubic[a:b],
+                                     points[pt_cut[t]:pt_cut[t + 1]], first[a:b], last[a:b],
+                                     worst[t], ns[k], kl[k])
     return out  # type: ignore[return-value]
 
 
@@ -1385,6 +1500,130 @@ def _valid_lines(W, K, Q, la, lb, lpts, lfirst, llast, lerr, eps):
     return la2, pts2, f2, l2, _line_errors(W, pts2, f2, l2), key
 
 
+@njit(cache=True, nogil=True)
+def _pairwise_block(a, s, n):  # pragma: no cover (compiled)
+    """numpy's pairwise sum of a[s : s + n] for n <= 128 (one unrolled block)."""
+    if n < 8:
+        res = 0.0
+        for i in range(s, s + n):
+            res += a[i]
+        return res
+    r0 = a[s]
+    r1 = a[s + 1]
+    r2 = a[s + 2]
+    r3 = a[s + 3]
+    r4 = a[s + 4]
+    r5 = a[s + 5]
+    r6 = a[s + 6]
+    r7 = a[s + 7]
+    i = 8
+    m = n - n % 8
+    while i < m:
+        r0 += a[s + i]
+        r1 += a[s + i + 1]
+        r2 += a[s + i + 2]
+        r3 += a[s + i + 3]
+        r4 += a[s + i + 4]
+        r5 += a[s + i + 5]
+        r6 += a[s + i + 6]
+        r7 += a[s + i + 7]
+        i += 8
+    res = ((r0 + r1) + (r2 + r3)) + ((r4 + r5) + (r6 + r7))
+    while i < n:
+        res += a[s + i]
+        i += 1
+    return res
+
+
+@njit(cache=True, nogil=True)
+def _pairwise_sum(a, s, n):  # pragma: no cover (compiled)
+    """numpy's pairwise sum of a[s : s + n] (its float64 add reduction), bit for bit: blocks
+    of <= 128 terms, a longer range the sum of its two halves (split at a multiple of 8),
+    evaluated with an explicit stack (a recursive compiled function does not load from
+    numba's cache)."""
+    if n <= 128:
+        return _pairwise_block(a, s, n)
+    st_s = np.empty(64, dtype=np.int64)
+    st_n = np.empty(64, dtype=np.int64)
+    st_k = np.empty(64, dtype=np.int64)  # 0: left half next, 1: right half next, 2: add
+    vals = np.empty(64)
+    top = 0
+    nv = 0
+    st_s[0] = s
+    st_n[0] = n
+    st_k[0] = 0
+    while top >= 0:
+        cs = st_s[top]
+        cn = st_n[top]
+        if cn <= 128:
+            vals[nv] = _pairwise_block(a, cs, cn)
+            nv += 1
+            top -= 1
+            continue
+        h = cn // 2
+        h -= h % 8
+        k = st_k[top]
+        st_k[top] = k + 1
+        if k == 0:
+            top += 1
+            st_s[top] = cs
+            st_n[top] = h
+            st_k[top] = 0
+        elif k == 1:
+            top += 1
+            st_s[top] = cs + h
+            st_n[top] = cn - h
+            st_k[top] = 0
+        else:
+            nv -= 1
+            vals[nv - 1] = vals[nv - 1] + vals[nv]
+            top -= 1
+    return vals[0]
+
+
+@njit(cache=True, nogil=True)
+def _window_sums(sv, W, idx, starts, mom, rx, ry):  # pragma: no cover (compiled)
+    """:func:`_local_fits`'s sums per window j (points starts[j] .. starts[j + 1] - 1 of
+    the flat ``sv``, the last to the end): mom[r] of sv^r (r = 0 .. 4), rx[r], ry[r] of
+    sv^r times the x, y of input point idx; each as np.add.reduceat sums them (the first
+    term plus numpy's pairwise sum of the rest). The powers are products (s^3 = s^2 s,
+    s^4 = s^2 s^2), the same on every machine (numpy's ``**`` takes a vector path on
+    AVX-512 machines and a 28x slower scalar one for negative bases, with different last
+    bits)."""
+    n_all = sv.shape[0]
+    v = starts.shape[0]
+    big = 0
+    for j in range(v):
+        e = starts[j + 1] if j + 1 < v else n_all
+        big = max(big, e - starts[j])
+    buf = np.empty((10, big))
+    for j in range(v):
+        s = starts[j]
+        e = starts[j + 1] if j + 1 < v else n_all
+        n = e - s
+        for k in range(n):
+            u = sv[s + k]
+            u2 = u * u
+            x = W[idx[s + k], 0]
+            y = W[idx[s + k], 1]
+            buf[0, k] = u
+            buf[1, k] = u2
+            buf[2, k] = u2 * u
+            buf[3, k] = u2 * u2
+            buf[4, k] = x
+            buf[5, k] = u * x
+            buf[6, k] = u2 * x
+            buf[7, k] = y
+            buf[8, k] = u * y
+            buf[9, k] = u2 * y
+        mom[0, j] = float(n)  # (a sum of ones is exact)
+        for r in range(4):
+            mom[r + 1, j] = buf[r, 0] + _pairwise_sum(buf[r], 1, n - 1)
+        for r in range(3):
+            rx[r, j] = buf[4 + r, 0] + _pairwise_sum(buf[4 + r], 1, n - 1)
+            ry[r, j] = buf[7 + r, 0] + _pairwise_sum(buf[7 + r], 1, n - 1)
+
+
 def _local_fits(
     W: np.ndarray, arc: np.ndarray, lo: np.ndarray, hi: np.ndarray, at: np.ndarray
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -1403,12 +1642,14 @@ def _local_fits(
     idx = lo[own] + off
     scale = np.maximum(arc[hi] - arc[lo], 1e-300)
     sv = (arc[idx] - arc[at][own]) / scale[own]  # in [-1, 1]: well scaled
-    pw = np.stack([np.ones_like(sv), sv, sv * sv, sv**3, sv**4])
     starts = np.cumsum(np.where(ok, cnt, 0)) - np.where(ok, cnt, 0)
     okk = np.flatnonzero(ok)
-    mom = np.add.reduceat(pw, starts[okk], axis=1)  # (5, V')
-    rx = np.add.reduceat(pw[:3] * W[idx, 0], starts[okk], axis=1)
-    ry = np.add.reduceat(pw[:3] * W[idx, 1], starts[okk], axis=1)
+    # the sums of 1, s .. s^4 and of x, y times 1, s, s^2 per window (compiled, in
+    # np.add.reduceat's order, without the (5, N) arrays)
+    mom = np.empty((5, len(okk)))
+    rx = np.empty((3, len(okk)))
+    ry = np.empty((3, len(okk)))
+    _window_sums(sv, W, idx, starts[okk], mom, rx, ry)
     A = np.stack([mom[0:3], mom[1:4], mom[2:5]]).transpose(2, 0, 1)  # (V', 3, 3)
     det = np.linalg.det(A)
     good = np.abs(det) > 1e-9 * np.abs(A).max(axis=(1, 2)) ** 3
@@ -1675,13 +1916,15 @@ def fit_drawing(
     eps_line: float = DEFAULT_EPS_LINE,
     e_per: float = DEFAULT_E_PER,
     eps_sum: float = DEFAULT_EPS_SUM,
-    batch: int = 4096,
+    batch: int = 16384,
     cancel: Callable[[], bool] | None = None,
     quantum_units: float | Sequence[float] | np.ndarray | None = None,
 ) -> tuple[FittedPath, ...]:
     """:func:`fit_path` for every path of the drawing, in order (``source_index`` = position),
-    fitted ``batch`` paths at a time (:func:`fit_paths`). ``cancel`` is called between
-    batches; when it returns True, :class:`FitCancelled` is raised. ``quantum_units``: as in
+    fitted ``batch`` paths at a time (:func:`fit_paths`; the fixed cost per batch is a few
+    hundred array calls: 512 paths per batch fit the 40,705 paths of a nesting file in 2x
+    the time of 16,384). ``cancel`` is called between batches; when it returns True,
+    :class:`FitCancelled` is raised. ``quantum_units``: as in
     :func:`fit_paths`; default: detected on the whole drawing, per path where a path is off
     the drawing's grid (:func:`galvo_core.precision.path_quanta`)."""
     _check_params(eps_line, e_per, eps_sum)
@@ -1715,9 +1958,11 @@ FitCancelled = Cancelled
 
 def warm_up() -> None:
     """Load (or, the first time on a machine, compile) the fitter's compiled kernels (the
-    thinning, the Newton refinement) now, so that a timed first fit does not pay for it."""
+    thinning, the Newton refinement, the local fits of rounded input) now, so that a timed
+    first fit does not pay for it."""
     t = np.linspace(0.0, 2.0 * np.pi, 97)
-    fit_paths([np.c_[40.0 * np.cos(t), 25.0 * np.sin(t)]], [True])
+    e = np.c_[40.0 * np.cos(t), 25.0 * np.sin(t)]
+    fit_paths([e, np.round(8.0 * e)], [True, True])
 
 
 def fit_report(

