@@ -77,7 +77,7 @@ from dataclasses import dataclass
 import numpy as np
 from numba import njit
 
-from galvo_core.drawing import Drawing
+from galvo_core.drawing import Drawing, Path
 from galvo_core.errors import Cancelled, ParamError
 from galvo_core.geometry import (
     _newton_step,
@@ -1917,13 +1917,16 @@ def fit_drawing(
     e_per: float = DEFAULT_E_PER,
     eps_sum: float = DEFAULT_EPS_SUM,
     batch: int = 16384,
+    batch_points: int | None = None,
     cancel: Callable[[], bool] | None = None,
     quantum_units: float | Sequence[float] | np.ndarray | None = None,
 ) -> tuple[FittedPath, ...]:
     """:func:`fit_path` for every path of the drawing, in order (``source_index`` = position),
     fitted ``batch`` paths at a time (:func:`fit_paths`; the fixed cost per batch is a few
     hundred array calls: 512 paths per batch fit the 40,705 paths of a nesting file in 2x
-    the time of 16,384). ``cancel`` is called between batches; when it returns True,
+    the time of 16,384); with ``batch_points`` a batch also ends once it holds that many
+    input points, so a few long paths do not make one long batch. The batches do not change
+    the result. ``cancel`` is called between batches; when it returns True,
     :class:`FitCancelled` is raised. ``quantum_units``: as in
     :func:`fit_paths`; default: detected on the whole drawing, per path where a path is off
     the drawing's grid (:func:`galvo_core.precision.path_quanta`)."""
@@ -1935,10 +1938,10 @@ def fit_drawing(
         qs = np.broadcast_to(np.asarray(quantum_units, dtype=np.float64).reshape(-1),
                              (len(paths),))
     out: list[FittedPath] = []
-    for b0 in range(0, len(paths), max(1, int(batch))):
+    for b0, b1 in _batches(paths, max(1, int(batch)), batch_points):
         if cancel is not None and cancel():
             raise FitCancelled()
-        chunk = paths[b0 : b0 + batch]
+        chunk = paths[b0:b1]
         out += fit_paths(
             [p.points for p in chunk],
             [p.closed for p in chunk],
@@ -1950,6 +1953,26 @@ def fit_drawing(
             quantum_units=qs[b0 : b0 + len(chunk)],
         )
     return tuple(out)
+
+
+def _batches(paths: Sequence[Path], batch: int, batch_points: int | None
+             ) -> list[tuple[int, int]]:
+    """[b0, b1) ranges of at most ``batch`` paths each, a range also ending at the path
+    that brings it to ``batch_points`` input points or more (see :func:`fit_drawing`)."""
+    n = len(paths)
+    if batch_points is None or n == 0:
+        return [(b0, min(n, b0 + batch)) for b0 in range(0, n, batch)]
+    ends = np.cumsum(np.fromiter((len(p) for p in paths), dtype=np.int64, count=n))
+    out = []
+    b0 = 0
+    while b0 < n:
+        base = int(ends[b0 - 1]) if b0 else 0
+        # the first path whose end reaches base + batch_points closes the batch
+        b1 = int(np.searchsorted(ends, base + batch_points, side="left")) + 1
+        b1 = max(b0 + 1, min(b1, b0 + batch, n))
+        out.append((b0, b1))
+        b0 = b1
+    return out
 
 
 #: what :func:`fit_drawing` raises when its ``cancel`` callback says stop

@@ -52,6 +52,9 @@ from galvo_core.timing import estimate_with_dwell, joined_marks
 __all__ = ["Cancelled", "Pipeline", "RunResult", "coordinate_quantum", "process"]
 
 T = TypeVar("T")
+#: the fit stage's batches end at this many input points (cancel is checked between them:
+#: ~0.1 s each); up to 16,384 small paths share one batch (its fixed cost is per batch)
+FIT_BATCH_POINTS = 65536
 Cancel = Callable[[], bool] | None
 
 
@@ -195,9 +198,10 @@ class Pipeline:
 
         def make() -> tuple[FittedPath, ...]:
             # all paths of a batch are thinned and fitted together; cancel() between batches
-            # raises errors.Cancelled
+            # (at most FIT_BATCH_POINTS input points each, ~0.1 s) raises errors.Cancelled
             return tuple(fit_drawing(work, eps_line=params.eps_line, e_per=params.e_per,
-                                     eps_sum=params.eps_sum, batch=512, cancel=run.cancel))
+                                     eps_sum=params.eps_sum, batch_points=FIT_BATCH_POINTS,
+                                     cancel=run.cancel))
 
         key = ("fit", self._kerf_key(params, fm), params.group("fit"))
         return self._cache.get(drawing, key, run.stage("fit", make))

@@ -501,3 +501,33 @@ def test_window_sums_equal_numpy_reduceat_bit_for_bit():
     assert np.array_equal(mom, np.add.reduceat(pw, starts, axis=1))
     assert np.array_equal(rx, np.add.reduceat(pw[:3] * W[idx, 0], starts, axis=1))
     assert np.array_equal(ry, np.add.reduceat(pw[:3] * W[idx, 1], starts, axis=1))
+
+
+def test_batches_by_points_cover_every_path_once_and_change_nothing() -> None:
+    """The pipeline fits in batches that end at a number of input points (cancel is checked
+    between them): every path in exactly one batch, in order, no batch over its path cap,
+    a batch past the point cap only by its last path, and the same fit as one batch."""
+    from galvo_core.fit import _batches
+
+    rng = np.random.default_rng(7)
+    sizes = [2, 2, 3, 400, 2, 5000, 7, 2, 2, 90, 3000, 2, 4]
+    paths = []
+    for i, n in enumerate(sizes):
+        t = np.linspace(0, 2 * np.pi, n)
+        pts = np.c_[100 * i + 30 * np.cos(t), 40 * np.sin(t) + rng.normal(0, 0.01, n)]
+        paths.append(Path(pts))
+    d = Drawing(tuple(paths))
+    ranges = _batches(d.paths, 4, 1000)
+    assert [r[0] for r in ranges][0] == 0 and ranges[-1][1] == len(paths)
+    assert all(a[1] == b[0] for a, b in zip(ranges, ranges[1:], strict=False))
+    for b0, b1 in ranges:
+        assert 1 <= b1 - b0 <= 4
+        pts = [len(p) for p in paths[b0:b1]]
+        assert sum(pts[:-1]) < 1000  # only the last path takes the batch past the cap
+    # the point cap ended some batch before its path cap (the 5000-point path)
+    assert any(b1 - b0 < 4 and b1 < len(paths) for b0, b1 in ranges)
+    one = fit_drawing(d, batch=len(paths))
+    split = fit_drawing(d, batch=4, batch_points=1000)
+    for a, b in zip(one, split, strict=True):
+        np.testing.assert_array_equal(a.points, b.points)
+        np.testing.assert_array_equal(a.is_cubic, b.is_cubic)
