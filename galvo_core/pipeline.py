@@ -318,8 +318,9 @@ class Pipeline:
                 [origin[fp.source_index] for fp in fitted], [fp.closed for fp in fitted],
                 [fp.pen for fp in fitted]))
             if keep is not None:  # paths without marks make no stroke
-                marks, segs, src, closed, pens = (
-                    [col[i] for i in keep] for col in (marks, segs, src, closed, pens))
+                marks, segs = [marks[i] for i in keep], [segs[i] for i in keep]
+                src, closed, pens = [src[i] for i in keep], [closed[i] for i in keep], \
+                    [pens[i] for i in keep]
             strokes = _new_strokes("contour", src, closed, marks, segs, pens)
             if hatched:
                 strokes += _new_strokes(
@@ -429,7 +430,7 @@ def _new_strokes(kind: str, src: list[int], closed: list[bool], marks: list[np.n
         return [Stroke(kind, s, c, m, sg, p)
                 for s, c, m, sg, p in zip(src, closed, marks, segs, pens, strict=True)]
     new = object.__new__
-    out = []
+    out: list[Stroke] = []
     append = out.append
     for s, c, m, sg, p in zip(src, closed, marks, segs, pens, strict=True):
         st = new(Stroke)

@@ -577,7 +577,7 @@ def deviation_samples(
     keep = np.flatnonzero(ok)
     if not len(keep):
         return EMPTY, EMPTY, np.empty(0)
-    fps = [fitted[i] for i in keep]
+    fps = [fitted[i] for i in keep.tolist()]
     plen, poff = all_len[si[keep]], all_off[si[keep]]
     # the fits' arrays, joined: segment kinds, input ranges, control points
     if arrays is None or not np.array_equal(arrays.index, keep):
@@ -716,10 +716,10 @@ def control_layer(fitted: Sequence[FittedPath], arrays: FitArrays | None = None
     hx = np.full((max(nh, 0), 2), np.nan)
     h_role = np.full(max(nh, 0), -1, dtype=np.int8)
     if len(cub):
-        for r, (k, role) in enumerate(((0, 0), (1, 2), (2, 2), (3, 0))):
+        for r, (k, hr) in enumerate(((0, 0), (1, 2), (2, 2), (3, 0))):
             rows = np.arange(len(cub)) * 6 + (r if r < 2 else r + 1)
             hx[rows] = cub[:, k]
-            h_role[rows] = role
+            h_role[rows] = hr
     # anchors: each path's start, then every segment's end (each joint once)
     last_seg = np.cumsum(nseg) - 1
     starts = ctrl[last_seg - nseg + 1, 0]

@@ -1214,7 +1214,7 @@ class _ParamBlock:
     a: np.ndarray | None = None
 
 
-def _cubic_params(cs: _CubicSet, cf: CF, geo: _Geometry, corner: np.ndarray,
+def _cubic_params(cs: _CubicSet, cf: CF, geo: _Geometry | _GeoView, corner: np.ndarray,
                   interpolation: str, tol: float, min_step: float, ms_max: float,
                   fixed_step: float, fixed_slope_tol: float, report: SampleReport,
                   cancel: Callable[[], bool] | None) -> list[_ParamBlock]:
@@ -1275,7 +1275,7 @@ class _MarkRows:
         return _MarkRows(*(getattr(self, f.name)[keep] for f in fields(self)))
 
 
-def _merged_marks(cs: _CubicSet, geo: _Geometry, ends: np.ndarray, corner: np.ndarray,
+def _merged_marks(cs: _CubicSet, geo: _Geometry | _GeoView, ends: np.ndarray, corner: np.ndarray,
                   blocks: list[_ParamBlock]) -> _MarkRows:
     """The blocks and the start mark of every non-empty path (first segment, t = 0; every
     other mark has t > 0), in path order, with their positions."""
