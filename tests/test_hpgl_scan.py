@@ -49,7 +49,8 @@ def _program(rng: random.Random, n: int) -> bytes:
             out.append(b"SP%d;" % rng.randint(0, 4))
         elif r < 0.85:
             out.append(rng.choice([b"LT;", b"CI5;", b"PD1:2;", b"PD1,2,3;", b"BP;", b"\n",
-                                   b"SC0,100,0,100;", b"SC;", b"PD1.2.3,4;", b"LBab\x03"]))
+                                   b"SC0,100,0,100;", b"SC;", b"PD1.2.3,4;", b"LBab\x03",
+                                   b"PW0.35;", b"PW0.5,2;", b"PW;", b"PW1,2,3;", b"PW.;"]))
         else:
             out.append(b"PD%d,%d" % (rng.randint(0, 99), rng.randint(0, 99)))  # no ';'
     return b"".join(out)
@@ -77,6 +78,25 @@ def test_path_open_across_an_interruption_is_one_path() -> None:
     a = _read(data, True, 8)
     assert_same(a, _read(data, False))
     np.testing.assert_array_equal(a.paths[0].points, [[0, 0], [1, 1], [2, 2], [3, 3]])
+
+
+def test_pen_width_between_paths_stays_in_the_scanner_and_makes_the_file_hpgl2() -> None:
+    """PW (pen width, recorded, not drawn) between paths, as plotting libraries write it
+    before every path: read in the compiled run like the general reader reads it; PW is an
+    HP-GL/2 command, so a later SP keeps the pen down (PCL5-II p. 17-21) in both readers."""
+    data = (b"IN;SP1;" + b"".join(b"PW0.75;PU%d,0;PD%d,10,%d,20;" % (k, k, k + 1)
+                                  for k in range(0, 300, 3))
+            + b"PU0,0;PD5,5;SP2;PA9,9;PU;")
+    calls = []
+    run = reader._Reader._compiled_run
+    with mock.patch.object(reader._Reader, "_compiled_run",
+                           lambda self, i: calls.append(i) or run(self, i)):
+        a = _read(data, True, 1 << 16)
+    assert_same(a, _read(data, False))
+    assert len(calls) <= 3  # one run over all 100 PW, not a hand-over at each one
+    assert a.commands["PW"] == 100
+    assert [p.pen for p in a.paths[-2:]] == [1, 2]  # SP2 kept the pen down: drawn with pen 2
+    np.testing.assert_array_equal(a.paths[-1].points, [[5, 5], [9, 9]])
 
 
 # ------------------------------------------------------------------ PE

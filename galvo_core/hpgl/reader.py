@@ -154,7 +154,7 @@ _PE_MESSAGES = {  # scan.PE_* problem codes -> the messages of pe.decode_pe
 #: restores the pen position it found
 _LABEL_ORIGINS = frozenset((*range(1, 10), *range(11, 20), 21))
 _LO_CONCATENATE = frozenset((1, 2, 3, 11, 12, 13, 21))
-_SCAN_CMDS = frozenset((b"PU", b"PD", b"PA", b"PR", b"SP"))  # what the scanner reads
+_SCAN_CMDS = frozenset((b"PU", b"PD", b"PA", b"PR", b"SP", b"PW"))  # what the scanner reads
 
 
 def _is_letter_or_esc(c: int) -> bool:
@@ -1048,7 +1048,7 @@ class _Reader:
             # the state in slot order (see scan.I_*)
             ist[:] = (i, self.pen_down, self.absolute, was_open, ch.npts, ch.nseg,
                       0, 0, 0, 0, 0, 0, 0, self.pen, self.hpgl2, 0, self.pen_selected,
-                      line, last_nl)
+                      line, last_nl, 0)
             sc = self.sc
             fst[:] = (self.x, self.y, 0.0, 0.0, 0.0, 0.0, 0.0) if sc is None else \
                 (self.x, self.y, sc[0], sc[1], sc[2], sc[3], 1.0)
@@ -1060,9 +1060,10 @@ class _Reader:
             self.pen_down = bool(out[scan.I_PEN])
             self.absolute = bool(out[scan.I_ABS])
             self.pen = out[scan.I_PENNO]
-            counts = out[scan.I_NU : scan.I_NR + 1] + [out[scan.I_NSP]]
+            counts = out[scan.I_NU : scan.I_NR + 1] + [out[scan.I_NSP], out[scan.I_NPW]]
+            self.hpgl2 = bool(out[scan.I_HPGL2])
             if any(counts):
-                for name, c in zip(("PU", "PD", "PA", "PR", "SP"), counts, strict=True):
+                for name, c in zip(("PU", "PD", "PA", "PR", "SP", "PW"), counts, strict=True):
                     if c:
                         self.commands[name] += c
                 self.recognised += sum(counts)

@@ -1,4 +1,4 @@
-"""Compiled reading of runs of plain pen commands (PU PD PA PR with numbers), for large files.
+"""Compiled reading of runs of plain pen commands (PU PD PA PR with numbers, SP, PW).
 
 One pass over the bytes, no per-byte temporary arrays: the scanner reads the commands one
 after the other, parses each number exactly (at most 15 digits: the integer mantissa is
@@ -24,8 +24,8 @@ from numba import njit
 
 # int state slots
 (I_POS, I_PEN, I_ABS, I_OPEN, I_NPTS, I_NSEG, I_CONT, I_NU, I_ND, I_NA, I_NR, I_FULL,
- I_NEED, I_PENNO, I_HPGL2, I_NSP, I_SPOK, I_LINE, I_LASTNL) = range(19)
-N_ISTATE = 19
+ I_NEED, I_PENNO, I_HPGL2, I_NSP, I_SPOK, I_LINE, I_LASTNL, I_NPW) = range(20)
+N_ISTATE = 20
 # float state slots
 F_X, F_Y, F_AX, F_BX, F_AY, F_BY, F_SC = range(7)
 N_FSTATE = 7
@@ -131,6 +131,7 @@ def scan_moves(b, ist, fst, pts, seg_start, seg_off, seg_pen, seg_line, seg_col,
     na = 0
     nr = 0
     nsp = 0
+    npw = 0
     while True:
         # separators before a command
         j = i
@@ -164,6 +165,8 @@ def scan_moves(b, ist, fst, pts, seg_start, seg_off, seg_pen, seg_line, seg_col,
                 code = 2
             elif c1 == 114:
                 code = 3
+            elif c1 == 119:  # 'pw': pen width, recorded, not drawn (an HP-GL/2 command)
+                code = 5
             else:
                 break
         elif c0 == 115 and c1 == 112 and ist[I_SPOK] != 0:  # 'sp' (once a pen was selected)
@@ -177,6 +180,38 @@ def scan_moves(b, ist, fst, pts, seg_start, seg_off, seg_pen, seg_line, seg_col,
         r_pen, r_absm, r_open, r_npts, r_nseg, r_x, r_y = pen, absm, is_open, npts, nseg, x, y
         r_pen_no = pen_no
         k = j + 2
+        if code == 5:
+            # PW [width[,pen]]: no geometry; the file is HP-GL/2 from here on (as the
+            # general reader says); anything but up to two numbers: the general reader's
+            count = 0
+            ok = True
+            while k < n:
+                t = cls[b[k]]
+                if t == C_SEMI:
+                    k += 1
+                    break
+                if t == C_ESC or t == C_LETTER:
+                    break
+                if t == C_SEP:
+                    if b[k] == 10:
+                        tl += 1
+                        tn = k
+                    k += 1
+                    continue
+                v, e = _read_number(b, k, n, pow10, cls)
+                if e < 0 or count == 2:
+                    ok = False
+                    break
+                count += 1
+                k = e
+            if not ok:
+                break
+            hpgl2 = True
+            npw += 1
+            i = k
+            line = tl
+            last_nl = tn
+            continue
         if code == 4:
             # SP [n]: ends the path; HP-GL/2 keeps the pen down, HP-GL/1 lifts it
             count = 0
@@ -376,6 +411,8 @@ def scan_moves(b, ist, fst, pts, seg_start, seg_off, seg_pen, seg_line, seg_col,
     ist[I_NA] = na
     ist[I_NR] = nr
     ist[I_NSP] = nsp
+    ist[I_NPW] = npw
+    ist[I_HPGL2] = 1 if hpgl2 else 0
     fst[F_X] = x
     fst[F_Y] = y
 
