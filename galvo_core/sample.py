@@ -95,6 +95,7 @@ from dataclasses import dataclass, field, fields
 from typing import Any
 
 import numpy as np
+from numba import njit
 
 from galvo_core.errors import Cancelled, ParamError
 from galvo_core.field import FieldMap
@@ -1323,9 +1324,13 @@ def _min_step_pass(mk: _MarkRows, cs: _CubicSet, tol: float, min_step: float,
     q = np.flatnonzero(short)
     # step (2 or 3) -> per mark a: -1 not measured, else whether a -> a + step holds
     known: dict[int, np.ndarray] = {}
+    # q and q - 1, sorted, each once (a mask: np.unique sorts and hashes)
+    qm = np.zeros(n, dtype=bool)
+    qm[q] = True
+    qm[q[q > 0] - 1] = True
+    qq = np.flatnonzero(qm)
     for step in (2, 3):
-        a = np.unique(np.concatenate([q, q - 1]))
-        a = a[(a >= 0) & (a + step < n)]
+        a = qq[qq + step < n]
         a = a[pid[a] == pid[a + step]]
         res = np.full(n, -1, dtype=np.int8)
         for c in range(0, len(a), 1 << 16):  # in pieces: the height temporaries stay small
@@ -1343,12 +1348,142 @@ def _min_step_pass(mk: _MarkRows, cs: _CubicSet, tol: float, min_step: float,
         h = _chords_heights(cs, sid[[a]], st[[a]], sid[[b]], st[[b]], pos[[a]], pos[[b]])
         return bool(h[0] <= tol)
 
-    keep = np.zeros(len(mk.pid), dtype=bool)
-    forced: list[int] = []
-    keep[_min_step_filter(pos, mk.prot, min_step, first=mk.first_of, d=dd,
-                          merge_ok=merge_ok, forced=forced)] = True
-    report.min_step_overrides += len(forced)
+    # the walk compiled over every stroke; a stroke that asks a question not measured above
+    # (or meets a distance within rounding of the minimum: math.hypot and the compiled
+    # hypot may differ in the last bit) is left to the Python walk, stroke by stroke
+    first = mk.first_of
+    kept, nforced, redo = _min_step_walk(
+        np.ascontiguousarray(pos[:, 0]), np.ascontiguousarray(pos[:, 1]),
+        (dd < min_step) & ~first[1:], mk.prot, first, min_step, known[2], known[3])
+    keep = np.zeros(n, dtype=bool)
+    keep[kept] = True
+    report.min_step_overrides += int(nforced)
+    if len(redo):
+        starts = np.flatnonzero(first)
+        for s0 in redo.tolist():
+            e0 = int(starts[np.searchsorted(starts, s0, side="right")]) if s0 < starts[-1] \
+                else n
+            forced: list[int] = []
+            sub = _min_step_filter(pos[s0:e0], mk.prot[s0:e0], min_step, first=first[s0:e0],
+                                   d=dd[s0:e0 - 1],
+                                   merge_ok=lambda a, b, s0=s0: merge_ok(a + s0, b + s0),
+                                   forced=forced)
+            keep[sub + s0] = True
+            report.min_step_overrides += len(forced)
     return mk.keep(keep)
+
+
+@njit(cache=True, nogil=True)
+def _known(ok2: np.ndarray, ok3: np.ndarray, a: int, b: int) -> int:
+    """Whether chord a -> b holds as measured beforehand: 1 / 0, -1 not measured."""
+    if a < 0 or a >= len(ok2):
+        return -1
+    if b - a == 2:
+        return ok2[a]
+    if b - a == 3:
+        return ok3[a]
+    return -1
+
+
+@njit(cache=True, nogil=True)
+def _min_step_walk(x: np.ndarray, y: np.ndarray, sh: np.ndarray, pr: np.ndarray,
+                   fs: np.ndarray, min_step: float, ok2: np.ndarray, ok3: np.ndarray
+                   ) -> tuple[np.ndarray, int, np.ndarray]:
+    """:func:`_min_step_filter` with ``first`` and ``merge_ok`` compiled, every stroke in
+    one pass (mark 0 starts a stroke). ``sh``: the short chords; ``ok2``/``ok3``: per mark
+    a, whether chord a -> a + 2 / a + 3 holds (-1: not measured). Returns (kept marks,
+    number of forced marks, first marks of the strokes not done: a question not measured,
+    or a distance within 1e-9 of ``min_step``, where the Python walk's math.hypot may
+    differ from this one in the last bit)."""
+    n = len(x)
+    keep = np.empty(n, dtype=np.int64)
+    redo = np.empty(n, dtype=np.int64)
+    nr = 0
+    keep[0] = 0
+    nk = 1
+    nf = 0
+    s_keep = 0
+    s_forced = 0
+    s_first = 0
+    near = 1e-9 * min_step
+    i = 1
+    while i < n:
+        if fs[i]:  # a stroke's first mark
+            s_keep = nk
+            s_forced = nf
+            s_first = i
+            keep[nk] = i
+            nk += 1
+            i += 1
+            continue
+        if keep[nk - 1] == i - 1 and not sh[i - 1]:
+            keep[nk] = i
+            nk += 1
+            i += 1
+            continue
+        bad = False
+        j = keep[nk - 1]
+        dj = math.hypot(x[i] - x[j], y[i] - y[j])
+        if abs(dj - min_step) <= near:
+            bad = True
+        elif dj >= min_step:
+            keep[nk] = i
+            nk += 1
+        elif pr[i]:
+            popped = False
+            while nk > 1 and not pr[keep[nk - 1]]:
+                m = keep[nk - 1]
+                dm = math.hypot(x[i] - x[m], y[i] - y[m])
+                if abs(dm - min_step) <= near:
+                    bad = True
+                    break
+                if dm >= min_step:
+                    break
+                nk -= 1
+                popped = True
+            if not bad:
+                if popped:
+                    v = _known(ok2, ok3, keep[nk - 1], i)
+                    if v < 0:
+                        bad = True
+                    elif v == 0:
+                        nf += 1
+                if not bad:
+                    keep[nk] = i
+                    nk += 1
+        else:
+            v = _known(ok2, ok3, j, i + 1)
+            if v < 0:
+                bad = True
+            elif v == 0:
+                k = keep[nk - 2] if nk > 1 else -1
+                alt = False
+                if k >= 0 and not pr[j] and not fs[j]:
+                    dk = math.hypot(x[i] - x[k], y[i] - y[k])
+                    if abs(dk - min_step) <= near:
+                        bad = True
+                    elif dk >= min_step:
+                        v2 = _known(ok2, ok3, k, i)
+                        if v2 < 0:
+                            bad = True
+                        else:
+                            alt = v2 == 1
+                if not bad:
+                    if alt:
+                        keep[nk - 1] = i
+                    else:
+                        nf += 1
+        if bad:  # this stroke is left to the caller: undo it, go to the next stroke
+            nk = s_keep
+            nf = s_forced
+            redo[nr] = s_first
+            nr += 1
+            i = s_first + 1
+            while i < n and not fs[i]:
+                i += 1
+            continue
+        i += 1
+    return keep[:nk], nf, redo[:nr]
 
 
 def _rounded(mk: _MarkRows) -> tuple[np.ndarray, _MarkRows]:
