@@ -795,23 +795,24 @@ class SampleResult:
     report: SampleReport
     coef: np.ndarray | None = None
     # per chunk of paths: float marks, segment ids (of the chunk), parameters, the first
-    # segment of the chunk and each path's span of rows
-    chunks: list[tuple[np.ndarray, np.ndarray, np.ndarray, int, list[tuple[int, int]]]] = (
+    # segment of the chunk and where each path's rows start (one more: the end)
+    chunks: list[tuple[np.ndarray, np.ndarray, np.ndarray, int, np.ndarray]] = (
         field(default_factory=list))
 
     @property
     def float_marks(self) -> list[np.ndarray]:
         """Per stroke, the float marks (bits, before rounding) — for tests and benchmarks,
         made when asked (not one array per path while the job is built)."""
-        return [pos[a:b] for pos, _, _, _, spans in self.chunks for a, b in spans]
+        return [x for pos, _, _, _, pc in self.chunks for x in _split_rows(pos, pc)]
 
     @property
     def params(self) -> list[tuple[np.ndarray, np.ndarray]]:
         """Per stroke, the marks' (global segment id, t), made when asked."""
         out = []
-        for _, sid, st, g0, spans in self.chunks:
+        for _, sid, st, g0, pc in self.chunks:
             sg = sid + g0
-            out += [(sg[a:b], st[a:b]) for a, b in spans]
+            out += [(sg[a:b], st[a:b]) for a, b in zip(pc[:-1].tolist(), pc[1:].tolist(),
+                                                        strict=True)]
         return out
 
 
@@ -1168,15 +1169,42 @@ def sample_paths(
             hmax.append(part.max_chord_height_bits)  # type: ignore[arg-type]
             himax.append(part.max_chord_height_int_bits)  # type: ignore[arg-type]
         # one stroke per path
-        pc = np.searchsorted(mk.pid, np.arange(p1 - p0 + 1)).tolist()
+        pc = np.searchsorted(mk.pid, np.arange(p1 - p0 + 1))
         pc[-1] = len(mk.pid)
-        spans = list(zip(pc[:-1], pc[1:], strict=True))
-        res.marks += [r[a:b] for a, b in spans]
-        res.chunks.append((mk.pos, mk.sid, mk.st, g0, spans))
+        res.marks += _split_rows(r, pc)
+        res.chunks.append((mk.pos, mk.sid, mk.st, g0, pc))
     report.chords = chords
     report.max_chord_height_bits = max(hmax, default=0.0)
     report.max_chord_height_int_bits = max(himax, default=0.0)
     return res
+
+
+#: a run of at least this many strokes of the same number of marks is split by a reshape
+_SAME_RUN = 16
+
+
+def _split_rows(r: np.ndarray, pc: np.ndarray) -> list[np.ndarray]:
+    """``[r[pc[i]:pc[i + 1]] for i]`` (views): a run of many strokes of the same length is
+    one reshape whose rows numpy hands out itself (files of 10^4–10^5 two-mark strokes),
+    the rest slices made by ``map`` (no Python loop per stroke)."""
+    ln = np.diff(pc)
+    if not len(ln):
+        return []
+    # runs of equal length: start of each, and the long ones
+    br = np.flatnonzero(np.r_[True, ln[1:] != ln[:-1], True])
+    long_ = np.flatnonzero((np.diff(br) >= _SAME_RUN) & (ln[br[:-1]] > 0))
+    pl = pc.tolist()
+    out: list[np.ndarray] = []
+    at = 0  # next stroke to hand out
+    for s, e in zip(br[long_].tolist(), br[long_ + 1].tolist(), strict=True):
+        if at < s:
+            out += map(r.__getitem__, map(slice, pl[at:s], pl[at + 1:s + 1]))
+        out.extend(r[pl[s]:pl[e]].reshape(e - s, pl[s + 1] - pl[s], r.shape[1]))
+        at = e
+    m = len(ln)
+    if at < m:
+        out += map(r.__getitem__, map(slice, pl[at:m], pl[at + 1:m + 1]))
+    return out
 
 
 @dataclass
@@ -1495,13 +1523,15 @@ def _rounded(mk: _MarkRows) -> tuple[np.ndarray, _MarkRows]:
     if not same.any():
         return r, mk
     drop = same.copy()
-    for e in np.flatnonzero(same & last_of).tolist():
-        j = e - 1
-        while same[j]:
-            j -= 1
-        if not first_of[j]:
-            drop[e] = False
-            drop[j] = True
+    e = np.flatnonzero(same & last_of)
+    if len(e):
+        # j: the twin's run start, the last mark before e that repeats nothing (a stroke's
+        # first never does: j stays in e's stroke, so the strokes do not interact)
+        idx = np.arange(len(same))
+        j = np.maximum.accumulate(np.where(same, 0, idx))[e - 1]
+        move = ~first_of[j]
+        drop[e[move]] = False
+        drop[j[move]] = True
     keep = ~drop
     out = mk.keep(keep)
     out.last_of = out.last_of | np.r_[out.pid[1:] != out.pid[:-1], True]
