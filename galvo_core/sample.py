@@ -1376,29 +1376,41 @@ def _min_step_pass(mk: _MarkRows, cs: _CubicSet, tol: float, min_step: float,
         h = _chords_heights(cs, sid[[a]], st[[a]], sid[[b]], st[[b]], pos[[a]], pos[[b]])
         return bool(h[0] <= tol)
 
-    # the walk compiled over every stroke; a stroke that asks a question not measured above
-    # (or meets a distance within rounding of the minimum: math.hypot and the compiled
-    # hypot may differ in the last bit) is left to the Python walk, stroke by stroke
-    first = mk.first_of
+    keep, nforced = _min_step_keep(pos, mk.prot, mk.first_of, dd, min_step, known[2],
+                                   known[3], merge_ok)
+    report.min_step_overrides += nforced
+    return mk.keep(keep)
+
+
+def _min_step_keep(pos: np.ndarray, prot: np.ndarray, first: np.ndarray, dd: np.ndarray,
+                   min_step: float, ok2: np.ndarray, ok3: np.ndarray,
+                   merge_ok: Callable[[int, int], bool]) -> tuple[np.ndarray, int]:
+    """:func:`_min_step_filter` over many strokes (``first``: each one's first mark) as a
+    mask of the marks kept, and the number of forced marks: the walk compiled over every
+    stroke at once (``ok2``/``ok3``: the answers of ``merge_ok`` measured beforehand, -1
+    where not); a stroke that asks another question, or meets a distance within rounding
+    of ``min_step`` (math.hypot and the compiled hypot may differ in the last bit), is left
+    to the Python walk, stroke by stroke: the result is the Python walk's."""
+    n = len(pos)
     kept, nforced, redo = _min_step_walk(
         np.ascontiguousarray(pos[:, 0]), np.ascontiguousarray(pos[:, 1]),
-        (dd < min_step) & ~first[1:], mk.prot, first, min_step, known[2], known[3])
+        (dd < min_step) & ~first[1:], prot, first, min_step, ok2, ok3)
     keep = np.zeros(n, dtype=bool)
     keep[kept] = True
-    report.min_step_overrides += int(nforced)
+    nforced = int(nforced)
     if len(redo):
         starts = np.flatnonzero(first)
+        nxt = np.r_[starts[1:], n]
         for s0 in redo.tolist():
-            e0 = int(starts[np.searchsorted(starts, s0, side="right")]) if s0 < starts[-1] \
-                else n
+            e0 = int(nxt[np.searchsorted(starts, s0)])
             forced: list[int] = []
-            sub = _min_step_filter(pos[s0:e0], mk.prot[s0:e0], min_step, first=first[s0:e0],
+            sub = _min_step_filter(pos[s0:e0], prot[s0:e0], min_step, first=first[s0:e0],
                                    d=dd[s0:e0 - 1],
                                    merge_ok=lambda a, b, s0=s0: merge_ok(a + s0, b + s0),
                                    forced=forced)
             keep[sub + s0] = True
-            report.min_step_overrides += len(forced)
-    return mk.keep(keep)
+            nforced += len(forced)
+    return keep, nforced
 
 
 @njit(cache=True, nogil=True)
