@@ -1301,7 +1301,8 @@ class _MarkRows:
     prot: np.ndarray
 
     def keep(self, keep: np.ndarray) -> _MarkRows:
-        return _MarkRows(*(getattr(self, f.name)[keep] for f in fields(self)))
+        idx = np.flatnonzero(keep)  # once, not once per column
+        return _MarkRows(*(getattr(self, f.name)[idx] for f in fields(self)))
 
 
 def _merged_marks(cs: _CubicSet, geo: _Geometry, ends: np.ndarray, corner: np.ndarray,
