@@ -1654,21 +1654,24 @@ def _max_int_heights(cs: _CubicSet, bound: np.ndarray, sa: np.ndarray, ta: np.nd
 
     ``bound[i]``: an upper bound of chord i's height (hf + the larger move of its ends by
     rounding; -inf for chords that do not count, ``n`` chords count). The chords of largest
-    bound (those within 0.05 bit of the largest, at most 1024 of them) are measured exactly,
-    then every chord whose bound still exceeds the largest exact height, until none does:
-    the maximum is then exact."""
+    bound are measured exactly, a batch at a time (1024, then four times more each round),
+    among those whose bound still exceeds the largest exact height found, until none does:
+    the maximum is then exact, and only the few chords that can hold it are measured (a
+    single batch of every chord above the first chord's height measured most chords of
+    the many-path files)."""
     out = bound.copy()
-    top = float(out.max())
-    idx = np.flatnonzero(out >= top - 0.05)
-    if len(idx) > 1024:
-        idx = idx[np.argpartition(out[idx], len(idx) - 1024)[len(idx) - 1024:]]
     best = -1.0
-    while len(idx):
+    batch = 1024
+    while True:
+        idx = np.flatnonzero(out > best)
+        if not len(idx):
+            return best
+        if len(idx) > batch:
+            idx = idx[np.argpartition(out[idx], len(idx) - batch)[len(idx) - batch:]]
         ex = _int_heights_exact(cs, sa[idx], ta[idx], sb[idx], tb[idx], rf[idx], rf[idx + 1])
         out[idx] = -np.inf  # done
         best = max(best, float(ex.max()))
-        idx = np.flatnonzero(out > best)
-    return best
+        batch *= 4
 
 
 def _int_heights_exact(cs: _CubicSet, sa: np.ndarray, ta: np.ndarray, sb: np.ndarray,
