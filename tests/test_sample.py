@@ -529,6 +529,31 @@ def test_a_stroke_end_rounded_onto_its_twin_keeps_the_true_end():
     assert out.last_of.tolist() == [False, True, True, False, True]
 
 
+def test_exact_integer_maximum_is_the_largest_of_all_chords_measured():
+    """The sampler measures only the integer chords whose bound can hold the maximum, in
+    batches: the value must be the largest exact height over every chord, whatever the
+    bounds (any upper bounds) and however many chords there are."""
+    from galvo_core.sample import _CubicSet, _int_heights_exact, _max_int_heights
+
+    rng = np.random.default_rng(9)
+    for trial, n in enumerate((5, 3000, 6000)):
+        coef = rng.normal(0, 20, (n, 4, 2))
+        cs = _CubicSet(coef)
+        sa = np.arange(n)
+        ta = rng.uniform(0, 0.5, n)
+        tb = ta + rng.uniform(0.01, 0.5, n)
+        pts = cs.point(sa, ta)
+        rf = np.round(pts + rng.normal(0, 0.3, pts.shape))
+        rf = np.r_[rf, rf[-1:]]  # chord i: rf[i] -> rf[i + 1]
+        exact = _int_heights_exact(cs, sa, ta, sa, tb, rf[:-1], rf[1:])
+        counts = rng.random(n) < 0.9
+        counts[0] = True
+        # upper bounds: the exact value plus any slack, most of them far above the answer
+        bound = np.where(counts, exact + rng.exponential(3.0, n), -np.inf)
+        got = _max_int_heights(cs, bound, sa, ta, sa, tb, rf, int(counts.sum()))
+        assert got == float(exact[counts].max()), trial
+
+
 def test_reported_heights_equal_a_fresh_closed_form_measurement():
     """The sampler reuses the step search's own measurement of each chord (and takes 0 for
     a chord on a line): the report must be what measuring every chord again gives."""
