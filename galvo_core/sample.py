@@ -95,6 +95,7 @@ from dataclasses import dataclass, field, fields
 from typing import Any
 
 import numpy as np
+from numba import njit
 
 from galvo_core.errors import Cancelled, ParamError
 from galvo_core.field import FieldMap
@@ -794,23 +795,24 @@ class SampleResult:
     report: SampleReport
     coef: np.ndarray | None = None
     # per chunk of paths: float marks, segment ids (of the chunk), parameters, the first
-    # segment of the chunk and each path's span of rows
-    chunks: list[tuple[np.ndarray, np.ndarray, np.ndarray, int, list[tuple[int, int]]]] = (
+    # segment of the chunk and where each path's rows start (one more: the end)
+    chunks: list[tuple[np.ndarray, np.ndarray, np.ndarray, int, np.ndarray]] = (
         field(default_factory=list))
 
     @property
     def float_marks(self) -> list[np.ndarray]:
         """Per stroke, the float marks (bits, before rounding) — for tests and benchmarks,
         made when asked (not one array per path while the job is built)."""
-        return [pos[a:b] for pos, _, _, _, spans in self.chunks for a, b in spans]
+        return [x for pos, _, _, _, pc in self.chunks for x in _split_rows(pos, pc)]
 
     @property
     def params(self) -> list[tuple[np.ndarray, np.ndarray]]:
         """Per stroke, the marks' (global segment id, t), made when asked."""
         out = []
-        for _, sid, st, g0, spans in self.chunks:
+        for _, sid, st, g0, pc in self.chunks:
             sg = sid + g0
-            out += [(sg[a:b], st[a:b]) for a, b in spans]
+            out += [(sg[a:b], st[a:b]) for a, b in zip(pc[:-1].tolist(), pc[1:].tolist(),
+                                                        strict=True)]
         return out
 
 
@@ -1167,15 +1169,42 @@ def sample_paths(
             hmax.append(part.max_chord_height_bits)  # type: ignore[arg-type]
             himax.append(part.max_chord_height_int_bits)  # type: ignore[arg-type]
         # one stroke per path
-        pc = np.searchsorted(mk.pid, np.arange(p1 - p0 + 1)).tolist()
+        pc = np.searchsorted(mk.pid, np.arange(p1 - p0 + 1))
         pc[-1] = len(mk.pid)
-        spans = list(zip(pc[:-1], pc[1:], strict=True))
-        res.marks += [r[a:b] for a, b in spans]
-        res.chunks.append((mk.pos, mk.sid, mk.st, g0, spans))
+        res.marks += _split_rows(r, pc)
+        res.chunks.append((mk.pos, mk.sid, mk.st, g0, pc))
     report.chords = chords
     report.max_chord_height_bits = max(hmax, default=0.0)
     report.max_chord_height_int_bits = max(himax, default=0.0)
     return res
+
+
+#: a run of at least this many strokes of the same number of marks is split by a reshape
+_SAME_RUN = 16
+
+
+def _split_rows(r: np.ndarray, pc: np.ndarray) -> list[np.ndarray]:
+    """``[r[pc[i]:pc[i + 1]] for i]`` (views): a run of many strokes of the same length is
+    one reshape whose rows numpy hands out itself (files of 10^4–10^5 two-mark strokes),
+    the rest slices made by ``map`` (no Python loop per stroke)."""
+    ln = np.diff(pc)
+    if not len(ln):
+        return []
+    # runs of equal length: start of each, and the long ones
+    br = np.flatnonzero(np.r_[True, ln[1:] != ln[:-1], True])
+    long_ = np.flatnonzero((np.diff(br) >= _SAME_RUN) & (ln[br[:-1]] > 0))
+    pl = pc.tolist()
+    out: list[np.ndarray] = []
+    at = 0  # next stroke to hand out
+    for s, e in zip(br[long_].tolist(), br[long_ + 1].tolist(), strict=True):
+        if at < s:
+            out += map(r.__getitem__, map(slice, pl[at:s], pl[at + 1:s + 1]))
+        out.extend(r[pl[s]:pl[e]].reshape(e - s, pl[s + 1] - pl[s], r.shape[1]))
+        at = e
+    m = len(ln)
+    if at < m:
+        out += map(r.__getitem__, map(slice, pl[at:m], pl[at + 1:m + 1]))
+    return out
 
 
 @dataclass
@@ -1272,7 +1301,8 @@ class _MarkRows:
     prot: np.ndarray
 
     def keep(self, keep: np.ndarray) -> _MarkRows:
-        return _MarkRows(*(getattr(self, f.name)[keep] for f in fields(self)))
+        idx = np.flatnonzero(keep)  # once, not once per column
+        return _MarkRows(*(getattr(self, f.name)[idx] for f in fields(self)))
 
 
 def _merged_marks(cs: _CubicSet, geo: _Geometry | _GeoView, ends: np.ndarray, corner: np.ndarray,
@@ -1323,9 +1353,13 @@ def _min_step_pass(mk: _MarkRows, cs: _CubicSet, tol: float, min_step: float,
     q = np.flatnonzero(short)
     # step (2 or 3) -> per mark a: -1 not measured, else whether a -> a + step holds
     known: dict[int, np.ndarray] = {}
+    # q and q - 1, sorted, each once (a mask: np.unique sorts and hashes)
+    qm = np.zeros(n, dtype=bool)
+    qm[q] = True
+    qm[q[q > 0] - 1] = True
+    qq = np.flatnonzero(qm)
     for step in (2, 3):
-        a = np.unique(np.concatenate([q, q - 1]))
-        a = a[(a >= 0) & (a + step < n)]
+        a = qq[qq + step < n]
         a = a[pid[a] == pid[a + step]]
         res = np.full(n, -1, dtype=np.int8)
         for c in range(0, len(a), 1 << 16):  # in pieces: the height temporaries stay small
@@ -1343,12 +1377,154 @@ def _min_step_pass(mk: _MarkRows, cs: _CubicSet, tol: float, min_step: float,
         h = _chords_heights(cs, sid[[a]], st[[a]], sid[[b]], st[[b]], pos[[a]], pos[[b]])
         return bool(h[0] <= tol)
 
-    keep = np.zeros(len(mk.pid), dtype=bool)
-    forced: list[int] = []
-    keep[_min_step_filter(pos, mk.prot, min_step, first=mk.first_of, d=dd,
-                          merge_ok=merge_ok, forced=forced)] = True
-    report.min_step_overrides += len(forced)
+    keep, nforced = _min_step_keep(pos, mk.prot, mk.first_of, dd, min_step, known[2],
+                                   known[3], merge_ok)
+    report.min_step_overrides += nforced
     return mk.keep(keep)
+
+
+def _min_step_keep(pos: np.ndarray, prot: np.ndarray, first: np.ndarray, dd: np.ndarray,
+                   min_step: float, ok2: np.ndarray, ok3: np.ndarray,
+                   merge_ok: Callable[[int, int], bool]) -> tuple[np.ndarray, int]:
+    """:func:`_min_step_filter` over many strokes (``first``: each one's first mark) as a
+    mask of the marks kept, and the number of forced marks: the walk compiled over every
+    stroke at once (``ok2``/``ok3``: the answers of ``merge_ok`` measured beforehand, -1
+    where not); a stroke that asks another question, or meets a distance within rounding
+    of ``min_step`` (math.hypot and the compiled hypot may differ in the last bit), is left
+    to the Python walk, stroke by stroke: the result is the Python walk's."""
+    n = len(pos)
+    kept, nforced, redo = _min_step_walk(
+        np.ascontiguousarray(pos[:, 0]), np.ascontiguousarray(pos[:, 1]),
+        (dd < min_step) & ~first[1:], prot, first, min_step, ok2, ok3)
+    keep = np.zeros(n, dtype=bool)
+    keep[kept] = True
+    nforced = int(nforced)
+    if len(redo):
+        starts = np.flatnonzero(first)
+        nxt = np.r_[starts[1:], n]
+        for s0 in redo.tolist():
+            e0 = int(nxt[np.searchsorted(starts, s0)])
+            forced: list[int] = []
+            sub = _min_step_filter(pos[s0:e0], prot[s0:e0], min_step, first=first[s0:e0],
+                                   d=dd[s0:e0 - 1],
+                                   merge_ok=lambda a, b, s0=s0: merge_ok(a + s0, b + s0),
+                                   forced=forced)
+            keep[sub + s0] = True
+            nforced += len(forced)
+    return keep, nforced
+
+
+@njit(cache=True, nogil=True)
+def _known(ok2: np.ndarray, ok3: np.ndarray, a: int, b: int) -> int:
+    """Whether chord a -> b holds as measured beforehand: 1 / 0, -1 not measured."""
+    if a < 0 or a >= len(ok2):
+        return -1
+    if b - a == 2:
+        return ok2[a]
+    if b - a == 3:
+        return ok3[a]
+    return -1
+
+
+@njit(cache=True, nogil=True)
+def _min_step_walk(x: np.ndarray, y: np.ndarray, sh: np.ndarray, pr: np.ndarray,
+                   fs: np.ndarray, min_step: float, ok2: np.ndarray, ok3: np.ndarray
+                   ) -> tuple[np.ndarray, int, np.ndarray]:
+    """:func:`_min_step_filter` with ``first`` and ``merge_ok`` compiled, every stroke in
+    one pass (mark 0 starts a stroke). ``sh``: the short chords; ``ok2``/``ok3``: per mark
+    a, whether chord a -> a + 2 / a + 3 holds (-1: not measured). Returns (kept marks,
+    number of forced marks, first marks of the strokes not done: a question not measured,
+    or a distance within 1e-9 of ``min_step``, where the Python walk's math.hypot may
+    differ from this one in the last bit)."""
+    n = len(x)
+    keep = np.empty(n, dtype=np.int64)
+    redo = np.empty(n, dtype=np.int64)
+    nr = 0
+    keep[0] = 0
+    nk = 1
+    nf = 0
+    s_keep = 0
+    s_forced = 0
+    s_first = 0
+    near = 1e-9 * min_step
+    i = 1
+    while i < n:
+        if fs[i]:  # a stroke's first mark
+            s_keep = nk
+            s_forced = nf
+            s_first = i
+            keep[nk] = i
+            nk += 1
+            i += 1
+            continue
+        if keep[nk - 1] == i - 1 and not sh[i - 1]:
+            keep[nk] = i
+            nk += 1
+            i += 1
+            continue
+        bad = False
+        j = keep[nk - 1]
+        dj = math.hypot(x[i] - x[j], y[i] - y[j])
+        if abs(dj - min_step) <= near:
+            bad = True
+        elif dj >= min_step:
+            keep[nk] = i
+            nk += 1
+        elif pr[i]:
+            popped = False
+            while nk > 1 and not pr[keep[nk - 1]]:
+                m = keep[nk - 1]
+                dm = math.hypot(x[i] - x[m], y[i] - y[m])
+                if abs(dm - min_step) <= near:
+                    bad = True
+                    break
+                if dm >= min_step:
+                    break
+                nk -= 1
+                popped = True
+            if not bad:
+                if popped:
+                    v = _known(ok2, ok3, keep[nk - 1], i)
+                    if v < 0:
+                        bad = True
+                    elif v == 0:
+                        nf += 1
+                if not bad:
+                    keep[nk] = i
+                    nk += 1
+        else:
+            v = _known(ok2, ok3, j, i + 1)
+            if v < 0:
+                bad = True
+            elif v == 0:
+                k = keep[nk - 2] if nk > 1 else -1
+                alt = False
+                if k >= 0 and not pr[j] and not fs[j]:
+                    dk = math.hypot(x[i] - x[k], y[i] - y[k])
+                    if abs(dk - min_step) <= near:
+                        bad = True
+                    elif dk >= min_step:
+                        v2 = _known(ok2, ok3, k, i)
+                        if v2 < 0:
+                            bad = True
+                        else:
+                            alt = v2 == 1
+                if not bad:
+                    if alt:
+                        keep[nk - 1] = i
+                    else:
+                        nf += 1
+        if bad:  # this stroke is left to the caller: undo it, go to the next stroke
+            nk = s_keep
+            nf = s_forced
+            redo[nr] = s_first
+            nr += 1
+            i = s_first + 1
+            while i < n and not fs[i]:
+                i += 1
+            continue
+        i += 1
+    return keep[:nk], nf, redo[:nr]
 
 
 def _rounded(mk: _MarkRows) -> tuple[np.ndarray, _MarkRows]:
@@ -1360,13 +1536,15 @@ def _rounded(mk: _MarkRows) -> tuple[np.ndarray, _MarkRows]:
     if not same.any():
         return r, mk
     drop = same.copy()
-    for e in np.flatnonzero(same & last_of).tolist():
-        j = e - 1
-        while same[j]:
-            j -= 1
-        if not first_of[j]:
-            drop[e] = False
-            drop[j] = True
+    e = np.flatnonzero(same & last_of)
+    if len(e):
+        # j: the twin's run start, the last mark before e that repeats nothing (a stroke's
+        # first never does: j stays in e's stroke, so the strokes do not interact)
+        idx = np.arange(len(same))
+        j = np.maximum.accumulate(np.where(same, 0, idx))[e - 1]
+        move = ~first_of[j]
+        drop[e[move]] = False
+        drop[j[move]] = True
     keep = ~drop
     out = mk.keep(keep)
     out.last_of = out.last_of | np.r_[out.pid[1:] != out.pid[:-1], True]
@@ -1476,21 +1654,24 @@ def _max_int_heights(cs: _CubicSet, bound: np.ndarray, sa: np.ndarray, ta: np.nd
 
     ``bound[i]``: an upper bound of chord i's height (hf + the larger move of its ends by
     rounding; -inf for chords that do not count, ``n`` chords count). The chords of largest
-    bound (those within 0.05 bit of the largest, at most 1024 of them) are measured exactly,
-    then every chord whose bound still exceeds the largest exact height, until none does:
-    the maximum is then exact."""
+    bound are measured exactly, a batch at a time (1024, then four times more each round),
+    among those whose bound still exceeds the largest exact height found, until none does:
+    the maximum is then exact, and only the few chords that can hold it are measured (a
+    single batch of every chord above the first chord's height measured most chords of
+    the many-path files)."""
     out = bound.copy()
-    top = float(out.max())
-    idx = np.flatnonzero(out >= top - 0.05)
-    if len(idx) > 1024:
-        idx = idx[np.argpartition(out[idx], len(idx) - 1024)[len(idx) - 1024:]]
     best = -1.0
-    while len(idx):
+    batch = 1024
+    while True:
+        idx = np.flatnonzero(out > best)
+        if not len(idx):
+            return best
+        if len(idx) > batch:
+            idx = idx[np.argpartition(out[idx], len(idx) - batch)[len(idx) - batch:]]
         ex = _int_heights_exact(cs, sa[idx], ta[idx], sb[idx], tb[idx], rf[idx], rf[idx + 1])
         out[idx] = -np.inf  # done
         best = max(best, float(ex.max()))
-        idx = np.flatnonzero(out > best)
-    return best
+        batch *= 4
 
 
 def _int_heights_exact(cs: _CubicSet, sa: np.ndarray, ta: np.ndarray, sb: np.ndarray,

@@ -437,6 +437,123 @@ def test_min_step_filter_walks_only_near_short_chords_with_the_same_result():
             assert _min_step_filter(pts, prot, 3.0).tolist() == want
 
 
+def _strokes_case(rng: np.random.Generator, grid: bool
+                  ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Random strokes (points, protected, first of a stroke); ``grid``: integer points, so
+    that distances exactly equal to the minimum step (2.0) occur."""
+    sizes = rng.integers(1, 40, rng.integers(1, 8))
+    if grid:
+        steps = rng.integers(-3, 4, (int(sizes.sum()), 2)).astype(np.float64)
+    else:
+        n = int(sizes.sum())
+        steps = np.where(rng.random((n, 1)) < 0.4, rng.uniform(0, 1.5, (n, 2)),
+                         rng.uniform(-6, 6, (n, 2)))
+    pts = np.cumsum(steps, axis=0)
+    first = np.zeros(len(pts), dtype=bool)
+    first[np.cumsum(sizes) - sizes] = True
+    last = np.r_[first[1:], True]
+    prot = first | last | (rng.random(len(pts)) < 0.1)
+    return pts, prot, first
+
+
+def test_compiled_min_step_walk_keeps_what_the_python_walk_keeps():
+    """The sampler's min-step pass walks every stroke compiled, with the chord questions
+    answered beforehand; its marks and forced count must be the Python walk's, also where
+    a question was not answered beforehand or a distance equals the minimum exactly."""
+    from galvo_core.sample import _min_step_filter, _min_step_keep
+
+    rng = np.random.default_rng(5)
+    redone = 0
+    for trial in range(400):
+        pts, prot, first = _strokes_case(rng, grid=trial % 2 == 1)
+        n = len(pts)
+        salt = int(rng.integers(1, 1 << 30))
+
+        def merge_ok(a: int, b: int, salt: int = salt) -> bool:
+            return (a * 7919 + b * 104729 + salt) % 5 != 0  # a tolerance that often breaks
+
+        ok2 = np.full(n, -1, dtype=np.int8)
+        ok3 = np.full(n, -1, dtype=np.int8)
+        answered = rng.random(n) < (0.7 if trial % 4 < 2 else 1.0)
+        for a in np.flatnonzero(answered).tolist():
+            if a + 2 < n:
+                ok2[a] = merge_ok(a, a + 2)
+            if a + 3 < n:
+                ok3[a] = merge_ok(a, a + 3)
+        dd = np.hypot(*np.diff(pts, axis=0).T)
+        forced: list[int] = []
+        want = _min_step_filter(pts, prot, 2.0, first=first, d=dd, merge_ok=merge_ok,
+                                forced=forced)
+        keep, nforced = _min_step_keep(pts, prot, first, dd, 2.0, ok2, ok3, merge_ok)
+        assert np.flatnonzero(keep).tolist() == want.tolist(), trial
+        assert nforced == len(forced), trial
+        redone += int(not answered.all())
+    assert redone > 0
+
+
+def test_strokes_are_split_into_the_rows_of_each_path():
+    from galvo_core.sample import _SAME_RUN, _split_rows
+
+    rng = np.random.default_rng(2)
+    for trial in range(60):
+        runs = [(int(rng.integers(0, 5)), int(rng.integers(1, 3 * _SAME_RUN)))
+                for _ in range(rng.integers(1, 6))]
+        lens = np.concatenate([np.full(k, m) for m, k in runs]).astype(np.int64)
+        pc = np.r_[0, np.cumsum(lens)]
+        r = rng.integers(0, 100, (int(pc[-1]), 2))
+        got = _split_rows(r, pc)
+        assert len(got) == len(lens), trial
+        for x, a, b in zip(got, pc[:-1].tolist(), pc[1:].tolist(), strict=True):
+            assert x.shape == (b - a, 2) and np.array_equal(x, r[a:b]), trial
+
+
+def test_a_stroke_end_rounded_onto_its_twin_keeps_the_true_end():
+    """Two marks rounding to the same integer mark at a stroke's end: the end stays and
+    its twin before it goes (unless the twin is the stroke's start)."""
+    from galvo_core.sample import _MarkRows, _rounded
+
+    pos = np.array([[0.0, 0.0], [10.2, 0.0], [10.4, 0.1], [10.1, 0.2],  # stroke 1
+                    [20.0, 0.0], [20.3, 0.0],                            # stroke 2: a dot
+                    [30.0, 0.0], [40.0, 0.0], [40.2, 0.0]])              # stroke 3
+    pid = np.array([0, 0, 0, 0, 1, 1, 2, 2, 2])
+    first = np.r_[True, pid[1:] != pid[:-1]]
+    last = np.r_[pid[1:] != pid[:-1], True]
+    n = len(pid)
+    mk = _MarkRows(np.arange(n), np.linspace(0.1, 1, n), pos, pid, np.full(n, np.nan),
+                   np.full(n, np.nan), first, last, first | last)
+    r, out = _rounded(mk)
+    # stroke 1: marks 1, 2, 3 round to (10, 0): 1 and 2 go, the true end 3 stays
+    # stroke 2: the twin is the start: the end goes; stroke 3: 7 goes, 8 stays
+    assert out.st.tolist() == mk.st[[0, 3, 4, 6, 8]].tolist()
+    assert r.tolist() == [[0, 0], [10, 0], [20, 0], [30, 0], [40, 0]]
+    assert out.last_of.tolist() == [False, True, True, False, True]
+
+
+def test_exact_integer_maximum_is_the_largest_of_all_chords_measured():
+    """The sampler measures only the integer chords whose bound can hold the maximum, in
+    batches: the value must be the largest exact height over every chord, whatever the
+    bounds (any upper bounds) and however many chords there are."""
+    from galvo_core.sample import _CubicSet, _int_heights_exact, _max_int_heights
+
+    rng = np.random.default_rng(9)
+    for trial, n in enumerate((5, 3000, 6000)):
+        coef = rng.normal(0, 20, (n, 4, 2))
+        cs = _CubicSet(coef)
+        sa = np.arange(n)
+        ta = rng.uniform(0, 0.5, n)
+        tb = ta + rng.uniform(0.01, 0.5, n)
+        pts = cs.point(sa, ta)
+        rf = np.round(pts + rng.normal(0, 0.3, pts.shape))
+        rf = np.r_[rf, rf[-1:]]  # chord i: rf[i] -> rf[i + 1]
+        exact = _int_heights_exact(cs, sa, ta, sa, tb, rf[:-1], rf[1:])
+        counts = rng.random(n) < 0.9
+        counts[0] = True
+        # upper bounds: the exact value plus any slack, most of them far above the answer
+        bound = np.where(counts, exact + rng.exponential(3.0, n), -np.inf)
+        got = _max_int_heights(cs, bound, sa, ta, sa, tb, rf, int(counts.sum()))
+        assert got == float(exact[counts].max()), trial
+
+
 def test_reported_heights_equal_a_fresh_closed_form_measurement():
     """The sampler reuses the step search's own measurement of each chord (and takes 0 for
     a chord on a line): the report must be what measuring every chord again gives."""
