@@ -1405,10 +1405,12 @@ def _min_step_keep(pos: np.ndarray, prot: np.ndarray, first: np.ndarray, dd: np.
         for s0 in redo.tolist():
             e0 = int(nxt[np.searchsorted(starts, s0)])
             forced: list[int] = []
+
+            def shifted_ok(a: int, b: int, s0: int = s0) -> bool:
+                return merge_ok(a + s0, b + s0)
+
             sub = _min_step_filter(pos[s0:e0], prot[s0:e0], min_step, first=first[s0:e0],
-                                   d=dd[s0:e0 - 1],
-                                   merge_ok=lambda a, b, s0=s0: merge_ok(a + s0, b + s0),
-                                   forced=forced)
+                                   d=dd[s0:e0 - 1], merge_ok=shifted_ok, forced=forced)
             keep[sub + s0] = True
             nforced += len(forced)
     return keep, nforced
