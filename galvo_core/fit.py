@@ -324,17 +324,8 @@ def _new_fitted(source_index, pen, closed, is_cubic, points, first, last, max_er
                 n_thinned) -> FittedPath:  # type: ignore[no-untyped-def]
     """:meth:`FittedPath.from_arrays` (the fitter's loop over paths calls this)."""
     fp = _new(FittedPath)
-    _s_src(fp, source_index)
-    _s_pen(fp, pen)
-    _s_closed(fp, closed)
-    _s_kinds(fp, is_cubic)
-    _s_points(fp, points)
-    _s_first(fp, first)
-    _s_last(fp, last)
-    _s_err(fp, max_error)
-    _s_nin(fp, n_input)
-    _s_nth(fp, n_thinned)
-    _s_segs(fp, None)
+    _init_fitted(fp, source_index, pen, closed, is_cubic, points, first, last, max_error,
+                 n_input, n_thinned)
     return fp
 
 

@@ -285,6 +285,24 @@ def _kd_build(pts: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray,
 
 
 @njit(cache=True, nogil=True)
+def _wake(j, cstart, alive, seq, n_seq, leaf_of, cnt):  # type: ignore[no-untyped-def]
+    """Stroke ``j``'s candidates become alive (numbered from ``n_seq`` in the order they
+    wake), counted up the k-d tree to its root; returns the next number."""
+    for k in range(cstart[j], cstart[j + 1]):
+        if not alive[k]:
+            alive[k] = True
+            seq[k] = n_seq
+            n_seq += 1
+            v = leaf_of[k]
+            while True:
+                cnt[v] += 1
+                if v == 0:
+                    break
+                v = (v - 1) // 2
+    return n_seq
+
+
+@njit(cache=True, nogil=True)
 def _greedy_walk(pts: np.ndarray, ext: np.ndarray, cstroke: np.ndarray, cstart: np.ndarray,
                  empty: np.ndarray, succ_start: np.ndarray, succ: np.ndarray,
                  npred: np.ndarray, first: int, cell: float) -> np.ndarray:  # pragma: no cover
@@ -338,17 +356,7 @@ def _greedy_walk(pts: np.ndarray, ext: np.ndarray, cstroke: np.ndarray, cstart: 
         if i < 0:  # the start: every stroke without predecessors becomes alive
             for j in range(n):
                 if not empty[j] and npred[j] == 0:
-                    for k in range(cstart[j], cstart[j + 1]):
-                        if not alive[k]:
-                            alive[k] = True
-                            seq[k] = n_seq
-                            n_seq += 1
-                            v = leaf_of[k]
-                            while True:
-                                cnt[v] += 1
-                                if v == 0:
-                                    break
-                                v = (v - 1) // 2
+                    n_seq = _wake(j, cstart, alive, seq, n_seq, leaf_of, cnt)
         i = cstroke[cand]
         out[n_out] = cand
         n_out += 1
@@ -365,17 +373,7 @@ def _greedy_walk(pts: np.ndarray, ext: np.ndarray, cstroke: np.ndarray, cstart: 
             j = succ[q]
             npred[j] -= 1
             if npred[j] == 0:
-                for k in range(cstart[j], cstart[j + 1]):
-                    if not alive[k]:
-                        alive[k] = True
-                        seq[k] = n_seq
-                        n_seq += 1
-                        v = leaf_of[k]
-                        while True:
-                            cnt[v] += 1
-                            if v == 0:
-                                break
-                            v = (v - 1) // 2
+                n_seq = _wake(j, cstart, alive, seq, n_seq, leaf_of, cnt)
         if n_out == todo or cnt[0] == 0:
             break
         px = ext[cand, 0]
