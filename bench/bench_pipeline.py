@@ -437,7 +437,8 @@ def report(results: list[dict], io: dict[str, float] | None,  # type: ignore[typ
         c = r.get("counts", {})
         pts, paths = c.get("points", 0), c.get("paths", 0)
         per = f"{1000 * paths / pts:.1f}" if pts else "—"
-        lines.append(f"| {r['kind']} | {r['fill']} | {r['n']:,} | {pts:,} | {paths:,} | {per} | "
+        read = f"{pts:,}" if pts else "—"
+        lines.append(f"| {r['kind']} | {r['fill']} | {r['n']:,} | {read} | {paths:,} | {per} | "
                      f"{c.get('strokes', 0):,} | "
                      + " | ".join(f"{st[s]['cpu']:.3f}" for s in STAGES)
                      + f" | {max(st[s]['rss_mb'] for s in STAGES):.0f} |")
