@@ -402,6 +402,30 @@ def meta() -> dict[str, str]:
             "cores": str(os.cpu_count()), "load": f"{os.getloadavg()[0]:.1f}"}
 
 
+def _exponent_rows(kind: str, fill: str, a: dict, b: dict,  # type: ignore[type-arg]
+                   full: bool) -> list[str]:
+    """The exponent rows of one drawing kind and fill setting between sizes ``a`` and ``b``:
+    CPU against the points read, and (``full``) user time and CPU against the strokes."""
+    lines = []
+    na, nb = a.get("counts", {}).get("strokes", 0), b.get("counts", {}).get("strokes", 0)
+    pa = a.get("counts", {}).get("points") or a["n"]
+    pb = b.get("counts", {}).get("points") or b["n"]
+    measures = [("CPU", "cpu", pa, pb)]
+    if full and any("user" in a["stages"][s] for s in STAGES):
+        measures.append(("user", "user", pa, pb))
+    if full and na and nb and na != nb:
+        measures.append((f"per stroke ({na:,} → {nb:,})", "cpu", na, nb))
+    for label, key, xa, xb in measures:
+        cells = []
+        for s in STAGES:
+            e = exponent(xa, a["stages"][s].get(key, 0.0), xb, b["stages"][s].get(key, 0.0))
+            cells.append("—" if e is None else f"{e:.2f}")
+        e = exponent(xa, a["gjob"]["cpu"], xb, b["gjob"]["cpu"]) if key == "cpu" else None
+        lines.append(f"| {kind} | {fill} | {a['n']:,} → {b['n']:,} | {label} | "
+                     + " | ".join(cells) + f" | {'—' if e is None else f'{e:.2f}'} |")
+    return lines
+
+
 def report(results: list[dict], io: dict[str, float] | None,  # type: ignore[type-arg]
            m: dict[str, str] | None = None) -> str:
     m = m or meta()
@@ -442,8 +466,8 @@ def report(results: list[dict], io: dict[str, float] | None,  # type: ignore[typ
                      f"{c.get('strokes', 0):,} | "
                      + " | ".join(f"{st[s]['cpu']:.3f}" for s in STAGES)
                      + f" | {max(st[s]['rss_mb'] for s in STAGES):.0f} |")
-    lines += ["", "### Growth exponent per stage (from 100 k points to the largest size; — "
-              "under 20 ms)", "",
+    lines += ["", "### Growth exponent per stage (from 100 k points to the largest size, and "
+              "between the two largest; — under 20 ms)", "",
               "CPU: user + system time against the points; user: user time alone (without "
               "the kernel's work, mostly zeroing fresh pages); per stroke: CPU time against "
               "the job's strokes. Against the points read (within 2 % of the size asked for: "
@@ -458,24 +482,11 @@ def report(results: list[dict], io: dict[str, float] | None,  # type: ignore[typ
         rows = [r for r in rows if r["n"] >= 100_000]
         if len(rows) < 2:
             continue
-        a, b = rows[0], rows[-1]
-        na, nb = a.get("counts", {}).get("strokes", 0), b.get("counts", {}).get("strokes", 0)
-        pa = a.get("counts", {}).get("points") or a["n"]
-        pb = b.get("counts", {}).get("points") or b["n"]
-        measures = [("CPU", "cpu", pa, pb)]
-        if any("user" in a["stages"][s] for s in STAGES):
-            measures.append(("user", "user", pa, pb))
-        if na and nb and na != nb:
-            measures.append((f"per stroke ({na:,} → {nb:,})", "cpu", na, nb))
-        for label, key, xa, xb in measures:
-            cells = []
-            for s in STAGES:
-                e = exponent(xa, a["stages"][s].get(key, 0.0), xb,
-                             b["stages"][s].get(key, 0.0))
-                cells.append("—" if e is None else f"{e:.2f}")
-            e = exponent(xa, a["gjob"]["cpu"], xb, b["gjob"]["cpu"]) if key == "cpu" else None
-            lines.append(f"| {kind} | {fill} | {a['n']:,} → {b['n']:,} | {label} | "
-                         + " | ".join(cells) + f" | {'—' if e is None else f'{e:.2f}'} |")
+        pairs = [(rows[0], rows[-1], True)]
+        if len(rows) > 2:  # and between the two largest sizes (CPU only)
+            pairs.append((rows[-2], rows[-1], False))
+        for a, b, full in pairs:
+            lines += _exponent_rows(kind, fill, a, b, full)
     if io:
         lines += ["", f"### Job file: writing and loading {io['marks']:,.0f} marks", "",
                   "A synthetic job (strokes of 400 marks, a line per two marks, a cubic per 40: "
