@@ -7,8 +7,9 @@ One command::
     python bench/bench_pipeline.py --kinds generated --fill off
 
 For each drawing kind (``generated``: bench/gen_plt.py's random CAD-style file;
-``real``: the PLT corpus (/work/shared/corpus/plt, MANIFEST.tsv) and the bundled samples
-tiled side by side, copies of whole drawings on a grid, until the point count is reached), size
+``real``: the PLT corpus (/work/shared/corpus/plt, MANIFEST.tsv) and the bundled samples,
+each drawing's share of the points in whole paths, side by side on a grid: the same mix of
+drawings and paths per point at every size, see ``real``), size
 and fill setting (off; ``zigzag`` with kerf and optimized order), it measures:
 
 * **end to end through the CLI**: ``galvo-core process FILE -o JOB.gjob --fit-field`` (and
@@ -94,33 +95,60 @@ def _real_paths() -> list[list[np.ndarray]]:
 
 
 def real(n: int) -> Path:
-    """Corpus drawings and samples side by side (each scaled into a 4000 x 4000 unit cell,
-    integer coordinates) until ``n`` points: the drawings in turn from the smallest to the
-    largest and again, whole, the last one cut at a path."""
-    p = OUT / f"real_{n}.plt"
+    """About ``n`` points of real drawings with the same mix at every size.
+
+    The pool: every readable corpus file and sample (64 drawings, 0.9 M points, 150 k paths).
+    Drawing ``k`` gets its share ``n * P_k / P`` of the points (``P_k`` its points, ``P``
+    the pool's): as many whole copies as fit, then whole paths in a fixed pseudo-random
+    order of that drawing's paths (the same order at every size) while they bring the share
+    nearer. So the paths per point, the path lengths and each drawing's share are the same
+    from 10 k to 5 M points (up to one path per drawing), instead of changing with the size.
+    Paths stay whole (closed paths stay closed: fill regions stay real). Each copy of a
+    drawing sits in its own 4000 x 4000 unit cell, scaled with its drawing as a whole
+    (integer coordinates): drawing ``k`` in column ``k`` of 64, copy ``c`` in row ``c``, so
+    the sheet is 64 cells wide at every size and ``--fit-field`` gives the same
+    magnification (the largest drawings at the two ends keep both edges filled)."""
+    p = OUT / f"real_mix_{n}.plt"
     if p.exists():
         return p
-    drawings = sorted(_real_paths(), key=lambda ps: sum(len(q) for q in ps))
+    pool = sorted(_real_paths(), key=lambda ps: sum(len(q) for q in ps), reverse=True)
+    # the two largest drawings at the two ends of the row: both edges filled at 10 k too
+    pool = [pool[0]] + pool[2:] + [pool[1]]
+    rng = np.random.default_rng(21)
+    sizes = [np.array([len(q) for q in ps]) for ps in pool]
+    total = sum(int(s.sum()) for s in sizes)
     cell = 4000.0
-    parts = ["IN;SP1;\n"]
-    left = n
-    k = 0
-    while left > 0:
-        paths = drawings[k % len(drawings)]
+    cols = max(64, len(pool))
+    rows: list[list[tuple[int, np.ndarray]]] = []  # per row (copy): (column, path in cell)
+    for k, paths in enumerate(pool):
         allp = np.concatenate(paths)
         lo, hi = allp.min(axis=0), allp.max(axis=0)
         s = 0.9 * cell / max(float((hi - lo).max()), 1e-9)
-        gx, gy = k % 64, k // 64
-        off = np.array([gx * cell, gy * cell]) + 0.05 * cell
-        for q in paths:
-            if left <= 0:
+        perm = rng.permutation(len(paths))
+        share = n * float(sizes[k].sum()) / total
+        full = int(share // sizes[k].sum())
+        left = share - full * float(sizes[k].sum())
+        chosen = [list(range(len(paths)))] * full
+        part = []
+        for i in perm:  # whole paths while they bring the share nearer (a prefix of the
+            if sizes[k][i] > 2 * left:  # order: no bias towards short paths)
                 break
-            q = q[: max(2, min(len(q), left))]
-            r = np.rint((q - lo) * s + off).astype(np.int64)
-            left -= len(r)
+            part.append(int(i))
+            left -= sizes[k][i]
+        if part:
+            chosen.append(sorted(part))  # a copy's paths in the drawing's own order
+        for c, idx in enumerate(chosen):
+            while len(rows) <= c:
+                rows.append([])
+            off = np.array([k * cell, c * cell]) + 0.05 * cell
+            for i in idx:
+                rows[c].append((k, np.rint((paths[i] - lo) * s + off).astype(np.int64)))
+    assert len(rows) <= cols, "more copies than columns: the sheet's height would set the scale"
+    parts = ["IN;SP1;\n"]
+    for row in rows:
+        for _, r in row:
             rest = ",".join(map(str, r[1:].ravel().tolist()))
             parts.append(f"PU{r[0, 0]},{r[0, 1]};PD{rest};\n")
-        k += 1
     parts.append("PU;SP0;\n")
     p.write_text("".join(parts), encoding="ascii")
     return p
@@ -279,8 +307,9 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--no-write", action="store_true")
     ap.add_argument("--io-marks", type=int, default=5_000_000,
                     help="marks of the job-file write/load measurement (0: skip)")
-    ap.add_argument("--from-json", metavar="RESULTS_JSON",
-                    help="only write the section from a results.json of an earlier run")
+    ap.add_argument("--from-json", metavar="RESULTS_JSON", nargs="+",
+                    help="only write the section from the results.json of earlier runs "
+                    "(several: their rows in turn, the job-file I/O of the last that has it)")
     ap.add_argument("--stage-worker", nargs=2, metavar=("SRC", "OUT"))
     ap.add_argument("--fill-on", action="store_true")
     ap.add_argument("--io-worker", nargs=2, type=int, metavar=("MARKS", "RUNS"))
@@ -299,8 +328,10 @@ def main(argv: list[str] | None = None) -> int:
         print(generated(n) if a.gen_worker[0] == "generated" else real(n))
         return 0
     if a.from_json:
-        saved = json.loads(Path(a.from_json).read_text())
-        text = report(saved["results"], saved.get("io"), saved.get("meta"))
+        saves = [json.loads(Path(f).read_text()) for f in a.from_json]
+        rows = [r for sv in saves for r in sv["results"]]
+        io_s = next((sv["io"] for sv in reversed(saves) if sv.get("io")), None)
+        text = report(rows, io_s, saves[-1].get("meta"))
         print(text)
         if not a.no_write:
             sys.path.insert(0, str(HERE))
@@ -371,6 +402,30 @@ def meta() -> dict[str, str]:
             "cores": str(os.cpu_count()), "load": f"{os.getloadavg()[0]:.1f}"}
 
 
+def _exponent_rows(kind: str, fill: str, a: dict, b: dict,  # type: ignore[type-arg]
+                   full: bool) -> list[str]:
+    """The exponent rows of one drawing kind and fill setting between sizes ``a`` and ``b``:
+    CPU against the points read, and (``full``) user time and CPU against the strokes."""
+    lines = []
+    na, nb = a.get("counts", {}).get("strokes", 0), b.get("counts", {}).get("strokes", 0)
+    pa = a.get("counts", {}).get("points") or a["n"]
+    pb = b.get("counts", {}).get("points") or b["n"]
+    measures = [("CPU", "cpu", pa, pb)]
+    if full and any("user" in a["stages"][s] for s in STAGES):
+        measures.append(("user", "user", pa, pb))
+    if full and na and nb and na != nb:
+        measures.append((f"per stroke ({na:,} → {nb:,})", "cpu", na, nb))
+    for label, key, xa, xb in measures:
+        cells = []
+        for s in STAGES:
+            e = exponent(xa, a["stages"][s].get(key, 0.0), xb, b["stages"][s].get(key, 0.0))
+            cells.append("—" if e is None else f"{e:.2f}")
+        e = exponent(xa, a["gjob"]["cpu"], xb, b["gjob"]["cpu"]) if key == "cpu" else None
+        lines.append(f"| {kind} | {fill} | {a['n']:,} → {b['n']:,} | {label} | "
+                     + " | ".join(cells) + f" | {'—' if e is None else f'{e:.2f}'} |")
+    return lines
+
+
 def report(results: list[dict], io: dict[str, float] | None,  # type: ignore[type-arg]
            m: dict[str, str] | None = None) -> str:
     m = m or meta()
@@ -398,22 +453,26 @@ def report(results: list[dict], io: dict[str, float] | None,  # type: ignore[typ
                      f"| {g['cpu']:.2f} | {g['rss_mb']:.0f} | {j['wall']:.2f} | {j['cpu']:.2f} "
                      f"| {r['gjob_bytes'] / 1e6:.1f} | {r['json_bytes'] / 1e6:.1f} |")
     lines += ["", "### CPU seconds per stage (peak RSS MB at the end of the job)", "",
-              "| drawing | fill | points | paths | strokes | " + " | ".join(STAGES)
-              + " | peak MB |",
-              "| --- | --- | ---: | ---: | ---: |" + " ---: |" * (len(STAGES) + 1)]
+              "| drawing | fill | points | points read | paths | paths / 1 k points | strokes | "
+              + " | ".join(STAGES) + " | peak MB |",
+              "| --- | --- | ---: | ---: | ---: | ---: | ---: |" + " ---: |" * (len(STAGES) + 1)]
     for r in results:
         st = r["stages"]
         c = r.get("counts", {})
-        lines.append(f"| {r['kind']} | {r['fill']} | {r['n']:,} | {c.get('paths', 0):,} | "
+        pts, paths = c.get("points", 0), c.get("paths", 0)
+        per = f"{1000 * paths / pts:.1f}" if pts else "—"
+        read = f"{pts:,}" if pts else "—"
+        lines.append(f"| {r['kind']} | {r['fill']} | {r['n']:,} | {read} | {paths:,} | {per} | "
                      f"{c.get('strokes', 0):,} | "
                      + " | ".join(f"{st[s]['cpu']:.3f}" for s in STAGES)
                      + f" | {max(st[s]['rss_mb'] for s in STAGES):.0f} |")
-    lines += ["", "### Growth exponent per stage (from 100 k points to the largest size; — "
-              "under 20 ms)", "",
+    lines += ["", "### Growth exponent per stage (from 100 k points to the largest size, and "
+              "between the two largest; — under 20 ms)", "",
               "CPU: user + system time against the points; user: user time alone (without "
               "the kernel's work, mostly zeroing fresh pages); per stroke: CPU time against "
-              "the job's strokes (the tiled real drawings have many more paths per point at "
-              "large sizes: their later drawings are the ones of many small paths).", "",
+              "the job's strokes. Against the points read (within 2 % of the size asked for: "
+              "the real drawings take whole paths). The real drawings have the same mix at "
+              "every size (paths per point in the table above).", "",
               "| drawing | fill | sizes | measure | " + " | ".join(STAGES) + " | end to end |",
               "| --- | --- | --- | --- |" + " ---: |" * (len(STAGES) + 1)]
     groups: dict[tuple[str, str], list[dict]] = {}  # type: ignore[type-arg]
@@ -423,20 +482,11 @@ def report(results: list[dict], io: dict[str, float] | None,  # type: ignore[typ
         rows = [r for r in rows if r["n"] >= 100_000]
         if len(rows) < 2:
             continue
-        a, b = rows[0], rows[-1]
-        na, nb = a.get("counts", {}).get("strokes", 0), b.get("counts", {}).get("strokes", 0)
-        measures = [("CPU", "cpu", a["n"], b["n"]), ("user", "user", a["n"], b["n"])]
-        if na and nb and na != nb:
-            measures.append((f"per stroke ({na:,} → {nb:,})", "cpu", na, nb))
-        for label, key, xa, xb in measures:
-            cells = []
-            for s in STAGES:
-                e = exponent(xa, a["stages"][s].get(key, 0.0), xb,
-                             b["stages"][s].get(key, 0.0))
-                cells.append("—" if e is None else f"{e:.2f}")
-            e = exponent(xa, a["gjob"]["cpu"], xb, b["gjob"]["cpu"]) if key == "cpu" else None
-            lines.append(f"| {kind} | {fill} | {a['n']:,} → {b['n']:,} | {label} | "
-                         + " | ".join(cells) + f" | {'—' if e is None else f'{e:.2f}'} |")
+        pairs = [(rows[0], rows[-1], True)]
+        if len(rows) > 2:  # and between the two largest sizes (CPU only)
+            pairs.append((rows[-2], rows[-1], False))
+        for a, b, full in pairs:
+            lines += _exponent_rows(kind, fill, a, b, full)
     if io:
         lines += ["", f"### Job file: writing and loading {io['marks']:,.0f} marks", "",
                   "A synthetic job (strokes of 400 marks, a line per two marks, a cubic per 40: "
