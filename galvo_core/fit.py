@@ -329,6 +329,14 @@ def _new_fitted(source_index, pen, closed, is_cubic, points, first, last, max_er
     return fp
 
 
+def with_source_index(fp: FittedPath, source_index: int) -> FittedPath:
+    """``fp`` as the fit of the path at ``source_index`` (the same arrays)."""
+    if fp.source_index == source_index:
+        return fp
+    return _new_fitted(source_index, fp.pen, fp.closed, fp.is_cubic, fp.points, fp.first,
+                       fp.last, fp.max_error, fp.n_input, fp.n_thinned)
+
+
 def control_points(fp: FittedPath) -> int:
     """Control points of a fitted path, counted as stored: the start point plus, per segment,
     its points minus the shared start (1 per line, 3 per cubic); a closed path's closing

@@ -34,7 +34,7 @@ from galvo_core.drawing import Drawing, Warning
 from galvo_core.errors import Cancelled
 from galvo_core.field import FieldMap, check_in_field, make_field
 from galvo_core.fill import HatchStroke, hatch
-from galvo_core.fit import FittedPath, control_points, fit_drawing
+from galvo_core.fit import FittedPath, control_points, fit_drawing, with_source_index
 from galvo_core.job import Job, Segments, Stroke, gc_paused
 from galvo_core.kerf import compensate_indexed
 from galvo_core.order import order_job_strokes
@@ -68,6 +68,12 @@ class _Cache:
         self.size = size
         self.data: OrderedDict[Hashable, tuple[object, Any]] = OrderedDict()
         self.lock = threading.Lock()
+
+    def peek(self, anchor: object, key: Hashable) -> Any:
+        """The entry for ``anchor`` and ``key`` if there is one (None otherwise); no make."""
+        with self.lock:
+            hit = self.data.get((id(anchor), key))
+            return hit[1] if hit is not None and hit[0] is anchor else None
 
     def get(self, anchor: object, key: Hashable, make: Callable[[], T]) -> T:
         full = (id(anchor), key)
@@ -194,17 +200,60 @@ class Pipeline:
         """The fit stage (paper 000 §2-3) on the (compensated) drawing."""
         fm = fm or self.field_map(drawing, params)
         run = run or _Run(None)
-        work, _ = self.compensated(drawing, params, fm, run)
+        work, origin = self.compensated(drawing, params, fm, run)
 
-        def make() -> tuple[FittedPath, ...]:
+        def fit(d: Drawing, quanta: np.ndarray | None = None) -> tuple[FittedPath, ...]:
             # all paths of a batch are thinned and fitted together; cancel() between batches
             # (at most FIT_BATCH_POINTS input points each, ~0.1 s) raises errors.Cancelled
-            return tuple(fit_drawing(work, eps_line=params.eps_line, e_per=params.e_per,
+            return tuple(fit_drawing(d, eps_line=params.eps_line, e_per=params.e_per,
                                      eps_sum=params.eps_sum, batch_points=FIT_BATCH_POINTS,
-                                     cancel=run.cancel))
+                                     cancel=run.cancel, quantum_units=quanta))
+
+        def make() -> tuple[FittedPath, ...]:
+            if work is drawing:
+                return fit(work)
+            # the kerf's paths keep the grid of the input path they came from: the file's
+            # precision, not the offset's floats (a path the kerf passes through is fitted
+            # as without kerf; an offset ring of rounded input is as uncertain as its input)
+            q_work = self.input_quanta(drawing)[np.asarray(origin, dtype=np.intp)]
+            base = self._cache.peek(drawing, ("fit", None, params.group("fit")))
+            if base is None:
+                return fit(work, q_work)
+            return self._refit_changed(drawing, work, origin, q_work, base, fit)
 
         key = ("fit", self._kerf_key(params, fm), params.group("fit"))
         return self._cache.get(drawing, key, run.stage("fit", make))
+
+    def input_quanta(self, drawing: Drawing) -> np.ndarray:
+        """Each input path's grid (:func:`galvo_core.precision.path_quanta`), cached."""
+        return self._fact(drawing, "path quanta", lambda: path_quanta(drawing.paths))
+
+    @staticmethod
+    def _refit_changed(drawing: Drawing, work: Drawing, origin: Sequence[int],
+                       q_work: np.ndarray, base: tuple[FittedPath, ...],
+                       fit: Callable[[Drawing, np.ndarray], tuple[FittedPath, ...]]
+                       ) -> tuple[FittedPath, ...]:
+        """The fit of the kerf's ``work`` drawing from the input drawing's cached fit
+        ``base``: a path the kerf passed through unchanged (the same object, with the same
+        grid) keeps its fit; only the others are fitted. A path's fit depends only on its
+        points, closedness and grid (``fit_paths`` fits each path as on its own), so this
+        is the fit of the whole ``work`` drawing with the grids ``q_work``."""
+        src = drawing.paths
+        same = [i for i, (p, o) in enumerate(zip(work.paths, origin, strict=True))
+                if p is src[o]]
+        if not same:
+            return fit(work, q_work)
+        keep = np.zeros(len(work.paths), dtype=bool)
+        keep[same] = True
+        redo = np.flatnonzero(~keep).tolist()
+        fresh = fit(work.with_paths([work.paths[i] for i in redo]), q_work[redo]) \
+            if redo else ()
+        out: list[FittedPath | None] = [None] * len(work.paths)
+        for i in same:
+            out[i] = with_source_index(base[origin[i]], i)
+        for k, i in enumerate(redo):
+            out[i] = with_source_index(fresh[k], i)
+        return tuple(out)  # type: ignore[arg-type]
 
     def marks(self, drawing: Drawing, params: Params, fm: FieldMap,
               run: _Run | None = None) -> _Marks:
@@ -341,10 +390,9 @@ class Pipeline:
         t, dwell = estimate_with_dwell(joined_marks(strokes), params.laser, fm.mm_per_bit)
         n_input = self._fact(drawing, "n_points", lambda: drawing.n_points)
         quantum = self._fact(drawing, "quantum", lambda: coordinate_quantum(drawing)) or 0.0
-        # the fit detects each path's own grid: its bound is the largest path's
-        fitted_on = work if work is not None else drawing
-        path_q = self._fact(fitted_on, "largest path quantum", lambda: float(
-            path_quanta(fitted_on.paths).max(initial=0.0)))
+        # the fit uses each input path's own grid (a kerf path its input path's): its bound
+        # is the largest path's
+        path_q = float(self.input_quanta(drawing).max(initial=0.0))
         fit_err, n_control, n_lines, n_cubics = self._fact(fitted, "counts", lambda: (
             max((f.max_error for f in fitted), default=0.0),
             sum(control_points(f) for f in fitted),

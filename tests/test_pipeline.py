@@ -147,3 +147,38 @@ def test_the_fit_bound_shown_holds_for_the_largest_fit_error(name):
     stats = Pipeline().run(read_file(SAMPLES / name), Params()).job.stats
     assert stats["max_fit_error"] <= stats["fit_bound_units"] * (1 + 1e-9)
     assert stats["fit_bound_units"] >= Params().e_per
+
+
+def test_kerf_after_a_plain_run_refits_only_what_the_kerf_changed() -> None:
+    """With the plain fit cached, a kerf change refits only the offset rings; the paths the
+    kerf passes through keep their fit. The job is the one a fresh pipeline makes, and
+    every kerf path is fitted on its input path's grid (whole units here), not on the
+    offset's floats."""
+    rng = np.random.default_rng(3)
+    body = ["IN;SP1;"]
+    for k in range(12):  # open wiggles (passed through) and closed squares (offset)
+        pts = np.round(np.c_[np.linspace(0, 300, 40), 2000 * k + 30 * np.sin(
+            np.linspace(0, 6, 40)) + rng.normal(0, 0.3, 40)]).astype(int)
+        body.append(f"PU{pts[0, 0]},{pts[0, 1]};PD" + ",".join(
+            f"{x},{y}" for x, y in pts[1:]) + ";")
+        x0, y0 = 600, 2000 * k
+        body.append(f"PU{x0},{y0};PD{x0 + 800},{y0},{x0 + 800},{y0 + 800},{x0},{y0 + 800},"
+                    f"{x0},{y0};")
+    d = read_bytes("".join(body).encode(), "mix.plt")
+    plain = Params(fit_field=True)
+    kerfed = plain.replace(kerf_mm=0.05)
+    warm = Pipeline()
+    base = warm.run(d, plain)
+    res = warm.run(d, kerfed)
+    fresh = Pipeline().run(d, kerfed)
+    assert [s.marks.tolist() for s in res.job.strokes] == \
+        [s.marks.tolist() for s in fresh.job.strokes]
+    assert res.job.stats == fresh.job.stats
+    passed = [i for i, o in enumerate(res.origin) if res.work.paths[i] is d.paths[o]]
+    assert len(passed) == 12  # the wiggles
+    for i in passed:  # the same fit as without kerf (the same arrays, not a refit)
+        assert res.fitted[i].points is base.fitted[res.origin[i]].points
+        assert res.fitted[i].source_index == i
+    # the offset rings carry their input's grid: the fit's bound is e_per + 1/sqrt(2)
+    assert res.job.stats["fit_bound_units"] == pytest.approx(
+        max(kerfed.e_per, kerfed.eps_line) + 1 / math.sqrt(2))
