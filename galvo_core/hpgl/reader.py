@@ -546,8 +546,13 @@ class _Reader:
         if len(pts) == 0:
             return
         if self.poly is not None:
-            for px, py in pts.tolist():
-                self._poly_move(px, py)
+            if self.pen_down and not self.poly_fresh:
+                # pen-down moves only append (what _poly_move does point by point)
+                self.poly_ring.extend(zip(pts[:, 0].tolist(), pts[:, 1].tolist(), strict=True))
+                self.poly_down.extend([True] * len(pts))
+            else:
+                for px, py in pts.tolist():
+                    self._poly_move(px, py)
         elif self.pen_down:
             if not self.cur and not self.cur_parts:
                 self.cur = [self.x, self.y]
@@ -578,7 +583,7 @@ class _Reader:
 
     def move_params(self, params: bytes, offset: int, mn: str) -> None:
         v = _nums(params)
-        if len(v) == 2 and self.poly is None:  # the common one-point command, no numpy
+        if len(v) == 2:  # the common one-point command, no numpy
             x, y = v
             if self.absolute:
                 if self.sc is not None:
@@ -1675,6 +1680,12 @@ def _pen_down_runs(ring: list[tuple[float, float]],
     entry is the closing edge back to ``ring[0]`` (none when the ring already ends there).
     A ring whose edges are all pen-down comes back as one closed run.
     """
+    if len(downs) >= len(ring) >= 2 and all(downs[: len(ring) - 1]):
+        # every edge of the ring is pen-down (always so for rings from polygon mode): one
+        # run, closed when the closing edge is pen-down too
+        if ring[0] != ring[-1] and downs[-1]:
+            return [[*ring, ring[0]]]
+        return [ring]
     pts = list(ring)
     flags = list(downs[: len(ring) - 1])
     if ring[0] != ring[-1]:
