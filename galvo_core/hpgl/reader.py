@@ -73,8 +73,11 @@ Speed
 -----
 Large inputs (from ``_COMPILED_MIN_BYTES``), or any input once numba is loaded, are read by
 the compiled scanner (:mod:`.scan`) wherever a PU/PD/PA/PR/SP command starts, and PE by its
-compiled decoder; the general reader takes every other command. Smaller inputs in a fresh
-process use the numpy runs of :mod:`.fastrun`. All three read the same geometry bit for bit
+compiled decoder; inside polygon mode its PU/PD/PA/PR runs are read by the compiled
+scanner too (``scan.scan_poly_moves``: the moves and their pen states, added to the polygon
+buffer a pen-down run at a time); the general reader takes every other command. Smaller
+inputs in a fresh process use the numpy runs of :mod:`.fastrun` (outside polygon mode). All
+three read the same geometry bit for bit
 (tests/test_hpgl_scan.py, tests/test_hpgl_fuzz.py).
 """
 
