@@ -99,6 +99,72 @@ def test_pen_width_between_paths_stays_in_the_scanner_and_makes_the_file_hpgl2()
     np.testing.assert_array_equal(a.paths[-1].points, [[5, 5], [9, 9]])
 
 
+def _poly_program(rng: random.Random, n: int) -> bytes:
+    """Random programs in and out of polygon mode (PM0/PM1/PM2, EP/FP, moves, odd counts,
+    junk, scaling, figures inside PM): what the general reader warns about or reads itself
+    must come out the same from the compiled one."""
+    out = [b"IN;SP1;"]
+    for _ in range(n):
+        r = rng.random()
+        if r < 0.1:
+            out.append(rng.choice([b"PM0;", b"PM;", b"PM1;", b"PM2;", b"PM 0;", b"PM0.5;"]))
+        elif r < 0.16:
+            out.append(rng.choice([b"EP;", b"FP;", b"FP1;", b"EP", b"FP0,2;"]))
+        elif r < 0.36:
+            out.append(b"PU%d,%d;" % (rng.randint(-999, 999), rng.randint(-999, 999))
+                       if rng.random() < 0.8 else b"PU;")
+        elif r < 0.66:
+            k = rng.randint(0, 12)
+            nums = ",".join(f"{rng.uniform(-500, 500):.{rng.randint(0, 3)}f}" for _ in range(2 * k))
+            out.append(rng.choice([b"PD", b"PA", b"PR", b"pd"]) + nums.encode() + b";")
+        elif r < 0.72:
+            out.append(rng.choice([b"PR;", b"PA;", b"PD;", b"PW0.3;", b"PW;"]))
+        elif r < 0.76:
+            out.append(b"SP%d;" % rng.randint(1, 3))
+        elif r < 0.82:
+            out.append(rng.choice([b"CI5;", b"PD1:2;", b"PD1,2,3;", b"PR1.2.3,4;", b"LBab\x03",
+                                   b"SC0,100,0,100;", b"SC;", b"EA50,50;", b"AA0,0,90;",
+                                   b"\n", b"LT;", b"PW1,2,3;", b"IN;SP1;", b"DF;"]))
+        else:
+            out.append(b"PD%d,%d" % (rng.randint(0, 99), rng.randint(0, 99)))  # no ';'
+    return b"".join(out)
+
+
+@pytest.mark.parametrize("seed", range(16))
+def test_compiled_polygon_mode_reads_what_the_general_reader_reads(seed: int) -> None:
+    """Moves inside polygon mode are read by the compiled scanner (scan.scan_poly_moves) and
+    added to the polygon buffer: same sub-polygons, EP/FP paths, warnings and counts."""
+    data = _poly_program(random.Random(1000 + seed), 500)
+    a = _read(data, True, 8)
+    assert_same(a, _read(data, False))
+    assert a.commands.get("PM", 0) > 0 and len(a.paths) > 0
+
+
+def test_polygon_mode_moves_are_read_by_the_scanner_in_one_call() -> None:
+    """Issue 20, reproducer 1 in polygon mode (GNU plotutils' open polylines,
+    ``PA x0,y0;PM0;PD;PA x1,y1,...;PU;PM2;EP;``): the PD;PA...;PU run between PM0 and PM2
+    is one compiled call, the polylines stay open, as the general reader reads them; a
+    single command with more moves than the move buffer holds (4,999 pairs) too."""
+    lines = [[(k, 0), (k + 100, 50), (k + 200, 0)] for k in range(0, 3000, 300)]
+    body = b"".join(b"PA%d,%d;PM0;PD;PA%s;PU;PM2;EP;" % (
+        *ln[0], ",".join(f"{x},{y}" for x, y in ln[1:]).encode()) for ln in lines)
+    big = ",".join(f"{k},{k % 7}" for k in range(1, 5000)).encode()
+    data = b"IN;SP1;" + body + b"PA0,0;PM0;PD;PA" + big + b";PM2;EP;"
+    calls = []
+    run = reader._Reader._compiled_poly_run
+    with mock.patch.object(reader._Reader, "_compiled_poly_run",
+                           lambda self, i: calls.append(i) or run(self, i)):
+        a = _read(data, True)
+    assert_same(a, _read(data, False))
+    assert len(calls) == len(lines) + 1
+    assert len(a.paths) == len(lines) + 1
+    for p, ln in zip(a.paths, lines, strict=False):
+        np.testing.assert_array_equal(p.points, ln)  # open: no closing edge added
+        assert not p.closed
+    # the last one ends with the pen down: PM2 closes it with a pen-down edge
+    assert len(a.paths[-1].points) == 5001 and a.paths[-1].closed
+
+
 # ------------------------------------------------------------------ PE
 def _pe_both(data: bytes, pos: int = 0):
     from galvo_core.hpgl import scan

@@ -73,8 +73,11 @@ Speed
 -----
 Large inputs (from ``_COMPILED_MIN_BYTES``), or any input once numba is loaded, are read by
 the compiled scanner (:mod:`.scan`) wherever a PU/PD/PA/PR/SP command starts, and PE by its
-compiled decoder; the general reader takes every other command. Smaller inputs in a fresh
-process use the numpy runs of :mod:`.fastrun`. All three read the same geometry bit for bit
+compiled decoder; inside polygon mode its PU/PD/PA/PR runs are read by the compiled
+scanner too (``scan.scan_poly_moves``: the moves and their pen states, added to the polygon
+buffer a pen-down run at a time); the general reader takes every other command. Smaller
+inputs in a fresh process use the numpy runs of :mod:`.fastrun` (outside polygon mode). All
+three read the same geometry bit for bit
 (tests/test_hpgl_scan.py, tests/test_hpgl_fuzz.py).
 """
 
@@ -155,6 +158,7 @@ _PE_MESSAGES = {  # scan.PE_* problem codes -> the messages of pe.decode_pe
 _LABEL_ORIGINS = frozenset((*range(1, 10), *range(11, 20), 21))
 _LO_CONCATENATE = frozenset((1, 2, 3, 11, 12, 13, 21))
 _SCAN_CMDS = frozenset((b"PU", b"PD", b"PA", b"PR", b"SP", b"PW"))  # what the scanner reads
+_POLY_SCAN_CMDS = frozenset((b"PU", b"PD", b"PA", b"PR", b"PW"))  # ... in polygon mode
 
 
 def _is_letter_or_esc(c: int) -> bool:
@@ -546,8 +550,13 @@ class _Reader:
         if len(pts) == 0:
             return
         if self.poly is not None:
-            for px, py in pts.tolist():
-                self._poly_move(px, py)
+            if self.pen_down and not self.poly_fresh:
+                # pen-down moves only append (what _poly_move does point by point)
+                self.poly_ring.extend(zip(pts[:, 0].tolist(), pts[:, 1].tolist(), strict=True))
+                self.poly_down.extend([True] * len(pts))
+            else:
+                for px, py in pts.tolist():
+                    self._poly_move(px, py)
         elif self.pen_down:
             if not self.cur and not self.cur_parts:
                 self.cur = [self.x, self.y]
@@ -578,7 +587,7 @@ class _Reader:
 
     def move_params(self, params: bytes, offset: int, mn: str) -> None:
         v = _nums(params)
-        if len(v) == 2 and self.poly is None:  # the common one-point command, no numpy
+        if len(v) == 2:  # the common one-point command, no numpy
             x, y = v
             if self.absolute:
                 if self.sc is not None:
@@ -920,10 +929,14 @@ class _Reader:
                 i = self._pcl(i)
                 continue
             m = None
-            if self.compiled and self.poly is None:
+            if self.compiled:
                 m = cmd_match(data, i)
-                if m is not None and m.group(1).upper() in _SCAN_CMDS:
-                    j = self._compiled_run(i)
+                if m is not None:
+                    mn2 = m.group(1).upper()
+                    if self.poly is None:
+                        j = self._compiled_run(i) if mn2 in _SCAN_CMDS else i
+                    else:
+                        j = self._compiled_poly_run(i) if mn2 in _POLY_SCAN_CMDS else i
                     if j != i:
                         i = j
                         continue
@@ -1073,6 +1086,87 @@ class _Reader:
                 return i
             line, last_nl = out[scan.I_LINE], out[scan.I_LASTNL]
             self._new_chunk(out[scan.I_NEED], i)
+
+    def _compiled_poly_run(self, i: int) -> int:
+        """Polygon mode: read the PU/PD/PA/PR/PW commands from ``i`` on with the compiled
+        scanner (scan.scan_poly_moves) and add their moves to the polygon buffer as
+        :meth:`_poly_move` would; returns the offset where it stopped."""
+        if self._scan is None:
+            from galvo_core.hpgl import scan as scan_module
+
+            self._scan = scan_module
+            self._u8 = np.frombuffer(self.data, dtype=np.uint8)
+            self._ist = np.zeros(scan_module.N_ISTATE, dtype=np.int64)
+            self._fst = np.zeros(scan_module.N_FSTATE, dtype=np.float64)
+        scan = self._scan
+        ist, fst = self._ist, self._fst
+        pos, line, last_nl = self._lc
+        if i != pos:  # the general reader's bytes since the last call
+            cnt = self.data.count(b"\n", pos, i)
+            if cnt:
+                line += cnt
+                last_nl = self.data.rfind(b"\n", pos, i)
+        moves = getattr(self, "_pm_moves", None)
+        if moves is None:
+            moves = self._pm_moves = (np.empty(4096), np.empty(4096), np.empty(4096, np.int8))
+        while True:
+            mx, my, md = moves
+            ist[:] = (i, self.pen_down, self.absolute, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0,
+                      self.pen, self.hpgl2, 0, self.pen_selected, line, last_nl, 0)
+            sc = self.sc
+            fst[:] = (self.x, self.y, 0.0, 0.0, 0.0, 0.0, 0.0) if sc is None else \
+                (self.x, self.y, sc[0], sc[1], sc[2], sc[3], 1.0)
+            scan.scan_poly_moves(self._u8, ist, fst, mx, my, md, _POW10, scan.CLASS)
+            out = ist.tolist()
+            nm = out[scan.I_NPTS]
+            if nm:
+                self._poly_moves(mx[:nm], my[:nm], md[:nm])
+            self.x, self.y = fst[0].item(), fst[1].item()
+            self.pen_down = bool(out[scan.I_PEN])
+            self.absolute = bool(out[scan.I_ABS])
+            self.hpgl2 = bool(out[scan.I_HPGL2])
+            counts = out[scan.I_NU : scan.I_NR + 1] + [out[scan.I_NPW]]
+            if any(counts):
+                for name, c in zip(("PU", "PD", "PA", "PR", "PW"), counts, strict=True):
+                    if c:
+                        self.commands[name] += c
+                self.recognised += sum(counts)
+            i = out[scan.I_POS]
+            line, last_nl = out[scan.I_LINE], out[scan.I_LASTNL]
+            self._lc = (i, line, last_nl)
+            if not out[scan.I_FULL]:
+                return i
+            cap = max(out[scan.I_NEED], 2 * len(mx))
+            moves = self._pm_moves = (np.empty(cap), np.empty(cap), np.empty(cap, np.int8))
+
+    def _poly_moves(self, mx: np.ndarray, my: np.ndarray, md: np.ndarray) -> None:
+        """:meth:`_poly_move` for each move (plotter point, pen state it was made with), a
+        run of pen-down moves at a time."""
+        xs = mx.tolist()
+        ys = my.tolist()
+        n = len(xs)
+        a = 0
+        if self.poly_fresh:
+            self.poly_fresh = False
+            self.poly_ring = [(xs[0], ys[0])]
+            self.poly_down = []
+            a = 1
+        ring = self.poly_ring
+        downs = self.poly_down
+        for u in (np.flatnonzero(md[a:] == 0) + a).tolist() + [n]:
+            if u > a:
+                ring.extend(zip(xs[a:u], ys[a:u], strict=True))
+                downs.extend([True] * (u - a))
+            if u == n:
+                break
+            # a pen-up move ends the sub-polygon (see _poly_move)
+            if len(ring) > 1:
+                self.poly_buffer.append((ring, downs + [False]))
+            ring = [(xs[u], ys[u])]
+            downs = []
+            a = u + 1
+        self.poly_ring = ring
+        self.poly_down = downs
 
     def _take_segments(self, ch: _Chunk, ist: list[int]) -> None:
         scan = self._scan
@@ -1675,6 +1769,12 @@ def _pen_down_runs(ring: list[tuple[float, float]],
     entry is the closing edge back to ``ring[0]`` (none when the ring already ends there).
     A ring whose edges are all pen-down comes back as one closed run.
     """
+    if len(downs) >= len(ring) >= 2 and all(downs[: len(ring) - 1]):
+        # every edge of the ring is pen-down (always so for rings from polygon mode): one
+        # run, closed when the closing edge is pen-down too
+        if ring[0] != ring[-1] and downs[-1]:
+            return [[*ring, ring[0]]]
+        return [ring]
     pts = list(ring)
     flags = list(downs[: len(ring) - 1])
     if ring[0] != ring[-1]:

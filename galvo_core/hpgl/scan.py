@@ -418,6 +418,196 @@ def scan_moves(b, ist, fst, pts, seg_start, seg_off, seg_pen, seg_line, seg_col,
 
 
 
+@njit(cache=True, nogil=True, boundscheck=False)
+def scan_poly_moves(b, ist, fst, mx, my, mdown, pow10, cls):
+    """Polygon mode: read PU/PD/PA/PR (and PW) commands from ``ist[I_POS]`` on, as
+    :func:`scan_moves` reads them, but record every move instead of drawing: the point
+    (``mx``, ``my``, plotter units) and the pen state it was made with (``mdown``); the
+    reader adds them to its polygon buffer. ``ist[I_NPTS]`` counts the moves. Stops at the
+    first command it does not read (rolled back: nothing of it kept), or (``I_FULL`` = 1)
+    before a command whose moves do not fit.
+    """
+    n = b.shape[0]
+    i = ist[I_POS]
+    line = ist[I_LINE]
+    last_nl = ist[I_LASTNL]
+    pen = ist[I_PEN]
+    absm = ist[I_ABS]
+    nm = ist[I_NPTS]
+    hpgl2 = ist[I_HPGL2] != 0
+    cap = mx.shape[0]
+    x = fst[F_X]
+    y = fst[F_Y]
+    ax = fst[F_AX]
+    bx = fst[F_BX]
+    ay = fst[F_AY]
+    by = fst[F_BY]
+    has_sc = fst[F_SC] != 0.0
+    ist[I_FULL] = 0
+    nu = 0
+    nd_ = 0
+    na = 0
+    nr = 0
+    npw = 0
+    while True:
+        j = i
+        tl = line
+        tn = last_nl
+        while j < n:
+            k = cls[b[j]]
+            if k == C_SEP or k == C_SEMI or k == C_CTRL:
+                if b[j] == 10:
+                    tl += 1
+                    tn = j
+                j += 1
+            else:
+                break
+        if j + 1 >= n:
+            if j >= n:
+                i = n
+                line = tl
+                last_nl = tn
+            break
+        if cls[b[j]] != C_LETTER or cls[b[j + 1]] != C_LETTER:
+            break
+        c0 = b[j] | 32
+        c1 = b[j + 1] | 32
+        if c0 != 112:  # 'p'
+            break
+        if c1 == 117:
+            code = 0
+        elif c1 == 100:
+            code = 1
+        elif c1 == 97:
+            code = 2
+        elif c1 == 114:
+            code = 3
+        elif c1 == 119:
+            code = 5
+        else:
+            break
+        r_pen, r_absm, r_nm, r_x, r_y = pen, absm, nm, x, y
+        k = j + 2
+        if code == 5:
+            count = 0
+            ok = True
+            while k < n:
+                t = cls[b[k]]
+                if t == C_SEMI:
+                    k += 1
+                    break
+                if t == C_ESC or t == C_LETTER:
+                    break
+                if t == C_SEP:
+                    if b[k] == 10:
+                        tl += 1
+                        tn = k
+                    k += 1
+                    continue
+                v, e = _read_number(b, k, n, pow10, cls)
+                if e < 0 or count == 2:
+                    ok = False
+                    break
+                count += 1
+                k = e
+            if not ok:
+                break
+            hpgl2 = True
+            npw += 1
+            i = k
+            line = tl
+            last_nl = tn
+            continue
+        if code == 0:
+            pen = 0
+        elif code == 1:
+            pen = 1
+        elif code == 2:
+            absm = 1
+        else:
+            absm = 0
+        ok = True
+        full = False
+        half = False
+        vx = 0.0
+        while k < n:
+            t = cls[b[k]]
+            if t == C_SEMI:
+                k += 1
+                break
+            if t == C_ESC or t == C_LETTER:
+                break
+            if t == C_SEP:
+                if b[k] == 10:
+                    tl += 1
+                    tn = k
+                k += 1
+                continue
+            v, e = _read_number(b, k, n, pow10, cls)
+            if e < 0:
+                ok = False
+                break
+            k = e
+            if not half:
+                vx = v
+                half = True
+                continue
+            half = False
+            if absm == 1:
+                if has_sc:
+                    nx = ax * vx + bx
+                    ny = ay * v + by
+                else:
+                    nx = vx
+                    ny = v
+            elif has_sc:
+                nx = x + ax * vx
+                ny = y + ay * v
+            else:
+                nx = x + vx
+                ny = y + v
+            if nm >= cap:
+                full = True
+                break
+            mx[nm] = nx
+            my[nm] = ny
+            mdown[nm] = pen
+            nm += 1
+            x = nx
+            y = ny
+        if full or not ok or half:
+            pen, absm, nm, x, y = r_pen, r_absm, r_nm, r_x, r_y
+            if full:
+                ist[I_FULL] = 1
+                ist[I_NEED] = 2 * cap
+            break
+        if code == 0:
+            nu += 1
+        elif code == 1:
+            nd_ += 1
+        elif code == 2:
+            na += 1
+        else:
+            nr += 1
+        i = k
+        line = tl
+        last_nl = tn
+    ist[I_POS] = i
+    ist[I_LINE] = line
+    ist[I_LASTNL] = last_nl
+    ist[I_PEN] = pen
+    ist[I_ABS] = absm
+    ist[I_NPTS] = nm
+    ist[I_NU] = nu
+    ist[I_ND] = nd_
+    ist[I_NA] = na
+    ist[I_NR] = nr
+    ist[I_NPW] = npw
+    ist[I_HPGL2] = 1 if hpgl2 else 0
+    fst[F_X] = x
+    fst[F_Y] = y
+
+
 # ------------------------------------------------------------------ PE (polyline encoded)
 # item kinds and problem codes of decode_pe (the same decoding as pe.decode_pe)
 PE_PEN, PE_PAIR = 0, 1
