@@ -1573,30 +1573,29 @@ def _pairwise_sum(a, s, n):  # pragma: no cover (compiled)
 
 
 @njit(cache=True, nogil=True)
-def _window_sums(sv, W, idx, starts, mom, rx, ry):  # pragma: no cover (compiled)
-    """:func:`_local_fits`'s sums per window j (points starts[j] .. starts[j + 1] - 1 of
-    the flat ``sv``, the last to the end): mom[r] of sv^r (r = 0 .. 4), rx[r], ry[r] of
-    sv^r times the x, y of input point idx; each as np.add.reduceat sums them (the first
-    term plus numpy's pairwise sum of the rest). The powers are products (s^3 = s^2 s,
-    s^4 = s^2 s^2), the same on every machine (numpy's ``**`` takes a vector path on
-    AVX-512 machines and a 28x slower scalar one for negative bases, with different last
-    bits)."""
-    n_all = sv.shape[0]
-    v = starts.shape[0]
+def _window_sums(arc, W, lo, hi, at, mom, rx, ry):  # pragma: no cover (compiled)
+    """:func:`_local_fits`'s sums per window j (the input points lo[j] .. hi[j], inclusive
+    global indices, at arc length s scaled to sv = (s - arc[at[j]]) / max(arc[hi[j]] -
+    arc[lo[j]], 1e-300)): mom[r] of sv^r (r = 0 .. 4), rx[r], ry[r] of sv^r times the x, y
+    of the input point; each as np.add.reduceat sums them (the first term plus numpy's
+    pairwise sum of the rest). The powers are products (s^3 = s^2 s, s^4 = s^2 s^2), the
+    same on every machine (numpy's ``**`` takes a vector path on AVX-512 machines and a 28x
+    slower scalar one for negative bases, with different last bits)."""
+    v = lo.shape[0]
     big = 0
     for j in range(v):
-        e = starts[j + 1] if j + 1 < v else n_all
-        big = max(big, e - starts[j])
+        big = max(big, hi[j] - lo[j] + 1)
     buf = np.empty((10, big))
     for j in range(v):
-        s = starts[j]
-        e = starts[j + 1] if j + 1 < v else n_all
-        n = e - s
+        s = lo[j]
+        n = hi[j] - s + 1
+        a0 = arc[at[j]]
+        scale = max(arc[hi[j]] - arc[s], 1e-300)
         for k in range(n):
-            u = sv[s + k]
+            u = (arc[s + k] - a0) / scale  # in [-1, 1]: well scaled
             u2 = u * u
-            x = W[idx[s + k], 0]
-            y = W[idx[s + k], 1]
+            x = W[s + k, 0]
+            y = W[s + k, 1]
             buf[0, k] = u
             buf[1, k] = u2
             buf[2, k] = u2 * u
@@ -1629,18 +1628,13 @@ def _local_fits(
     ok = cnt >= 4
     if not ok.any():
         return pos, tan, ok
-    own, off = _ragged(np.zeros(v, dtype=np.intp), np.where(ok, cnt, 0))
-    idx = lo[own] + off
-    scale = np.maximum(arc[hi] - arc[lo], 1e-300)
-    sv = (arc[idx] - arc[at][own]) / scale[own]  # in [-1, 1]: well scaled
-    starts = np.cumsum(np.where(ok, cnt, 0)) - np.where(ok, cnt, 0)
     okk = np.flatnonzero(ok)
     # the sums of 1, s .. s^4 and of x, y times 1, s, s^2 per window (compiled, in
-    # np.add.reduceat's order, without the (5, N) arrays)
+    # np.add.reduceat's order)
     mom = np.empty((5, len(okk)))
     rx = np.empty((3, len(okk)))
     ry = np.empty((3, len(okk)))
-    _window_sums(sv, W, idx, starts[okk], mom, rx, ry)
+    _window_sums(arc, W, lo[okk], hi[okk], at[okk], mom, rx, ry)
     A = np.stack([mom[0:3], mom[1:4], mom[2:5]]).transpose(2, 0, 1)  # (V', 3, 3)
     det = np.linalg.det(A)
     good = np.abs(det) > 1e-9 * np.abs(A).max(axis=(1, 2)) ** 3
