@@ -579,6 +579,10 @@ class _BatchFitter:
         self.arc = arc
         self._cubics: list[tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]] = []
         self._lines: list[np.ndarray] = []
+        # :meth:`_all_segments` as :meth:`_store` left it (and its :meth:`_fixed_lines`),
+        # valid while _lines and _cubics are the lists it stored
+        self._all: tuple | None = None
+        self._all_fixed: np.ndarray | None = None
         #: keys a (M + 1) + b of the ranges a..b that :meth:`_try` found no cubic for
         self._failed = np.zeros(0, dtype=np.int64)
 
@@ -868,7 +872,10 @@ class _BatchFitter:
 
     def _all_segments(self):
         """All segments so far, lines and cubics, sorted by start: (A, B, C, E, is_line)
-        (a line's C and E are zeros)."""
+        (a line's C and E are zeros). The rounds that change them write into these
+        arrays, then :meth:`_store` them."""
+        if self._all is not None and self._all_valid():
+            return self._all[2]
         la = np.concatenate(self._lines) if self._lines else np.zeros(0, dtype=np.intp)
         cub = self._cubics
         nC = sum(len(c[0]) for c in cub)
@@ -878,17 +885,42 @@ class _BatchFitter:
         E = np.concatenate([np.zeros(len(la))] + [c[3] for c in cub])
         isl = np.r_[np.ones(len(la), dtype=bool), np.zeros(nC, dtype=bool)]
         o = np.argsort(A, kind="stable")
-        return A[o], B[o], C[o], E[o], isl[o]
+        out = (A[o], B[o], C[o], E[o], isl[o])
+        self._all = (self._lines, self._cubics, out, len(self._lines), len(self._cubics))
+        self._all_fixed = None
+        return out
+
+    def _all_valid(self) -> bool:
+        """The cached segments are still all of them (the lists are only appended to or
+        replaced)."""
+        lines, cubics, _, n_lines, n_cubics = self._all
+        return (self._lines is lines and self._cubics is cubics and len(lines) == n_lines
+                and len(cubics) == n_cubics)
 
     def _store(self, A, B, C, E, isl) -> None:
+        """The segments (sorted by start, as :meth:`_all_segments` gives them) kept as the
+        lines and cubics; the arrays themselves are what :meth:`_all_segments` returns next
+        (the same values it would build: one segment per start, a line's B = A + 1 and its
+        C, E zeros)."""
         self._lines = [A[isl]]
         c = ~isl
         self._cubics = [(A[c], B[c], C[c], E[c])]
+        self._all = (self._lines, self._cubics, (A, B, C, E, isl), 1, 1)
+        self._all_fixed = None
 
     def _fixed_lines(self, A, B, isl) -> np.ndarray:
         """Rounded input: the lines with no input point between their ends, longer than
         ``_ABSORB_SHORT`` times the bound: lines of the design (a cubic over one could stray
-        by the rounding), never merged into a cubic."""
+        by the rounding), never merged into a cubic. (Cached for the stored segments.)"""
+        cached = self._all is not None and self._all[2][0] is A and self._all_valid()
+        if cached and self._all_fixed is not None:
+            return self._all_fixed
+        fixed = self._fixed_lines_of(A, B, isl)
+        if cached:
+            self._all_fixed = fixed
+        return fixed
+
+    def _fixed_lines_of(self, A, B, isl) -> np.ndarray:
         fixed = np.zeros(len(A), dtype=bool)
         if self.quant is not None:
             ch = self.q[B] - self.q[A]
