@@ -867,7 +867,8 @@ class _BatchFitter:
         isl[t + 1] = False
         keep = np.ones(len(A), dtype=bool)
         keep[t + 2] = False
-        self._store(A[keep], B[keep], C[keep], E[keep], isl[keep])
+        # (the triples held no design line: the others' stay as they were)
+        self._store(A[keep], B[keep], C[keep], E[keep], isl[keep], fixed[keep])
         return True
 
     def _all_segments(self):
@@ -897,16 +898,16 @@ class _BatchFitter:
         return (self._lines is lines and self._cubics is cubics and len(lines) == n_lines
                 and len(cubics) == n_cubics)
 
-    def _store(self, A, B, C, E, isl) -> None:
+    def _store(self, A, B, C, E, isl, fixed: np.ndarray | None = None) -> None:
         """The segments (sorted by start, as :meth:`_all_segments` gives them) kept as the
         lines and cubics; the arrays themselves are what :meth:`_all_segments` returns next
         (the same values it would build: one segment per start, a line's B = A + 1 and its
-        C, E zeros)."""
+        C, E zeros). ``fixed``: their :meth:`_fixed_lines` where known."""
         self._lines = [A[isl]]
         c = ~isl
         self._cubics = [(A[c], B[c], C[c], E[c])]
         self._all = (self._lines, self._cubics, (A, B, C, E, isl), 1, 1)
-        self._all_fixed = None
+        self._all_fixed = fixed
 
     def _fixed_lines(self, A, B, isl) -> np.ndarray:
         """Rounded input: the lines with no input point between their ends, longer than
@@ -962,7 +963,8 @@ class _BatchFitter:
         isl[i] = False
         keep = np.ones(len(A), dtype=bool)
         keep[i + 1] = False
-        self._store(A[keep], B[keep], C[keep], E[keep], isl[keep])
+        # (the merged segments were no design lines: the others' stay as they were)
+        self._store(A[keep], B[keep], C[keep], E[keep], isl[keep], fixed[keep])
         return True
 
     def _try(self, A: np.ndarray, B: np.ndarray):
