@@ -489,13 +489,20 @@ def test_window_sums_equal_numpy_reduceat_bit_for_bit():
 
     rng = np.random.default_rng(11)
     cnt = np.r_[4, 5, 8, 9, 127, 128, 129, 136, 255, 257, 1000, 3000, rng.integers(4, 400, 50)]
-    n = int(cnt.sum())
-    sv = rng.uniform(-1.0, 1.0, n)
-    W = rng.normal(size=(n + 10, 2)) * rng.lognormal(0.0, 4.0, size=(n + 10, 1))
-    idx = rng.integers(0, n + 10, n)
-    starts = np.cumsum(cnt) - cnt
+    n = int(cnt.sum()) + 10
+    # windows lo..hi (inclusive, overlapping) of a path's input points W at arc lengths arc,
+    # the fit's point ``at`` inside each: s scaled to (arc - arc[at]) / (arc[hi] - arc[lo])
+    arc = np.cumsum(rng.uniform(0.0, 3.0, n))
+    W = rng.normal(size=(n, 2)) * rng.lognormal(0.0, 4.0, size=(n, 1))
+    lo = rng.integers(0, n - cnt)
+    hi = lo + cnt - 1
+    at = lo + rng.integers(0, cnt)
     mom, rx, ry = np.empty((5, len(cnt))), np.empty((3, len(cnt))), np.empty((3, len(cnt)))
-    _window_sums(sv, W, idx, starts, mom, rx, ry)
+    _window_sums(arc, W, lo, hi, at, mom, rx, ry)
+    own = np.repeat(np.arange(len(cnt)), cnt)
+    idx = lo[own] + np.arange(int(cnt.sum())) - np.repeat(np.cumsum(cnt) - cnt, cnt)
+    sv = (arc[idx] - arc[at][own]) / (arc[hi] - arc[lo])[own]
+    starts = np.cumsum(cnt) - cnt
     s2 = sv * sv
     pw = np.stack([np.ones_like(sv), sv, s2, s2 * sv, s2 * s2])
     assert np.array_equal(mom, np.add.reduceat(pw, starts, axis=1))
