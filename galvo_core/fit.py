@@ -1684,6 +1684,40 @@ def _local_fits(
     return pos, tan, ok
 
 
+@njit(cache=True, nogil=True)
+def _line_moments(W, lo, hi, at, ok, mx, my, sxx, syy, sxy):  # pragma: no cover (compiled)
+    """:func:`_local_lines`' sums per window j where ok[j] (the input points lo[j] ..
+    hi[j] as offsets d from W[at[j]]): mx, my the means of d, sxx, syy, sxy the sums of the
+    products of d minus its mean, each summed in order from 0 (as np.bincount does)."""
+    for j in range(lo.shape[0]):
+        if not ok[j]:
+            continue
+        rx = W[at[j], 0]
+        ry = W[at[j], 1]
+        n = hi[j] - lo[j] + 1
+        sx = 0.0
+        sy = 0.0
+        for i in range(lo[j], hi[j] + 1):
+            sx += W[i, 0] - rx
+            sy += W[i, 1] - ry
+        ax = sx / n
+        ay = sy / n
+        a = 0.0
+        b = 0.0
+        c = 0.0
+        for i in range(lo[j], hi[j] + 1):
+            dx = (W[i, 0] - rx) - ax
+            dy = (W[i, 1] - ry) - ay
+            a += dx * dx
+            b += dy * dy
+            c += dx * dy
+        mx[j] = ax
+        my[j] = ay
+        sxx[j] = a
+        syy[j] = b
+        sxy[j] = c
+
+
 def _local_lines(
     W: np.ndarray, lo: np.ndarray, hi: np.ndarray, at: np.ndarray
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -1697,19 +1731,15 @@ def _local_lines(
     tan = np.zeros((v, 2))
     if not ok.any():
         return pos, tan, ok
-    c = np.where(ok, cnt, 0)
-    own, off = _ragged(np.zeros(v, dtype=np.intp), c)
-    idx = lo[own] + off
     ref = W[at]
-    d = W[idx] - ref[own]
-    n = np.maximum(c, 1)
-    mx = np.bincount(own, d[:, 0], v) / n
-    my = np.bincount(own, d[:, 1], v) / n
-    dx = d[:, 0] - mx[own]
-    dy = d[:, 1] - my[own]
-    sxx = np.bincount(own, dx * dx, v)
-    syy = np.bincount(own, dy * dy, v)
-    sxy = np.bincount(own, dx * dy, v)
+    # the mean offset from the reference point and the second moments about the mean per
+    # window (compiled: the sums in np.bincount's order, the same numbers)
+    mx = np.zeros(v)
+    my = np.zeros(v)
+    sxx = np.zeros(v)
+    syy = np.zeros(v)
+    sxy = np.zeros(v)
+    _line_moments(W, lo, hi, at, ok, mx, my, sxx, syy, sxy)
     ang = 0.5 * np.arctan2(2.0 * sxy, sxx - syy)
     tx, ty = np.cos(ang), np.sin(ang)
     ch = W[hi] - W[lo]
