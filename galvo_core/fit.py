@@ -583,6 +583,7 @@ class _BatchFitter:
         # valid while _lines and _cubics are the lists it stored
         self._all: tuple | None = None
         self._all_fixed: np.ndarray | None = None
+        self._barely_turns: np.ndarray | None = None
         #: keys a (M + 1) + b of the ranges a..b that :meth:`_try` found no cubic for
         self._failed = np.zeros(0, dtype=np.int64)
 
@@ -939,12 +940,11 @@ class _BatchFitter:
         A, B, C, E, isl = self._all_segments()
         if len(A) < 2:
             return False
-        v = B[:-1]
-        ti, to = self.t_in[v], self.t_out[v]
-        cosv = (ti * to).sum(axis=1)
+        if self._barely_turns is None:  # per thinned point (the tangents stay as they are)
+            cosv = (self.t_in * self.t_out).sum(axis=1)
+            self._barely_turns = cosv > math.cos(_ABSORB_TURN)
         fixed = self._fixed_lines(A, B, isl)
-        adj = ((B[:-1] == A[1:]) & ~fixed[:-1] & ~fixed[1:]
-               & (cosv > math.cos(_ABSORB_TURN)))
+        adj = ((B[:-1] == A[1:]) & ~fixed[:-1] & ~fixed[1:] & self._barely_turns[B[:-1]])
         if not adj.any():
             return False
         idx = np.flatnonzero(adj)
