@@ -584,6 +584,10 @@ class _BatchFitter:
         self._all: tuple | None = None
         self._all_fixed: np.ndarray | None = None
         self._barely_turns: np.ndarray | None = None
+        # the candidate pairs / triples of the merge rounds for the segments starting at A
+        # (the array itself): (A, idx, position in its chain)
+        self._pairs: tuple | None = None
+        self._triples: tuple | None = None
         #: keys a (M + 1) + b of the ranges a..b that :meth:`_try` found no cubic for
         self._failed = np.zeros(0, dtype=np.int64)
 
@@ -805,17 +809,22 @@ class _BatchFitter:
         A, B, C, E, isl = self._all_segments()
         if len(A) < 3:
             return False
-        adj = B[:-1] == A[1:]
         fixed = self._fixed_lines(A, B, isl)
-        nl = isl[:-2].astype(np.int8) + isl[1:-1] + isl[2:]
-        tri = (adj[:-1] & adj[1:] & (nl <= _RESPLIT_LINES)
-               & ~fixed[:-2] & ~fixed[1:-1] & ~fixed[2:])
-        idx = np.flatnonzero(tri)
+        if self._triples is not None and self._triples[0] is A:  # (phases of one state)
+            idx, pos = self._triples[1], self._triples[2]
+        else:
+            adj = B[:-1] == A[1:]
+            nl = isl[:-2].astype(np.int8) + isl[1:-1] + isl[2:]
+            tri = (adj[:-1] & adj[1:] & (nl <= _RESPLIT_LINES)
+                   & ~fixed[:-2] & ~fixed[1:-1] & ~fixed[2:])
+            idx = np.flatnonzero(tri)
+            brk = np.r_[True, idx[1:] != idx[:-1] + 1]
+            chain_start = np.maximum.accumulate(np.where(brk, np.arange(len(idx)), 0))
+            pos = (np.arange(len(idx)) - chain_start) % 3
+            self._triples = (A, idx, pos)
         if len(idx) == 0:
             return False
-        brk = np.r_[True, idx[1:] != idx[:-1] + 1]
-        chain_start = np.maximum.accumulate(np.where(brk, np.arange(len(idx)), 0))
-        pick = idx[(np.arange(len(idx)) - chain_start) % 3 == phase]
+        pick = idx[pos == phase]
         if len(pick) == 0:
             return False
         a0, d0 = A[pick], B[pick + 2]
@@ -944,13 +953,19 @@ class _BatchFitter:
             cosv = (self.t_in * self.t_out).sum(axis=1)
             self._barely_turns = cosv > math.cos(_ABSORB_TURN)
         fixed = self._fixed_lines(A, B, isl)
-        adj = ((B[:-1] == A[1:]) & ~fixed[:-1] & ~fixed[1:] & self._barely_turns[B[:-1]])
-        if not adj.any():
+        if self._pairs is not None and self._pairs[0] is A:  # (both parities of one state)
+            idx, pos = self._pairs[1], self._pairs[2]
+        else:
+            adj = ((B[:-1] == A[1:]) & ~fixed[:-1] & ~fixed[1:]
+                   & self._barely_turns[B[:-1]])
+            idx = np.flatnonzero(adj)
+            brk = np.r_[True, idx[1:] != idx[:-1] + 1]
+            chain_start = np.maximum.accumulate(np.where(brk, np.arange(len(idx)), 0))
+            pos = (np.arange(len(idx)) - chain_start) % 2
+            self._pairs = (A, idx, pos)
+        if len(idx) == 0:
             return False
-        idx = np.flatnonzero(adj)
-        brk = np.r_[True, idx[1:] != idx[:-1] + 1]
-        chain_start = np.maximum.accumulate(np.where(brk, np.arange(len(idx)), 0))
-        pick = idx[(np.arange(len(idx)) - chain_start) % 2 == parity]
+        pick = idx[pos == parity]
         if len(pick) == 0:
             return False
         ok, ctrl, em = self._try(A[pick], B[pick + 1])
