@@ -1663,6 +1663,110 @@ def _window_sums(arc, W, lo, hi, at, mom, rx, ry):  # pragma: no cover (compiled
             ry[r, j] = buf[7 + r, 0] + _pairwise_sum(buf[7 + r], 1, n - 1)
 
 
+@njit(cache=True, nogil=True)
+def _lu3_one(a, piv) -> None:  # pragma: no cover (compiled)
+    """LU with partial pivoting of the 3x3 ``a`` in place (unit lower L below the diagonal,
+    U on and above; row j swapped with piv[j]), in LAPACK getf2's left-looking order as
+    the bundled OpenBLAS runs it (the multipliers scaled by the pivot's reciprocal)."""
+    for j in range(3):
+        for i in range(j):
+            ip = piv[i]
+            if ip != i:
+                t = a[i, j]
+                a[i, j] = a[ip, j]
+                a[ip, j] = t
+        for i in range(1, j):
+            s = 0.0
+            for k in range(i):
+                s += a[i, k] * a[k, j]
+            a[i, j] -= s
+        for i in range(j, 3):
+            s = 0.0
+            for k in range(j):
+                s += a[i, k] * a[k, j]
+            a[i, j] -= s
+        jp = j
+        mx = abs(a[j, j])
+        for i in range(j + 1, 3):
+            if abs(a[i, j]) > mx:
+                mx = abs(a[i, j])
+                jp = i
+        piv[j] = jp
+        t1 = a[jp, j]
+        if t1 != 0.0:
+            rcp = 1.0 / t1
+            if jp != j:
+                for k in range(j + 1):
+                    t = a[j, k]
+                    a[j, k] = a[jp, k]
+                    a[jp, k] = t
+            for i in range(j + 1, 3):
+                a[i, j] *= rcp
+
+
+@njit(cache=True, nogil=True)
+def _lu3(A, lu, piv, det) -> None:  # pragma: no cover (compiled)
+    """Per 3x3 matrix A[m]: its LU (:func:`_lu3_one`) and its determinant as np.linalg.det
+    gives it (sign times exp of the sum of the logs of the pivots' magnitudes)."""
+    for m in range(A.shape[0]):
+        a = lu[m]
+        a[:, :] = A[m]
+        p = piv[m]
+        _lu3_one(a, p)
+        sign = 1.0
+        logdet = 0.0
+        zero = False
+        for i in range(3):
+            if p[i] != i:
+                sign = -sign
+        for i in range(3):
+            d = a[i, i]
+            if d == 0.0:
+                zero = True
+            if d < 0.0:
+                sign = -sign
+                d = -d
+            logdet += np.log(d)
+        det[m] = 0.0 if zero else sign * np.exp(logdet)
+
+
+@njit(cache=True, nogil=True)
+def _solve3(lu, piv, good, rx, ry, cx, cy) -> None:  # pragma: no cover (compiled)
+    """cx[m], cy[m]: the solutions of A[m] c = rx[:, m], ry[:, m] from its LU, in
+    np.linalg.solve's order (getrs: the row swaps, L forward, U backward from the last
+    column); the identity's solution (the right side) where not good[m]."""
+    eye = np.eye(3)
+    ep = np.empty(3, dtype=np.intp)
+    _lu3_one(eye, ep)
+    x = np.empty(3)
+    for m in range(lu.shape[0]):
+        a = lu[m] if good[m] else eye
+        p = piv[m] if good[m] else ep
+        for side in range(2):
+            r = rx if side == 0 else ry
+            for i in range(3):
+                x[i] = r[i, m]
+            for i in range(3):
+                ip = p[i]
+                if ip != i:
+                    t = x[i]
+                    x[i] = x[ip]
+                    x[ip] = t
+            for i in range(3):
+                s = x[i]
+                for k in range(i):
+                    s -= a[i, k] * x[k]
+                x[i] = s
+            for i in range(2, -1, -1):
+                s = x[i]
+                for k in range(2, i, -1):
+                    s -= a[i, k] * x[k]
+                x[i] = s / a[i, i]
+            c = cx if side == 0 else cy
+            for i in range(3):
+                c[m, i] = x[i]
+
+
 def _local_fits(
     W: np.ndarray, arc: np.ndarray, lo: np.ndarray, hi: np.ndarray, at: np.ndarray
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -1685,11 +1789,15 @@ def _local_fits(
     ry = np.empty((3, len(okk)))
     _window_sums(arc, W, lo[okk], hi[okk], at[okk], mom, rx, ry)
     A = np.stack([mom[0:3], mom[1:4], mom[2:5]]).transpose(2, 0, 1)  # (V', 3, 3)
-    det = np.linalg.det(A)
+    # (compiled: np.linalg.det's and np.linalg.solve's numbers, one factorization)
+    lu = np.empty_like(A)
+    piv = np.empty((len(A), 3), dtype=np.intp)
+    det = np.empty(len(A))
+    _lu3(A, lu, piv, det)
     good = np.abs(det) > 1e-9 * np.abs(A).max(axis=(1, 2)) ** 3
-    A[~good] = np.eye(3)
-    cx = np.linalg.solve(A, rx.T[:, :, None])[:, :, 0]
-    cy = np.linalg.solve(A, ry.T[:, :, None])[:, :, 0]
+    cx = np.empty((len(A), 3))
+    cy = np.empty((len(A), 3))
+    _solve3(lu, piv, good, rx, ry, cx, cy)
     pos[okk] = np.stack([cx[:, 0], cy[:, 0]], axis=1)
     t = np.stack([cx[:, 1], cy[:, 1]], axis=1)
     ln = np.hypot(t[:, 0], t[:, 1])
