@@ -538,3 +538,43 @@ def test_batches_by_points_cover_every_path_once_and_change_nothing() -> None:
     for a, b in zip(one, split, strict=True):
         np.testing.assert_array_equal(a.points, b.points)
         np.testing.assert_array_equal(a.is_cubic, b.is_cubic)
+
+
+def test_local_fit_3x3_kernels_match_numpy_det_and_solve() -> None:
+    """The local fits' compiled 3x3 LU gives np.linalg.det's determinant and
+    np.linalg.solve's solutions (to the last bits here; checked to 1e-12 relative so
+    another BLAS's rounding does not fail it), on the moment matrices of windows (sums of
+    1, s .. s^4), also singular and permuted ones; where a matrix is not used (not good)
+    the solution is the right-hand side."""
+    from galvo_core.fit import _lu3, _solve3
+
+    rng = np.random.default_rng(5)
+    mats = []
+    for _ in range(400):
+        sv = rng.uniform(-1.0, 1.0, rng.integers(4, 60))
+        m = np.array([[np.sum(sv ** (i + j)) for j in range(3)] for i in range(3)])
+        mats.append(m)
+    mats.append(np.ones((3, 3)))  # singular
+    mats.append(np.array([[0.0, 1.0, 2.0], [3.0, 0.0, 1.0], [1.0, 4.0, 0.0]]))  # pivots
+    mats.append(np.zeros((3, 3)))
+    A = np.array(mats)
+    lu = np.empty_like(A)
+    piv = np.empty((len(A), 3), dtype=np.intp)
+    det = np.empty(len(A))
+    _lu3(A, lu, piv, det)
+    want = np.linalg.det(A)
+    assert np.allclose(det, want, rtol=1e-12, atol=0.0)
+    assert det[-3] == 0.0 and det[-1] == 0.0
+    good = np.abs(det) > 1e-9 * np.abs(A).max(axis=(1, 2)) ** 3
+    assert good[:-3].all() and not good[-3] and good[-2] and not good[-1]
+    rx = rng.normal(size=(3, len(A)))
+    ry = rng.normal(size=(3, len(A)))
+    cx = np.empty((len(A), 3))
+    cy = np.empty((len(A), 3))
+    _solve3(lu, piv, good, rx, ry, cx, cy)
+    Ag = A.copy()
+    Ag[~good] = np.eye(3)
+    assert np.allclose(cx, np.linalg.solve(Ag, rx.T[:, :, None])[:, :, 0], rtol=1e-9, atol=1e-12)
+    assert np.allclose(cy, np.linalg.solve(Ag, ry.T[:, :, None])[:, :, 0], rtol=1e-9, atol=1e-12)
+    assert np.array_equal(cx[~good], rx.T[~good])
+    assert np.allclose(np.einsum("mij,mj->mi", Ag, cx), rx.T, rtol=1e-7, atol=1e-9)
