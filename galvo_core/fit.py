@@ -1705,29 +1705,45 @@ def _lu3_one(a, piv) -> None:  # pragma: no cover (compiled)
 
 
 @njit(cache=True, nogil=True)
-def _lu3(A, lu, piv, det) -> None:  # pragma: no cover (compiled)
-    """Per 3x3 matrix A[m]: its LU (:func:`_lu3_one`) and its determinant as np.linalg.det
-    gives it (sign times exp of the sum of the logs of the pivots' magnitudes)."""
+def _det3(a, p) -> float:  # pragma: no cover (compiled)
+    """The determinant of the matrix whose LU (:func:`_lu3_one`) is ``a``, ``p`` as
+    np.linalg.det gives it: sign times exp of the sum of the logs of the pivots'
+    magnitudes (0 with a zero pivot)."""
+    sign = 1.0
+    logdet = 0.0
+    zero = False
+    for i in range(3):
+        if p[i] != i:
+            sign = -sign
+    for i in range(3):
+        d = a[i, i]
+        if d == 0.0:
+            zero = True
+        if d < 0.0:
+            sign = -sign
+            d = -d
+        logdet += np.log(d)
+    return 0.0 if zero else sign * np.exp(logdet)
+
+
+@njit(cache=True, nogil=True)
+def _lu3(A, lu, piv, lim, good) -> None:  # pragma: no cover (compiled)
+    """Per 3x3 matrix A[m]: its LU (:func:`_lu3_one`) and good[m] = |det| > lim[m] for
+    np.linalg.det's determinant (:func:`_det3`). The product of the pivots decides where it
+    is clear of lim by a relative 1e-9 (np.linalg.det's log-exp path differs from it by a
+    few 1e-16 relative); only the others take the logs."""
     for m in range(A.shape[0]):
         a = lu[m]
         a[:, :] = A[m]
         p = piv[m]
         _lu3_one(a, p)
-        sign = 1.0
-        logdet = 0.0
-        zero = False
-        for i in range(3):
-            if p[i] != i:
-                sign = -sign
-        for i in range(3):
-            d = a[i, i]
-            if d == 0.0:
-                zero = True
-            if d < 0.0:
-                sign = -sign
-                d = -d
-            logdet += np.log(d)
-        det[m] = 0.0 if zero else sign * np.exp(logdet)
+        prod = abs(a[0, 0] * a[1, 1] * a[2, 2])
+        if prod > lim[m] * (1.0 + 1e-9):
+            good[m] = True
+        elif prod < lim[m] * (1.0 - 1e-9):
+            good[m] = False
+        else:
+            good[m] = abs(_det3(a, p)) > lim[m]
 
 
 @njit(cache=True, nogil=True)
@@ -1792,9 +1808,8 @@ def _local_fits(
     # (compiled: np.linalg.det's and np.linalg.solve's numbers, one factorization)
     lu = np.empty_like(A)
     piv = np.empty((len(A), 3), dtype=np.intp)
-    det = np.empty(len(A))
-    _lu3(A, lu, piv, det)
-    good = np.abs(det) > 1e-9 * np.abs(A).max(axis=(1, 2)) ** 3
+    good = np.empty(len(A), dtype=np.bool_)
+    _lu3(A, lu, piv, 1e-9 * np.abs(A).max(axis=(1, 2)) ** 3, good)
     cx = np.empty((len(A), 3))
     cy = np.empty((len(A), 3))
     _solve3(lu, piv, good, rx, ry, cx, cy)

@@ -546,7 +546,7 @@ def test_local_fit_3x3_kernels_match_numpy_det_and_solve() -> None:
     another BLAS's rounding does not fail it), on the moment matrices of windows (sums of
     1, s .. s^4), also singular and permuted ones; where a matrix is not used (not good)
     the solution is the right-hand side."""
-    from galvo_core.fit import _lu3, _solve3
+    from galvo_core.fit import _det3, _lu3, _solve3
 
     rng = np.random.default_rng(5)
     mats = []
@@ -560,12 +560,21 @@ def test_local_fit_3x3_kernels_match_numpy_det_and_solve() -> None:
     A = np.array(mats)
     lu = np.empty_like(A)
     piv = np.empty((len(A), 3), dtype=np.intp)
-    det = np.empty(len(A))
-    _lu3(A, lu, piv, det)
+    lim = 1e-9 * np.abs(A).max(axis=(1, 2)) ** 3
+    good = np.empty(len(A), dtype=bool)
+    _lu3(A, lu, piv, lim, good)
+    det = np.array([_det3(lu[m], piv[m]) for m in range(len(A))])
     want = np.linalg.det(A)
     assert np.allclose(det, want, rtol=1e-12, atol=0.0)
     assert det[-3] == 0.0 and det[-1] == 0.0
-    good = np.abs(det) > 1e-9 * np.abs(A).max(axis=(1, 2)) ** 3
+    assert np.array_equal(good, np.abs(want) > lim)
+    # at the limit itself the decision is the determinant's (the log-exp one)
+    at = np.abs(det[:5])
+    _lu3(A[:5], lu[:5], piv[:5], at, good[:5])
+    assert not good[:5].any()
+    _lu3(A[:5], lu[:5], piv[:5], np.nextafter(at, 0.0), good[:5])
+    assert good[:5].all()
+    _lu3(A, lu, piv, lim, good)
     assert good[:-3].all() and not good[-3] and good[-2] and not good[-1]
     rx = rng.normal(size=(3, len(A)))
     ry = rng.normal(size=(3, len(A)))
