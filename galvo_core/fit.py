@@ -904,6 +904,8 @@ class _BatchFitter:
     def _all_valid(self) -> bool:
         """The cached segments are still all of them (the lists are only appended to or
         replaced)."""
+        if self._all is None:
+            return False
         lines, cubics, _, n_lines, n_cubics = self._all
         return (self._lines is lines and self._cubics is cubics and len(lines) == n_lines
                 and len(cubics) == n_cubics)
