@@ -993,7 +993,7 @@ class _BatchFitter:
         em_all = np.zeros(m)
         # a range that failed before fails again (same ends, tangents and points): skipped
         key = A.astype(np.int64) * (len(self.kept) + 1) + B
-        fresh = ~np.isin(key, self._failed) if len(self._failed) else np.ones(m, dtype=bool)
+        fresh = ~self._failed_before(key)
         ok, p0, qq, p3, sig = self._triangle(A, B)
         ok &= fresh
         w = np.flatnonzero(ok)
@@ -1037,7 +1037,7 @@ class _BatchFitter:
         triangle does not exist, the range failed before, or the coarse screening cubic
         misses by over ``_SCREEN_SLACK`` times the bound); True otherwise."""
         key = A.astype(np.int64) * (len(self.kept) + 1) + B
-        hope = ~np.isin(key, self._failed) if len(self._failed) else np.ones(len(A), bool)
+        hope = ~self._failed_before(key)
         ok, p0, qq, p3, sig = self._triangle(A, B)
         hope &= ok
         w = np.flatnonzero(hope)
@@ -1049,6 +1049,15 @@ class _BatchFitter:
                              _SCREEN_STEPS, 10.0 * self.eps_sum)
         hope[w] = self._sample_ok(cc, i0, i1, _SCREEN_SLACK * self.e_per[a], _SCREEN_SAMPLE)
         return hope
+
+    def _failed_before(self, keys: np.ndarray) -> np.ndarray:
+        """np.isin(keys, self._failed) by binary search (the failed keys are sorted and
+        unique: np.union1d keeps them so)."""
+        f = self._failed
+        if len(f) == 0:
+            return np.zeros(len(keys), dtype=bool)
+        pos = np.minimum(np.searchsorted(f, keys), len(f) - 1)
+        return f[pos] == keys
 
     def _remember_failed(self, keys: np.ndarray) -> None:
         if len(keys):
