@@ -587,6 +587,15 @@ class _BatchFitter:
         self.arc = arc
         self._cubics: list[tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]] = []
         self._lines: list[np.ndarray] = []
+        # :meth:`_all_segments` as :meth:`_store` left it (and its :meth:`_fixed_lines`),
+        # valid while _lines and _cubics are the lists it stored
+        self._all: tuple | None = None
+        self._all_fixed: np.ndarray | None = None
+        self._barely_turns: np.ndarray | None = None
+        # the candidate pairs / triples of the merge rounds for the segments starting at A
+        # (the array itself): (A, idx, position in its chain)
+        self._pairs: tuple | None = None
+        self._triples: tuple | None = None
         #: keys a (M + 1) + b of the ranges a..b that :meth:`_try` found no cubic for
         self._failed = np.zeros(0, dtype=np.int64)
 
@@ -808,17 +817,22 @@ class _BatchFitter:
         A, B, C, E, isl = self._all_segments()
         if len(A) < 3:
             return False
-        adj = B[:-1] == A[1:]
         fixed = self._fixed_lines(A, B, isl)
-        nl = isl[:-2].astype(np.int8) + isl[1:-1] + isl[2:]
-        tri = (adj[:-1] & adj[1:] & (nl <= _RESPLIT_LINES)
-               & ~fixed[:-2] & ~fixed[1:-1] & ~fixed[2:])
-        idx = np.flatnonzero(tri)
+        if self._triples is not None and self._triples[0] is A:  # (phases of one state)
+            idx, pos = self._triples[1], self._triples[2]
+        else:
+            adj = B[:-1] == A[1:]
+            nl = isl[:-2].astype(np.int8) + isl[1:-1] + isl[2:]
+            tri = (adj[:-1] & adj[1:] & (nl <= _RESPLIT_LINES)
+                   & ~fixed[:-2] & ~fixed[1:-1] & ~fixed[2:])
+            idx = np.flatnonzero(tri)
+            brk = np.r_[True, idx[1:] != idx[:-1] + 1]
+            chain_start = np.maximum.accumulate(np.where(brk, np.arange(len(idx)), 0))
+            pos = (np.arange(len(idx)) - chain_start) % 3
+            self._triples = (A, idx, pos)
         if len(idx) == 0:
             return False
-        brk = np.r_[True, idx[1:] != idx[:-1] + 1]
-        chain_start = np.maximum.accumulate(np.where(brk, np.arange(len(idx)), 0))
-        pick = idx[(np.arange(len(idx)) - chain_start) % 3 == phase]
+        pick = idx[pos == phase]
         if len(pick) == 0:
             return False
         a0, d0 = A[pick], B[pick + 2]
@@ -871,12 +885,16 @@ class _BatchFitter:
         isl[t + 1] = False
         keep = np.ones(len(A), dtype=bool)
         keep[t + 2] = False
-        self._store(A[keep], B[keep], C[keep], E[keep], isl[keep])
+        # (the triples held no design line: the others' stay as they were)
+        self._store(A[keep], B[keep], C[keep], E[keep], isl[keep], fixed[keep])
         return True
 
     def _all_segments(self):
         """All segments so far, lines and cubics, sorted by start: (A, B, C, E, is_line)
-        (a line's C and E are zeros)."""
+        (a line's C and E are zeros). The rounds that change them write into these
+        arrays, then :meth:`_store` them."""
+        if self._all is not None and self._all_valid():
+            return self._all[2]
         la = np.concatenate(self._lines) if self._lines else np.zeros(0, dtype=np.intp)
         cub = self._cubics
         nC = sum(len(c[0]) for c in cub)
@@ -886,17 +904,44 @@ class _BatchFitter:
         E = np.concatenate([np.zeros(len(la))] + [c[3] for c in cub])
         isl = np.r_[np.ones(len(la), dtype=bool), np.zeros(nC, dtype=bool)]
         o = np.argsort(A, kind="stable")
-        return A[o], B[o], C[o], E[o], isl[o]
+        out = (A[o], B[o], C[o], E[o], isl[o])
+        self._all = (self._lines, self._cubics, out, len(self._lines), len(self._cubics))
+        self._all_fixed = None
+        return out
 
-    def _store(self, A, B, C, E, isl) -> None:
+    def _all_valid(self) -> bool:
+        """The cached segments are still all of them (the lists are only appended to or
+        replaced)."""
+        if self._all is None:
+            return False
+        lines, cubics, _, n_lines, n_cubics = self._all
+        return (self._lines is lines and self._cubics is cubics and len(lines) == n_lines
+                and len(cubics) == n_cubics)
+
+    def _store(self, A, B, C, E, isl, fixed: np.ndarray | None = None) -> None:
+        """The segments (sorted by start, as :meth:`_all_segments` gives them) kept as the
+        lines and cubics; the arrays themselves are what :meth:`_all_segments` returns next
+        (the same values it would build: one segment per start, a line's B = A + 1 and its
+        C, E zeros). ``fixed``: their :meth:`_fixed_lines` where known."""
         self._lines = [A[isl]]
         c = ~isl
         self._cubics = [(A[c], B[c], C[c], E[c])]
+        self._all = (self._lines, self._cubics, (A, B, C, E, isl), 1, 1)
+        self._all_fixed = fixed
 
     def _fixed_lines(self, A, B, isl) -> np.ndarray:
         """Rounded input: the lines with no input point between their ends, longer than
         ``_ABSORB_SHORT`` times the bound: lines of the design (a cubic over one could stray
-        by the rounding), never merged into a cubic."""
+        by the rounding), never merged into a cubic. (Cached for the stored segments.)"""
+        cached = self._all is not None and self._all[2][0] is A and self._all_valid()
+        if cached and self._all_fixed is not None:
+            return self._all_fixed
+        fixed = self._fixed_lines_of(A, B, isl)
+        if cached:
+            self._all_fixed = fixed
+        return fixed
+
+    def _fixed_lines_of(self, A, B, isl) -> np.ndarray:
         fixed = np.zeros(len(A), dtype=bool)
         if self.quant is not None:
             ch = self.q[B] - self.q[A]
@@ -914,18 +959,23 @@ class _BatchFitter:
         A, B, C, E, isl = self._all_segments()
         if len(A) < 2:
             return False
-        v = B[:-1]
-        ti, to = self.t_in[v], self.t_out[v]
-        cosv = (ti * to).sum(axis=1)
+        if self._barely_turns is None:  # per thinned point (the tangents stay as they are)
+            cosv = (self.t_in * self.t_out).sum(axis=1)
+            self._barely_turns = cosv > math.cos(_ABSORB_TURN)
         fixed = self._fixed_lines(A, B, isl)
-        adj = ((B[:-1] == A[1:]) & ~fixed[:-1] & ~fixed[1:]
-               & (cosv > math.cos(_ABSORB_TURN)))
-        if not adj.any():
+        if self._pairs is not None and self._pairs[0] is A:  # (both parities of one state)
+            idx, pos = self._pairs[1], self._pairs[2]
+        else:
+            adj = ((B[:-1] == A[1:]) & ~fixed[:-1] & ~fixed[1:]
+                   & self._barely_turns[B[:-1]])
+            idx = np.flatnonzero(adj)
+            brk = np.r_[True, idx[1:] != idx[:-1] + 1]
+            chain_start = np.maximum.accumulate(np.where(brk, np.arange(len(idx)), 0))
+            pos = (np.arange(len(idx)) - chain_start) % 2
+            self._pairs = (A, idx, pos)
+        if len(idx) == 0:
             return False
-        idx = np.flatnonzero(adj)
-        brk = np.r_[True, idx[1:] != idx[:-1] + 1]
-        chain_start = np.maximum.accumulate(np.where(brk, np.arange(len(idx)), 0))
-        pick = idx[(np.arange(len(idx)) - chain_start) % 2 == parity]
+        pick = idx[pos == parity]
         if len(pick) == 0:
             return False
         ok, ctrl, em = self._try(A[pick], B[pick + 1])
@@ -938,7 +988,8 @@ class _BatchFitter:
         isl[i] = False
         keep = np.ones(len(A), dtype=bool)
         keep[i + 1] = False
-        self._store(A[keep], B[keep], C[keep], E[keep], isl[keep])
+        # (the merged segments were no design lines: the others' stay as they were)
+        self._store(A[keep], B[keep], C[keep], E[keep], isl[keep], fixed[keep])
         return True
 
     def _try(self, A: np.ndarray, B: np.ndarray):
@@ -950,7 +1001,7 @@ class _BatchFitter:
         em_all = np.zeros(m)
         # a range that failed before fails again (same ends, tangents and points): skipped
         key = A.astype(np.int64) * (len(self.kept) + 1) + B
-        fresh = ~np.isin(key, self._failed) if len(self._failed) else np.ones(m, dtype=bool)
+        fresh = ~self._failed_before(key)
         ok, p0, qq, p3, sig = self._triangle(A, B)
         ok &= fresh
         w = np.flatnonzero(ok)
@@ -994,7 +1045,7 @@ class _BatchFitter:
         triangle does not exist, the range failed before, or the coarse screening cubic
         misses by over ``_SCREEN_SLACK`` times the bound); True otherwise."""
         key = A.astype(np.int64) * (len(self.kept) + 1) + B
-        hope = ~np.isin(key, self._failed) if len(self._failed) else np.ones(len(A), bool)
+        hope = ~self._failed_before(key)
         ok, p0, qq, p3, sig = self._triangle(A, B)
         hope &= ok
         w = np.flatnonzero(hope)
@@ -1006,6 +1057,15 @@ class _BatchFitter:
                              _SCREEN_STEPS, 10.0 * self.eps_sum)
         hope[w] = self._sample_ok(cc, i0, i1, _SCREEN_SLACK * self.e_per[a], _SCREEN_SAMPLE)
         return hope
+
+    def _failed_before(self, keys: np.ndarray) -> np.ndarray:
+        """np.isin(keys, self._failed) by binary search (the failed keys are sorted and
+        unique: np.union1d keeps them so)."""
+        f = self._failed
+        if len(f) == 0:
+            return np.zeros(len(keys), dtype=bool)
+        pos = np.minimum(np.searchsorted(f, keys), len(f) - 1)
+        return f[pos] == keys
 
     def _remember_failed(self, keys: np.ndarray) -> None:
         if len(keys):
@@ -1581,30 +1641,29 @@ def _pairwise_sum(a, s, n):  # pragma: no cover (compiled)
 
 
 @njit(cache=True, nogil=True)
-def _window_sums(sv, W, idx, starts, mom, rx, ry):  # pragma: no cover (compiled)
-    """:func:`_local_fits`'s sums per window j (points starts[j] .. starts[j + 1] - 1 of
-    the flat ``sv``, the last to the end): mom[r] of sv^r (r = 0 .. 4), rx[r], ry[r] of
-    sv^r times the x, y of input point idx; each as np.add.reduceat sums them (the first
-    term plus numpy's pairwise sum of the rest). The powers are products (s^3 = s^2 s,
-    s^4 = s^2 s^2), the same on every machine (numpy's ``**`` takes a vector path on
-    AVX-512 machines and a 28x slower scalar one for negative bases, with different last
-    bits)."""
-    n_all = sv.shape[0]
-    v = starts.shape[0]
+def _window_sums(arc, W, lo, hi, at, mom, rx, ry):  # pragma: no cover (compiled)
+    """:func:`_local_fits`'s sums per window j (the input points lo[j] .. hi[j], inclusive
+    global indices, at arc length s scaled to sv = (s - arc[at[j]]) / max(arc[hi[j]] -
+    arc[lo[j]], 1e-300)): mom[r] of sv^r (r = 0 .. 4), rx[r], ry[r] of sv^r times the x, y
+    of the input point; each as np.add.reduceat sums them (the first term plus numpy's
+    pairwise sum of the rest). The powers are products (s^3 = s^2 s, s^4 = s^2 s^2), the
+    same on every machine (numpy's ``**`` takes a vector path on AVX-512 machines and a 28x
+    slower scalar one for negative bases, with different last bits)."""
+    v = lo.shape[0]
     big = 0
     for j in range(v):
-        e = starts[j + 1] if j + 1 < v else n_all
-        big = max(big, e - starts[j])
+        big = max(big, hi[j] - lo[j] + 1)
     buf = np.empty((10, big))
     for j in range(v):
-        s = starts[j]
-        e = starts[j + 1] if j + 1 < v else n_all
-        n = e - s
+        s = lo[j]
+        n = hi[j] - s + 1
+        a0 = arc[at[j]]
+        scale = max(arc[hi[j]] - arc[s], 1e-300)
         for k in range(n):
-            u = sv[s + k]
+            u = (arc[s + k] - a0) / scale  # in [-1, 1]: well scaled
             u2 = u * u
-            x = W[idx[s + k], 0]
-            y = W[idx[s + k], 1]
+            x = W[s + k, 0]
+            y = W[s + k, 1]
             buf[0, k] = u
             buf[1, k] = u2
             buf[2, k] = u2 * u
@@ -1623,6 +1682,126 @@ def _window_sums(sv, W, idx, starts, mom, rx, ry):  # pragma: no cover (compiled
             ry[r, j] = buf[7 + r, 0] + _pairwise_sum(buf[7 + r], 1, n - 1)
 
 
+@njit(cache=True, nogil=True)
+def _lu3_one(a, piv) -> None:  # pragma: no cover (compiled)
+    """LU with partial pivoting of the 3x3 ``a`` in place (unit lower L below the diagonal,
+    U on and above; row j swapped with piv[j]), in LAPACK getf2's left-looking order as
+    the bundled OpenBLAS runs it (the multipliers scaled by the pivot's reciprocal)."""
+    for j in range(3):
+        for i in range(j):
+            ip = piv[i]
+            if ip != i:
+                t = a[i, j]
+                a[i, j] = a[ip, j]
+                a[ip, j] = t
+        for i in range(1, j):
+            s = 0.0
+            for k in range(i):
+                s += a[i, k] * a[k, j]
+            a[i, j] -= s
+        for i in range(j, 3):
+            s = 0.0
+            for k in range(j):
+                s += a[i, k] * a[k, j]
+            a[i, j] -= s
+        jp = j
+        mx = abs(a[j, j])
+        for i in range(j + 1, 3):
+            if abs(a[i, j]) > mx:
+                mx = abs(a[i, j])
+                jp = i
+        piv[j] = jp
+        t1 = a[jp, j]
+        if t1 != 0.0:
+            rcp = 1.0 / t1
+            if jp != j:
+                for k in range(j + 1):
+                    t = a[j, k]
+                    a[j, k] = a[jp, k]
+                    a[jp, k] = t
+            for i in range(j + 1, 3):
+                a[i, j] *= rcp
+
+
+@njit(cache=True, nogil=True)
+def _det3(a, p) -> float:  # pragma: no cover (compiled)
+    """The determinant of the matrix whose LU (:func:`_lu3_one`) is ``a``, ``p`` as
+    np.linalg.det gives it: sign times exp of the sum of the logs of the pivots'
+    magnitudes (0 with a zero pivot)."""
+    sign = 1.0
+    logdet = 0.0
+    zero = False
+    for i in range(3):
+        if p[i] != i:
+            sign = -sign
+    for i in range(3):
+        d = a[i, i]
+        if d == 0.0:
+            zero = True
+        if d < 0.0:
+            sign = -sign
+            d = -d
+        logdet += np.log(d)
+    return 0.0 if zero else sign * np.exp(logdet)
+
+
+@njit(cache=True, nogil=True)
+def _lu3(A, lu, piv, lim, good) -> None:  # pragma: no cover (compiled)
+    """Per 3x3 matrix A[m]: its LU (:func:`_lu3_one`) and good[m] = |det| > lim[m] for
+    np.linalg.det's determinant (:func:`_det3`). The product of the pivots decides where it
+    is clear of lim by a relative 1e-9 (np.linalg.det's log-exp path differs from it by a
+    few 1e-16 relative); only the others take the logs."""
+    for m in range(A.shape[0]):
+        a = lu[m]
+        a[:, :] = A[m]
+        p = piv[m]
+        _lu3_one(a, p)
+        prod = abs(a[0, 0] * a[1, 1] * a[2, 2])
+        if prod > lim[m] * (1.0 + 1e-9):
+            good[m] = True
+        elif prod < lim[m] * (1.0 - 1e-9):
+            good[m] = False
+        else:
+            good[m] = abs(_det3(a, p)) > lim[m]
+
+
+@njit(cache=True, nogil=True)
+def _solve3(lu, piv, good, rx, ry, cx, cy) -> None:  # pragma: no cover (compiled)
+    """cx[m], cy[m]: the solutions of A[m] c = rx[:, m], ry[:, m] from its LU, in
+    np.linalg.solve's order (getrs: the row swaps, L forward, U backward from the last
+    column); the identity's solution (the right side) where not good[m]."""
+    eye = np.eye(3)
+    ep = np.empty(3, dtype=np.intp)
+    _lu3_one(eye, ep)
+    x = np.empty(3)
+    for m in range(lu.shape[0]):
+        a = lu[m] if good[m] else eye
+        p = piv[m] if good[m] else ep
+        for side in range(2):
+            r = rx if side == 0 else ry
+            for i in range(3):
+                x[i] = r[i, m]
+            for i in range(3):
+                ip = p[i]
+                if ip != i:
+                    t = x[i]
+                    x[i] = x[ip]
+                    x[ip] = t
+            for i in range(3):
+                s = x[i]
+                for k in range(i):
+                    s -= a[i, k] * x[k]
+                x[i] = s
+            for i in range(2, -1, -1):
+                s = x[i]
+                for k in range(2, i, -1):
+                    s -= a[i, k] * x[k]
+                x[i] = s / a[i, i]
+            c = cx if side == 0 else cy
+            for i in range(3):
+                c[m, i] = x[i]
+
+
 def _local_fits(
     W: np.ndarray, arc: np.ndarray, lo: np.ndarray, hi: np.ndarray, at: np.ndarray
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -1637,24 +1816,22 @@ def _local_fits(
     ok = cnt >= 4
     if not ok.any():
         return pos, tan, ok
-    own, off = _ragged(np.zeros(v, dtype=np.intp), np.where(ok, cnt, 0))
-    idx = lo[own] + off
-    scale = np.maximum(arc[hi] - arc[lo], 1e-300)
-    sv = (arc[idx] - arc[at][own]) / scale[own]  # in [-1, 1]: well scaled
-    starts = np.cumsum(np.where(ok, cnt, 0)) - np.where(ok, cnt, 0)
     okk = np.flatnonzero(ok)
     # the sums of 1, s .. s^4 and of x, y times 1, s, s^2 per window (compiled, in
-    # np.add.reduceat's order, without the (5, N) arrays)
+    # np.add.reduceat's order)
     mom = np.empty((5, len(okk)))
     rx = np.empty((3, len(okk)))
     ry = np.empty((3, len(okk)))
-    _window_sums(sv, W, idx, starts[okk], mom, rx, ry)
+    _window_sums(arc, W, lo[okk], hi[okk], at[okk], mom, rx, ry)
     A = np.stack([mom[0:3], mom[1:4], mom[2:5]]).transpose(2, 0, 1)  # (V', 3, 3)
-    det = np.linalg.det(A)
-    good = np.abs(det) > 1e-9 * np.abs(A).max(axis=(1, 2)) ** 3
-    A[~good] = np.eye(3)
-    cx = np.linalg.solve(A, rx.T[:, :, None])[:, :, 0]
-    cy = np.linalg.solve(A, ry.T[:, :, None])[:, :, 0]
+    # (compiled: np.linalg.det's and np.linalg.solve's numbers, one factorization)
+    lu = np.empty_like(A)
+    piv = np.empty((len(A), 3), dtype=np.intp)
+    good = np.empty(len(A), dtype=np.bool_)
+    _lu3(A, lu, piv, 1e-9 * np.abs(A).max(axis=(1, 2)) ** 3, good)
+    cx = np.empty((len(A), 3))
+    cy = np.empty((len(A), 3))
+    _solve3(lu, piv, good, rx, ry, cx, cy)
     pos[okk] = np.stack([cx[:, 0], cy[:, 0]], axis=1)
     t = np.stack([cx[:, 1], cy[:, 1]], axis=1)
     ln = np.hypot(t[:, 0], t[:, 1])
@@ -1662,6 +1839,40 @@ def _local_fits(
     tan[okk] = t / np.where(ln > 0.0, ln, 1.0)[:, None]
     ok[okk] = good
     return pos, tan, ok
+
+
+@njit(cache=True, nogil=True)
+def _line_moments(W, lo, hi, at, ok, mx, my, sxx, syy, sxy):  # pragma: no cover (compiled)
+    """:func:`_local_lines`' sums per window j where ok[j] (the input points lo[j] ..
+    hi[j] as offsets d from W[at[j]]): mx, my the means of d, sxx, syy, sxy the sums of the
+    products of d minus its mean, each summed in order from 0 (as np.bincount does)."""
+    for j in range(lo.shape[0]):
+        if not ok[j]:
+            continue
+        rx = W[at[j], 0]
+        ry = W[at[j], 1]
+        n = hi[j] - lo[j] + 1
+        sx = 0.0
+        sy = 0.0
+        for i in range(lo[j], hi[j] + 1):
+            sx += W[i, 0] - rx
+            sy += W[i, 1] - ry
+        ax = sx / n
+        ay = sy / n
+        a = 0.0
+        b = 0.0
+        c = 0.0
+        for i in range(lo[j], hi[j] + 1):
+            dx = (W[i, 0] - rx) - ax
+            dy = (W[i, 1] - ry) - ay
+            a += dx * dx
+            b += dy * dy
+            c += dx * dy
+        mx[j] = ax
+        my[j] = ay
+        sxx[j] = a
+        syy[j] = b
+        sxy[j] = c
 
 
 def _local_lines(
@@ -1677,19 +1888,15 @@ def _local_lines(
     tan = np.zeros((v, 2))
     if not ok.any():
         return pos, tan, ok
-    c = np.where(ok, cnt, 0)
-    own, off = _ragged(np.zeros(v, dtype=np.intp), c)
-    idx = lo[own] + off
     ref = W[at]
-    d = W[idx] - ref[own]
-    n = np.maximum(c, 1)
-    mx = np.bincount(own, d[:, 0], v) / n
-    my = np.bincount(own, d[:, 1], v) / n
-    dx = d[:, 0] - mx[own]
-    dy = d[:, 1] - my[own]
-    sxx = np.bincount(own, dx * dx, v)
-    syy = np.bincount(own, dy * dy, v)
-    sxy = np.bincount(own, dx * dy, v)
+    # the mean offset from the reference point and the second moments about the mean per
+    # window (compiled: the sums in np.bincount's order, the same numbers)
+    mx = np.zeros(v)
+    my = np.zeros(v)
+    sxx = np.zeros(v)
+    syy = np.zeros(v)
+    sxy = np.zeros(v)
+    _line_moments(W, lo, hi, at, ok, mx, my, sxx, syy, sxy)
     ang = 0.5 * np.arctan2(2.0 * sxy, sxx - syy)
     tx, ty = np.cos(ang), np.sin(ang)
     ch = W[hi] - W[lo]

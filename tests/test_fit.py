@@ -489,13 +489,20 @@ def test_window_sums_equal_numpy_reduceat_bit_for_bit():
 
     rng = np.random.default_rng(11)
     cnt = np.r_[4, 5, 8, 9, 127, 128, 129, 136, 255, 257, 1000, 3000, rng.integers(4, 400, 50)]
-    n = int(cnt.sum())
-    sv = rng.uniform(-1.0, 1.0, n)
-    W = rng.normal(size=(n + 10, 2)) * rng.lognormal(0.0, 4.0, size=(n + 10, 1))
-    idx = rng.integers(0, n + 10, n)
-    starts = np.cumsum(cnt) - cnt
+    n = int(cnt.sum()) + 10
+    # windows lo..hi (inclusive, overlapping) of a path's input points W at arc lengths arc,
+    # the fit's point ``at`` inside each: s scaled to (arc - arc[at]) / (arc[hi] - arc[lo])
+    arc = np.cumsum(rng.uniform(0.0, 3.0, n))
+    W = rng.normal(size=(n, 2)) * rng.lognormal(0.0, 4.0, size=(n, 1))
+    lo = rng.integers(0, n - cnt)
+    hi = lo + cnt - 1
+    at = lo + rng.integers(0, cnt)
     mom, rx, ry = np.empty((5, len(cnt))), np.empty((3, len(cnt))), np.empty((3, len(cnt)))
-    _window_sums(sv, W, idx, starts, mom, rx, ry)
+    _window_sums(arc, W, lo, hi, at, mom, rx, ry)
+    own = np.repeat(np.arange(len(cnt)), cnt)
+    idx = lo[own] + np.arange(int(cnt.sum())) - np.repeat(np.cumsum(cnt) - cnt, cnt)
+    sv = (arc[idx] - arc[at][own]) / (arc[hi] - arc[lo])[own]
+    starts = np.cumsum(cnt) - cnt
     s2 = sv * sv
     pw = np.stack([np.ones_like(sv), sv, s2, s2 * sv, s2 * s2])
     assert np.array_equal(mom, np.add.reduceat(pw, starts, axis=1))
@@ -531,3 +538,52 @@ def test_batches_by_points_cover_every_path_once_and_change_nothing() -> None:
     for a, b in zip(one, split, strict=True):
         np.testing.assert_array_equal(a.points, b.points)
         np.testing.assert_array_equal(a.is_cubic, b.is_cubic)
+
+
+def test_local_fit_3x3_kernels_match_numpy_det_and_solve() -> None:
+    """The local fits' compiled 3x3 LU gives np.linalg.det's determinant and
+    np.linalg.solve's solutions (to the last bits here; checked to 1e-12 relative so
+    another BLAS's rounding does not fail it), on the moment matrices of windows (sums of
+    1, s .. s^4), also singular and permuted ones; where a matrix is not used (not good)
+    the solution is the right-hand side."""
+    from galvo_core.fit import _det3, _lu3, _solve3
+
+    rng = np.random.default_rng(5)
+    mats = []
+    for _ in range(400):
+        sv = rng.uniform(-1.0, 1.0, rng.integers(4, 60))
+        m = np.array([[np.sum(sv ** (i + j)) for j in range(3)] for i in range(3)])
+        mats.append(m)
+    mats.append(np.ones((3, 3)))  # singular
+    mats.append(np.array([[0.0, 1.0, 2.0], [3.0, 0.0, 1.0], [1.0, 4.0, 0.0]]))  # pivots
+    mats.append(np.zeros((3, 3)))
+    A = np.array(mats)
+    lu = np.empty_like(A)
+    piv = np.empty((len(A), 3), dtype=np.intp)
+    lim = 1e-9 * np.abs(A).max(axis=(1, 2)) ** 3
+    good = np.empty(len(A), dtype=bool)
+    _lu3(A, lu, piv, lim, good)
+    det = np.array([_det3(lu[m], piv[m]) for m in range(len(A))])
+    want = np.linalg.det(A)
+    assert np.allclose(det, want, rtol=1e-12, atol=0.0)
+    assert det[-3] == 0.0 and det[-1] == 0.0
+    assert np.array_equal(good, np.abs(want) > lim)
+    # at the limit itself the decision is the determinant's (the log-exp one)
+    at = np.abs(det[:5])
+    _lu3(A[:5], lu[:5], piv[:5], at, good[:5])
+    assert not good[:5].any()
+    _lu3(A[:5], lu[:5], piv[:5], np.nextafter(at, 0.0), good[:5])
+    assert good[:5].all()
+    _lu3(A, lu, piv, lim, good)
+    assert good[:-3].all() and not good[-3] and good[-2] and not good[-1]
+    rx = rng.normal(size=(3, len(A)))
+    ry = rng.normal(size=(3, len(A)))
+    cx = np.empty((len(A), 3))
+    cy = np.empty((len(A), 3))
+    _solve3(lu, piv, good, rx, ry, cx, cy)
+    Ag = A.copy()
+    Ag[~good] = np.eye(3)
+    assert np.allclose(cx, np.linalg.solve(Ag, rx.T[:, :, None])[:, :, 0], rtol=1e-9, atol=1e-12)
+    assert np.allclose(cy, np.linalg.solve(Ag, ry.T[:, :, None])[:, :, 0], rtol=1e-9, atol=1e-12)
+    assert np.array_equal(cx[~good], rx.T[~good])
+    assert np.allclose(np.einsum("mij,mj->mi", Ag, cx), rx.T, rtol=1e-7, atol=1e-9)
