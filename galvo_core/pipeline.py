@@ -321,7 +321,12 @@ class Pipeline:
             warnings.append(Warning(0, 0, out_msg))
         sampled = self.marks(drawing, params, fm, run)
         hatched = self.hatched(drawing, params, fm, run)
-        strokes, clamped = self._strokes(work, origin, fitted, sampled, hatched, params, fm)
+        # the input points are in the field (else out_msg), but a fitted curve may bulge past
+        # its edge by up to the fit's bound: those marks are clamped, never left outside
+        rep = sampled.report
+        bulge = not params.clamp and not out_msg and rep is not None and rep.outside_points > 0
+        strokes, clamped = self._strokes(work, origin, fitted, sampled, hatched, params, fm,
+                                         clamp=params.clamp or bulge)
         run.check()
         t1 = time.perf_counter()
         ordered: tuple[Stroke, ...] = tuple(order_job_strokes(  # type: ignore[arg-type]
@@ -329,7 +334,9 @@ class Pipeline:
         t2 = time.perf_counter()
         stats = self.stats(drawing, params, fitted, fm, ordered, sampled.report, work)
         if clamped:
-            warnings.append(Warning(0, 0, f"{clamped} marks were outside the field and clamped"))
+            warnings.append(Warning(0, 0, f"{clamped} marks were outside the field and clamped"
+                                    + ("" if params.clamp else " (curves that bulge past the "
+                                       "field edge within the fit tolerance)")))
         if stats["dwell_points"]:
             warnings.append(Warning(0, 0, (
                 f"dwell: {stats['dwell_points']} consecutive marks closer than "
@@ -347,15 +354,16 @@ class Pipeline:
 
     def _strokes(self, work: Drawing, origin: tuple[int, ...], fitted: tuple[FittedPath, ...],
                  sampled: _Marks, hatched: tuple[tuple[HatchStroke, np.ndarray], ...],
-                 params: Params, fm: FieldMap) -> tuple[list[Stroke], int]:
-        """The job's strokes in the stages' order (contours, then hatch), clamped when asked;
-        and how many marks were clamped."""
+                 params: Params, fm: FieldMap, *, clamp: bool = False
+                 ) -> tuple[list[Stroke], int]:
+        """The job's strokes in the stages' order (contours, then hatch), clamped to the field
+        when ``clamp``; and how many marks were clamped."""
         clamped = 0
         marks: list[np.ndarray] = list(sampled.marks)
         keep = [i for i, m in enumerate(marks) if len(m)] if not all(map(len, marks)) \
             else None
         hatch_marks = [hm for _, hm in hatched]
-        if params.clamp:  # read once: Params attribute reads cost µs, strokes are 10^4-10^5
+        if clamp:
             marks, n1 = _clamped(marks, fm.max_bit)
             hatch_marks, n2 = _clamped(hatch_marks, fm.max_bit)
             clamped = n1 + n2

@@ -6,7 +6,7 @@ import math
 
 import numpy as np
 import pytest
-from _util import circle_plt
+from _util import SAMPLES, circle_plt
 
 from galvo_core.drawing import Drawing, Path
 from galvo_core.errors import ParamError
@@ -182,3 +182,16 @@ def test_kerf_after_a_plain_run_refits_only_what_the_kerf_changed() -> None:
     # the offset rings carry their input's grid: the fit's bound is e_per + 1/sqrt(2)
     assert res.job.stats["fit_bound_units"] == pytest.approx(
         max(kerfed.e_per, kerfed.eps_line) + 1 / math.sqrt(2))
+
+
+def test_marks_of_a_curve_bulging_past_the_field_edge_are_clamped_not_left_outside() -> None:
+    """Fit field puts the input points inside the field; a fitted curve may still bulge
+    past its edge by up to the fit's bound (e_per 0.75 here, ~31 bits). Those marks are
+    clamped with a warning: no mark of the job is outside the field (the job loads back)."""
+    d = read_file(SAMPLES / "seal.plt")
+    res = Pipeline().run(d, Params(fit_field=True, e_per=0.75, fill="zigzag",
+                                   hatch_spacing_mm=0.5, scan_order="greedy", kerf_mm=0.1))
+    top = res.job.field_map.max_bit
+    assert all(((s.marks >= 0) & (s.marks <= top)).all() for s in res.job.strokes)
+    if res.sample_report.outside_points:  # the case this guards: say what was done
+        assert any("clamped" in w.message for w in res.job.warnings)
