@@ -1035,24 +1035,35 @@ class _Reader:
         self.chunks.append(ch)
         return ch
 
-    def _compiled_run(self, i: int) -> int:
-        """Read the PU/PD/PA/PR/SP commands from ``i`` on with the compiled scanner; returns
-        the offset where it stopped (``i`` when the next command is not one it reads)."""
-        scan = self._scan
-        if scan is None:
+    def _scanner(self):  # type: ignore[no-untyped-def]
+        """The compiled scanner module (:mod:`.scan`, imported at the first use: it loads
+        numba) with this reader's byte view and state arrays made for it."""
+        if self._scan is None:
             from galvo_core.hpgl import scan as scan_module
 
-            scan = self._scan = scan_module
+            self._scan = scan_module
             self._u8 = np.frombuffer(self.data, dtype=np.uint8)
-            self._ist = np.zeros(scan.N_ISTATE, dtype=np.int64)
-            self._fst = np.zeros(scan.N_FSTATE, dtype=np.float64)
-        ist, fst = self._ist, self._fst
+            self._ist = np.zeros(scan_module.N_ISTATE, dtype=np.int64)
+            self._fst = np.zeros(scan_module.N_FSTATE, dtype=np.float64)
+        return self._scan
+
+    def _line_at(self, i: int) -> tuple[int, int]:
+        """(line, offset of the last newline) at ``i``, counted on from where the compiled
+        scanner last stopped over the general reader's bytes since."""
         pos, line, last_nl = self._lc
-        if i != pos:  # the general reader's bytes since the last call
+        if i != pos:
             cnt = self.data.count(b"\n", pos, i)
             if cnt:
                 line += cnt
                 last_nl = self.data.rfind(b"\n", pos, i)
+        return line, last_nl
+
+    def _compiled_run(self, i: int) -> int:
+        """Read the PU/PD/PA/PR/SP commands from ``i`` on with the compiled scanner; returns
+        the offset where it stopped (``i`` when the next command is not one it reads)."""
+        scan = self._scanner()
+        ist, fst = self._ist, self._fst
+        line, last_nl = self._line_at(i)
         while True:
             ch = self._chunk
             if ch is None or len(ch.pts) - ch.npts < 2 or len(ch.seg_start) - ch.nseg < 3:
@@ -1091,21 +1102,9 @@ class _Reader:
         """Polygon mode: read the PU/PD/PA/PR/PW commands from ``i`` on with the compiled
         scanner (scan.scan_poly_moves) and add their moves to the polygon buffer as
         :meth:`_poly_move` would; returns the offset where it stopped."""
-        if self._scan is None:
-            from galvo_core.hpgl import scan as scan_module
-
-            self._scan = scan_module
-            self._u8 = np.frombuffer(self.data, dtype=np.uint8)
-            self._ist = np.zeros(scan_module.N_ISTATE, dtype=np.int64)
-            self._fst = np.zeros(scan_module.N_FSTATE, dtype=np.float64)
-        scan = self._scan
+        scan = self._scanner()
         ist, fst = self._ist, self._fst
-        pos, line, last_nl = self._lc
-        if i != pos:  # the general reader's bytes since the last call
-            cnt = self.data.count(b"\n", pos, i)
-            if cnt:
-                line += cnt
-                last_nl = self.data.rfind(b"\n", pos, i)
+        line, last_nl = self._line_at(i)
         moves = getattr(self, "_pm_moves", None)
         if moves is None:
             moves = self._pm_moves = (np.empty(4096), np.empty(4096), np.empty(4096, np.int8))
@@ -1647,14 +1646,7 @@ class _Reader:
 
     def _pe_compiled(self, pos: int) -> int:
         """PE decoded by the compiled decoder (scan.decode_pe, the same decoding)."""
-        if self._scan is None:
-            from galvo_core.hpgl import scan as scan_module
-
-            self._scan = scan_module
-            self._u8 = np.frombuffer(self.data, dtype=np.uint8)
-            self._ist = np.zeros(scan_module.N_ISTATE, dtype=np.int64)
-            self._fst = np.zeros(scan_module.N_FSTATE, dtype=np.float64)
-        scan = self._scan
+        scan = self._scanner()
         if not hasattr(self, "_pe_span"):
             self._pe_span = np.array([-1, -1, -1, -1], dtype=np.int64)
         end, kinds, xs, ys, flags, ni, p_off, p_code, p_val, npb = scan.decode_pe(
