@@ -57,90 +57,10 @@ CLASS[46] = C_DOT
 CLASS[59] = C_SEMI
 CLASS[27] = C_ESC
 
-_MANY = 1 << 30  # "any number of parameters"
+_MANY = 1 << 62  # "any number of parameters"
 
 
-@njit(cache=True, nogil=True, boundscheck=False, inline="always")
-def _read_number(b, j, n, pow10, cls):
-    """The number at ``j``: (value, end), end = -1 when the general reader must read it
-    ("1.2.3", a sign or point without digits, more than 15 digits, junk right after).
-    Inlined where it is used (a call per number would cost more than the number)."""
-    neg = False
-    c = b[j]
-    if c == 43 or c == 45:
-        neg = c == 45
-        j += 1
-    mant = 0
-    nd = 0
-    frac = 0
-    while j < n:
-        c = b[j]
-        if 48 <= c <= 57:
-            mant = mant * 10 + (c - 48)
-            nd += 1
-            j += 1
-        else:
-            break
-    if j < n and b[j] == 46:
-        j += 1
-        while j < n:
-            c = b[j]
-            if 48 <= c <= 57:
-                mant = mant * 10 + (c - 48)
-                nd += 1
-                frac += 1
-                j += 1
-            else:
-                break
-        if j < n and b[j] == 46:
-            return 0.0, -1
-    if nd == 0 or nd > 15:
-        return 0.0, -1
-    if j < n:
-        k = cls[b[j]]
-        # a number ends at a separator, a sign, ';', a letter or ESC
-        if not (k == C_SEP or k == C_SIGN or k == C_SEMI or k == C_LETTER or k == C_ESC):
-            return 0.0, -1
-    v = float(mant)
-    if frac:
-        v = v / pow10[frac]
-    return (-v if neg else v), j
-
-
-@njit(cache=True, nogil=True, boundscheck=False, inline="always")
-def _read_params(b, k, n, pow10, cls, tl, tn, most):
-    """The parameters of a command without geometry (SP, PW, PM, EP, FP) from ``k``: at
-    most ``most`` numbers. Returns (end, count, first number, ok, line, last newline);
-    ok is False when the general reader must read the command (a number it would read
-    otherwise or warn about, more numbers than ``most``)."""
-    count = 0
-    first = 0.0
-    ok = True
-    while k < n:
-        t = cls[b[k]]
-        if t == C_SEMI:
-            k += 1
-            break
-        if t == C_ESC or t == C_LETTER:
-            break
-        if t == C_SEP:
-            if b[k] == 10:
-                tl += 1
-                tn = k
-            k += 1
-            continue
-        v, e = _read_number(b, k, n, pow10, cls)
-        if e < 0 or count == most:
-            ok = False
-            break
-        if count == 0:
-            first = v
-        count += 1
-        k = e
-    return k, count, first, ok, tl, tn
-
-
-@njit(cache=True, nogil=True, boundscheck=False, inline="always")
+@njit(cache=True, nogil=True, boundscheck=False)
 def _rings_fit(pb, rs, nr):
     """EP/FP may be read here: every completed ring has a point, every point is finite
     (the general reader drops a non-finite path with a warning)."""
@@ -151,6 +71,34 @@ def _rings_fit(pb, rs, nr):
         if not (np.isfinite(pb[q, 0]) and np.isfinite(pb[q, 1])):
             return False
     return True
+
+
+@njit(cache=True, nogil=True, boundscheck=False)
+def _write_rings(pts, seg_start, seg_off, seg_pen, seg_line, seg_col, npts, nseg, pb, rs, rcl,
+                 nr, fill, off, line, col, pen_no):
+    """EP (``fill`` False): each ring's pen-down edges as a segment, closed when its closing
+    edge is pen-down (a ring of one point has no edge); FP: each ring closed. Returns the
+    points and segments used."""
+    for r in range(nr):
+        a = rs[r]
+        e = rs[r + 1]
+        if not fill and e - a < 2:
+            continue
+        seg_start[nseg] = npts
+        seg_off[nseg] = off
+        seg_line[nseg] = line
+        seg_col[nseg] = col
+        seg_pen[nseg] = pen_no
+        nseg += 1
+        for q in range(a, e):
+            pts[npts, 0] = pb[q, 0]
+            pts[npts, 1] = pb[q, 1]
+            npts += 1
+        if (fill or rcl[r]) and not (pb[a, 0] == pb[e - 1, 0] and pb[a, 1] == pb[e - 1, 1]):
+            pts[npts, 0] = pb[a, 0]
+            pts[npts, 1] = pb[a, 1]
+            npts += 1
+    return npts, nseg
 
 
 @njit(cache=True, nogil=True, boundscheck=False)
@@ -290,160 +238,16 @@ def scan_moves(b, ist, fst, pts, seg_start, seg_off, seg_pen, seg_line, seg_col,
         cmd_line = tl
         cmd_col = j - tn
         k = j + 2
-        if code >= 4:
-            # no geometry of its own: all parameters are read before anything is applied
-            most = 1 if code == 4 else (2 if code == 5 else _MANY)
-            k, count, val, ok, tl, tn = _read_params(b, k, n, pow10, cls, tl, tn, most)
-            if not ok:
-                break
-            if code == 5:
-                # PW [width[,pen]]: no geometry; the file is HP-GL/2 from here on (as the
-                # general reader says)
-                hpgl2 = True
-                npw += 1
-            elif code == 4:
-                # SP [n]: ends the path; HP-GL/2 keeps the pen down, HP-GL/1 lifts it
-                pen_no = int(val) if count else 0
-                is_open = 0
-                if not hpgl2:
-                    pen = 0
-                nsp += 1
-            elif code == 6:
-                mode = int(val) if count else 0
-                if mode == 0:
-                    if in_poly:
-                        break  # PM0 inside PM: the general reader warns
-                    # PM0: the path ends, a new buffer starts at the current point
-                    is_open = 0
-                    in_poly = 1
-                    nr = 0
-                    rs[0] = 0
-                    pb[0, 0] = x
-                    pb[0, 1] = y
-                    npb = 1
-                    fresh = 0
-                    emitted = 0
-                    edged = 0
-                    poff = cmd_at
-                    pline = cmd_line
-                    pcol = cmd_col
-                    plc = 1
-                elif mode == 1 or mode == 2:
-                    if not in_poly:
-                        break  # PM1/PM2 outside PM: the general reader warns
-                    if npb + 1 > pcap or nr + 2 > rcap:
-                        ist[I_FULL] = FULL_POLY
-                        ist[I_NEED] = npb + 1
-                        break
-                    # close the ring with the current pen state, the next starts here
-                    if npb - rs[nr] > 1:
-                        rcl[nr] = pen
-                        nr += 1
-                        rs[nr] = npb
-                    npb = rs[nr]
-                    pb[npb, 0] = x
-                    pb[npb, 1] = y
-                    npb += 1
-                    if mode == 1:
-                        fresh = 1
-                    else:
-                        in_poly = 0
-                else:
-                    break  # unknown mode: the general reader warns
-                npm += 1
-            elif code == 7:
-                if in_poly:
-                    break  # EP inside PM: the general reader warns
-                if not emitted:
-                    # (a path still open is written after EP's in the general reader)
-                    if is_open or not poly_ok or not plc or not _rings_fit(pb, rs, nr):
-                        break
-                    need = rs[nr] + nr
-                    if npts + need > cap or nseg + nr + 2 > scap:
-                        ist[I_FULL] = FULL_CHUNK
-                        ist[I_NEED] = need
-                        break
-                    e_s0 = nseg
-                    e_p0 = npts
-                    for r in range(nr):
-                        a = rs[r]
-                        e = rs[r + 1]
-                        if e - a < 2:
-                            continue  # one point: no edge
-                        seg_start[nseg] = npts
-                        seg_off[nseg] = poff
-                        seg_line[nseg] = pline
-                        seg_col[nseg] = pcol
-                        seg_pen[nseg] = pen_no
-                        nseg += 1
-                        for q in range(a, e):
-                            pts[npts, 0] = pb[q, 0]
-                            pts[npts, 1] = pb[q, 1]
-                            npts += 1
-                        if rcl[r] and not (pb[a, 0] == pb[e - 1, 0]
-                                           and pb[a, 1] == pb[e - 1, 1]):
-                            pts[npts, 0] = pb[a, 0]
-                            pts[npts, 1] = pb[a, 1]
-                            npts += 1
-                    e_s1 = nseg
-                    e_p1 = npts
-                    emitted = 1
-                    edged = 1
-                nep += 1
-            else:
-                if in_poly:
-                    break  # FP inside PM: the general reader warns
-                if edged == 2:
-                    break  # EP's paths are the caller's: it replaces them
-                if edged == 1 and (nseg != e_s1 or npts != e_p1):
-                    break  # something was drawn after EP's paths
-                if not emitted or edged == 1:
-                    if is_open or not poly_ok or not plc or not _rings_fit(pb, rs, nr):
-                        break
-                    s_at = e_s0 if edged == 1 else nseg
-                    p_at = e_p0 if edged == 1 else npts
-                    need = rs[nr] + nr
-                    if p_at + need > cap or s_at + nr + 2 > scap:
-                        ist[I_FULL] = FULL_CHUNK
-                        ist[I_NEED] = need
-                        break
-                    if edged == 1:
-                        # a buffer edged and filled is one region: the rings replace
-                        # EP's segments
-                        drop += e_s1 - e_s0
-                        nseg = s_at
-                        npts = p_at
-                    for r in range(nr):
-                        a = rs[r]
-                        e = rs[r + 1]
-                        seg_start[nseg] = npts
-                        seg_off[nseg] = poff
-                        seg_line[nseg] = pline
-                        seg_col[nseg] = pcol
-                        seg_pen[nseg] = pen_no
-                        nseg += 1
-                        for q in range(a, e):
-                            pts[npts, 0] = pb[q, 0]
-                            pts[npts, 1] = pb[q, 1]
-                            npts += 1
-                        if not (pb[a, 0] == pb[e - 1, 0] and pb[a, 1] == pb[e - 1, 1]):
-                            pts[npts, 0] = pb[a, 0]
-                            pts[npts, 1] = pb[a, 1]
-                            npts += 1
-                    emitted = 1
-                    edged = 0
-                nfp += 1
-            i = k
-            line = tl
-            last_nl = tn
-            continue
         # state at the command's start, to roll back to
         r_pen, r_absm, r_open, r_npts, r_nseg, r_x, r_y = pen, absm, is_open, npts, nseg, x, y
         r_npb, r_nr, r_fresh = npb, nr, fresh
-        # the ring being drawn: its first point is overwritten when a move replaces it
-        r_q0 = rs[nr]
-        r_p0x = pb[r_q0, 0] if r_q0 < pcap else 0.0
-        r_p0y = pb[r_q0, 1] if r_q0 < pcap else 0.0
+        r_q0 = -1
+        r_p0x = r_p0y = 0.0
+        if in_poly:
+            # the ring being drawn: its first point is overwritten when a move replaces it
+            r_q0 = rs[nr]
+            r_p0x = pb[r_q0, 0]
+            r_p0y = pb[r_q0, 1]
         if code == 0:
             if pen == 1:
                 pen = 0
@@ -469,9 +273,13 @@ def scan_moves(b, ist, fst, pts, seg_start, seg_off, seg_pen, seg_line, seg_col,
                     is_open = 1
         elif code == 2:
             absm = 1
-        else:
+        elif code == 3:
             absm = 0
-        # the pairs, applied as read
+        # the parameters: pairs applied as read; the numbers of the commands without
+        # geometry of their own (SP, PW, PM, EP, FP) counted (at most ``most``; PM with
+        # more than one number is the general reader's), the command applied after
+        most = 1 if code == 4 or code == 6 else (2 if code == 5 else _MANY)
+        count = 0
         ok = True
         full = 0
         half = False
@@ -489,13 +297,60 @@ def scan_moves(b, ist, fst, pts, seg_start, seg_off, seg_pen, seg_line, seg_col,
                     tn = k
                 k += 1
                 continue
-            v, k = _read_number(b, k, n, pow10, cls)
-            if k < 0:
+            # the number at k, read in place: the only copy of the number syntax (a helper
+            # function per number costs 2-4 times the whole scan: the arrays' reference
+            # counts, even inlined); at most 15 digits, "1.2.3", a sign or point without
+            # digits, junk right after: the general reader's
+            neg = False
+            if t == C_SIGN:
+                neg = b[k] == 45
+                k += 1
+            mant = 0
+            nd = 0
+            frac = 0
+            while k < n:
+                c = b[k]
+                if 48 <= c <= 57:
+                    mant = mant * 10 + (c - 48)
+                    nd += 1
+                    k += 1
+                else:
+                    break
+            if k < n and b[k] == 46:
+                k += 1
+                while k < n:
+                    c = b[k]
+                    if 48 <= c <= 57:
+                        mant = mant * 10 + (c - 48)
+                        nd += 1
+                        frac += 1
+                        k += 1
+                    else:
+                        break
+                if k < n and b[k] == 46:
+                    ok = False
+                    break
+            if nd == 0 or nd > 15:
                 ok = False
                 break
+            if k < n:
+                t = cls[b[k]]
+                # a number ends at a separator, a sign, ';', a letter or ESC
+                if not (t == C_SEP or t == C_SIGN or t == C_SEMI or t == C_LETTER
+                        or t == C_ESC):
+                    ok = False
+                    break
+            v = float(mant)
+            if frac:
+                v = v / pow10[frac]
+            if neg:
+                v = -v
             if not half:
+                # (a command without geometry never completes a pair: its numbers are
+                # counted, the last kept, without a test per number in the moves' loop)
                 vx = v
-                half = True
+                half = code < 4
+                count += 1
                 continue
             half = False
             if absm == 1:
@@ -553,19 +408,125 @@ def scan_moves(b, ist, fst, pts, seg_start, seg_off, seg_pen, seg_line, seg_col,
                 npts += 1
             x = nx
             y = ny
+        if code >= 4 and count > most:
+            ok = False
         if full or not ok or half:
             # roll back: the general reader reads this command (or a larger chunk or
             # buffer is made)
             pen, absm, is_open, npts, nseg, x, y = r_pen, r_absm, r_open, r_npts, r_nseg, r_x, r_y
             npb, nr, fresh = r_npb, r_nr, r_fresh
-            if r_q0 < pcap:
+            if r_q0 >= 0:
                 pb[r_q0, 0] = r_p0x
                 pb[r_q0, 1] = r_p0y
             if full:
                 ist[I_FULL] = full
                 ist[I_NEED] = 2 * (pcap if full == FULL_POLY else cap)
             break
-        if code == 0:
+        if code == 4:
+            # SP [n]: ends the path; HP-GL/2 keeps the pen down, HP-GL/1 lifts it
+            pen_no = int(vx) if count else 0
+            is_open = 0
+            if not hpgl2:
+                pen = 0
+            nsp += 1
+        elif code == 5:
+            # PW [width[,pen]]: no geometry; the file is HP-GL/2 from here on (as the
+            # general reader says)
+            hpgl2 = True
+            npw += 1
+        elif code == 6:
+            mode = int(vx) if count else 0
+            if mode == 0:
+                if in_poly:
+                    break  # PM0 inside PM: the general reader warns
+                # PM0: the path ends, a new buffer starts at the current point
+                is_open = 0
+                in_poly = 1
+                nr = 0
+                rs[0] = 0
+                pb[0, 0] = x
+                pb[0, 1] = y
+                npb = 1
+                fresh = 0
+                emitted = 0
+                edged = 0
+                poff = cmd_at
+                pline = cmd_line
+                pcol = cmd_col
+                plc = 1
+            elif mode == 1 or mode == 2:
+                if not in_poly:
+                    break  # PM1/PM2 outside PM: the general reader warns
+                if npb + 1 > pcap or nr + 2 > rcap:
+                    ist[I_FULL] = FULL_POLY
+                    ist[I_NEED] = 2 * pcap
+                    break
+                # close the ring with the current pen state, the next starts here
+                if npb - rs[nr] > 1:
+                    rcl[nr] = pen
+                    nr += 1
+                    rs[nr] = npb
+                npb = rs[nr]
+                pb[npb, 0] = x
+                pb[npb, 1] = y
+                npb += 1
+                if mode == 1:
+                    fresh = 1
+                else:
+                    in_poly = 0
+            else:
+                break  # unknown mode: the general reader warns
+            npm += 1
+        elif code == 7:
+            if in_poly:
+                break  # EP inside PM: the general reader warns
+            if not emitted:
+                # (a path still open is written after EP's in the general reader)
+                if is_open or not poly_ok or not plc or not _rings_fit(pb, rs, nr):
+                    break
+                need = rs[nr] + nr
+                if npts + need > cap or nseg + nr + 2 > scap:
+                    ist[I_FULL] = FULL_CHUNK
+                    ist[I_NEED] = need
+                    break
+                e_s0 = nseg
+                e_p0 = npts
+                npts, nseg = _write_rings(pts, seg_start, seg_off, seg_pen, seg_line, seg_col,
+                                          npts, nseg, pb, rs, rcl, nr, False, poff, pline,
+                                          pcol, pen_no)
+                e_s1 = nseg
+                e_p1 = npts
+                emitted = 1
+                edged = 1
+            nep += 1
+        elif code == 8:
+            if in_poly:
+                break  # FP inside PM: the general reader warns
+            if edged == 2:
+                break  # EP's paths are the caller's: it replaces them
+            if edged == 1 and (nseg != e_s1 or npts != e_p1):
+                break  # something was drawn after EP's paths
+            if not emitted or edged == 1:
+                if is_open or not poly_ok or not plc or not _rings_fit(pb, rs, nr):
+                    break
+                s_at = e_s0 if edged == 1 else nseg
+                p_at = e_p0 if edged == 1 else npts
+                need = rs[nr] + nr
+                if p_at + need > cap or s_at + nr + 2 > scap:
+                    ist[I_FULL] = FULL_CHUNK
+                    ist[I_NEED] = need
+                    break
+                if edged == 1:
+                    # a buffer edged and filled is one region: the rings replace EP's
+                    # segments
+                    drop += e_s1 - e_s0
+                npts, nseg = _write_rings(pts, seg_start, seg_off, seg_pen, seg_line, seg_col,
+                                          p_at, s_at, pb, rs, rcl, nr, True, poff, pline,
+                                          pcol, pen_no)
+                emitted = 1
+                edged = 0
+            nfp += 1
+        elif code == 0:
             nu += 1
         elif code == 1:
             nd_ += 1
