@@ -1133,44 +1133,39 @@ class _Reader:
         scanner needs its points only for FP after EP, which it leaves to the reader when
         EP was not its own)."""
         scan = self._scan
-        ist = self._ist
         if not hasattr(self, "_pbuf"):
             self._grow_poly_buffer(0)
-        ist[scan.I_POLYOK] = self.window is None and self.rot == 0
+        ok = self.window is None and self.rot == 0
+        edged = 0 if self.poly_edged is None else 2
+        # slots I_POLY .. I_POLYOK in one assignment (see scan.I_*)
         if self.poly is None and self.poly_emitted:
-            ist[scan.I_POLY] = ist[scan.I_NPB] = ist[scan.I_NRING] = 0
-            ist[scan.I_EMITTED] = 1
-            ist[scan.I_EDGED] = 0 if self.poly_edged is None else 2
-            ist[scan.I_PLC] = 0
+            self._ist[scan.I_POLY : scan.I_POLYOK + 1] = (
+                0, 0, 1, edged, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, ok)
             return False
         rings = self.poly_buffer
-        pts = [p for ring, _c in rings for p in ring]
-        pts.extend(self.poly_ring)
-        if len(pts) + 1 > len(self._pbuf[0]) or len(rings) + 2 > len(self._pbuf[1]):
-            self._grow_poly_buffer(2 * (len(pts) + len(rings)) + 2)
+        ring = self.poly_ring
+        npb = sum(len(r) for r, _c in rings) + len(ring)
+        if npb + 1 > len(self._pbuf[0]) or len(rings) + 2 > len(self._pbuf[1]):
+            self._grow_poly_buffer(2 * (npb + len(rings)) + 2)
         pb, rs, rcl = self._pbuf
-        if pts:
-            pb[: len(pts)] = pts
-        lens = [len(ring) for ring, _c in rings]
-        rs[0] = 0
         if rings:
-            rs[1 : len(rings) + 1] = np.cumsum(lens)
+            pb[:npb] = [p for r, _c in rings for p in r] + ring
+            rs[1 : len(rings) + 1] = np.cumsum([len(r) for r, _c in rings])
             rcl[: len(rings)] = [c for _r, c in rings]
-        ist[scan.I_NPB] = len(pts)
-        ist[scan.I_NRING] = len(rings)
-        ist[scan.I_POLY] = self.poly is not None
-        ist[scan.I_FRESH] = self.poly_fresh
-        ist[scan.I_EMITTED] = self.poly_emitted
-        ist[scan.I_EDGED] = 2 if self.poly_edged is not None else 0
-        ist[scan.I_POFF] = off = self.poly_offset
+        elif len(ring) == 1:
+            pb[0] = ring[0]
+        elif ring:
+            pb[:npb] = ring
+        rs[0] = 0
+        off = self.poly_offset
         lc = self.poly_lc
         if lc is None and off <= i and self.data.count(b"\n", off, i) == 0:
             lc = self.poly_lc = (off, line, off - last_nl)  # PM0 on the line of i
-        if lc is not None and lc[0] == off:
-            ist[scan.I_PLINE], ist[scan.I_PCOL] = lc[1], lc[2]
-            ist[scan.I_PLC] = 1
-        else:
-            ist[scan.I_PLC] = 0  # the general reader writes EP's and FP's paths
+        # without PM0's line and column the general reader writes EP's and FP's paths
+        plc = lc is not None and lc[0] == off
+        self._ist[scan.I_POLY : scan.I_POLYOK + 1] = (
+            self.poly is not None, self.poly_fresh, self.poly_emitted, edged, 0, 0, 0, 0, off,
+            lc[1] if plc else 0, lc[2] if plc else 0, plc, npb, len(rings), ok)
         return True
 
     def _poly_from_scanner(self, out: list[int], buffered: bool) -> None:
