@@ -186,8 +186,11 @@ def _pm_program(rng: random.Random, n: int) -> bytes:
             out.append(rng.choice([b"CI5;", b"EA50,50;", pe + b";", b"<" + pe[2:] + b";",
                                    b"LBab\x03", b"IW-400,-400,400,400;", b"IW;", b"RO90;",
                                    b"RO;", b"SC0,100,0,100;", b"SC;", b"IN;", b"DF;", b"LT;",
-                                   b"FT1;", b"PD1:2;", b"PR1.2.3,4;", b"PD1,2,3;"]))
-        elif r < 0.86:
+                                   b"PD1:2;", b"PR1.2.3,4;", b"PD1,2,3;"]))
+        elif r < 0.84:  # fill type (recorded, not drawn), as files write it before PM0
+            out.append(rng.choice([b"FT1;", b"FT;", b"FT10,30,45;", b"FT:;", b"ft 3,5",
+                                   b"FT1,2,3,4,5,6;", b"FT1.2.3;"]))
+        elif r < 0.87:
             out.append(b"\n")
         else:
             out.append(b"PD%d,%d" % (rng.randint(0, 99), rng.randint(0, 99)))  # no ';'
@@ -224,15 +227,16 @@ def test_compiled_polygon_commands_read_what_the_general_reader_reads(seed: int,
 
 def test_polygon_mode_is_read_by_the_scanner_in_one_call() -> None:
     """Issue 20, reproducer 1 in polygon mode (GNU plotutils' open polylines,
-    ``PA x0,y0;PM0;PD;PA x1,y1,...;PU;PM2;EP;``) and per-point PD in PM closed by FP: the
-    whole file is one compiled call (PM0/PM2/EP/FP and the moves), the polylines stay open
+    ``PA x0,y0;PM0;PD;PA x1,y1,...;PU;PM2;EP;``) and per-point PD in PM closed by FP (FT
+    before it): the whole file is one compiled call (PM0/PM2/EP/FP/FT and the moves), the
+    polylines stay open
     (PM2 closes them with the pen up: EP does not draw that edge), FP's rings are closed,
     as the general reader reads them; a single command with more moves than the polygon
     buffer holds (4,999 pairs) too."""
     lines = [[(k, 0), (k + 100, 50), (k + 200, 0)] for k in range(0, 3000, 300)]
     body = b"".join(b"PA%d,%d;PM0;PD;PA%s;PU;PM2;EP;\n" % (
         *ln[0], ",".join(f"{x},{y}" for x, y in ln[1:]).encode()) for ln in lines)
-    rings = b"".join(b"PU%d,0;PM0;PD%d,9;PD%d,0;PM2;FP;\n" % (k, k + 5, k + 9)
+    rings = b"".join(b"PU%d,0;FT1;PM0;PD%d,9;PD%d,0;PM2;FP;\n" % (k, k + 5, k + 9)
                      for k in range(0, 100, 10))
     big = ",".join(f"{k},{k % 7}" for k in range(1, 5000)).encode()
     data = b"IN;SP1;" + body + rings + b"PU;PA0,0;PM0;PD;PA" + big + b";PM2;EP;"
@@ -245,6 +249,7 @@ def test_polygon_mode_is_read_by_the_scanner_in_one_call() -> None:
     assert [c for c in calls if c >= len(b"IN;SP1;")] == [len(b"IN;SP1;")]  # (SP1 first:
     # the general reader's, no pen was selected)
     assert a.commands["PM"] == 2 * (len(lines) + 11) and a.commands["EP"] == len(lines) + 1
+    assert a.commands["FT"] == 10
     assert len(a.paths) == len(lines) + 10 + 1
     for p, ln in zip(a.paths, lines, strict=False):
         np.testing.assert_array_equal(p.points, ln)  # open: no closing edge added

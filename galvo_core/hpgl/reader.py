@@ -160,7 +160,7 @@ _PE_MESSAGES = {  # scan.PE_* problem codes -> the messages of pe.decode_pe
 #: restores the pen position it found
 _LABEL_ORIGINS = frozenset((*range(1, 10), *range(11, 20), 21))
 _LO_CONCATENATE = frozenset((1, 2, 3, 11, 12, 13, 21))
-#: where the compiled scanner is started (it reads PM, EP and FP too once it runs)
+#: where the compiled scanner is started (it reads PM, EP, FP and FT too once it runs)
 _SCAN_CMDS = frozenset((b"PU", b"PD", b"PA", b"PR", b"SP", b"PW"))
 
 
@@ -1057,7 +1057,7 @@ class _Reader:
         return line, last_nl
 
     def _compiled_run(self, i: int) -> int:
-        """Read the PU/PD/PA/PR/SP/PW commands (and PM/EP/FP) from ``i`` on with the
+        """Read the PU/PD/PA/PR/SP/PW commands (and PM/EP/FP/FT) from ``i`` on with the
         compiled scanner; returns the offset where it stopped (``i`` when the next command
         is not one it reads)."""
         scan = self._scanner()
@@ -1091,10 +1091,10 @@ class _Reader:
             self.absolute = bool(out[scan.I_ABS])
             self.pen = out[scan.I_PENNO]
             counts = out[scan.I_NU : scan.I_NR + 1] + [out[scan.I_NSP], out[scan.I_NPW]] + \
-                out[scan.I_NPM : scan.I_NFP + 1]
+                out[scan.I_NPM : scan.I_NFP + 1] + [out[scan.I_NFT]]
             self.hpgl2 = bool(out[scan.I_HPGL2])
             if any(counts):
-                for name, c in zip(("PU", "PD", "PA", "PR", "SP", "PW", "PM", "EP", "FP"),
+                for name, c in zip(("PU", "PD", "PA", "PR", "SP", "PW", "PM", "EP", "FP", "FT"),
                                    counts, strict=True):
                     if c:
                         self.commands[name] += c

@@ -30,11 +30,11 @@ from numba import njit
  # polygon mode: in PM, after PM1, buffer edged or filled, EP's segments (0: none, 1: in
  # this call, [I_EDGE_S0, I_EDGE_S1) and points [I_EDGE_P0, I_EDGE_P1) of the chunk, 2: the
  # caller's), PM0's offset, line, column (I_PLC: known), buffer points and completed rings,
- # EP/FP allowed (no IW window, no RO), PM/EP/FP counts, EP segments FP replaced
+ # EP/FP allowed (no IW window, no RO), PM/EP/FP counts, EP segments FP replaced; FT count
  I_POLY, I_FRESH, I_EMITTED, I_EDGED, I_EDGE_S0, I_EDGE_S1, I_EDGE_P0, I_EDGE_P1,
  I_POFF, I_PLINE, I_PCOL, I_PLC, I_NPB, I_NRING, I_POLYOK, I_NPM, I_NEP, I_NFP,
- I_DROP) = range(39)
-N_ISTATE = 39
+ I_DROP, I_NFT) = range(40)
+N_ISTATE = 40
 N_MOVE_STATE = 20  # slots I_POS..I_NPW: the move state the caller sets at every call
 # I_FULL values: the output chunk is full / the polygon buffer is full
 FULL_CHUNK, FULL_POLY = 1, 2
@@ -183,6 +183,7 @@ def scan_moves(b, ist, fst, pts, seg_start, seg_off, seg_pen, seg_line, seg_col,
     npm = 0
     nep = 0
     nfp = 0
+    nft = 0
     drop = 0
     while True:
         # separators before a command
@@ -232,6 +233,8 @@ def scan_moves(b, ist, fst, pts, seg_start, seg_off, seg_pen, seg_line, seg_col,
                 code = 8
             else:
                 break
+        elif c0 == 102 and c1 == 116:  # 'ft': fill type, recorded, not drawn
+            code = 9
         else:
             break
         cmd_at = j
@@ -526,6 +529,8 @@ def scan_moves(b, ist, fst, pts, seg_start, seg_off, seg_pen, seg_line, seg_col,
                 emitted = 1
                 edged = 0
             nfp += 1
+        elif code == 9:
+            nft += 1  # FT [type[,option...]]: nothing to apply (the general reader's too)
         elif code == 0:
             nu += 1
         elif code == 1:
@@ -570,6 +575,7 @@ def scan_moves(b, ist, fst, pts, seg_start, seg_off, seg_pen, seg_line, seg_col,
     ist[I_NPM] = npm
     ist[I_NEP] = nep
     ist[I_NFP] = nfp
+    ist[I_NFT] = nft
     ist[I_DROP] = drop
     fst[F_X] = x
     fst[F_Y] = y
