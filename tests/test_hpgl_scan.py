@@ -133,8 +133,8 @@ def _poly_program(rng: random.Random, n: int) -> bytes:
 
 @pytest.mark.parametrize("seed", range(16))
 def test_compiled_polygon_mode_reads_what_the_general_reader_reads(seed: int) -> None:
-    """Moves inside polygon mode are read by the compiled scanner (scan.scan_poly_moves) and
-    added to the polygon buffer: same sub-polygons, EP/FP paths, warnings and counts."""
+    """Moves inside polygon mode are read by the compiled scanner into its polygon buffer:
+    same sub-polygons, EP/FP paths, warnings and counts."""
     data = _poly_program(random.Random(1000 + seed), 500)
     a = _read(data, True, 8)
     assert_same(a, _read(data, False))
