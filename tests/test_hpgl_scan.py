@@ -225,6 +225,25 @@ def test_compiled_polygon_commands_read_what_the_general_reader_reads(seed: int,
     assert read_by_scanner["PM"] > 0 and read_by_scanner["EP"] + read_by_scanner["FP"] > 0
 
 
+@pytest.mark.parametrize("data", [
+    b"IN;SP1;PU0,0;LT;PM0;\nCI3;\nPD10,0,10,10;PM2;EP;FP;PU;PD3,3;",
+    b"IN;SP1;PU0,0;LT;PM0;\nLT;PD10,0,10,10;\nPM2;FP;\nEP;PU;PD3,3;",
+    b"IN;SP1;PU0,0;LT;PM0;PD10,0;\nPD10,10;PM1;PD20,20,30,30;PM2;FP;EP;PA0,0;",
+    b"IN;SP1;PU1,1;PM0;PD5,5;CI3;PD9,9;PM2;EP;LT;FP;PU;PD1,2;",
+])
+def test_polygon_begun_by_the_general_reader_is_finished_by_the_scanner(data: bytes) -> None:
+    """A polygon the general reader began (PM0 after a command the scanner does not read)
+    or added to (CI inside PM) is handed to the scanner with the moves that follow; FP after
+    an EP the scanner wrote is the general reader's when something came between. EP's and
+    FP's paths start at PM0 (line 1) also when the scanner took the polygon over on a later
+    line."""
+    a = _read(data, True)
+    assert_same(a, _read(data, False))
+    at_pm0 = [p for p in a.paths
+              if (p.start.line, p.start.col) == (1, data.index(b"PM0") + 1)]
+    assert at_pm0 and any(len(p.points) >= 3 for p in at_pm0)
+
+
 def test_polygon_mode_is_read_by_the_scanner_in_one_call() -> None:
     """Issue 20, reproducer 1 in polygon mode (GNU plotutils' open polylines,
     ``PA x0,y0;PM0;PD;PA x1,y1,...;PU;PM2;EP;``) and per-point PD in PM closed by FP (FT
