@@ -73,13 +73,12 @@ Speed
 -----
 Large inputs (from ``_COMPILED_MIN_BYTES``), or any input once numba is loaded, are read by
 the compiled scanner (:mod:`.scan`) wherever a PU/PD/PA/PR/SP/PW command starts, and PE by
-its compiled decoder. Once running, the scanner reads polygon mode too (PM0/PM1/PM2 into
-its own polygon buffer, EP's and FP's paths written as its segments); it hands the buffer
-back to the general reader (``_poly_from_scanner``) at anything else (PE, CI, LB... inside
-PM; IW or RO in force; FP after an EP it did not write). The general reader takes every
-other command. Smaller
-inputs in a fresh process use the numpy runs of :mod:`.fastrun` (outside polygon mode). All
-three read the same geometry bit for bit
+its compiled decoder. Once running, the scanner reads FT and polygon mode too (PM0/PM1/PM2
+into its own polygon buffer, EP's and FP's paths written as its segments); it hands the
+buffer back to the general reader (``_poly_from_scanner``) at anything else (PE, CI, LB...
+inside PM; IW or RO in force; FP after an EP it did not write). The general reader takes
+every other command. Smaller inputs in a fresh process use the numpy runs of
+:mod:`.fastrun` (outside polygon mode). All three read the same geometry bit for bit
 (tests/test_hpgl_scan.py, tests/test_hpgl_fuzz.py).
 """
 
