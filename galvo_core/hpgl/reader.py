@@ -340,6 +340,9 @@ class _Reader:
         self.poly_fresh = False
         self.poly_offset = 0
         self.poly_lc: tuple[int, int, int] | None = None  # offset, line, column of PM0
+        # an edged polygon whose points are still only in the scanner's buffer (points,
+        # rings): read back when an FP needs them (see _poly_from_scanner)
+        self.poly_lazy: tuple[int, int] | None = None
         self.tick = (0.5, 0.5)
         self.char_size: tuple[float, float] | None = None  # SI: width, height (plotter units)
         self.char_rel: tuple[float, float] | None = None  # SR: % of P2-P1
@@ -658,6 +661,7 @@ class _Reader:
             self.poly_edged = None
             self.poly_offset = offset
             self.poly_lc = None
+            self.poly_lazy = None
         elif mode == 1:
             if self.poly is None:
                 self.warn(offset, "PM1 outside polygon mode ignored")
@@ -696,6 +700,8 @@ class _Reader:
             return
         if self.poly_emitted and self.poly_edged is None:
             return  # filled already
+        if self.poly_lazy is not None:
+            self._poly_buffer_from_scanner(*self.poly_lazy)
         rings = []
         for ring, _closing in self.poly_buffer:
             closed_ring = ring if ring[0] == ring[-1] else ring + [ring[0]]
@@ -1118,8 +1124,8 @@ class _Reader:
         old = getattr(self, "_pbuf", None)
         cap = max(need, 2 * len(old[0]) if old is not None else _POLY_POINTS)
         pb = np.empty((cap, 2), dtype=np.float64)
-        rs = np.zeros(cap + 2, dtype=np.int64)
-        rcl = np.zeros(cap + 2, dtype=np.int64)
+        rs = np.zeros(cap // 2 + 2, dtype=np.int64)  # (a ring has two points but the
+        rcl = np.zeros(cap // 2 + 2, dtype=np.int8)  # reader's one-point figures; checked)
         if old is not None:
             pb[: len(old[0])] = old[0]
             rs[: len(old[1])] = old[1]
@@ -1181,14 +1187,27 @@ class _Reader:
             # no polygon, or one filled: its points no longer matter
             self.poly_buffer = []
             self.poly_ring = [(self.x, self.y)]
+            self.poly_lazy = None
             return
         if not buffered:
             return  # the reader's edged polygon, untouched
         off = self.poly_offset = out[scan.I_POFF]
         if out[scan.I_PLC]:
             self.poly_lc = (off, out[scan.I_PLINE], out[scan.I_PCOL])
-        pb, rs, rcl = self._pbuf
         npb, nr = out[scan.I_NPB], out[scan.I_NRING]
+        if not in_poly and self.poly_emitted:
+            # edged: its points matter only to an FP the general reader reads (it replaces
+            # EP's paths); until then they stay in the scanner's buffer, which only a new
+            # polygon overwrites
+            self.poly_buffer = []
+            self.poly_lazy = (npb, nr)
+            return
+        self._poly_buffer_from_scanner(npb, nr)
+
+    def _poly_buffer_from_scanner(self, npb: int, nr: int) -> None:
+        """The polygon buffer as lists from the scanner's arrays (``npb`` points, ``nr``
+        completed rings)."""
+        pb, rs, rcl = self._pbuf
         xs = pb[:npb, 0].tolist()
         ys = pb[:npb, 1].tolist()
         bounds = rs[: nr + 1].tolist()
@@ -1197,6 +1216,7 @@ class _Reader:
                             for a, e, c in zip(bounds, bounds[1:], flags, strict=False)]
         a = bounds[nr]
         self.poly_ring = list(zip(xs[a:], ys[a:], strict=True))
+        self.poly_lazy = None
 
     def _take_segments(self, ch: _Chunk, ist: list[int]) -> None:
         scan = self._scan
