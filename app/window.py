@@ -12,6 +12,7 @@ from __future__ import annotations
 import json
 import os
 import re
+import sys
 import time
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -103,6 +104,12 @@ BUSY_DELAY_MS = 200
 #: a result of another file is marked at once.
 STALE_DELAY_MS = 400
 MAX_RECENT = 8
+#: The interpreter's thread switch interval while a window is open (s; Python's default is
+#: 5 ms). The GUI thread shares the GIL with the workers, and every Qt call that releases
+#: it (each painter call of a paint) must win it back: with a worker busy in Python code
+#: each takes up to a whole interval, so a 10 ms paint took 40-60 ms while a file
+#: processed. 1 ms keeps such waits short at a small cost in switches for the worker.
+SWITCH_INTERVAL_S = 0.001
 
 _EXTS = ("plt", "hpgl", "hpg", "hp", "pgl", "pcl", "spl")
 FILE_FILTER = (
@@ -268,6 +275,8 @@ class MainWindow(QMainWindow):
     def __init__(self, drawing: Drawing | None = None, parent: QWidget | None = None, *,
                  settings: QSettings | None = None, restore: bool = True) -> None:
         super().__init__(parent)
+        if sys.getswitchinterval() > SWITCH_INTERVAL_S:
+            sys.setswitchinterval(SWITCH_INTERVAL_S)
         self.settings = settings if settings is not None else app_settings()
         self._restore_settings = restore
         self.drawing: Drawing | None = None
@@ -1027,18 +1036,20 @@ class MainWindow(QMainWindow):
     # --- data -----------------------------------------------------------------------------
     def set_drawing(self, drawing: Drawing, path: str | os.PathLike | None = None, *,
                     bbox: tuple[float, float, float, float] | None = None,
-                    size_mm: tuple[float, float] | None = None) -> None:
+                    size_mm: tuple[float, float] | None = None,
+                    pipeline: Pipeline | None = None) -> None:
         """Process ``drawing`` (on the worker) and show it when its result is ready; the
         selection of the previous drawing is cleared at once. ``bbox``/``size_mm``: its
-        facts when already known (computed on the worker by :meth:`load_file`)."""
+        facts when already known (computed on the worker by :meth:`load_file`, as is
+        ``pipeline``, a fresh one that knows the bbox)."""
         self._leave_job_mode()
         self._fit_banner = False
         if drawing is not self.drawing:
-            self._fresh_caches()
+            self._fresh_caches(pipeline)
         self.drawing = drawing
         self._drawing_bbox = bbox if bbox is not None else self.pipeline.bbox(drawing)
         if size_mm is not None:
-            self._size_mm_of = (drawing, size_mm)
+            self._remember_facts(drawing, size=size_mm)
         self.file_path = FsPath(path) if path is not None else None
         self.selected = None
         self._show_selection(None)
@@ -1051,11 +1062,12 @@ class MainWindow(QMainWindow):
         self._update_status()
         self._update_stale()
 
-    def _fresh_caches(self) -> None:
+    def _fresh_caches(self, pipeline: Pipeline | None = None) -> None:
         """Empty caches for a new file: they hold the stages, display geometry and item
         data of the drawings they were made from, so what the last file left there is
-        freed with its result (memory stays about one file's, not the session's)."""
-        self.pipeline = Pipeline()
+        freed with its result (memory stays about one file's, not the session's).
+        ``pipeline``: a fresh one made on the worker (see :func:`load_task`)."""
+        self.pipeline = pipeline if pipeline is not None else Pipeline()
         self.preview_cache = PreviewCache()
         self.prepared_cache = PreparedCache()
 
@@ -1104,7 +1116,7 @@ class MainWindow(QMainWindow):
             return self.load_job_file(path, wait=wait, timeout_s=timeout_s)
         self.loading_path = path
         self.last_load_ok = None
-        self.io.request(load_task(path, _read_for_gui, self.pipeline))
+        self.io.request(load_task(path, _read_for_gui))
         self._update_stale()
         if not wait:
             return True
@@ -1130,8 +1142,11 @@ class MainWindow(QMainWindow):
             keep = self._keep_selection
             self._keep_selection = None
             self._open_fitting_field(loaded)
+            if loaded.n_points >= 0:
+                self._remember_facts(loaded.drawing,
+                                     counts=(loaded.n_points, loaded.n_closed))
             self.set_drawing(loaded.drawing, loaded.path, bbox=loaded.bbox,
-                             size_mm=loaded.size_mm)
+                             size_mm=loaded.size_mm, pipeline=loaded.pipeline)
             if keep is not None:
                 self._fit_pending = False
                 self.selected = keep
@@ -1172,7 +1187,7 @@ class MainWindow(QMainWindow):
         from galvo_core.field import check_in_field
 
         try:
-            fm = self.pipeline.field_map(loaded.drawing, p)
+            fm = (loaded.pipeline or self.pipeline).field_map(loaded.drawing, p)
             check_in_field(fm, loaded.bbox, clamp=False)
             return
         except (GalvoError, ValueError):
@@ -1789,13 +1804,31 @@ class MainWindow(QMainWindow):
         if self.windowTitle() != title:
             self.setWindowTitle(title)
 
+    def _remember_facts(self, d: Drawing, **facts: object) -> dict[str, object]:
+        """The status bar's facts of ``d`` (size, point and closed-path counts: each walks
+        every path, 10-30 ms on 40 k paths), kept for the drawing shown and the one
+        opening, whose status lines alternate while it processes (others are dropped:
+        the memo must not keep a closed file alive)."""
+        memo: dict[int, tuple[Drawing, dict[str, object]]] = self.__dict__.setdefault(
+            "_facts_of", {})
+        hit = memo.get(id(d))
+        if hit is None or hit[0] is not d:
+            hit = (d, {})
+            memo[id(d)] = hit
+        live = {id(d), id(self.drawing)}
+        if self.result is not None:
+            live.add(id(self.result.drawing))
+        for k in [k for k in memo if k not in live]:
+            del memo[k]
+        hit[1].update(facts)
+        return hit[1]
+
     def _size_mm(self, d: Drawing) -> tuple[float, float]:
         """``d.size_mm()``, kept per drawing (a bbox over every point: too slow per run)."""
-        cached = getattr(self, "_size_mm_of", None)
-        if cached is None or cached[0] is not d:
-            cached = (d, d.size_mm())
-            self._size_mm_of = cached
-        return cached[1]
+        facts = self._remember_facts(d)
+        if "size" not in facts:
+            facts["size"] = d.size_mm()
+        return facts["size"]  # type: ignore[return-value]
 
     def status_summary(self) -> str:
         """The counts shown in the status bar, as plain text."""
@@ -1807,14 +1840,15 @@ class MainWindow(QMainWindow):
                 return f"job file {job_path.name}"
             return "No file — File ▸ Open… or drop an HP-GL file onto the window"
         w, h = self._size_mm(d)
-        memo = getattr(self, "_counts_of", None)
-        if memo is None or memo[0] is not d:  # walks every path: once per drawing
-            memo = self._counts_of = (d, d.n_points, d.n_closed)
+        facts = self._remember_facts(d)
+        if "counts" not in facts:  # walks every path: once per drawing
+            facts["counts"] = (d.n_points, d.n_closed)
+        n_points, n_closed = facts["counts"]  # type: ignore[misc]
         return "   ·   ".join(
             [
                 f"{_fmt_int(len(d.paths))} paths",
-                f"{_fmt_int(memo[1])} points",
-                f"{_fmt_int(memo[2])} closed",
+                f"{_fmt_int(n_points)} points",
+                f"{_fmt_int(n_closed)} closed",
                 f"{w:.2f} × {h:.2f} mm",
                 (self.shown_name() if res is not None else self.file_name()) or "untitled",
             ]

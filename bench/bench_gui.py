@@ -45,6 +45,9 @@ os.environ.setdefault("GALVO_WORKSTATION_SETTINGS",
                       os.path.join(tempfile.mkdtemp(prefix="galvo-bench-"), "s.ini"))
 
 SIZE = (1400, 800)
+#: GALVO_BENCH_WHERE=<ms>: sample the GUI thread and print what it ran in gaps over <ms>
+_WHERE = os.environ.get("GALVO_BENCH_WHERE", "")
+WHERE_MS = float(_WHERE) if _WHERE.replace(".", "", 1).isdigit() else 100.0
 
 
 class StallProbe:
@@ -68,20 +71,13 @@ class StallProbe:
         self.max_gap = max(self.max_gap, gap)
         if gap > 100.0:
             self.long.append(gap)
-            if os.environ.get("GALVO_BENCH_WHERE"):  # what the other threads were doing
-                import threading
-                import traceback
-
-                main = threading.main_thread().ident
-                for ident, frame in sys._current_frames().items():  # noqa: SLF001
-                    if ident == main:
-                        continue
-                    st = traceback.extract_stack(frame)[-4:]
-                    where = " <- ".join(f"{x.filename.split('/')[-1]}:{x.lineno} {x.line}"
-                                        for x in reversed(st))
-                    print(f"    gap {gap:.0f} ms: {where}", file=sys.stderr)
+        if gap > WHERE_MS:
+            if hasattr(self, "sampler"):
+                self.sampler.report(now - gap / 1000.0, now, gap)
 
     def start(self) -> None:
+        if os.environ.get("GALVO_BENCH_WHERE") and not hasattr(self, "sampler"):
+            self.sampler = MainSampler()
         self.last = time.perf_counter()
         self.max_gap = 0.0
         self.long = []
@@ -90,6 +86,52 @@ class StallProbe:
     def stop(self) -> float:
         self.timer.stop()
         return self.max_gap
+
+
+class MainSampler:
+    """With GALVO_BENCH_WHERE set: a thread that samples the GUI thread's Python stack
+    every 5 ms, so a stall can be attributed (the samples taken inside a gap name what the
+    GUI thread ran; none at all means a thread held the GIL in one C call, or the process
+    was not scheduled)."""
+
+    def __init__(self) -> None:
+        import collections
+        import threading
+
+        self.samples: collections.deque = collections.deque(maxlen=400)
+        self.main = threading.main_thread().ident
+        threading.Thread(target=self._run, daemon=True).start()
+
+    def _run(self) -> None:
+        import traceback
+
+        while True:
+            time.sleep(0.005)
+            frames = sys._current_frames()  # noqa: SLF001
+            now = time.perf_counter()
+            st = []
+            for ident, frame in frames.items():
+                tag = "gui" if ident == self.main else "bg"
+                if ident == threading_ident():
+                    continue
+                fr = traceback.extract_stack(frame)[-5:]
+                st.append(tag + ": " + " <- ".join(
+                    f"{x.filename.split('/')[-1]}:{x.lineno} {x.name}" for x in reversed(fr)))
+            self.samples.append((now, st))
+
+    def report(self, t0: float, t1: float, gap: float) -> None:
+        inside = [(t, st) for t, st in self.samples if t0 - 0.006 <= t <= t1 + 0.006]
+        print(f"    gap {gap:.0f} ms, {len(inside)} samples of the GUI thread in it:",
+              file=sys.stderr)
+        for t, st in inside:
+            for line in st:
+                print(f"      {(t - t0) * 1000:6.0f} ms {line}", file=sys.stderr)
+
+
+def threading_ident() -> int:
+    import threading
+
+    return threading.get_ident()
 
 
 def peak_mb() -> float:
@@ -140,6 +182,8 @@ def make_window():
     from app.window import MainWindow
 
     win = MainWindow(restore=False)
+    if os.environ.get("GALVO_BENCH_SWITCH_S"):  # compare the window's switch interval
+        sys.setswitchinterval(float(os.environ["GALVO_BENCH_SWITCH_S"]))
     win.gui_work = GuiWork(win)
     win.resize(*SIZE)
     win.show()
