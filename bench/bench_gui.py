@@ -17,7 +17,7 @@ Driven through the window's scripting surface, offscreen (software rasteriser), 
   at the end (memory must stay about one file's, not grow with each file opened).
 
     .venv/bin/python bench/bench_gui.py latency [FILES...] [--points 150000] [--repeats 5]
-    .venv/bin/python bench/bench_gui.py stalls [--points 1000000]
+    .venv/bin/python bench/bench_gui.py stalls [--points 1000000 | --file F] [--opens 5]
     .venv/bin/python bench/bench_gui.py memory [FILES...] [--opens 10]
 
 Without FILES, ``latency`` uses a generated ``--points`` file (bench/gen_plt.py); give the
@@ -151,6 +151,7 @@ class GuiWork:
     def __init__(self, win) -> None:
         self.apply = 0.0
         self.paint = 0.0
+        self.paint_cpu = 0.0  # the GUI thread's CPU time in the longest paint
         real_apply = win.apply_result
 
         def apply(result) -> None:
@@ -163,9 +164,11 @@ class GuiWork:
             real_paint = v.paintEvent
 
             def paint(ev, real=real_paint) -> None:
-                t = time.perf_counter()
+                t, c = time.perf_counter(), time.thread_time()
                 real(ev)
-                self.paint = max(self.paint, (time.perf_counter() - t) * 1000)
+                ms = (time.perf_counter() - t) * 1000
+                if ms > self.paint:
+                    self.paint, self.paint_cpu = ms, (time.thread_time() - c) * 1000
 
             v.paintEvent = paint
 
@@ -310,7 +313,7 @@ def latency(files: list[Path], repeats: int, only: list[str] | None = None) -> N
     win.close()
 
 
-def stalls(points: int, big: Path | None) -> None:
+def stalls(points: int, big: Path | None, opens: int = 1) -> None:
     from gen_plt import generate_plt
 
     app, win = make_window()
@@ -335,12 +338,23 @@ def stalls(points: int, big: Path | None) -> None:
         win.processed.repaint_now()
         dt = time.perf_counter() - t0
         gap = probe.stop()
+        probe.max_gap = gap
+        pc = win.gui_work.paint_cpu
         ap, pt = win.gui_work.take()
         print(f"{name:34s} {dt:7.1f} {gap:21.0f} {peak_mb():8.0f}   "
-              f"(gaps > 100 ms: {len(probe.long)}; apply {ap:.0f}, paint {pt:.0f})")
+              f"(gaps > 100 ms: {len(probe.long)}; apply {ap:.0f}, paint {pt:.0f}"
+              f" of which CPU {pc:.0f})")
 
     win.gui_work.take()
-    phase("open + process", lambda: win.load_file(big))
+    gaps = []
+    for k in range(opens):
+        # the same file again: the window frees the last one's result as for a new file
+        phase("open + process" if k == 0 else f"open again ({k + 1}/{opens})",
+              lambda: win.load_file(big))
+        gaps.append(probe.max_gap)
+    if opens > 1:
+        print(f"  open + process over {opens} opens: longest stall max {max(gaps):.0f} ms, "
+              f"median {statistics.median(gaps):.0f} ms")
     d = win.drawing
     print(f"  {d.n_points} points, {len(d.paths)} paths, "
           f"{win.result.job.stats['mark_points']} marks, error: {win.run_error}")
@@ -402,6 +416,8 @@ def main(argv: list[str] | None = None) -> int:
     a2 = sub.add_parser("stalls")
     a2.add_argument("--points", type=int, default=1_000_000)
     a2.add_argument("--file", type=Path, default=None)
+    a2.add_argument("--opens", type=int, default=1, help="open the file this many times "
+                    "(the longest stall of each open; max and median)")
     a3 = sub.add_parser("memory")
     a3.add_argument("files", nargs="*", type=Path)
     a3.add_argument("--opens", type=int, default=10)
@@ -427,7 +443,7 @@ def main(argv: list[str] | None = None) -> int:
             files = [f]
         latency(files, a.repeats, [w for w in a.rows.split(",") if w] or None)
     else:
-        stalls(a.points, a.file)
+        stalls(a.points, a.file, a.opens)
     return 0
 
 
