@@ -900,6 +900,9 @@ class WorkView(pg.PlotWidget):
         return True
 
     def set_highlight(self, xy: np.ndarray, transform: QTransform) -> None:
+        if not len(xy) and getattr(self, "_highlight_empty", False):
+            return  # already empty: no change, no repaint of the whole view
+        self._highlight_empty = not len(xy)
         self.highlight.setTransform(transform)
         if len(xy):
             self.highlight.setData(xy[:, 0], xy[:, 1], connect="finite")

@@ -307,6 +307,10 @@ class MainWindow(QMainWindow):
         self._committed: Params | None = None
         self._reloading = False
         self._fit_banner = False
+        #: the banner's text once the next result is shown ("" hides it; None: no change):
+        #: the banner speaks of the result shown, and changing it resizes the views (a
+        #: full repaint of both), which the new result's paint then includes
+        self._banner_next: str | None = None
         self._stale_shown = False
         #: File ▸ Export kinds (other modules may add to it, then rebuild_export_menu())
         self.export_kinds: dict[str, ExportKind] = default_export_kinds()
@@ -881,9 +885,10 @@ class MainWindow(QMainWindow):
         if self.last_load_ok is None:
             self.last_load_ok = False
         res = self.result
+        self._banner_next = None  # the banner stays the shown result's
         if res is not None:
             if res.job_path is None:
-                self._leave_job_mode()
+                self._leave_job_mode(now=True)
             self.drawing = res.drawing
             self.file_path = FsPath(res.path) if res.path is not None else None
             self.job_path = res.job_path
@@ -952,6 +957,7 @@ class MainWindow(QMainWindow):
     def apply_result(self, result: RunResult) -> None:
         """Show a finished run: layers, field, stats, warnings, conversions."""
         self.result = result
+        self._apply_banner()
         err = getattr(result, "error", None)
         self.run_error = self.gui_message(err) if err else None
         pv = result.preview
@@ -1198,11 +1204,10 @@ class MainWindow(QMainWindow):
             return
         self.set_params(params, run=False)
         w, h = loaded.size_mm
-        self.banner.setText(
+        self._banner_next = (
             f"{loaded.path.name} is {w:.1f} × {h:.1f} mm, bigger than the "
             f"{p.field_size_mm:g} mm field at true size: opened with Fit field on (scaled "
             "to the field). Untick Fit field for a fixed magnification.")
-        self.banner.show()
         self._fit_banner = True
 
     def _show_job(self, loaded: LoadedJob) -> None:
@@ -1220,9 +1225,9 @@ class MainWindow(QMainWindow):
         self.controls.setEnabled(False)
         where = f"; original from {source.name}" if source is not None else (
             "; its source file was not found beside it, so the original view is empty")
-        self.banner.setText(f"Showing the job file {path.name} as written (processing controls "
-                            f"are inactive{where}). Open a PLT file to process again.")
-        self.banner.show()
+        self._banner_next = (f"Showing the job file {path.name} as written (processing "
+                             f"controls are inactive{where}). Open a PLT file to process "
+                             "again.")
         self._add_recent(path)
         self.runner.request(job_task(loaded.job, source, self.preview_cache, path,
                                      self.prepared_cache))
@@ -1244,13 +1249,30 @@ class MainWindow(QMainWindow):
             return None
         return d
 
-    def _leave_job_mode(self) -> None:
+    def _leave_job_mode(self, now: bool = False) -> None:
+        """Back to processing files: the banner (of a job file, or of the last file's Fit
+        field) goes with the next result, or ``now``."""
         if self.job_path is not None:
             self.job_path = None
             self.controls.setEnabled(True)
+        if not self._fit_banner:  # (set when the file opening got Fit field: its banner)
+            self._banner_next = ""
+        if now:
+            self._apply_banner()
+
+    def _apply_banner(self) -> None:
+        """The banner change asked for (see ``_banner_next``), the views resized at once."""
+        text, self._banner_next = self._banner_next, None
+        if text is None or (not text and self.banner.isHidden()):
+            return
+        if text:
+            self.banner.setText(text)
+            self.banner.show()
+        else:
             self.banner.hide()
-        elif not self._fit_banner:
-            self.banner.hide()
+        layout = self.centralWidget().layout()
+        if layout is not None:
+            layout.activate()  # the views take their size now (before a fit to them)
 
     def reload(self) -> bool:
         if self.job_path is not None:

@@ -276,7 +276,7 @@ def latency(files: list[Path], repeats: int, only: list[str] | None = None) -> N
         if only:
             rows = [r for r in rows if any(o in r[0] for o in only)]
         print(f"  {'change':26s} {'wall ms':>9s} {'CPU ms':>8s} {'stall ms':>9s}"
-              f" {'apply/paint ms':>15s}")
+              f" {'apply/paint ms':>15s} {'max wall/CPU ms':>16s}")
         for name, make in rows:
             walls, cpus, stalls, gui = [], [], [], []
             if name.startswith("layer:") and win.params.kerf_mm:
@@ -307,7 +307,7 @@ def latency(files: list[Path], repeats: int, only: list[str] | None = None) -> N
             ap = statistics.median(g[0] for g in gui)
             pa = statistics.median(g[1] for g in gui)
             print(f"  {name:26s} {statistics.median(walls):9.0f} {statistics.median(cpus):8.0f}"
-                  f" {max(stalls):9.0f} {ap:7.0f}/{pa:<7.0f}")
+                  f" {max(stalls):9.0f} {ap:7.0f}/{pa:<7.0f} {max(walls):8.0f}/{max(cpus):<7.0f}")
         win.set_param("kerf_mm", 0.0)
         win.wait_idle(600)
     win.close()
