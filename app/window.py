@@ -783,6 +783,11 @@ class MainWindow(QMainWindow):
                     t.wait(5)
             if app is not None:
                 app.processEvents()
+        # the processed view's staggered paint: let it through in its own pass
+        for _ in range(20):
+            if app is None or self.processed.updatesEnabled():
+                break
+            app.processEvents()
         self._paint_processed()
         return not self.busy()
 
