@@ -21,7 +21,15 @@ Driven through the window's scripting surface, offscreen (software rasteriser), 
     .venv/bin/python bench/bench_gui.py memory [FILES...] [--opens 10]
 
 Without FILES, ``latency`` uses a generated ``--points`` file (bench/gen_plt.py); give the
-corpus files (``../shared/corpus/plt/...``) to measure them.
+corpus files (``../shared/corpus/plt/...``) to measure them. ``stalls --opens N`` opens the
+file N times in the same window (each open replaces the last one's result) and gives the
+max and median of the opens' longest stalls.
+
+``GALVO_BENCH_WHERE=<ms>``: a thread samples every thread's Python stack each 5 ms, and for
+each gap of the GUI timer longer than <ms> the samples taken inside it are printed (what
+the GUI thread ran, what the worker ran; no sample for a while: one thread held the GIL in
+a single C call, or the process was not scheduled). ``GALVO_BENCH_SWITCH_S``: set the
+interpreter's switch interval after the window set its own (to compare).
 """
 
 from __future__ import annotations
