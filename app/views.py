@@ -26,6 +26,7 @@ Layers (key: what, view):
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
@@ -988,9 +989,14 @@ class WorkView(pg.PlotWidget):
     #: viewport paints so far (the benchmark tells whether a result was drawn already)
     paint_count = 0
 
+    #: called (once set) after each paint of the view (the window staggers the views' paints)
+    on_painted: Callable[[], None] | None = None
+
     def paintEvent(self, ev) -> None:  # noqa: N802 - Qt API
         super().paintEvent(ev)
         self.paint_count += 1
+        if self.on_painted is not None:
+            self.on_painted()
 
     def data_items(self) -> list[pg.GraphicsObject]:
         return [self.layers[k] for k in self.layers]

@@ -114,6 +114,9 @@ SWITCH_INTERVAL_S = 0.001
 #: this long after (ms): freeing 40 k paths with their fits, strokes and display data takes
 #: the GUI thread 10-20 ms, which then no longer adds to the new result's apply and paint.
 RELEASE_DELAY_MS = 150
+#: The processed view paints after the original (see MainWindow._stagger_paints), at the
+#: latest this long after a result (ms).
+STAGGER_MAX_MS = 80
 
 _EXTS = ("plt", "hpgl", "hpg", "hp", "pgl", "pcl", "spl")
 FILE_FILTER = (
@@ -1093,9 +1096,17 @@ class MainWindow(QMainWindow):
         between."""
         if self.processed.updatesEnabled():
             self.processed.setUpdatesEnabled(False)
-            QTimer.singleShot(0, self._paint_processed)
+            # once the original has painted (then timers get their turn), or at the latest
+            # after STAGGER_MAX_MS
+            self.original.on_painted = self._after_original_paint
+            QTimer.singleShot(STAGGER_MAX_MS, self._paint_processed)
+
+    def _after_original_paint(self) -> None:
+        self.original.on_painted = None
+        QTimer.singleShot(0, self._paint_processed)
 
     def _paint_processed(self) -> None:
+        self.original.on_painted = None
         if not self.processed.updatesEnabled():
             self.processed.setUpdatesEnabled(True)  # (schedules its repaint)
 
