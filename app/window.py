@@ -1089,17 +1089,24 @@ class MainWindow(QMainWindow):
         self._update_stale()
 
     def _stagger_paints(self) -> None:
-        """The processed view paints one event-loop pass after the original: a new result
-        repaints both in full (20-35 ms of the GUI thread each on 100 k+ points, two to
-        four times that when a worker holds the interpreter lock), and Qt paints all the
-        window's dirty widgets in one go; in two passes input and timers get a turn in
+        """A new result's apply, the original view's paint and the processed view's paint
+        run in three event-loop passes: after a new result both views repaint in full
+        (20-35 ms of the GUI thread each on 100 k+ points, two to four times that when a
+        worker holds the interpreter lock) and Qt paints all the window's dirty widgets in
+        one go, right after the apply; in separate passes input and timers get a turn in
         between."""
         if self.processed.updatesEnabled():
+            self.original.setUpdatesEnabled(False)
             self.processed.setUpdatesEnabled(False)
-            # once the original has painted (then timers get their turn), or at the latest
-            # after STAGGER_MAX_MS
-            self.original.on_painted = self._after_original_paint
+            QTimer.singleShot(0, self._paint_original)
+            # at the latest after STAGGER_MAX_MS
             QTimer.singleShot(STAGGER_MAX_MS, self._paint_processed)
+
+    def _paint_original(self) -> None:
+        if not self.original.updatesEnabled():
+            # the processed view once the original has painted (then timers get a turn)
+            self.original.on_painted = self._after_original_paint
+            self.original.setUpdatesEnabled(True)  # (schedules its repaint)
 
     def _after_original_paint(self) -> None:
         self.original.on_painted = None
@@ -1107,8 +1114,9 @@ class MainWindow(QMainWindow):
 
     def _paint_processed(self) -> None:
         self.original.on_painted = None
-        if not self.processed.updatesEnabled():
-            self.processed.setUpdatesEnabled(True)  # (schedules its repaint)
+        for v in (self.original, self.processed):
+            if not v.updatesEnabled():
+                v.setUpdatesEnabled(True)  # (schedules its repaint)
 
     def grab(self, *args: Any) -> QPixmap:
         """``QWidget.grab``, with the processed view's staggered paint let through."""
