@@ -36,7 +36,7 @@ from galvo_core.field import FieldMap, check_in_field, make_field
 from galvo_core.fill import HatchStroke, hatch
 from galvo_core.fit import FittedPath, control_points, fit_drawing, with_source_index
 from galvo_core.job import Job, Segments, Stroke, gc_paused
-from galvo_core.kerf import compensate_indexed
+from galvo_core.kerf import compensate_indexed, kerf_regions
 from galvo_core.order import order_job_strokes
 from galvo_core.params import UNITS_PER_MM, Params
 from galvo_core.precision import path_quanta
@@ -188,9 +188,12 @@ class Pipeline:
         run = run or _Run(None)
 
         def make() -> tuple[Drawing, tuple[int, ...]]:
+            # the rings' even-odd regions do not depend on the kerf: once per drawing
+            regions = self._fact(drawing, "kerf_regions",
+                                 lambda: kerf_regions(drawing, self.bbox(drawing)))
             return compensate_indexed(drawing, kerf_mm=params.kerf_mm, side=params.kerf_side,
                                       method=params.kerf_method, fm=fm,
-                                      arc_tol_bits=params.arc_tol_bits)
+                                      arc_tol_bits=params.arc_tol_bits, regions=regions)
 
         return self._cache.get(drawing, ("kerf", self._kerf_key(params, fm)),
                                run.stage("kerf", make))
