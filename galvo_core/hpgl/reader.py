@@ -160,7 +160,7 @@ _PE_MESSAGES = {  # scan.PE_* problem codes -> the messages of pe.decode_pe
 _LABEL_ORIGINS = frozenset((*range(1, 10), *range(11, 20), 21))
 _LO_CONCATENATE = frozenset((1, 2, 3, 11, 12, 13, 21))
 #: where the compiled scanner is started (it reads PM, EP, FP and FT too once it runs)
-_SCAN_CMDS = frozenset((b"PU", b"PD", b"PA", b"PR", b"SP", b"PW"))
+_SCAN_CMDS = frozenset((b"PU", b"PD", b"PA", b"PR", b"SP", b"PW", b"PE"))
 
 
 def _is_letter_or_esc(c: int) -> bool:
@@ -1048,6 +1048,9 @@ class _Reader:
             self._u8 = np.frombuffer(self.data, dtype=np.uint8)
             self._ist = np.zeros(scan_module.N_ISTATE, dtype=np.int64)
             self._fst = np.zeros(scan_module.N_FSTATE, dtype=np.float64)
+            # PE's look-ahead cache (scan._pe_looks_like_number), the scanner's and
+            # _pe_compiled's
+            self._pe_span = np.array([-1, -1, -1, -1], dtype=np.int64)
         return self._scan
 
     def _line_at(self, i: int) -> tuple[int, int]:
@@ -1085,7 +1088,8 @@ class _Reader:
                 (self.x, self.y, sc[0], sc[1], sc[2], sc[3], 1.0)
             pb, rs, rcl = self._pbuf
             scan.scan_moves(self._u8, ist, fst, ch.pts, ch.seg_start, ch.seg_off, ch.seg_pen,
-                            ch.seg_line, ch.seg_col, pb, rs, rcl, _POW10, scan.CLASS)
+                            ch.seg_line, ch.seg_col, pb, rs, rcl, _POW10, scan.CLASS,
+                            self._pe_span)
             out = ist.tolist()
             buffered = buffered or out[scan.I_NPM] > 0
             self._take_segments(ch, out)
@@ -1096,11 +1100,11 @@ class _Reader:
             self.absolute = bool(out[scan.I_ABS])
             self.pen = out[scan.I_PENNO]
             counts = out[scan.I_NU : scan.I_NR + 1] + [out[scan.I_NSP], out[scan.I_NPW]] + \
-                out[scan.I_NPM : scan.I_NFP + 1] + [out[scan.I_NFT]]
+                out[scan.I_NPM : scan.I_NFP + 1] + out[scan.I_NFT : scan.I_NRF + 1]
             self.hpgl2 = bool(out[scan.I_HPGL2])
             if any(counts):
-                for name, c in zip(("PU", "PD", "PA", "PR", "SP", "PW", "PM", "EP", "FP", "FT"),
-                                   counts, strict=True):
+                for name, c in zip(("PU", "PD", "PA", "PR", "SP", "PW", "PM", "EP", "FP", "FT",
+                                    "PE", "RF"), counts, strict=True):
                     if c:
                         self.commands[name] += c
                 self.recognised += sum(counts)
@@ -1713,8 +1717,6 @@ class _Reader:
     def _pe_compiled(self, pos: int) -> int:
         """PE decoded by the compiled decoder (scan.decode_pe, the same decoding)."""
         scan = self._scanner()
-        if not hasattr(self, "_pe_span"):
-            self._pe_span = np.array([-1, -1, -1, -1], dtype=np.int64)
         end, kinds, xs, ys, flags, ni, p_off, p_code, p_val, npb = scan.decode_pe(
             self._u8, pos, self._pe_span)
         for off, code, val in zip(p_off[:npb].tolist(), p_code[:npb].tolist(),

@@ -30,11 +30,12 @@ from numba import njit
  # polygon mode: in PM, after PM1, buffer edged or filled, EP's segments (0: none, 1: in
  # this call, [I_EDGE_S0, I_EDGE_S1) and points [I_EDGE_P0, I_EDGE_P1) of the chunk, 2: the
  # caller's), PM0's offset, line, column (I_PLC: known), buffer points and completed rings,
- # EP/FP allowed (no IW window, no RO), PM/EP/FP counts, EP segments FP replaced; FT count
+ # EP/FP allowed (no IW window, no RO), PM/EP/FP counts, EP segments FP replaced; FT count;
+ # PE and RF counts
  I_POLY, I_FRESH, I_EMITTED, I_EDGED, I_EDGE_S0, I_EDGE_S1, I_EDGE_P0, I_EDGE_P1,
  I_POFF, I_PLINE, I_PCOL, I_PLC, I_NPB, I_NRING, I_POLYOK, I_NPM, I_NEP, I_NFP,
- I_DROP, I_NFT) = range(40)
-N_ISTATE = 40
+ I_DROP, I_NFT, I_NPE, I_NRF) = range(42)
+N_ISTATE = 42
 N_MOVE_STATE = 20  # slots I_POS..I_NPW: the move state the caller sets at every call
 # I_FULL values: the output chunk is full / the polygon buffer is full
 FULL_CHUNK, FULL_POLY = 1, 2
@@ -102,8 +103,194 @@ def _write_rings(pts, seg_start, seg_off, seg_pen, seg_line, seg_col, npts, nseg
 
 
 @njit(cache=True, nogil=True, boundscheck=False)
+def _pe_moves(b, k, pe_cache, pen, is_open, npts, nseg, x, y, npb, nr, fresh, pen_no, in_poly,
+              spok, has_sc, ax, bx, ay, by, line, col, pts, seg_start, seg_off, seg_pen,
+              seg_line, seg_col, pb, rs, rcl):
+    """A PE run from ``k`` (just after the mnemonic, at line ``line``, column ``col``), decoded
+    as :func:`galvo_core.hpgl.pe.decode_pe` and applied as the general reader's
+    ``_Reader._pe_apply``: ``:`` selects a pen (the path ends), ``<`` makes the next pair a
+    pen-up move (the pair after it puts the pen down again), ``=`` the next pair absolute,
+    ``>`` the fractional bits, ``7`` base-32 numbers; the moves go to the chunk or, in polygon
+    mode, to the polygon buffer, as the scanner's PU/PD/PA/PR moves.
+
+    ``ok`` is False where the general reader warns (a number clamped, fractional bits out of
+    range, half a pair or a flag without its number at the end) or where a pen is selected
+    before any SP; ``full`` says the chunk or the polygon buffer is full. The caller then
+    rolls the command back. ``pe_cache`` is the look-ahead cache of
+    :func:`_pe_looks_like_number` (one number read: its look-ahead is the same walk).
+
+    Returns (end, ok, full, pen, is_open, npts, nseg, x, y, npb, nr, fresh, pen_no).
+    """
+    n = b.shape[0]
+    cap = pts.shape[0]
+    scap = seg_start.shape[0]
+    pcap = pb.shape[0]
+    rcap = rs.shape[0]
+    off = k  # the general reader's offset of PE's paths: just after the mnemonic
+    ok = True
+    full = 0
+    seven = False
+    scale = 1.0
+    pending = 0  # ':' or '>' waiting for its number
+    up_next = False
+    abs_next = False
+    have_x = False
+    cx = 0
+    while k < n:
+        c = b[k]
+        if c == 59:  # ';'
+            k += 1
+            break
+        if c == 27:  # ESC: a PCL escape ends the run
+            break
+        if c == 58 or c == 60 or c == 62 or c == 61 or c == 55:  # : < > = 7
+            if c == 55:
+                seven = True
+            elif c == 60:
+                up_next = True
+            elif c == 61:
+                abs_next = True
+            else:
+                pending = c
+            k += 1
+            continue
+        if _pe_ign(c, seven):
+            k += 1
+            continue
+        if c < 63:
+            break  # not PE data ('0'..'6', '8', '9', punctuation)
+        # a digit: read the number; a run that meets a byte neither a digit nor ignorable
+        # before its terminating digit is no number (pe._looks_like_number), the run ends
+        s = 2 if seven else 0
+        if pe_cache[s] <= k < pe_cache[s + 1]:
+            break
+        q = k
+        value = 0
+        shift = 0
+        bits = 5 if seven else 6
+        big = False
+        done = False
+        while q < n:
+            c = b[q]
+            if _pe_cont(c, seven):
+                if shift < 60:
+                    value |= (c - 63) << shift
+                elif c != 63:
+                    big = True
+                shift += bits
+                q += 1
+            elif _pe_term(c, seven):
+                d = c - (95 if seven else 191)
+                if shift < 60:
+                    if shift > 0 and (d >> (62 - shift)) != 0:
+                        big = True
+                    else:
+                        value |= d << shift
+                elif d != 0:
+                    big = True
+                q += 1
+                done = True
+                break
+            elif _pe_ign(c, seven):
+                q += 1
+            else:
+                break
+        if not done:
+            pe_cache[s] = k
+            pe_cache[s + 1] = q
+            break  # an unterminated PE run followed by ordinary commands
+        k = q
+        if big or value > 2 * _PE_MAX + 1:
+            ok = False  # clamped: the general reader warns
+            break
+        num = -(value >> 1) if value & 1 else value >> 1
+        if pending == 58:  # ':' pen select (the general reader's flush ends the path)
+            pending = 0
+            if not spok or num < -(1 << 31) or num >= (1 << 31):
+                ok = False
+                break
+            pen_no = num
+            is_open = 0
+            continue
+        if pending == 62:  # '>' fractional bits
+            pending = 0
+            if num < 0 or num > 26:
+                ok = False
+                break
+            scale = float(1 << num) if num else 1.0
+            continue
+        if not have_x:
+            cx = num
+            have_x = True
+            continue
+        have_x = False
+        px = cx / scale
+        py = num / scale
+        if up_next:
+            if pen == 1:
+                pen = 0
+                is_open = 0
+        elif pen == 0:
+            pen = 1  # (outside PM the path starts at the current point: is_open is 0)
+        if abs_next:
+            if has_sc:
+                nx = ax * px + bx
+                ny = ay * py + by
+            else:
+                nx = px
+                ny = py
+        elif has_sc:
+            nx = x + ax * px
+            ny = y + ay * py
+        else:
+            nx = x + px
+            ny = y + py
+        up_next = False
+        abs_next = False
+        if in_poly:
+            if npb + 1 > pcap or nr + 2 > rcap:
+                full = FULL_POLY
+                break
+            if fresh:
+                fresh = 0
+                npb = rs[nr]
+            elif pen == 0:
+                if npb - rs[nr] > 1:
+                    rcl[nr] = 0
+                    nr += 1
+                    rs[nr] = npb
+                npb = rs[nr]
+            pb[npb, 0] = nx
+            pb[npb, 1] = ny
+            npb += 1
+        elif pen == 1:
+            if npts + 2 > cap or nseg + 2 > scap:
+                full = FULL_CHUNK
+                break
+            if is_open == 0:
+                seg_start[nseg] = npts
+                seg_off[nseg] = off
+                seg_line[nseg] = line
+                seg_col[nseg] = col
+                seg_pen[nseg] = pen_no
+                nseg += 1
+                pts[npts, 0] = x
+                pts[npts, 1] = y
+                npts += 1
+                is_open = 1
+            pts[npts, 0] = nx
+            pts[npts, 1] = ny
+            npts += 1
+        x = nx
+        y = ny
+    if ok and not full and (have_x or pending != 0):
+        ok = False  # half a pair or a flag without its number: the general reader warns
+    return k, ok, full, pen, is_open, npts, nseg, x, y, npb, nr, fresh, pen_no
+
+
+@njit(cache=True, nogil=True, boundscheck=False)
 def scan_moves(b, ist, fst, pts, seg_start, seg_off, seg_pen, seg_line, seg_col, pb, rs, rcl,
-               pow10, cls):
+               pow10, cls, pe_cache):
     """Read PU/PD/PA/PR (and SP, PW, and in polygon mode PM, EP, FP) commands from
     ``ist[I_POS]`` on; see the module docstring.
 
@@ -184,6 +371,8 @@ def scan_moves(b, ist, fst, pts, seg_start, seg_off, seg_pen, seg_line, seg_col,
     nep = 0
     nfp = 0
     nft = 0
+    npe = 0
+    nrf = 0
     drop = 0
     while True:
         # separators before a command
@@ -222,6 +411,8 @@ def scan_moves(b, ist, fst, pts, seg_start, seg_off, seg_pen, seg_line, seg_col,
                 code = 5
             elif c1 == 109:  # 'pm'
                 code = 6
+            elif c1 == 101:  # 'pe': polyline encoded
+                code = 10
             else:
                 break
         elif c1 == 112:
@@ -235,6 +426,8 @@ def scan_moves(b, ist, fst, pts, seg_start, seg_off, seg_pen, seg_line, seg_col,
                 break
         elif c0 == 102 and c1 == 116:  # 'ft': fill type, recorded, not drawn
             code = 9
+        elif c0 == 114 and c1 == 102:  # 'rf': raster fill pattern, recorded, not drawn
+            code = 11
         else:
             break
         cmd_at = j
@@ -243,6 +436,7 @@ def scan_moves(b, ist, fst, pts, seg_start, seg_off, seg_pen, seg_line, seg_col,
         k = j + 2
         # state at the command's start, to roll back to
         r_pen, r_absm, r_open, r_npts, r_nseg, r_x, r_y = pen, absm, is_open, npts, nseg, x, y
+        r_pen_no = pen_no
         r_npb, r_nr, r_fresh = npb, nr, fresh
         r_q0 = -1
         r_p0x = r_p0y = 0.0
@@ -287,7 +481,12 @@ def scan_moves(b, ist, fst, pts, seg_start, seg_off, seg_pen, seg_line, seg_col,
         full = 0
         half = False
         vx = 0.0
-        while k < n:
+        if code == 10:
+            k, ok, full, pen, is_open, npts, nseg, x, y, npb, nr, fresh, pen_no = _pe_moves(
+                b, k, pe_cache, pen, is_open, npts, nseg, x, y, npb, nr, fresh, pen_no,
+                in_poly, ist[I_SPOK] != 0, has_sc, ax, bx, ay, by, cmd_line, cmd_col + 2,
+                pts, seg_start, seg_off, seg_pen, seg_line, seg_col, pb, rs, rcl)
+        while k < n and code != 10:
             t = cls[b[k]]
             if t == C_SEMI:
                 k += 1
@@ -417,7 +616,7 @@ def scan_moves(b, ist, fst, pts, seg_start, seg_off, seg_pen, seg_line, seg_col,
             # roll back: the general reader reads this command (or a larger chunk or
             # buffer is made)
             pen, absm, is_open, npts, nseg, x, y = r_pen, r_absm, r_open, r_npts, r_nseg, r_x, r_y
-            npb, nr, fresh = r_npb, r_nr, r_fresh
+            npb, nr, fresh, pen_no = r_npb, r_nr, r_fresh, r_pen_no
             if r_q0 >= 0:
                 pb[r_q0, 0] = r_p0x
                 pb[r_q0, 1] = r_p0y
@@ -531,6 +730,18 @@ def scan_moves(b, ist, fst, pts, seg_start, seg_off, seg_pen, seg_line, seg_col,
             nfp += 1
         elif code == 9:
             nft += 1  # FT [type[,option...]]: nothing to apply (the general reader's too)
+        elif code == 10:
+            # PE: an HP-GL/2 command; the newlines of its bytes (ignored inside the run)
+            hpgl2 = True
+            npe += 1
+            for q in range(j + 2, k):
+                if b[q] == 10:
+                    tl += 1
+                    tn = q
+        elif code == 11:
+            # RF [index[,width,height,pixels...]]: no geometry; an HP-GL/2 command
+            hpgl2 = True
+            nrf += 1
         elif code == 0:
             nu += 1
         elif code == 1:
@@ -576,6 +787,8 @@ def scan_moves(b, ist, fst, pts, seg_start, seg_off, seg_pen, seg_line, seg_col,
     ist[I_NEP] = nep
     ist[I_NFP] = nfp
     ist[I_NFT] = nft
+    ist[I_NPE] = npe
+    ist[I_NRF] = nrf
     ist[I_DROP] = drop
     fst[F_X] = x
     fst[F_Y] = y
