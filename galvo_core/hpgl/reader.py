@@ -1068,6 +1068,8 @@ class _Reader:
         """Read the PU/PD/PA/PR/SP/PW commands (and PM/EP/FP/FT) from ``i`` on with the
         compiled scanner; returns the offset where it stopped (``i`` when the next command
         is not one it reads)."""
+        if not -(1 << 31) <= self.pen < 1 << 31:
+            return i  # the scanner's segments hold the pen number as int32
         scan = self._scanner()
         ist, fst = self._ist, self._fst
         line, last_nl = self._line_at(i)

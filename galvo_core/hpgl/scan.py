@@ -612,6 +612,8 @@ def scan_moves(b, ist, fst, pts, seg_start, seg_off, seg_pen, seg_line, seg_col,
             y = ny
         if code >= 4 and count > most:
             ok = False
+        elif code == 4 and count and not (-2147483648.0 <= vx < 2147483648.0):
+            ok = False  # a pen number the segments' int32 cannot hold: the general reader's
         if full or not ok or half:
             # roll back: the general reader reads this command (or a larger chunk or
             # buffer is made)
