@@ -1102,11 +1102,11 @@ class _Reader:
             self.absolute = bool(out[scan.I_ABS])
             self.pen = out[scan.I_PENNO]
             counts = out[scan.I_NU : scan.I_NR + 1] + [out[scan.I_NSP], out[scan.I_NPW]] + \
-                out[scan.I_NPM : scan.I_NFP + 1] + out[scan.I_NFT : scan.I_NRF + 1]
+                out[scan.I_NPM : scan.I_NFP + 1] + out[scan.I_NFT : scan.I_NMC + 1]
             self.hpgl2 = bool(out[scan.I_HPGL2])
             if any(counts):
                 for name, c in zip(("PU", "PD", "PA", "PR", "SP", "PW", "PM", "EP", "FP", "FT",
-                                    "PE", "RF"), counts, strict=True):
+                                    "PE", "RF", "MC"), counts, strict=True):
                     if c:
                         self.commands[name] += c
                 self.recognised += sum(counts)
@@ -1855,22 +1855,20 @@ def _clip_polyline(pts: np.ndarray, win: tuple[float, float, float, float]) -> l
         t0 = np.where(neg, np.maximum(t0, r), t0)
         t1 = np.where(pos_, np.minimum(t1, r), t1)
     visible &= t0 <= t1
-    out: list[np.ndarray] = []
-    cur: list[np.ndarray] = []
-    for k in np.flatnonzero(visible):
-        s = a[k] + t0[k] * d[k]
-        e = a[k] + t1[k] * d[k]
-        # segment k goes on from segment k-1 when that one was visible up to its end
-        # and this one is visible from its start
-        if cur and k > 0 and visible[k - 1] and t1[k - 1] == 1.0 and t0[k] == 0.0:
-            cur.append(e)
-        else:
-            if cur:
-                out.append(np.array(cur))
-            cur = [s, e]
-    if cur:
-        out.append(np.array(cur))
-    return out
+    ks = np.flatnonzero(visible)
+    if not len(ks):
+        return []
+    # the visible part of segment k runs from s to e; segment k goes on from segment k-1
+    # when that one was visible up to its end and this one is visible from its start
+    s = a[ks] + t0[ks, None] * d[ks]
+    e = a[ks] + t1[ks, None] * d[ks]
+    kp = np.maximum(ks - 1, 0)
+    new = ~((ks > 0) & visible[kp] & (t1[kp] == 1.0) & (t0[ks] == 0.0))
+    at_e = np.arange(len(ks)) + np.cumsum(new)  # where each e goes; s before it when new
+    out_pts = np.empty((len(ks) + int(new.sum()), 2))
+    out_pts[at_e] = e
+    out_pts[at_e[new] - 1] = s[new]
+    return np.split(out_pts, at_e[new][1:] - 1)
 
 
 def _line_cols_arrays(data: bytes, offs: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

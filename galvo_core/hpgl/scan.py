@@ -31,11 +31,11 @@ from numba import njit
  # this call, [I_EDGE_S0, I_EDGE_S1) and points [I_EDGE_P0, I_EDGE_P1) of the chunk, 2: the
  # caller's), PM0's offset, line, column (I_PLC: known), buffer points and completed rings,
  # EP/FP allowed (no IW window, no RO), PM/EP/FP counts, EP segments FP replaced; FT count;
- # PE and RF counts
+ # PE, RF and MC counts
  I_POLY, I_FRESH, I_EMITTED, I_EDGED, I_EDGE_S0, I_EDGE_S1, I_EDGE_P0, I_EDGE_P1,
  I_POFF, I_PLINE, I_PCOL, I_PLC, I_NPB, I_NRING, I_POLYOK, I_NPM, I_NEP, I_NFP,
- I_DROP, I_NFT, I_NPE, I_NRF) = range(42)
-N_ISTATE = 42
+ I_DROP, I_NFT, I_NPE, I_NRF, I_NMC) = range(43)
+N_ISTATE = 43
 N_MOVE_STATE = 20  # slots I_POS..I_NPW: the move state the caller sets at every call
 # I_FULL values: the output chunk is full / the polygon buffer is full
 FULL_CHUNK, FULL_POLY = 1, 2
@@ -373,6 +373,7 @@ def scan_moves(b, ist, fst, pts, seg_start, seg_off, seg_pen, seg_line, seg_col,
     nft = 0
     npe = 0
     nrf = 0
+    nmc = 0
     drop = 0
     while True:
         # separators before a command
@@ -428,6 +429,8 @@ def scan_moves(b, ist, fst, pts, seg_start, seg_off, seg_pen, seg_line, seg_col,
             code = 9
         elif c0 == 114 and c1 == 102:  # 'rf': raster fill pattern, recorded, not drawn
             code = 11
+        elif c0 == 109 and c1 == 99:  # 'mc': merge control, recorded, not drawn
+            code = 12
         else:
             break
         cmd_at = j
@@ -744,6 +747,10 @@ def scan_moves(b, ist, fst, pts, seg_start, seg_off, seg_pen, seg_line, seg_col,
             # RF [index[,width,height,pixels...]]: no geometry; an HP-GL/2 command
             hpgl2 = True
             nrf += 1
+        elif code == 12:
+            # MC [mode[,opcode]]: no geometry; an HP-GL/2 command
+            hpgl2 = True
+            nmc += 1
         elif code == 0:
             nu += 1
         elif code == 1:
@@ -791,6 +798,7 @@ def scan_moves(b, ist, fst, pts, seg_start, seg_off, seg_pen, seg_line, seg_col,
     ist[I_NFT] = nft
     ist[I_NPE] = npe
     ist[I_NRF] = nrf
+    ist[I_NMC] = nmc
     ist[I_DROP] = drop
     fst[F_X] = x
     fst[F_Y] = y
