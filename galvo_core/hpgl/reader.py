@@ -446,7 +446,13 @@ class _Reader:
             self.warn(offset, "path with coordinates out of range dropped", key="non-finite")
             return
         if self.window is not None:
-            pieces = _clip_polyline(pts, self.window)
+            if self._scan is not None and len(pts) > 1:
+                # (numba loaded: the compiled clipping, the same pieces)
+                cp, cs, cn = self._scan.clip_polyline(pts, *self.window)
+                cs = cs.tolist()
+                pieces = [cp[cs[k] : cs[k + 1]] for k in range(cn)]
+            else:
+                pieces = _clip_polyline(pts, self.window)
             if len(pieces) != 1 or len(pieces[0]) != len(pts) or not np.array_equal(pieces[0], pts):
                 self.clipped += 1
                 if self.first_clip < 0:

@@ -1031,3 +1031,67 @@ def _grow_f64(a, cap):
     out = np.empty(cap, np.float64)
     out[: a.shape[0]] = a
     return out
+
+
+# ------------------------------------------------------------------ IW clipping
+@njit(cache=True, nogil=True, boundscheck=False)
+def clip_polyline(pts, xmin, ymin, xmax, ymax):
+    """The pieces of the polyline ``pts`` (n >= 2 points) inside the window, computed as
+    ``reader._clip_polyline`` computes them (Liang-Barsky per segment, the same operations
+    value for value, numpy's ``maximum``/``minimum`` on ties): returns (points, starts,
+    count), piece k being ``points[starts[k]:starts[k + 1]]``."""
+    n = pts.shape[0]
+    out = np.empty((2 * n, 2))
+    starts = np.empty(n + 1, np.int64)
+    m = 0
+    npc = 0
+    prev_vis = False
+    prev_t1 = 0.0
+    for k in range(n - 1):
+        ax = pts[k, 0]
+        ay = pts[k, 1]
+        dx = pts[k + 1, 0] - ax
+        dy = pts[k + 1, 1] - ay
+        t0 = 0.0
+        t1 = 1.0
+        vis = True
+        for side in range(4):
+            if side == 0:
+                p = -dx
+                q = ax - xmin
+            elif side == 1:
+                p = dx
+                q = xmax - ax
+            elif side == 2:
+                p = -dy
+                q = ay - ymin
+            else:
+                p = dy
+                q = ymax - ay
+            if p == 0.0:
+                if q < 0.0:
+                    vis = False
+            else:
+                r = q / p
+                if p < 0.0:
+                    if not t0 > r:  # np.maximum(t0, r)
+                        t0 = r
+                elif not t1 < r:  # np.minimum(t1, r)
+                    t1 = r
+        vis = vis and t0 <= t1
+        if vis:
+            ex = ax + t1 * dx
+            ey = ay + t1 * dy
+            if not (prev_vis and prev_t1 == 1.0 and t0 == 0.0):
+                starts[npc] = m
+                npc += 1
+                out[m, 0] = ax + t0 * dx
+                out[m, 1] = ay + t0 * dy
+                m += 1
+            out[m, 0] = ex
+            out[m, 1] = ey
+            m += 1
+        prev_vis = vis
+        prev_t1 = t1
+    starts[npc] = m
+    return out, starts, npc
