@@ -1071,7 +1071,7 @@ class _Reader:
         return line, last_nl
 
     def _compiled_run(self, i: int) -> int:
-        """Read the PU/PD/PA/PR/SP/PW commands (and PM/EP/FP/FT) from ``i`` on with the
+        """Read the PU/PD/PA/PR/SP/PW/PE commands (and PM/EP/FP/FT/RF/MC) from ``i`` on with the
         compiled scanner; returns the offset where it stopped (``i`` when the next command
         is not one it reads)."""
         if not -(1 << 31) <= self.pen < 1 << 31:

@@ -1,5 +1,6 @@
-"""Compiled reading of runs of plain pen commands (PU PD PA PR with numbers, SP, PW) and of
-polygon mode (PM0 PM1 PM2 EP FP).
+"""Compiled reading of runs of plain pen commands (PU PD PA PR with numbers, SP, PW, PE) and
+of polygon mode (PM0 PM1 PM2 EP FP), and of the commands without geometry files put between
+them (FT, RF, MC: counted).
 
 One pass over the bytes, no per-byte temporary arrays: the scanner reads the commands one
 after the other, parses each number exactly (at most 15 digits: the integer mantissa is
@@ -103,196 +104,11 @@ def _write_rings(pts, seg_start, seg_off, seg_pen, seg_line, seg_col, npts, nseg
 
 
 @njit(cache=True, nogil=True, boundscheck=False)
-def _pe_moves(b, k, pe_cache, pen, is_open, npts, nseg, x, y, npb, nr, fresh, pen_no, in_poly,
-              spok, has_sc, ax, bx, ay, by, line, col, pts, seg_start, seg_off, seg_pen,
-              seg_line, seg_col, pb, rs, rcl):
-    """A PE run from ``k`` (just after the mnemonic, at line ``line``, column ``col``), decoded
-    as :func:`galvo_core.hpgl.pe.decode_pe` and applied as the general reader's
-    ``_Reader._pe_apply``: ``:`` selects a pen (the path ends), ``<`` makes the next pair a
-    pen-up move (the pair after it puts the pen down again), ``=`` the next pair absolute,
-    ``>`` the fractional bits, ``7`` base-32 numbers; the moves go to the chunk or, in polygon
-    mode, to the polygon buffer, as the scanner's PU/PD/PA/PR moves.
-
-    ``ok`` is False where the general reader warns (a number clamped, fractional bits out of
-    range, half a pair or a flag without its number at the end) or where a pen is selected
-    before any SP; ``full`` says the chunk or the polygon buffer is full. The caller then
-    rolls the command back. ``pe_cache`` is the look-ahead cache of
-    :func:`_pe_looks_like_number` (one number read: its look-ahead is the same walk).
-
-    Returns (end, ok, full, pen, is_open, npts, nseg, x, y, npb, nr, fresh, pen_no).
-    """
-    n = b.shape[0]
-    cap = pts.shape[0]
-    scap = seg_start.shape[0]
-    pcap = pb.shape[0]
-    rcap = rs.shape[0]
-    off = k  # the general reader's offset of PE's paths: just after the mnemonic
-    ok = True
-    full = 0
-    seven = False
-    scale = 1.0
-    pending = 0  # ':' or '>' waiting for its number
-    up_next = False
-    abs_next = False
-    have_x = False
-    cx = 0
-    while k < n:
-        c = b[k]
-        if c == 59:  # ';'
-            k += 1
-            break
-        if c == 27:  # ESC: a PCL escape ends the run
-            break
-        if c == 58 or c == 60 or c == 62 or c == 61 or c == 55:  # : < > = 7
-            if c == 55:
-                seven = True
-            elif c == 60:
-                up_next = True
-            elif c == 61:
-                abs_next = True
-            else:
-                pending = c
-            k += 1
-            continue
-        if _pe_ign(c, seven):
-            k += 1
-            continue
-        if c < 63:
-            break  # not PE data ('0'..'6', '8', '9', punctuation)
-        # a digit: read the number; a run that meets a byte neither a digit nor ignorable
-        # before its terminating digit is no number (pe._looks_like_number), the run ends
-        s = 2 if seven else 0
-        if pe_cache[s] <= k < pe_cache[s + 1]:
-            break
-        q = k
-        value = 0
-        shift = 0
-        bits = 5 if seven else 6
-        big = False
-        done = False
-        while q < n:
-            c = b[q]
-            if _pe_cont(c, seven):
-                if shift < 60:
-                    value |= (c - 63) << shift
-                elif c != 63:
-                    big = True
-                shift += bits
-                q += 1
-            elif _pe_term(c, seven):
-                d = c - (95 if seven else 191)
-                if shift < 60:
-                    if shift > 0 and (d >> (62 - shift)) != 0:
-                        big = True
-                    else:
-                        value |= d << shift
-                elif d != 0:
-                    big = True
-                q += 1
-                done = True
-                break
-            elif _pe_ign(c, seven):
-                q += 1
-            else:
-                break
-        if not done:
-            pe_cache[s] = k
-            pe_cache[s + 1] = q
-            break  # an unterminated PE run followed by ordinary commands
-        k = q
-        if big or value > 2 * _PE_MAX + 1:
-            ok = False  # clamped: the general reader warns
-            break
-        num = -(value >> 1) if value & 1 else value >> 1
-        if pending == 58:  # ':' pen select (the general reader's flush ends the path)
-            pending = 0
-            if not spok or num < -(1 << 31) or num >= (1 << 31):
-                ok = False
-                break
-            pen_no = num
-            is_open = 0
-            continue
-        if pending == 62:  # '>' fractional bits
-            pending = 0
-            if num < 0 or num > 26:
-                ok = False
-                break
-            scale = float(1 << num) if num else 1.0
-            continue
-        if not have_x:
-            cx = num
-            have_x = True
-            continue
-        have_x = False
-        px = cx / scale
-        py = num / scale
-        if up_next:
-            if pen == 1:
-                pen = 0
-                is_open = 0
-        elif pen == 0:
-            pen = 1  # (outside PM the path starts at the current point: is_open is 0)
-        if abs_next:
-            if has_sc:
-                nx = ax * px + bx
-                ny = ay * py + by
-            else:
-                nx = px
-                ny = py
-        elif has_sc:
-            nx = x + ax * px
-            ny = y + ay * py
-        else:
-            nx = x + px
-            ny = y + py
-        up_next = False
-        abs_next = False
-        if in_poly:
-            if npb + 1 > pcap or nr + 2 > rcap:
-                full = FULL_POLY
-                break
-            if fresh:
-                fresh = 0
-                npb = rs[nr]
-            elif pen == 0:
-                if npb - rs[nr] > 1:
-                    rcl[nr] = 0
-                    nr += 1
-                    rs[nr] = npb
-                npb = rs[nr]
-            pb[npb, 0] = nx
-            pb[npb, 1] = ny
-            npb += 1
-        elif pen == 1:
-            if npts + 2 > cap or nseg + 2 > scap:
-                full = FULL_CHUNK
-                break
-            if is_open == 0:
-                seg_start[nseg] = npts
-                seg_off[nseg] = off
-                seg_line[nseg] = line
-                seg_col[nseg] = col
-                seg_pen[nseg] = pen_no
-                nseg += 1
-                pts[npts, 0] = x
-                pts[npts, 1] = y
-                npts += 1
-                is_open = 1
-            pts[npts, 0] = nx
-            pts[npts, 1] = ny
-            npts += 1
-        x = nx
-        y = ny
-    if ok and not full and (have_x or pending != 0):
-        ok = False  # half a pair or a flag without its number: the general reader warns
-    return k, ok, full, pen, is_open, npts, nseg, x, y, npb, nr, fresh, pen_no
-
-
-@njit(cache=True, nogil=True, boundscheck=False)
 def scan_moves(b, ist, fst, pts, seg_start, seg_off, seg_pen, seg_line, seg_col, pb, rs, rcl,
                pow10, cls, pe_cache):
-    """Read PU/PD/PA/PR (and SP, PW, and in polygon mode PM, EP, FP) commands from
-    ``ist[I_POS]`` on; see the module docstring.
+    """Read PU/PD/PA/PR and PE (and SP, PW, FT, RF, MC, and in polygon mode PM, EP, FP)
+    commands from ``ist[I_POS]`` on; see the module docstring. ``pe_cache`` is PE's
+    look-ahead cache (see :func:`_pe_looks_like_number`), shared with :func:`decode_pe`.
 
     ``ist``/``fst`` hold the state in and out (position, pen down, absolute mode, path
     open, points and segments used in the chunk, counts per command, pen number, dialect,
@@ -484,11 +300,168 @@ def scan_moves(b, ist, fst, pts, seg_start, seg_off, seg_pen, seg_line, seg_col,
         full = 0
         half = False
         vx = 0.0
-        if code == 10:
-            k, ok, full, pen, is_open, npts, nseg, x, y, npb, nr, fresh, pen_no = _pe_moves(
-                b, k, pe_cache, pen, is_open, npts, nseg, x, y, npb, nr, fresh, pen_no,
-                in_poly, ist[I_SPOK] != 0, has_sc, ax, bx, ay, by, cmd_line, cmd_col + 2,
-                pts, seg_start, seg_off, seg_pen, seg_line, seg_col, pb, rs, rcl)
+        # PE, decoded as pe.decode_pe, applied as the general reader's _pe_apply (its own
+        # loop: the moves' loop below stays as fast as it was); what the general reader
+        # warns about (a number clamped, fractional bits out of range, half a pair or a
+        # flag without its number at the end) and a pen selected before any SP are its own
+        # (the command is rolled back)
+        seven = False  # 7-bit numbers
+        scale = 1.0  # of the fractional bits
+        pending = 0  # ':' or '>' waiting for its number
+        up_next = False  # the next pair pen-up / absolute
+        abs_next = False
+        have_x = False
+        cx = 0
+        while k < n and code == 10:
+            c = b[k]
+            if c == 59:  # ';'
+                k += 1
+                break
+            if c == 27:  # ESC: a PCL escape ends the run
+                break
+            if c == 58 or c == 60 or c == 62 or c == 61 or c == 55:  # : < > = 7
+                if c == 55:
+                    seven = True
+                elif c == 60:
+                    up_next = True
+                elif c == 61:
+                    abs_next = True
+                else:
+                    pending = c
+                k += 1
+                continue
+            if _pe_ign(c, seven):
+                k += 1
+                continue
+            if c < 63:
+                break  # not PE data ('0'..'6', '8', '9', punctuation)
+            # a digit: the number; continuation digits that meet a byte neither a
+            # digit nor ignorable before the terminating digit are no number
+            # (pe._looks_like_number, its cache): the run ends before them
+            s = 2 if seven else 0
+            if pe_cache[s] <= k < pe_cache[s + 1]:
+                break
+            q = k
+            value = 0
+            shift = 0
+            bits = 5 if seven else 6
+            big = False
+            done = False
+            while q < n:
+                c = b[q]
+                if _pe_cont(c, seven):
+                    if shift < 60:
+                        value |= (c - 63) << shift
+                    elif c != 63:
+                        big = True
+                    shift += bits
+                    q += 1
+                elif _pe_term(c, seven):
+                    d = c - (95 if seven else 191)
+                    if shift < 60:
+                        if shift > 0 and (d >> (62 - shift)) != 0:
+                            big = True
+                        else:
+                            value |= d << shift
+                    elif d != 0:
+                        big = True
+                    q += 1
+                    done = True
+                    break
+                elif _pe_ign(c, seven):
+                    q += 1
+                else:
+                    break
+            if not done:
+                pe_cache[s] = k
+                pe_cache[s + 1] = q
+                break  # an unterminated PE run followed by ordinary commands
+            k = q
+            if big or value > 2 * _PE_MAX + 1:
+                ok = False  # clamped: the general reader warns
+                break
+            num = -(value >> 1) if value & 1 else value >> 1
+            if pending == 58:  # ':' pen select (the general reader's flush)
+                pending = 0
+                if ist[I_SPOK] == 0 or num < -(1 << 31) or num >= (1 << 31):
+                    ok = False
+                    break
+                pen_no = num
+                is_open = 0
+                continue
+            if pending == 62:  # '>' fractional bits
+                pending = 0
+                if num < 0 or num > 26:
+                    ok = False
+                    break
+                scale = float(1 << num) if num else 1.0
+                continue
+            if not have_x:
+                cx = num
+                have_x = True
+                continue
+            have_x = False
+            vx = cx / scale
+            v = num / scale
+            if up_next:
+                if pen == 1:
+                    pen = 0
+                    is_open = 0
+            elif pen == 0:
+                pen = 1  # (outside PM the path starts at the current point)
+            if abs_next:
+                if has_sc:
+                    nx = ax * vx + bx
+                    ny = ay * v + by
+                else:
+                    nx = vx
+                    ny = v
+            elif has_sc:
+                nx = x + ax * vx
+                ny = y + ay * v
+            else:
+                nx = x + vx
+                ny = y + v
+            up_next = False
+            abs_next = False
+            # (the moves' loop below says why)
+            if in_poly:
+                if npb + 1 > pcap or nr + 2 > rcap:
+                    full = FULL_POLY
+                    break
+                if fresh:
+                    fresh = 0
+                    npb = rs[nr]
+                elif pen == 0:
+                    if npb - rs[nr] > 1:
+                        rcl[nr] = 0
+                        nr += 1
+                        rs[nr] = npb
+                    npb = rs[nr]
+                pb[npb, 0] = nx
+                pb[npb, 1] = ny
+                npb += 1
+            elif pen == 1:
+                if npts + 2 > cap or nseg + 2 > scap:
+                    full = FULL_CHUNK
+                    break
+                if is_open == 0:
+                    # (PE's paths start just after the mnemonic, as the general reader's)
+                    seg_start[nseg] = npts
+                    seg_off[nseg] = cmd_at + 2
+                    seg_line[nseg] = cmd_line
+                    seg_col[nseg] = cmd_col + 2
+                    seg_pen[nseg] = pen_no
+                    nseg += 1
+                    pts[npts, 0] = x
+                    pts[npts, 1] = y
+                    npts += 1
+                    is_open = 1
+                pts[npts, 0] = nx
+                pts[npts, 1] = ny
+                npts += 1
+            x = nx
+            y = ny
         while k < n and code != 10:
             t = cls[b[k]]
             if t == C_SEMI:
@@ -613,6 +586,8 @@ def scan_moves(b, ist, fst, pts, seg_start, seg_off, seg_pen, seg_line, seg_col,
                 npts += 1
             x = nx
             y = ny
+        if code == 10 and (have_x or pending != 0) and not full:
+            ok = False  # half a pair or a flag without its number: the general reader warns
         if code >= 4 and count > most:
             ok = False
         elif code == 4 and count and not (-2147483648.0 <= vx < 2147483648.0):
