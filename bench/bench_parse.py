@@ -941,8 +941,10 @@ data = open(path, "rb").read()
 if which == "ours":
     import galvo_core.hpgl.scan  # noqa: F401  (numba loaded: the compiled scanner, as timed)
     from galvo_core.hpgl import read_bytes
-    # warm-up through every compiled path (scanner, PE decoder) and the general reader
-    read_bytes(b"IN;SP1;PU0,0;PD10,10;PE;LBa\x03PM0;PD1,1;PM2;EP;CI5;", "warm.plt")
+    # warm-up through every compiled path (scanner, PE in it and the PE decoder the general
+    # reader calls for a PE it warns about, IW clipping) and the general reader
+    read_bytes(b"IN;SP1;PU0,0;PD10,10;PE;PE:;LBa\x03PM0;PD1,1;PM2;EP;CI5;IW0,0,5,5;PD9,9;"
+               b"PU;", "warm.plt")
     def parse(b):
         return read_bytes(b, "f.plt")
 else:

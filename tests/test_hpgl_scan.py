@@ -335,3 +335,131 @@ def test_compiled_pe_reads_files_as_the_python_decoder() -> None:
         pytest.skip("corpus file not present")
     data = f.read_bytes()
     assert_same(_read(data, True), _read(data, False))
+
+
+def _pe_run(rng: random.Random) -> bytes:
+    """One PE command as files and encoders write it, and as they should not: random numbers
+    (8-bit and 7-bit after ``7``), pen-up ``<``, absolute ``=``, pen select ``:``, fractional
+    bits ``>`` (in and out of 0..26), numbers beyond the clamp, half pairs, flags without
+    their number, newlines and ignored bytes inside, no ``;`` (ended by the next command or
+    a byte that is no PE data), ESC."""
+    from galvo_core.hpgl.pe import encode_number
+
+    out = [rng.choice([b"PE", b"PE", b"PE", b"pe", b"PE\n"])]
+    seven = False
+    for _ in range(rng.randint(0, 16)):
+        r = rng.random()
+        if r < 0.04 and not seven:
+            out.append(b"7")
+            seven = True
+        elif r < 0.14:
+            out.append(b"<")
+        elif r < 0.20:
+            out.append(b"=")
+        elif r < 0.23:
+            pen = rng.choice([1, 2, 3, 0, -1, 1, 2, 3, 0, 2**40])
+            out.append(b":" + encode_number(pen, seven=seven))
+        elif r < 0.27:
+            bits = rng.choice([0, 1, 3, 8, 26, 0, 1, 3, 8, 26, 27, -1])
+            out.append(b">" + encode_number(bits, seven=seven))
+        elif r < 0.30:
+            out.append(rng.choice([b"\n", b" ", b"\x80", b"\xff", b"\r\n"]))
+        elif r < 0.305:
+            out.append(rng.choice([b":", b">", b"1"]))  # a flag without its number, junk
+        else:
+            v = rng.choice([rng.randint(-300, 300)] * 12 + [rng.randint(-10**6, 10**6)] * 4
+                           + [rng.randint(-10**16, 10**16)])
+            out.append(encode_number(v, seven=seven))
+    out.append(rng.choice([b";"] * 12 + [b"", b"\x1b%0A\x1b%0B", b";\n"]))
+    return b"".join(out)
+
+
+def _pe_program(rng: random.Random, n: int) -> bytes:
+    """Random programs with PE in and out of polygon mode, mixed with moves, PM0/PM1/PM2,
+    EP/FP, pen selects, scaling, RF/FT and what the scanner hands back (IW, RO, CI, LB)."""
+    def nums(k: int) -> bytes:
+        return ",".join(f"{rng.uniform(-500, 500):.{rng.randint(0, 2)}f}"
+                        for _ in range(2 * k)).encode()
+
+    out = [rng.choice([b"IN;SP1;", b"IN;", b"", b"SP2;", b"IN;SC0,100,0,100;SP1;"])]
+    for _ in range(n):
+        r = rng.random()
+        if r < 0.35:
+            out.append(_pe_run(rng))
+        elif r < 0.45:  # grashopp.pcl: PE=<x,y;PM0PE...;PM2FP (PM1PE...; between too)
+            out.append(b"PE=<%s;PM0%s%sPM2%s" % (
+                _pe_run(rng)[2:-1] or b"?\xbf?\xbf", _pe_run(rng),
+                rng.choice([b"", b"", b"PM1" + _pe_run(rng), b"PM1PE;" + _pe_run(rng)]),
+                rng.choice([b"FP", b"EP", b"FP;EP;", b""])))
+        elif r < 0.55:
+            out.append(rng.choice([b"PM0;", b"PM1;", b"PM2;", b"EP;", b"FP;", b"PM1"]))
+        elif r < 0.70:
+            out.append(rng.choice([b"PU", b"PD", b"PA", b"PR"]) + nums(rng.randint(0, 3))
+                       + b";")
+        elif r < 0.78:
+            out.append(rng.choice([b"SP1;", b"SP2;", b"PA;", b"PR;", b"PU;", b"PD;",
+                                   b"RF1,2,2,0,1,1,0;", b"FT11,2", b"RF;", b"RF1,2.2.2;",
+                                   b"FT1;"]))
+        elif r < 0.84:
+            out.append(rng.choice([b"IW-400,-400,400,400;", b"IW;", b"RO90;", b"RO;",
+                                   b"SC0,100,0,100;", b"SC;", b"SC0,300,0,50;", b"CI5;",
+                                   b"LBab\x03", b"IN;", b"MC1,90", b"LT;"]))
+        else:
+            out.append(b"\n")
+    return b"".join(out)
+
+
+@pytest.mark.parametrize("seed", range(24))
+@pytest.mark.parametrize("small", [True, False])
+def test_compiled_pe_reads_what_the_general_reader_reads(seed: int, small: bool) -> None:
+    """PE decoded and applied by the compiled scanner, in and out of polygon mode (issue
+    20, grashopp.pcl's ``PE=<..;PM0PE..;PM2FP``), gives the same paths (bit for bit), pens,
+    closed flags, positions (PE's paths start just after the mnemonic), warnings (the PE
+    problems the general reader reports: the scanner hands those PE back) and command
+    counts as the general reader with the Python decoder (pe.decode_pe); with tiny chunks
+    and polygon buffers (``small``) they fill up in the middle of a PE."""
+    from galvo_core.hpgl import scan
+
+    data = _pe_program(random.Random(3000 + seed), 300)
+    read_by_scanner = Counter()
+    orig = scan.scan_moves
+
+    def spy(*args):  # type: ignore[no-untyped-def]
+        orig(*args)
+        read_by_scanner.update(PE=int(args[1][scan.I_NPE]))
+
+    with mock.patch.object(scan, "scan_moves", spy), \
+            mock.patch.object(reader, "_POLY_POINTS", 4 if small else reader._POLY_POINTS):
+        a = _read(data, True, 8 if small else 1 << 16)
+    b = _read(data, False)
+    assert_same(a, b)
+    assert read_by_scanner["PE"] >= 10  # (the rest: problems, handed back, no SP yet)
+
+
+def test_pe_polygons_are_read_by_the_scanner_in_one_call() -> None:
+    """grashopp.pcl's polygons (``PE=<x,y;PM0PE<pairs>;PM2FP`` with RF/FT between, HP-GL/2
+    reference, PE p. 20-... and PM): one compiled call reads them all; each is a closed ring
+    starting at the absolute pen-up point (relative pairs after it, pen down)."""
+    from galvo_core.hpgl.pe import encode_number as enc
+
+    polys = []
+    for k in range(50):
+        x0, y0 = 10 * k, -3 * k
+        d = [(5, 0), (0, 5), (-2, -1)]
+        body = b"".join(enc(dx) + enc(dy) for dx, dy in d)
+        rf = b"RF1,2,2,0,1,1,0;FT11,1" if k % 7 == 0 else b""
+        polys.append(b"PE=<%s%s;PM0PE%s;PM2%sFP" % (enc(x0), enc(y0), body, rf))
+    data = b"\x1bE\x1b%0BIN;SP1;PU0,0;" + b"".join(polys) + b"\x1b%0A"
+    calls = []
+    run = reader._Reader._compiled_run
+    with mock.patch.object(reader._Reader, "_compiled_run",
+                           lambda self, i: calls.append(i) or run(self, i)):
+        a = _read(data, True)
+    assert_same(a, _read(data, False))
+    assert [c for c in calls if c >= data.index(b"PU0,0")] == [data.index(b"PU0,0")]
+    assert a.commands["PE"] == 100 and a.commands["FP"] == 50 and len(a.paths) == 50
+    for k, p in enumerate(a.paths):
+        x0, y0 = 10 * k, -3 * k
+        np.testing.assert_array_equal(p.points, [(x0, y0), (x0 + 5, y0), (x0 + 5, y0 + 5),
+                                                 (x0 + 3, y0 + 4), (x0, y0)])
+        assert p.closed

@@ -160,7 +160,7 @@ _PE_MESSAGES = {  # scan.PE_* problem codes -> the messages of pe.decode_pe
 _LABEL_ORIGINS = frozenset((*range(1, 10), *range(11, 20), 21))
 _LO_CONCATENATE = frozenset((1, 2, 3, 11, 12, 13, 21))
 #: where the compiled scanner is started (it reads PM, EP, FP and FT too once it runs)
-_SCAN_CMDS = frozenset((b"PU", b"PD", b"PA", b"PR", b"SP", b"PW"))
+_SCAN_CMDS = frozenset((b"PU", b"PD", b"PA", b"PR", b"SP", b"PW", b"PE"))
 
 
 def _is_letter_or_esc(c: int) -> bool:
@@ -446,7 +446,13 @@ class _Reader:
             self.warn(offset, "path with coordinates out of range dropped", key="non-finite")
             return
         if self.window is not None:
-            pieces = _clip_polyline(pts, self.window)
+            if self._scan is not None and len(pts) > 1:
+                # (numba loaded: the compiled clipping, the same pieces)
+                cp, cs, cn = self._scan.clip_polyline(pts, *self.window)
+                cs = cs.tolist()
+                pieces = [cp[cs[k] : cs[k + 1]] for k in range(cn)]
+            else:
+                pieces = _clip_polyline(pts, self.window)
             if len(pieces) != 1 or len(pieces[0]) != len(pts) or not np.array_equal(pieces[0], pts):
                 self.clipped += 1
                 if self.first_clip < 0:
@@ -1048,6 +1054,9 @@ class _Reader:
             self._u8 = np.frombuffer(self.data, dtype=np.uint8)
             self._ist = np.zeros(scan_module.N_ISTATE, dtype=np.int64)
             self._fst = np.zeros(scan_module.N_FSTATE, dtype=np.float64)
+            # PE's look-ahead cache (scan._pe_looks_like_number), the scanner's and
+            # _pe_compiled's
+            self._pe_span = np.array([-1, -1, -1, -1], dtype=np.int64)
         return self._scan
 
     def _line_at(self, i: int) -> tuple[int, int]:
@@ -1062,9 +1071,11 @@ class _Reader:
         return line, last_nl
 
     def _compiled_run(self, i: int) -> int:
-        """Read the PU/PD/PA/PR/SP/PW commands (and PM/EP/FP/FT) from ``i`` on with the
+        """Read the PU/PD/PA/PR/SP/PW/PE commands (and PM/EP/FP/FT/RF/MC) from ``i`` on with the
         compiled scanner; returns the offset where it stopped (``i`` when the next command
         is not one it reads)."""
+        if not -(1 << 31) <= self.pen < 1 << 31:
+            return i  # the scanner's segments hold the pen number as int32
         scan = self._scanner()
         ist, fst = self._ist, self._fst
         line, last_nl = self._line_at(i)
@@ -1085,7 +1096,8 @@ class _Reader:
                 (self.x, self.y, sc[0], sc[1], sc[2], sc[3], 1.0)
             pb, rs, rcl = self._pbuf
             scan.scan_moves(self._u8, ist, fst, ch.pts, ch.seg_start, ch.seg_off, ch.seg_pen,
-                            ch.seg_line, ch.seg_col, pb, rs, rcl, _POW10, scan.CLASS)
+                            ch.seg_line, ch.seg_col, pb, rs, rcl, _POW10, scan.CLASS,
+                            self._pe_span)
             out = ist.tolist()
             buffered = buffered or out[scan.I_NPM] > 0
             self._take_segments(ch, out)
@@ -1096,11 +1108,11 @@ class _Reader:
             self.absolute = bool(out[scan.I_ABS])
             self.pen = out[scan.I_PENNO]
             counts = out[scan.I_NU : scan.I_NR + 1] + [out[scan.I_NSP], out[scan.I_NPW]] + \
-                out[scan.I_NPM : scan.I_NFP + 1] + [out[scan.I_NFT]]
+                out[scan.I_NPM : scan.I_NFP + 1] + out[scan.I_NFT : scan.I_NMC + 1]
             self.hpgl2 = bool(out[scan.I_HPGL2])
             if any(counts):
-                for name, c in zip(("PU", "PD", "PA", "PR", "SP", "PW", "PM", "EP", "FP", "FT"),
-                                   counts, strict=True):
+                for name, c in zip(("PU", "PD", "PA", "PR", "SP", "PW", "PM", "EP", "FP", "FT",
+                                    "PE", "RF", "MC"), counts, strict=True):
                     if c:
                         self.commands[name] += c
                 self.recognised += sum(counts)
@@ -1713,8 +1725,6 @@ class _Reader:
     def _pe_compiled(self, pos: int) -> int:
         """PE decoded by the compiled decoder (scan.decode_pe, the same decoding)."""
         scan = self._scanner()
-        if not hasattr(self, "_pe_span"):
-            self._pe_span = np.array([-1, -1, -1, -1], dtype=np.int64)
         end, kinds, xs, ys, flags, ni, p_off, p_code, p_val, npb = scan.decode_pe(
             self._u8, pos, self._pe_span)
         for off, code, val in zip(p_off[:npb].tolist(), p_code[:npb].tolist(),
@@ -1851,22 +1861,20 @@ def _clip_polyline(pts: np.ndarray, win: tuple[float, float, float, float]) -> l
         t0 = np.where(neg, np.maximum(t0, r), t0)
         t1 = np.where(pos_, np.minimum(t1, r), t1)
     visible &= t0 <= t1
-    out: list[np.ndarray] = []
-    cur: list[np.ndarray] = []
-    for k in np.flatnonzero(visible):
-        s = a[k] + t0[k] * d[k]
-        e = a[k] + t1[k] * d[k]
-        # segment k goes on from segment k-1 when that one was visible up to its end
-        # and this one is visible from its start
-        if cur and k > 0 and visible[k - 1] and t1[k - 1] == 1.0 and t0[k] == 0.0:
-            cur.append(e)
-        else:
-            if cur:
-                out.append(np.array(cur))
-            cur = [s, e]
-    if cur:
-        out.append(np.array(cur))
-    return out
+    ks = np.flatnonzero(visible)
+    if not len(ks):
+        return []
+    # the visible part of segment k runs from s to e; segment k goes on from segment k-1
+    # when that one was visible up to its end and this one is visible from its start
+    s = a[ks] + t0[ks, None] * d[ks]
+    e = a[ks] + t1[ks, None] * d[ks]
+    kp = np.maximum(ks - 1, 0)
+    new = ~((ks > 0) & visible[kp] & (t1[kp] == 1.0) & (t0[ks] == 0.0))
+    at_e = np.arange(len(ks)) + np.cumsum(new)  # where each e goes; s before it when new
+    out_pts = np.empty((len(ks) + int(new.sum()), 2))
+    out_pts[at_e] = e
+    out_pts[at_e[new] - 1] = s[new]
+    return np.split(out_pts, at_e[new][1:] - 1)
 
 
 def _line_cols_arrays(data: bytes, offs: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

@@ -1,5 +1,6 @@
-"""Compiled reading of runs of plain pen commands (PU PD PA PR with numbers, SP, PW) and of
-polygon mode (PM0 PM1 PM2 EP FP).
+"""Compiled reading of runs of plain pen commands (PU PD PA PR with numbers, SP, PW, PE) and
+of polygon mode (PM0 PM1 PM2 EP FP), and of the commands without geometry files put between
+them (FT, RF, MC: counted).
 
 One pass over the bytes, no per-byte temporary arrays: the scanner reads the commands one
 after the other, parses each number exactly (at most 15 digits: the integer mantissa is
@@ -30,11 +31,12 @@ from numba import njit
  # polygon mode: in PM, after PM1, buffer edged or filled, EP's segments (0: none, 1: in
  # this call, [I_EDGE_S0, I_EDGE_S1) and points [I_EDGE_P0, I_EDGE_P1) of the chunk, 2: the
  # caller's), PM0's offset, line, column (I_PLC: known), buffer points and completed rings,
- # EP/FP allowed (no IW window, no RO), PM/EP/FP counts, EP segments FP replaced; FT count
+ # EP/FP allowed (no IW window, no RO), PM/EP/FP counts, EP segments FP replaced; FT count;
+ # PE, RF and MC counts
  I_POLY, I_FRESH, I_EMITTED, I_EDGED, I_EDGE_S0, I_EDGE_S1, I_EDGE_P0, I_EDGE_P1,
  I_POFF, I_PLINE, I_PCOL, I_PLC, I_NPB, I_NRING, I_POLYOK, I_NPM, I_NEP, I_NFP,
- I_DROP, I_NFT) = range(40)
-N_ISTATE = 40
+ I_DROP, I_NFT, I_NPE, I_NRF, I_NMC) = range(43)
+N_ISTATE = 43
 N_MOVE_STATE = 20  # slots I_POS..I_NPW: the move state the caller sets at every call
 # I_FULL values: the output chunk is full / the polygon buffer is full
 FULL_CHUNK, FULL_POLY = 1, 2
@@ -103,9 +105,10 @@ def _write_rings(pts, seg_start, seg_off, seg_pen, seg_line, seg_col, npts, nseg
 
 @njit(cache=True, nogil=True, boundscheck=False)
 def scan_moves(b, ist, fst, pts, seg_start, seg_off, seg_pen, seg_line, seg_col, pb, rs, rcl,
-               pow10, cls):
-    """Read PU/PD/PA/PR (and SP, PW, and in polygon mode PM, EP, FP) commands from
-    ``ist[I_POS]`` on; see the module docstring.
+               pow10, cls, pe_cache):
+    """Read PU/PD/PA/PR and PE (and SP, PW, FT, RF, MC, and in polygon mode PM, EP, FP)
+    commands from ``ist[I_POS]`` on; see the module docstring. ``pe_cache`` is PE's
+    look-ahead cache (see :func:`_pe_looks_like_number`), shared with :func:`decode_pe`.
 
     ``ist``/``fst`` hold the state in and out (position, pen down, absolute mode, path
     open, points and segments used in the chunk, counts per command, pen number, dialect,
@@ -184,6 +187,9 @@ def scan_moves(b, ist, fst, pts, seg_start, seg_off, seg_pen, seg_line, seg_col,
     nep = 0
     nfp = 0
     nft = 0
+    npe = 0
+    nrf = 0
+    nmc = 0
     drop = 0
     while True:
         # separators before a command
@@ -222,6 +228,8 @@ def scan_moves(b, ist, fst, pts, seg_start, seg_off, seg_pen, seg_line, seg_col,
                 code = 5
             elif c1 == 109:  # 'pm'
                 code = 6
+            elif c1 == 101:  # 'pe': polyline encoded
+                code = 10
             else:
                 break
         elif c1 == 112:
@@ -235,6 +243,10 @@ def scan_moves(b, ist, fst, pts, seg_start, seg_off, seg_pen, seg_line, seg_col,
                 break
         elif c0 == 102 and c1 == 116:  # 'ft': fill type, recorded, not drawn
             code = 9
+        elif c0 == 114 and c1 == 102:  # 'rf': raster fill pattern, recorded, not drawn
+            code = 11
+        elif c0 == 109 and c1 == 99:  # 'mc': merge control, recorded, not drawn
+            code = 12
         else:
             break
         cmd_at = j
@@ -243,6 +255,7 @@ def scan_moves(b, ist, fst, pts, seg_start, seg_off, seg_pen, seg_line, seg_col,
         k = j + 2
         # state at the command's start, to roll back to
         r_pen, r_absm, r_open, r_npts, r_nseg, r_x, r_y = pen, absm, is_open, npts, nseg, x, y
+        r_pen_no = pen_no
         r_npb, r_nr, r_fresh = npb, nr, fresh
         r_q0 = -1
         r_p0x = r_p0y = 0.0
@@ -287,7 +300,169 @@ def scan_moves(b, ist, fst, pts, seg_start, seg_off, seg_pen, seg_line, seg_col,
         full = 0
         half = False
         vx = 0.0
-        while k < n:
+        # PE, decoded as pe.decode_pe, applied as the general reader's _pe_apply (its own
+        # loop: the moves' loop below stays as fast as it was); what the general reader
+        # warns about (a number clamped, fractional bits out of range, half a pair or a
+        # flag without its number at the end) and a pen selected before any SP are its own
+        # (the command is rolled back)
+        seven = False  # 7-bit numbers
+        scale = 1.0  # of the fractional bits
+        pending = 0  # ':' or '>' waiting for its number
+        up_next = False  # the next pair pen-up / absolute
+        abs_next = False
+        have_x = False
+        cx = 0
+        while k < n and code == 10:
+            c = b[k]
+            if c == 59:  # ';'
+                k += 1
+                break
+            if c == 27:  # ESC: a PCL escape ends the run
+                break
+            if c == 58 or c == 60 or c == 62 or c == 61 or c == 55:  # : < > = 7
+                if c == 55:
+                    seven = True
+                elif c == 60:
+                    up_next = True
+                elif c == 61:
+                    abs_next = True
+                else:
+                    pending = c
+                k += 1
+                continue
+            if _pe_ign(c, seven):
+                k += 1
+                continue
+            if c < 63:
+                break  # not PE data ('0'..'6', '8', '9', punctuation)
+            # a digit: the number; continuation digits that meet a byte neither a
+            # digit nor ignorable before the terminating digit are no number
+            # (pe._looks_like_number, its cache): the run ends before them
+            s = 2 if seven else 0
+            if pe_cache[s] <= k < pe_cache[s + 1]:
+                break
+            q = k
+            value = 0
+            shift = 0
+            bits = 5 if seven else 6
+            big = False
+            done = False
+            while q < n:
+                c = b[q]
+                if _pe_cont(c, seven):
+                    if shift < 60:
+                        value |= (c - 63) << shift
+                    elif c != 63:
+                        big = True
+                    shift += bits
+                    q += 1
+                elif _pe_term(c, seven):
+                    d = c - (95 if seven else 191)
+                    if shift < 60:
+                        if shift > 0 and (d >> (62 - shift)) != 0:
+                            big = True
+                        else:
+                            value |= d << shift
+                    elif d != 0:
+                        big = True
+                    q += 1
+                    done = True
+                    break
+                elif _pe_ign(c, seven):
+                    q += 1
+                else:
+                    break
+            if not done:
+                pe_cache[s] = k
+                pe_cache[s + 1] = q
+                break  # an unterminated PE run followed by ordinary commands
+            k = q
+            if big or value > 2 * _PE_MAX + 1:
+                ok = False  # clamped: the general reader warns
+                break
+            num = -(value >> 1) if value & 1 else value >> 1
+            if pending == 58:  # ':' pen select (the general reader's flush)
+                pending = 0
+                if ist[I_SPOK] == 0 or num < -(1 << 31) or num >= (1 << 31):
+                    ok = False
+                    break
+                pen_no = num
+                is_open = 0
+                continue
+            if pending == 62:  # '>' fractional bits
+                pending = 0
+                if num < 0 or num > 26:
+                    ok = False
+                    break
+                scale = float(1 << num) if num else 1.0
+                continue
+            if not have_x:
+                cx = num
+                have_x = True
+                continue
+            have_x = False
+            vx = cx / scale
+            v = num / scale
+            if up_next:
+                if pen == 1:
+                    pen = 0
+                    is_open = 0
+            elif pen == 0:
+                pen = 1  # (outside PM the path starts at the current point)
+            if abs_next:
+                if has_sc:
+                    nx = ax * vx + bx
+                    ny = ay * v + by
+                else:
+                    nx = vx
+                    ny = v
+            elif has_sc:
+                nx = x + ax * vx
+                ny = y + ay * v
+            else:
+                nx = x + vx
+                ny = y + v
+            up_next = False
+            abs_next = False
+            # (the moves' loop below says why)
+            if in_poly:
+                if npb + 1 > pcap or nr + 2 > rcap:
+                    full = FULL_POLY
+                    break
+                if fresh:
+                    fresh = 0
+                    npb = rs[nr]
+                elif pen == 0:
+                    if npb - rs[nr] > 1:
+                        rcl[nr] = 0
+                        nr += 1
+                        rs[nr] = npb
+                    npb = rs[nr]
+                pb[npb, 0] = nx
+                pb[npb, 1] = ny
+                npb += 1
+            elif pen == 1:
+                if npts + 2 > cap or nseg + 2 > scap:
+                    full = FULL_CHUNK
+                    break
+                if is_open == 0:
+                    # (PE's paths start just after the mnemonic, as the general reader's)
+                    seg_start[nseg] = npts
+                    seg_off[nseg] = cmd_at + 2
+                    seg_line[nseg] = cmd_line
+                    seg_col[nseg] = cmd_col + 2
+                    seg_pen[nseg] = pen_no
+                    nseg += 1
+                    pts[npts, 0] = x
+                    pts[npts, 1] = y
+                    npts += 1
+                    is_open = 1
+                pts[npts, 0] = nx
+                pts[npts, 1] = ny
+                npts += 1
+            x = nx
+            y = ny
+        while k < n and code != 10:
             t = cls[b[k]]
             if t == C_SEMI:
                 k += 1
@@ -411,13 +586,17 @@ def scan_moves(b, ist, fst, pts, seg_start, seg_off, seg_pen, seg_line, seg_col,
                 npts += 1
             x = nx
             y = ny
+        if code == 10 and (have_x or pending != 0) and not full:
+            ok = False  # half a pair or a flag without its number: the general reader warns
         if code >= 4 and count > most:
             ok = False
+        elif code == 4 and count and not (-2147483648.0 <= vx < 2147483648.0):
+            ok = False  # a pen number the segments' int32 cannot hold: the general reader's
         if full or not ok or half:
             # roll back: the general reader reads this command (or a larger chunk or
             # buffer is made)
             pen, absm, is_open, npts, nseg, x, y = r_pen, r_absm, r_open, r_npts, r_nseg, r_x, r_y
-            npb, nr, fresh = r_npb, r_nr, r_fresh
+            npb, nr, fresh, pen_no = r_npb, r_nr, r_fresh, r_pen_no
             if r_q0 >= 0:
                 pb[r_q0, 0] = r_p0x
                 pb[r_q0, 1] = r_p0y
@@ -531,6 +710,22 @@ def scan_moves(b, ist, fst, pts, seg_start, seg_off, seg_pen, seg_line, seg_col,
             nfp += 1
         elif code == 9:
             nft += 1  # FT [type[,option...]]: nothing to apply (the general reader's too)
+        elif code == 10:
+            # PE: an HP-GL/2 command; the newlines of its bytes (ignored inside the run)
+            hpgl2 = True
+            npe += 1
+            for q in range(j + 2, k):
+                if b[q] == 10:
+                    tl += 1
+                    tn = q
+        elif code == 11:
+            # RF [index[,width,height,pixels...]]: no geometry; an HP-GL/2 command
+            hpgl2 = True
+            nrf += 1
+        elif code == 12:
+            # MC [mode[,opcode]]: no geometry; an HP-GL/2 command
+            hpgl2 = True
+            nmc += 1
         elif code == 0:
             nu += 1
         elif code == 1:
@@ -576,6 +771,9 @@ def scan_moves(b, ist, fst, pts, seg_start, seg_off, seg_pen, seg_line, seg_col,
     ist[I_NEP] = nep
     ist[I_NFP] = nfp
     ist[I_NFT] = nft
+    ist[I_NPE] = npe
+    ist[I_NRF] = nrf
+    ist[I_NMC] = nmc
     ist[I_DROP] = drop
     fst[F_X] = x
     fst[F_Y] = y
@@ -808,3 +1006,67 @@ def _grow_f64(a, cap):
     out = np.empty(cap, np.float64)
     out[: a.shape[0]] = a
     return out
+
+
+# ------------------------------------------------------------------ IW clipping
+@njit(cache=True, nogil=True, boundscheck=False)
+def clip_polyline(pts, xmin, ymin, xmax, ymax):
+    """The pieces of the polyline ``pts`` (n >= 2 points) inside the window, computed as
+    ``reader._clip_polyline`` computes them (Liang-Barsky per segment, the same operations
+    value for value, numpy's ``maximum``/``minimum`` on ties): returns (points, starts,
+    count), piece k being ``points[starts[k]:starts[k + 1]]``."""
+    n = pts.shape[0]
+    out = np.empty((2 * n, 2))
+    starts = np.empty(n + 1, np.int64)
+    m = 0
+    npc = 0
+    prev_vis = False
+    prev_t1 = 0.0
+    for k in range(n - 1):
+        ax = pts[k, 0]
+        ay = pts[k, 1]
+        dx = pts[k + 1, 0] - ax
+        dy = pts[k + 1, 1] - ay
+        t0 = 0.0
+        t1 = 1.0
+        vis = True
+        for side in range(4):
+            if side == 0:
+                p = -dx
+                q = ax - xmin
+            elif side == 1:
+                p = dx
+                q = xmax - ax
+            elif side == 2:
+                p = -dy
+                q = ay - ymin
+            else:
+                p = dy
+                q = ymax - ay
+            if p == 0.0:
+                if q < 0.0:
+                    vis = False
+            else:
+                r = q / p
+                if p < 0.0:
+                    if not t0 > r:  # np.maximum(t0, r)
+                        t0 = r
+                elif not t1 < r:  # np.minimum(t1, r)
+                    t1 = r
+        vis = vis and t0 <= t1
+        if vis:
+            ex = ax + t1 * dx
+            ey = ay + t1 * dy
+            if not (prev_vis and prev_t1 == 1.0 and t0 == 0.0):
+                starts[npc] = m
+                npc += 1
+                out[m, 0] = ax + t0 * dx
+                out[m, 1] = ay + t0 * dy
+                m += 1
+            out[m, 0] = ex
+            out[m, 1] = ey
+            m += 1
+        prev_vis = vis
+        prev_t1 = t1
+    starts[npc] = m
+    return out, starts, npc
