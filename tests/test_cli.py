@@ -194,3 +194,23 @@ def test_report_gives_segments_and_worst_error_per_path_within_its_bound():
     for p in paths:
         assert p["lines"] + p["cubics"] == p["segments"]
         assert p["max_error"] <= p["bound"] * (1 + 1e-9)
+
+
+def test_one_blas_thread_unless_the_user_chose_otherwise():
+    """galvo_core asks OpenBLAS for one thread before numpy loads (its pool cost 0.1-0.3 s
+    of every CLI start on a busy machine), but an explicit setting of the user's stands."""
+    import os
+    import subprocess
+    import sys
+
+    code = ("import os, galvo_core, numpy; "
+            "print(os.environ['OPENBLAS_NUM_THREADS'], os.environ['OMP_NUM_THREADS'])")
+    env = {k: v for k, v in os.environ.items()
+           if k not in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS")}
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                         env=env, timeout=120, check=True).stdout.split()
+    assert out == ["1", "1"]
+    env["OPENBLAS_NUM_THREADS"] = "2"
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                         env=env, timeout=120, check=True).stdout.split()
+    assert out == ["2", "1"]
