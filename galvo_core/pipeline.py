@@ -35,7 +35,7 @@ from galvo_core.errors import Cancelled
 from galvo_core.field import FieldMap, check_in_field, make_field
 from galvo_core.fill import HatchStroke, hatch
 from galvo_core.fit import FittedPath, control_points, fit_drawing, with_source_index
-from galvo_core.job import Job, Segments, Stroke, gc_paused
+from galvo_core.job import Job, Segments, Stroke, StrokeColumns, gc_paused
 from galvo_core.kerf import compensate_indexed
 from galvo_core.order import order_job_strokes
 from galvo_core.params import UNITS_PER_MM, Params
@@ -325,8 +325,8 @@ class Pipeline:
         # its edge by up to the fit's bound: those marks are clamped, never left outside
         rep = sampled.report
         bulge = not params.clamp and not out_msg and rep is not None and rep.outside_points > 0
-        strokes, clamped = self._strokes(work, origin, fitted, sampled, hatched, params, fm,
-                                         clamp=params.clamp or bulge)
+        strokes, clamped, cols = self._strokes(work, origin, fitted, sampled, hatched, params,
+                                               fm, clamp=params.clamp or bulge)
         run.check()
         t1 = time.perf_counter()
         ordered: tuple[Stroke, ...] = tuple(order_job_strokes(  # type: ignore[arg-type]
@@ -346,6 +346,8 @@ class Pipeline:
         job_params["quantum_units"] = stats["quantum_units"]  # detected, not set
         job = Job(drawing.name, drawing.sha256, fm, job_params,
                   params.laser.as_dict(), ordered, stats, tuple(warnings))
+        if params.scan_order == "file":  # the strokes as made: their columns are known
+            job = job.with_columns(cols.finish(ordered))
         t3 = time.perf_counter()
         run.timings["order"] = t2 - t1
         run.timings["stats"] = t3 - t2
@@ -355,9 +357,10 @@ class Pipeline:
     def _strokes(self, work: Drawing, origin: tuple[int, ...], fitted: tuple[FittedPath, ...],
                  sampled: _Marks, hatched: tuple[tuple[HatchStroke, np.ndarray], ...],
                  params: Params, fm: FieldMap, *, clamp: bool = False
-                 ) -> tuple[list[Stroke], int]:
+                 ) -> tuple[list[Stroke], int, _Columns]:
         """The job's strokes in the stages' order (contours, then hatch), clamped to the field
-        when ``clamp``; and how many marks were clamped."""
+        when ``clamp``; how many marks were clamped; and their columns but the marks (from
+        the stages' arrays: no pass over the strokes)."""
         clamped = 0
         marks: list[np.ndarray] = list(sampled.marks)
         keep = [i for i, m in enumerate(marks) if len(m)] if not all(map(len, marks)) \
@@ -379,12 +382,36 @@ class Pipeline:
                 src, closed, pens = [src[i] for i in keep], [closed[i] for i in keep], \
                     [pens[i] for i in keep]
             strokes = _new_strokes("contour", src, closed, marks, segs, pens)
+            hatch_pens = [work.paths[h.source_index].pen for h, _ in hatched]
             if hatched:
                 strokes += _new_strokes(
                     "hatch", [origin[h.source_index] for h, _ in hatched],
                     [False] * len(hatched), hatch_marks, [Segments.empty()] * len(hatched),
-                    [work.paths[h.source_index].pen for h, _ in hatched])
-        return strokes, clamped
+                    hatch_pens)
+        return strokes, clamped, self._columns(fitted, keep, hatch_pens)
+
+    def _columns(self, fitted: tuple[FittedPath, ...], keep: list[int] | None,
+                 hatch_pens: list[int]) -> _Columns:
+        """The columns of :meth:`_strokes`' strokes but the marks: the contours' from the
+        fit's arrays (the sampler's gathered geometry), the hatch strokes' appended."""
+        geo = self._fact(fitted, "sample_geometry", lambda: sample_geometry(fitted))
+        closed, pens = self._fact(fitted, "stroke column arrays", lambda: (
+            np.fromiter((fp.closed for fp in fitted), dtype=bool, count=len(fitted)),
+            np.fromiter((fp.pen for fp in fitted), dtype=np.int64, count=len(fitted))))
+        nseg, npts, is_cubic, points = geo.path_n, geo.path_npts, geo.is_cubic, geo.points
+        if keep is not None:  # paths without marks make no stroke
+            on = np.zeros(len(fitted), dtype=bool)
+            on[keep] = True
+            is_cubic = is_cubic[np.repeat(on, nseg)]
+            points = points[np.repeat(on, npts)]
+            closed, pens, nseg, npts = closed[on], pens[on], nseg[on], npts[on]
+        nh = len(hatch_pens)
+        if nh:
+            closed = np.concatenate([closed, np.zeros(nh, dtype=bool)])
+            pens = np.concatenate([pens, np.array(hatch_pens, dtype=np.int64)])
+            nseg = np.concatenate([nseg, np.zeros(nh, dtype=np.int64)])
+            npts = np.concatenate([npts, np.zeros(nh, dtype=np.int64)])
+        return _Columns(closed, pens, nseg, is_cubic, npts, points)
 
     def stats(self, drawing: Drawing, params: Params, fitted: tuple[FittedPath, ...],
               fm: FieldMap, strokes: Sequence[Stroke], report: SampleReport | None,
@@ -447,6 +474,28 @@ class Pipeline:
                 "outside_points": report.outside_points,
             })
         return out
+
+
+@dataclass(frozen=True, eq=False)
+class _Columns:
+    """:class:`~galvo_core.job.StrokeColumns` of the strokes made by a run, but what the
+    strokes' tuple gives at once (marks, kinds, sources: :func:`joined_marks`, made for the
+    stats anyway)."""
+
+    closed: np.ndarray
+    pen: np.ndarray
+    segment_count: np.ndarray
+    is_cubic: np.ndarray
+    point_count: np.ndarray
+    points: np.ndarray
+
+    def finish(self, strokes: tuple[Stroke, ...]) -> StrokeColumns:
+        jm = joined_marks(strokes)
+        return StrokeColumns(strokes, kind=jm.hatch.astype(np.uint8), closed=self.closed,
+                             pen=self.pen, source_index=jm.source, mark_count=jm.lens,
+                             marks=jm.marks, segment_count=self.segment_count,
+                             is_cubic=self.is_cubic, point_count=self.point_count,
+                             points=self.points)
 
 
 def _clamped(marks: list[np.ndarray], max_bit: int) -> tuple[list[np.ndarray], int]:

@@ -989,6 +989,9 @@ class _Geometry:
             self.is_cubic = np.zeros(0, dtype=bool)
             self.points = np.zeros((0, 2))
             self.row = np.zeros(0, dtype=np.int64)
+            npts = np.zeros(len(fitted), dtype=np.int64)
+        #: control points per path (rows of ``points``; 0 for a path without segments)
+        self.path_npts = npts
         self._fielded: OrderedDict[tuple[float, ...], tuple[Any, ...]] = OrderedDict()
         self._lock = threading.Lock()
 
