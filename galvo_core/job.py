@@ -36,6 +36,7 @@ import tempfile
 from collections.abc import Iterable, Iterator, Sequence
 from dataclasses import dataclass
 from dataclasses import field as dc_field
+from operator import attrgetter
 from typing import Any
 
 import numpy as np
@@ -245,21 +246,30 @@ class StrokeColumns:
     def of(cls, strokes: Sequence[Stroke]) -> StrokeColumns:
         """The columns of any strokes (a pass over them: what the pipeline avoids by
         giving its jobs columns made from its own arrays)."""
+        from galvo_core.timing import joined_marks
+
         st = tuple(strokes)
-        marks = [np.asarray(s.marks).reshape(-1, 2) for s in st]
-        segs = [s.segments for s in st]
+        n = len(st)
+        bad = set(map(attrgetter("kind"), st)) - set(_STROKE_KINDS)
+        if bad:
+            raise ValueError(f"stroke kind {sorted(bad)[0]!r} is not 'contour' or 'hatch'")
+        # the marks, counts, sources and kinds joined once per strokes tuple (the pipeline's
+        # stats and the preview ask for the same)
+        jm = joined_marks(st)
+        segs = list(map(attrgetter("segments"), st))
         return cls(
             st,
-            kind=np.array([_STROKE_KINDS.index(s.kind) for s in st], dtype=np.uint8),
-            closed=np.array([bool(s.closed) for s in st], dtype=bool),
-            pen=np.array([int(s.pen) for s in st], dtype=np.int64),
-            source_index=np.array([int(s.source_index) for s in st], dtype=np.int64),
-            mark_count=np.array([len(m) for m in marks], dtype=np.int64),
-            marks=_cat(marks, np.int64, 2),
-            segment_count=np.array([len(g) for g in segs], dtype=np.int64),
-            is_cubic=_cat([g.is_cubic for g in segs], bool, 0),
-            point_count=np.array([len(g.points) for g in segs], dtype=np.int64),
-            points=_cat([g.points for g in segs], np.float64, 2),
+            kind=jm.hatch.astype(np.uint8),
+            closed=np.fromiter(map(bool, map(attrgetter("closed"), st)), dtype=bool, count=n),
+            pen=np.fromiter(map(int, map(attrgetter("pen"), st)), dtype=np.int64, count=n),
+            source_index=jm.source,
+            mark_count=jm.lens,
+            marks=jm.marks,
+            segment_count=np.fromiter(map(len, segs), dtype=np.int64, count=n),
+            is_cubic=_cat(list(map(attrgetter("is_cubic"), segs)), bool, 0),
+            point_count=np.fromiter(map(len, map(attrgetter("points"), segs)), dtype=np.int64,
+                                    count=n),
+            points=_cat(list(map(attrgetter("points"), segs)), np.float64, 2),
         )
 
 
