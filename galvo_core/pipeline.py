@@ -26,6 +26,7 @@ import time
 from collections import OrderedDict
 from collections.abc import Callable, Hashable, Sequence
 from dataclasses import dataclass, field
+from operator import attrgetter
 from typing import Any, TypeVar
 
 import numpy as np
@@ -34,12 +35,12 @@ from galvo_core.drawing import Drawing, Warning
 from galvo_core.errors import Cancelled
 from galvo_core.field import FieldMap, check_in_field, make_field
 from galvo_core.fill import HatchStroke, hatch
-from galvo_core.fit import FittedPath, control_points, fit_drawing, with_source_index
+from galvo_core.fit import FittedPath, fit_drawing, with_source_index
 from galvo_core.job import Job, Segments, Stroke, StrokeColumns, gc_paused
 from galvo_core.kerf import compensate_indexed
 from galvo_core.order import order_job_strokes
 from galvo_core.params import UNITS_PER_MM, Params
-from galvo_core.precision import path_quanta
+from galvo_core.precision import drawing_quantum, path_quanta
 from galvo_core.sample import (
     ROUNDING_BOUND_BITS,
     SampleReport,
@@ -159,7 +160,26 @@ class Pipeline:
 
     def bbox(self, drawing: Drawing) -> tuple[float, float, float, float] | None:
         """``drawing.bbox()``, cached."""
-        return self._fact(drawing, "bbox", drawing.bbox)
+        return self._fact(drawing, "bbox", lambda: _bbox(_joined(self._point_arrays(drawing))))
+
+    def _point_arrays(self, drawing: Drawing) -> list[np.ndarray]:
+        """Each path's points as an (N, 2) float64 array (one pass over the paths, shared by
+        the bbox, the grids and the point count)."""
+        return self._fact(drawing, "point arrays", lambda: [
+            np.asarray(p.points, dtype=np.float64).reshape(-1, 2) for p in drawing.paths])
+
+    def _input_facts(self, drawing: Drawing) -> None:
+        """The input drawing's bounding box and coordinate grid from one join of its points
+        (each alone joins them again: 10-300 ms at 1 M points, more for many paths)."""
+        if self._facts.peek(drawing, "bbox") is not None \
+                and self._facts.peek(drawing, "quantum") is not None:
+            return
+        allp = _joined(self._point_arrays(drawing))
+        self._fact(drawing, "n_points", lambda: len(allp))
+        self._fact(drawing, "bbox", lambda: _bbox(allp))
+        # drawing.quantum(): drawing_quantum of the paths, which joins them the same way
+        self._fact(drawing, "quantum", lambda: (
+            float(drawing_quantum([allp])[0]) if len(allp) else 0.0,))
 
     # ---------------------------------------------------------------- stages
     def field_map(self, drawing: Drawing, params: Params) -> FieldMap:
@@ -171,6 +191,7 @@ class Pipeline:
             mag = true_size
         grow_bits = (params.kerf_mm / 2 if params.kerf_side == "outside" else 0.0) / (
             params.field_size_mm / params.field_bits)
+        self._input_facts(drawing)
         return make_field(self.bbox(drawing), magnification=mag, fit_field=params.fit_field,
                           field_bits=params.field_bits, field_size_mm=params.field_size_mm,
                           offset_bits=params.offset_bits, margin_bits=grow_bits)
@@ -210,8 +231,8 @@ class Pipeline:
                                      cancel=run.cancel, quantum_units=quanta))
 
         def make() -> tuple[FittedPath, ...]:
-            if work is drawing:
-                return fit(work)
+            if work is drawing:  # the grids the stats report too: detected once
+                return fit(work, self.input_quanta(drawing))
             # the kerf's paths keep the grid of the input path they came from: the file's
             # precision, not the offset's floats (a path the kerf passes through is fitted
             # as without kerf; an offset ring of rounded input is as uncertain as its input)
@@ -226,7 +247,8 @@ class Pipeline:
 
     def input_quanta(self, drawing: Drawing) -> np.ndarray:
         """Each input path's grid (:func:`galvo_core.precision.path_quanta`), cached."""
-        return self._fact(drawing, "path quanta", lambda: path_quanta(drawing.paths))
+        return self._fact(drawing, "path quanta",
+                          lambda: path_quanta(self._point_arrays(drawing)))
 
     @staticmethod
     def _refit_changed(drawing: Drawing, work: Drawing, origin: Sequence[int],
@@ -424,15 +446,13 @@ class Pipeline:
         # simulation reuse them)
         t, dwell = estimate_with_dwell(joined_marks(strokes), params.laser, fm.mm_per_bit)
         n_input = self._fact(drawing, "n_points", lambda: drawing.n_points)
-        quantum = self._fact(drawing, "quantum", lambda: coordinate_quantum(drawing)) or 0.0
+        quantum = self._fact(drawing, "quantum", lambda: (drawing.quantum(),))[0] or 0.0
         # the fit uses each input path's own grid (a kerf path its input path's): its bound
         # is the largest path's
         path_q = float(self.input_quanta(drawing).max(initial=0.0))
         fit_err, n_control, n_lines, n_cubics = self._fact(fitted, "counts", lambda: (
-            max((f.max_error for f in fitted), default=0.0),
-            sum(control_points(f) for f in fitted),
-            sum(f.n_lines for f in fitted),
-            sum(f.n_cubics for f in fitted)))
+            _fit_counts(fitted, self._fact(fitted, "sample_geometry",
+                                           lambda: sample_geometry(fitted)))))
         out: dict[str, Any] = {
             "input_points": n_input,
             # the file's coordinate grid (0: exact) and the fit's bound from the input
@@ -496,6 +516,36 @@ class _Columns:
                              marks=jm.marks, segment_count=self.segment_count,
                              is_cubic=self.is_cubic, point_count=self.point_count,
                              points=self.points)
+
+
+def _joined(arrs: list[np.ndarray]) -> np.ndarray:
+    """Every point of a drawing's paths (their (N, 2) arrays), in one array."""
+    return np.concatenate(arrs) if arrs else np.zeros((0, 2))
+
+
+def _bbox(allp: np.ndarray) -> tuple[float, float, float, float] | None:
+    """:meth:`Drawing.bbox` of the joined points (None without points)."""
+    if not len(allp):
+        return None
+    x, y = allp[:, 0], allp[:, 1]
+    return float(x.min()), float(y.min()), float(x.max()), float(y.max())
+
+
+def _fit_counts(fitted: Sequence[FittedPath], geo: Any) -> tuple[float, int, int, int]:
+    """The largest fit error, the control points (:func:`galvo_core.fit.control_points`
+    summed), lines and cubics of a fit, from the sampler's gathered arrays ``geo``."""
+    n = len(fitted)
+    err = np.fromiter(map(attrgetter("max_error"), fitted), dtype=np.float64, count=n)
+    nseg, npts = geo.path_n, geo.path_npts
+    # control_points: 0 without segments, 1 for a dot (one line from a point to itself),
+    # else the stored points
+    one = np.flatnonzero(nseg == 1)
+    first = (np.cumsum(npts) - npts)[one]
+    dot = ~geo.is_cubic[geo.path_first[one]] & (
+        geo.points[first] == geo.points[first + 1]).all(axis=1)
+    n_control = int(npts[nseg > 0].sum()) - int((npts[one[dot]] - 1).sum())
+    n_cubics = int(np.count_nonzero(geo.is_cubic))
+    return (float(err.max()) if n else 0.0, n_control, len(geo.is_cubic) - n_cubics, n_cubics)
 
 
 def _clamped(marks: list[np.ndarray], max_bit: int) -> tuple[list[np.ndarray], int]:
