@@ -27,18 +27,15 @@ from collections import OrderedDict
 from collections.abc import Callable, Hashable, Sequence
 from dataclasses import dataclass, field
 from operator import attrgetter
-from typing import Any, TypeVar
+from typing import TYPE_CHECKING, Any, TypeVar
 
 import numpy as np
 
 from galvo_core.drawing import Drawing, Warning
 from galvo_core.errors import Cancelled
 from galvo_core.field import FieldMap, check_in_field, make_field
-from galvo_core.fill import HatchStroke, hatch
 from galvo_core.fit import FittedPath, fit_drawing, with_source_index
 from galvo_core.job import Job, Segments, Stroke, StrokeColumns, gc_paused
-from galvo_core.kerf import compensate_indexed
-from galvo_core.order import order_job_strokes
 from galvo_core.params import UNITS_PER_MM, Params
 from galvo_core.precision import drawing_quantum, path_quanta
 from galvo_core.sample import (
@@ -50,7 +47,34 @@ from galvo_core.sample import (
 )
 from galvo_core.timing import estimate_with_dwell, joined_marks
 
+if TYPE_CHECKING:
+    from galvo_core.fill import HatchStroke
+
 __all__ = ["Cancelled", "Pipeline", "RunResult", "coordinate_quantum", "process"]
+
+
+# kerf, fill and order (and shapely, 0.1 s of a process's start) are imported when a run
+# first needs them, not for every job: these are their functions under the names the
+# stages call (and benchmarks wrap)
+def compensate_indexed(*args: Any, **kw: Any) -> Any:
+    from galvo_core.kerf import compensate_indexed as f
+
+    return f(*args, **kw)
+
+
+def hatch(*args: Any, **kw: Any) -> Any:
+    from galvo_core.fill import hatch as f
+
+    return f(*args, **kw)
+
+
+def order_job_strokes(strokes: Sequence[Stroke], fm: FieldMap, *, method: str,
+                      **kw: Any) -> list[Stroke]:
+    if method == "file":  # as made: nothing to import
+        return list(strokes)
+    from galvo_core.order import order_job_strokes as f
+
+    return f(strokes, fm, method=method, **kw)  # type: ignore[return-value]
 
 T = TypeVar("T")
 #: the fit stage's batches end at this many input points (cancel is checked between them:

@@ -194,3 +194,27 @@ def test_report_gives_segments_and_worst_error_per_path_within_its_bound():
     for p in paths:
         assert p["lines"] + p["cubics"] == p["segments"]
         assert p["max_error"] <= p["bound"] * (1 + 1e-9)
+
+
+def test_a_plain_process_run_imports_no_kerf_fill_or_order(tmp_path):
+    """`process` without kerf, fill or a scan order does not import them (nor shapely, a
+    tenth of a second of every start); with them, it does."""
+    import subprocess
+    import sys
+
+    from _util import ROOT, SAMPLES
+
+    code = ("import sys; from galvo_core.cli import main; rc = main(sys.argv[1:]); "
+            "print(rc, sorted(m for m in ('shapely', 'galvo_core.kerf', 'galvo_core.fill', "
+            "'galvo_core.order') if m in sys.modules))")
+    src = str(SAMPLES / "seal.plt")
+    plain = subprocess.run([sys.executable, "-c", code, "process", src, "-o",
+                            str(tmp_path / "a.gjob"), "--fit-field"], capture_output=True,
+                           text=True, cwd=ROOT, check=True)
+    assert plain.stdout.splitlines()[-1] == "0 []"
+    full = subprocess.run([sys.executable, "-c", code, "process", src, "-o",
+                           str(tmp_path / "b.gjob"), "--fit-field", "--kerf-mm", "0.1",
+                           "--fill", "zigzag", "--scan-order", "greedy"], capture_output=True,
+                          text=True, cwd=ROOT, check=True)
+    assert full.stdout.splitlines()[-1] == ("0 ['galvo_core.fill', 'galvo_core.kerf', "
+                                            "'galvo_core.order', 'shapely']")
