@@ -184,26 +184,24 @@ class Pipeline:
 
     def bbox(self, drawing: Drawing) -> tuple[float, float, float, float] | None:
         """``drawing.bbox()``, cached."""
-        return self._fact(drawing, "bbox", lambda: _bbox(_joined(self._point_arrays(drawing))))
-
-    def _point_arrays(self, drawing: Drawing) -> list[np.ndarray]:
-        """Each path's points as an (N, 2) float64 array (one pass over the paths, shared by
-        the bbox, the grids and the point count)."""
-        return self._fact(drawing, "point arrays", lambda: [
-            np.asarray(p.points, dtype=np.float64).reshape(-1, 2) for p in drawing.paths])
+        return self._fact(drawing, "bbox", lambda: _bbox(_joined(_point_arrays(drawing))))
 
     def _input_facts(self, drawing: Drawing) -> None:
-        """The input drawing's bounding box and coordinate grid from one join of its points
-        (each alone joins them again: 10-300 ms at 1 M points, more for many paths)."""
-        if self._facts.peek(drawing, "bbox") is not None \
-                and self._facts.peek(drawing, "quantum") is not None:
+        """The input drawing's bounding box, point count, coordinate grid and each path's
+        grid from one pass over its paths and one join of their points (each alone passes
+        over them again: 10-300 ms each at 1 M points, more for many paths); the arrays are
+        not kept."""
+        if self._facts.peek(drawing, "path quanta") is not None:
             return
-        allp = _joined(self._point_arrays(drawing))
-        self._fact(drawing, "n_points", lambda: len(allp))
-        self._fact(drawing, "bbox", lambda: _bbox(allp))
+        arrs = _point_arrays(drawing)
+        allp = _joined(arrs)
         # drawing.quantum(): drawing_quantum of the paths, which joins them the same way
-        self._fact(drawing, "quantum", lambda: (
-            float(drawing_quantum([allp])[0]) if len(allp) else 0.0,))
+        facts = {"n_points": len(allp), "bbox": _bbox(allp),
+                 "quantum": (float(drawing_quantum([allp])[0]) if len(allp) else 0.0,)}
+        del allp
+        facts["path quanta"] = path_quanta(arrs)
+        for name, value in facts.items():
+            self._fact(drawing, name, lambda v=value: v)
 
     # ---------------------------------------------------------------- stages
     def field_map(self, drawing: Drawing, params: Params) -> FieldMap:
@@ -271,8 +269,7 @@ class Pipeline:
 
     def input_quanta(self, drawing: Drawing) -> np.ndarray:
         """Each input path's grid (:func:`galvo_core.precision.path_quanta`), cached."""
-        return self._fact(drawing, "path quanta",
-                          lambda: path_quanta(self._point_arrays(drawing)))
+        return self._fact(drawing, "path quanta", lambda: path_quanta(_point_arrays(drawing)))
 
     @staticmethod
     def _refit_changed(drawing: Drawing, work: Drawing, origin: Sequence[int],
@@ -540,6 +537,15 @@ class _Columns:
                              marks=jm.marks, segment_count=self.segment_count,
                              is_cubic=self.is_cubic, point_count=self.point_count,
                              points=self.points)
+
+
+def _point_arrays(drawing: Drawing) -> list[np.ndarray]:
+    """Each path's points as an (N, 2) float64 array (the path's own when it is one)."""
+    out = []
+    for p in drawing.paths:
+        a = np.asarray(p.points, dtype=np.float64)
+        out.append(a if a.ndim == 2 and a.shape[1] == 2 else a.reshape(-1, 2))
+    return out
 
 
 def _joined(arrs: list[np.ndarray]) -> np.ndarray:
