@@ -317,6 +317,7 @@ class Pipeline:
                 if params.interpolation == "raw" else None,
                 cancel=run.cancel,
                 geometry=self._fact(fitted, "sample_geometry", lambda: sample_geometry(fitted)),
+                keep_chunks=False,  # only the marks and the report are kept
             )
             return _Marks(tuple(res.marks), res.report)
 
