@@ -190,7 +190,8 @@ class Pipeline:
         """The input drawing's bounding box, point count, coordinate grid and each path's
         grid from one pass over its paths and one join of their points (each alone passes
         over them again: 10-300 ms each at 1 M points, more for many paths); the arrays are
-        not kept."""
+        not kept. Made by :meth:`run` (a worker), not by :meth:`field_map` or :meth:`bbox`,
+        which a window may call on its own thread."""
         if self._facts.peek(drawing, "path quanta") is not None:
             return
         arrs = _point_arrays(drawing)
@@ -213,7 +214,6 @@ class Pipeline:
             mag = true_size
         grow_bits = (params.kerf_mm / 2 if params.kerf_side == "outside" else 0.0) / (
             params.field_size_mm / params.field_bits)
-        self._input_facts(drawing)
         return make_field(self.bbox(drawing), magnification=mag, fit_field=params.fit_field,
                           field_bits=params.field_bits, field_size_mm=params.field_size_mm,
                           offset_bits=params.offset_bits, margin_bits=grow_bits)
@@ -354,6 +354,7 @@ class Pipeline:
         drawing that leaves the field without ``clamp``), Cancelled when ``cancel()`` says so."""
         t0 = time.perf_counter()
         run = _Run(cancel)
+        self._input_facts(drawing)
         fm = self.field_map(drawing, params)
         work, origin = self.compensated(drawing, params, fm, run)
         fitted = self.fitted(drawing, params, fm, run)
