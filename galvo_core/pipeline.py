@@ -197,12 +197,13 @@ class Pipeline:
         arrs = _point_arrays(drawing)
         allp = _joined(arrs)
         # drawing.quantum(): drawing_quantum of the paths, which joins them the same way
-        facts = {"n_points": len(allp), "bbox": _bbox(allp),
-                 "quantum": (float(drawing_quantum([allp])[0]) if len(allp) else 0.0,)}
+        facts: dict[str, Any] = {
+            "n_points": len(allp), "bbox": _bbox(allp),
+            "quantum": (float(drawing_quantum([allp])[0]) if len(allp) else 0.0,)}
         del allp
         facts["path quanta"] = path_quanta(arrs)
         for name, value in facts.items():
-            self._fact(drawing, name, lambda v=value: v)
+            self._fact(drawing, name, _const(value))
 
     # ---------------------------------------------------------------- stages
     def field_map(self, drawing: Drawing, params: Params) -> FieldMap:
@@ -539,6 +540,10 @@ class _Columns:
                              marks=jm.marks, segment_count=self.segment_count,
                              is_cubic=self.is_cubic, point_count=self.point_count,
                              points=self.points)
+
+
+def _const(value: T) -> Callable[[], T]:
+    return lambda: value
 
 
 def _point_arrays(drawing: Drawing) -> list[np.ndarray]:
