@@ -29,8 +29,11 @@ from typing import Any
 from galvo_core.errors import GalvoError
 from galvo_core.job import Job, Stroke
 
-#: A job file bigger than this (bytes) is read in a helper process.
-BIG_JOB_BYTES = 8_000_000
+#: A job file bigger than this (bytes) is read in a helper process: ``json.loads`` holds
+#: the GIL for the whole parse, about 14 ms of CPU per MB (an 8 MB job: 111 ms CPU, 440 ms
+#: wall at load 4.8; read in the worker thread it stalled the GUI thread 168 ms), so the
+#: bound keeps that one call near 30 ms of CPU; the helper process costs about a second.
+BIG_JOB_BYTES = 2_000_000
 #: A job with more marks + segments than this is written stroke by stroke.
 BIG_JOB_ITEMS = 300_000
 #: Strokes travel in pickles of at most this many segments (one stroke is never split).

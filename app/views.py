@@ -26,6 +26,7 @@ Layers (key: what, view):
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
@@ -900,6 +901,9 @@ class WorkView(pg.PlotWidget):
         return True
 
     def set_highlight(self, xy: np.ndarray, transform: QTransform) -> None:
+        if not len(xy) and getattr(self, "_highlight_empty", False):
+            return  # already empty: no change, no repaint of the whole view
+        self._highlight_empty = not len(xy)
         self.highlight.setTransform(transform)
         if len(xy):
             self.highlight.setData(xy[:, 0], xy[:, 1], connect="finite")
@@ -985,9 +989,14 @@ class WorkView(pg.PlotWidget):
     #: viewport paints so far (the benchmark tells whether a result was drawn already)
     paint_count = 0
 
+    #: called (once set) after each paint of the view (the window staggers the views' paints)
+    on_painted: Callable[[], None] | None = None
+
     def paintEvent(self, ev) -> None:  # noqa: N802 - Qt API
         super().paintEvent(ev)
         self.paint_count += 1
+        if self.on_painted is not None:
+            self.on_painted()
 
     def data_items(self) -> list[pg.GraphicsObject]:
         return [self.layers[k] for k in self.layers]

@@ -12,6 +12,7 @@ from __future__ import annotations
 import json
 import os
 import re
+import sys
 import time
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -103,6 +104,19 @@ BUSY_DELAY_MS = 200
 #: a result of another file is marked at once.
 STALE_DELAY_MS = 400
 MAX_RECENT = 8
+#: The interpreter's thread switch interval while a window is open (s; Python's default is
+#: 5 ms). The GUI thread shares the GIL with the workers, and every Qt call that releases
+#: it (each painter call of a paint) must win it back: with a worker busy in Python code
+#: each takes up to a whole interval, so a 10 ms paint took 40-60 ms while a file
+#: processed. 1 ms keeps such waits short at a small cost in switches for the worker.
+SWITCH_INTERVAL_S = 0.001
+#: What a new file or result replaces (the last file's drawing, result and caches) is let go
+#: this long after (ms): freeing 40 k paths with their fits, strokes and display data takes
+#: the GUI thread 10-20 ms, which then no longer adds to the new result's apply and paint.
+RELEASE_DELAY_MS = 150
+#: The processed view paints after the original (see MainWindow._stagger_paints), at the
+#: latest this long after a result (ms).
+STAGGER_MAX_MS = 80
 
 _EXTS = ("plt", "hpgl", "hpg", "hp", "pgl", "pcl", "spl")
 FILE_FILTER = (
@@ -268,6 +282,8 @@ class MainWindow(QMainWindow):
     def __init__(self, drawing: Drawing | None = None, parent: QWidget | None = None, *,
                  settings: QSettings | None = None, restore: bool = True) -> None:
         super().__init__(parent)
+        if sys.getswitchinterval() > SWITCH_INTERVAL_S:
+            sys.setswitchinterval(SWITCH_INTERVAL_S)
         self.settings = settings if settings is not None else app_settings()
         self._restore_settings = restore
         self.drawing: Drawing | None = None
@@ -298,6 +314,10 @@ class MainWindow(QMainWindow):
         self._committed: Params | None = None
         self._reloading = False
         self._fit_banner = False
+        #: the banner's text once the next result is shown ("" hides it; None: no change):
+        #: the banner speaks of the result shown, and changing it resizes the views (a
+        #: full repaint of both), which the new result's paint then includes
+        self._banner_next: str | None = None
         self._stale_shown = False
         #: File ▸ Export kinds (other modules may add to it, then rebuild_export_menu())
         self.export_kinds: dict[str, ExportKind] = default_export_kinds()
@@ -480,6 +500,11 @@ class MainWindow(QMainWindow):
         self.exporter.failed.connect(self._on_export_failed)
         self.exporter.busy_changed.connect(self._on_busy_changed)
         self._export_target: tuple[str, FsPath] | None = None
+        self._released: list[object] = []
+        self._release_timer = QTimer(self)
+        self._release_timer.setSingleShot(True)
+        self._release_timer.setInterval(RELEASE_DELAY_MS)
+        self._release_timer.timeout.connect(self._released.clear)
         self._throttle = QTimer(self)
         self._throttle.setSingleShot(True)
         self._throttle.setInterval(THROTTLE_MS)
@@ -761,6 +786,12 @@ class MainWindow(QMainWindow):
                     t.wait(5)
             if app is not None:
                 app.processEvents()
+        # the processed view's staggered paint: let it through in its own pass
+        for _ in range(20):
+            if app is None or self.processed.updatesEnabled():
+                break
+            app.processEvents()
+        self._paint_processed()
         return not self.busy()
 
     def wait_for_result(self, timeout_s: float = 60.0) -> bool:
@@ -872,9 +903,10 @@ class MainWindow(QMainWindow):
         if self.last_load_ok is None:
             self.last_load_ok = False
         res = self.result
+        self._banner_next = None  # the banner stays the shown result's
         if res is not None:
             if res.job_path is None:
-                self._leave_job_mode()
+                self._leave_job_mode(now=True)
             self.drawing = res.drawing
             self.file_path = FsPath(res.path) if res.path is not None else None
             self.job_path = res.job_path
@@ -942,7 +974,10 @@ class MainWindow(QMainWindow):
 
     def apply_result(self, result: RunResult) -> None:
         """Show a finished run: layers, field, stats, warnings, conversions."""
+        self._stagger_paints()
+        self._release_later(self.result)
         self.result = result
+        self._apply_banner()
         err = getattr(result, "error", None)
         self.run_error = self.gui_message(err) if err else None
         pv = result.preview
@@ -1027,18 +1062,20 @@ class MainWindow(QMainWindow):
     # --- data -----------------------------------------------------------------------------
     def set_drawing(self, drawing: Drawing, path: str | os.PathLike | None = None, *,
                     bbox: tuple[float, float, float, float] | None = None,
-                    size_mm: tuple[float, float] | None = None) -> None:
+                    size_mm: tuple[float, float] | None = None,
+                    pipeline: Pipeline | None = None) -> None:
         """Process ``drawing`` (on the worker) and show it when its result is ready; the
         selection of the previous drawing is cleared at once. ``bbox``/``size_mm``: its
-        facts when already known (computed on the worker by :meth:`load_file`)."""
+        facts when already known (computed on the worker by :meth:`load_file`, as is
+        ``pipeline``, a fresh one that knows the bbox)."""
         self._leave_job_mode()
         self._fit_banner = False
         if drawing is not self.drawing:
-            self._fresh_caches()
+            self._fresh_caches(pipeline)
         self.drawing = drawing
         self._drawing_bbox = bbox if bbox is not None else self.pipeline.bbox(drawing)
         if size_mm is not None:
-            self._size_mm_of = (drawing, size_mm)
+            self._remember_facts(drawing, size=size_mm)
         self.file_path = FsPath(path) if path is not None else None
         self.selected = None
         self._show_selection(None)
@@ -1051,11 +1088,55 @@ class MainWindow(QMainWindow):
         self._update_status()
         self._update_stale()
 
-    def _fresh_caches(self) -> None:
+    def _stagger_paints(self) -> None:
+        """A new result's apply, the original view's paint and the processed view's paint
+        run in three event-loop passes: after a new result both views repaint in full
+        (20-35 ms of the GUI thread each on 100 k+ points, two to four times that when a
+        worker holds the interpreter lock) and Qt paints all the window's dirty widgets in
+        one go, right after the apply; in separate passes input and timers get a turn in
+        between."""
+        if self.processed.updatesEnabled():
+            self.original.setUpdatesEnabled(False)
+            self.processed.setUpdatesEnabled(False)
+            QTimer.singleShot(0, self._paint_original)
+            # at the latest after STAGGER_MAX_MS
+            QTimer.singleShot(STAGGER_MAX_MS, self._paint_processed)
+
+    def _paint_original(self) -> None:
+        if not self.original.updatesEnabled():
+            # the processed view once the original has painted (then timers get a turn)
+            self.original.on_painted = self._after_original_paint
+            self.original.setUpdatesEnabled(True)  # (schedules its repaint)
+
+    def _after_original_paint(self) -> None:
+        self.original.on_painted = None
+        QTimer.singleShot(0, self._paint_processed)
+
+    def _paint_processed(self) -> None:
+        self.original.on_painted = None
+        for v in (self.original, self.processed):
+            if not v.updatesEnabled():
+                v.setUpdatesEnabled(True)  # (schedules its repaint)
+
+    def grab(self, *args: Any) -> QPixmap:
+        """``QWidget.grab``, with the processed view's staggered paint let through."""
+        self._paint_processed()
+        return super().grab(*args)
+
+    def _release_later(self, *objs: object) -> None:
+        """Drop ``objs`` (the window's last references to replaced results, drawings,
+        caches) after ``RELEASE_DELAY_MS``, in an event-loop pass of their own."""
+        self._released.extend(o for o in objs if o is not None)
+        if self._released and not self._release_timer.isActive():
+            self._release_timer.start()
+
+    def _fresh_caches(self, pipeline: Pipeline | None = None) -> None:
         """Empty caches for a new file: they hold the stages, display geometry and item
         data of the drawings they were made from, so what the last file left there is
-        freed with its result (memory stays about one file's, not the session's)."""
-        self.pipeline = Pipeline()
+        freed with its result (memory stays about one file's, not the session's).
+        ``pipeline``: a fresh one made on the worker (see :func:`load_task`)."""
+        self._release_later(self.pipeline, self.preview_cache, self.prepared_cache)
+        self.pipeline = pipeline if pipeline is not None else Pipeline()
         self.preview_cache = PreviewCache()
         self.prepared_cache = PreparedCache()
 
@@ -1104,7 +1185,7 @@ class MainWindow(QMainWindow):
             return self.load_job_file(path, wait=wait, timeout_s=timeout_s)
         self.loading_path = path
         self.last_load_ok = None
-        self.io.request(load_task(path, _read_for_gui, self.pipeline))
+        self.io.request(load_task(path, _read_for_gui))
         self._update_stale()
         if not wait:
             return True
@@ -1130,8 +1211,11 @@ class MainWindow(QMainWindow):
             keep = self._keep_selection
             self._keep_selection = None
             self._open_fitting_field(loaded)
+            if loaded.n_points >= 0:
+                self._remember_facts(loaded.drawing,
+                                     counts=(loaded.n_points, loaded.n_closed))
             self.set_drawing(loaded.drawing, loaded.path, bbox=loaded.bbox,
-                             size_mm=loaded.size_mm)
+                             size_mm=loaded.size_mm, pipeline=loaded.pipeline)
             if keep is not None:
                 self._fit_pending = False
                 self.selected = keep
@@ -1172,7 +1256,7 @@ class MainWindow(QMainWindow):
         from galvo_core.field import check_in_field
 
         try:
-            fm = self.pipeline.field_map(loaded.drawing, p)
+            fm = (loaded.pipeline or self.pipeline).field_map(loaded.drawing, p)
             check_in_field(fm, loaded.bbox, clamp=False)
             return
         except (GalvoError, ValueError):
@@ -1183,11 +1267,10 @@ class MainWindow(QMainWindow):
             return
         self.set_params(params, run=False)
         w, h = loaded.size_mm
-        self.banner.setText(
+        self._banner_next = (
             f"{loaded.path.name} is {w:.1f} × {h:.1f} mm, bigger than the "
             f"{p.field_size_mm:g} mm field at true size: opened with Fit field on (scaled "
             "to the field). Untick Fit field for a fixed magnification.")
-        self.banner.show()
         self._fit_banner = True
 
     def _show_job(self, loaded: LoadedJob) -> None:
@@ -1205,9 +1288,9 @@ class MainWindow(QMainWindow):
         self.controls.setEnabled(False)
         where = f"; original from {source.name}" if source is not None else (
             "; its source file was not found beside it, so the original view is empty")
-        self.banner.setText(f"Showing the job file {path.name} as written (processing controls "
-                            f"are inactive{where}). Open a PLT file to process again.")
-        self.banner.show()
+        self._banner_next = (f"Showing the job file {path.name} as written (processing "
+                             f"controls are inactive{where}). Open a PLT file to process "
+                             "again.")
         self._add_recent(path)
         self.runner.request(job_task(loaded.job, source, self.preview_cache, path,
                                      self.prepared_cache))
@@ -1229,13 +1312,30 @@ class MainWindow(QMainWindow):
             return None
         return d
 
-    def _leave_job_mode(self) -> None:
+    def _leave_job_mode(self, now: bool = False) -> None:
+        """Back to processing files: the banner (of a job file, or of the last file's Fit
+        field) goes with the next result, or ``now``."""
         if self.job_path is not None:
             self.job_path = None
             self.controls.setEnabled(True)
+        if not self._fit_banner:  # (set when the file opening got Fit field: its banner)
+            self._banner_next = ""
+        if now:
+            self._apply_banner()
+
+    def _apply_banner(self) -> None:
+        """The banner change asked for (see ``_banner_next``), the views resized at once."""
+        text, self._banner_next = self._banner_next, None
+        if text is None or (not text and self.banner.isHidden()):
+            return
+        if text:
+            self.banner.setText(text)
+            self.banner.show()
+        else:
             self.banner.hide()
-        elif not self._fit_banner:
-            self.banner.hide()
+        layout = self.centralWidget().layout()
+        if layout is not None:
+            layout.activate()  # the views take their size now (before a fit to them)
 
     def reload(self) -> bool:
         if self.job_path is not None:
@@ -1436,6 +1536,7 @@ class MainWindow(QMainWindow):
 
     def views_png(self) -> bytes:
         """Both views (as shown) as PNG bytes."""
+        self._paint_processed()
         image = self.splitter.grab().toImage()
         data = QByteArray()
         buf = QBuffer(data)
@@ -1789,13 +1890,31 @@ class MainWindow(QMainWindow):
         if self.windowTitle() != title:
             self.setWindowTitle(title)
 
+    def _remember_facts(self, d: Drawing, **facts: object) -> dict[str, object]:
+        """The status bar's facts of ``d`` (size, point and closed-path counts: each walks
+        every path, 10-30 ms on 40 k paths), kept for the drawing shown and the one
+        opening, whose status lines alternate while it processes (others are dropped:
+        the memo must not keep a closed file alive)."""
+        memo: dict[int, tuple[Drawing, dict[str, object]]] = self.__dict__.setdefault(
+            "_facts_of", {})
+        hit = memo.get(id(d))
+        if hit is None or hit[0] is not d:
+            hit = (d, {})
+            memo[id(d)] = hit
+        live = {id(d), id(self.drawing)}
+        if self.result is not None:
+            live.add(id(self.result.drawing))
+        for k in [k for k in memo if k not in live]:
+            self._release_later(memo.pop(k))
+        hit[1].update(facts)
+        return hit[1]
+
     def _size_mm(self, d: Drawing) -> tuple[float, float]:
         """``d.size_mm()``, kept per drawing (a bbox over every point: too slow per run)."""
-        cached = getattr(self, "_size_mm_of", None)
-        if cached is None or cached[0] is not d:
-            cached = (d, d.size_mm())
-            self._size_mm_of = cached
-        return cached[1]
+        facts = self._remember_facts(d)
+        if "size" not in facts:
+            facts["size"] = d.size_mm()
+        return facts["size"]  # type: ignore[return-value]
 
     def status_summary(self) -> str:
         """The counts shown in the status bar, as plain text."""
@@ -1807,14 +1926,15 @@ class MainWindow(QMainWindow):
                 return f"job file {job_path.name}"
             return "No file — File ▸ Open… or drop an HP-GL file onto the window"
         w, h = self._size_mm(d)
-        memo = getattr(self, "_counts_of", None)
-        if memo is None or memo[0] is not d:  # walks every path: once per drawing
-            memo = self._counts_of = (d, d.n_points, d.n_closed)
+        facts = self._remember_facts(d)
+        if "counts" not in facts:  # walks every path: once per drawing
+            facts["counts"] = (d.n_points, d.n_closed)
+        n_points, n_closed = facts["counts"]  # type: ignore[misc]
         return "   ·   ".join(
             [
                 f"{_fmt_int(len(d.paths))} paths",
-                f"{_fmt_int(memo[1])} points",
-                f"{_fmt_int(memo[2])} closed",
+                f"{_fmt_int(n_points)} points",
+                f"{_fmt_int(n_closed)} closed",
                 f"{w:.2f} × {h:.2f} mm",
                 (self.shown_name() if res is not None else self.file_name()) or "untitled",
             ]

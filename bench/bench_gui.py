@@ -17,11 +17,19 @@ Driven through the window's scripting surface, offscreen (software rasteriser), 
   at the end (memory must stay about one file's, not grow with each file opened).
 
     .venv/bin/python bench/bench_gui.py latency [FILES...] [--points 150000] [--repeats 5]
-    .venv/bin/python bench/bench_gui.py stalls [--points 1000000]
+    .venv/bin/python bench/bench_gui.py stalls [--points 1000000 | --file F] [--opens 5]
     .venv/bin/python bench/bench_gui.py memory [FILES...] [--opens 10]
 
 Without FILES, ``latency`` uses a generated ``--points`` file (bench/gen_plt.py); give the
-corpus files (``../shared/corpus/plt/...``) to measure them.
+corpus files (``../shared/corpus/plt/...``) to measure them. ``stalls --opens N`` opens the
+file N times in the same window (each open replaces the last one's result) and gives the
+max and median of the opens' longest stalls.
+
+``GALVO_BENCH_WHERE=<ms>``: a thread samples every thread's Python stack each 5 ms, and for
+each gap of the GUI timer longer than <ms> the samples taken inside it are printed (what
+the GUI thread ran, what the worker ran; no sample for a while: one thread held the GIL in
+a single C call, or the process was not scheduled). ``GALVO_BENCH_SWITCH_S``: set the
+interpreter's switch interval after the window set its own (to compare).
 """
 
 from __future__ import annotations
@@ -45,6 +53,9 @@ os.environ.setdefault("GALVO_WORKSTATION_SETTINGS",
                       os.path.join(tempfile.mkdtemp(prefix="galvo-bench-"), "s.ini"))
 
 SIZE = (1400, 800)
+#: GALVO_BENCH_WHERE=<ms>: sample the GUI thread and print what it ran in gaps over <ms>
+_WHERE = os.environ.get("GALVO_BENCH_WHERE", "")
+WHERE_MS = float(_WHERE) if _WHERE.replace(".", "", 1).isdigit() else 100.0
 
 
 class StallProbe:
@@ -68,20 +79,13 @@ class StallProbe:
         self.max_gap = max(self.max_gap, gap)
         if gap > 100.0:
             self.long.append(gap)
-            if os.environ.get("GALVO_BENCH_WHERE"):  # what the other threads were doing
-                import threading
-                import traceback
-
-                main = threading.main_thread().ident
-                for ident, frame in sys._current_frames().items():  # noqa: SLF001
-                    if ident == main:
-                        continue
-                    st = traceback.extract_stack(frame)[-4:]
-                    where = " <- ".join(f"{x.filename.split('/')[-1]}:{x.lineno} {x.line}"
-                                        for x in reversed(st))
-                    print(f"    gap {gap:.0f} ms: {where}", file=sys.stderr)
+        if gap > WHERE_MS:
+            if hasattr(self, "sampler"):
+                self.sampler.report(now - gap / 1000.0, now, gap)
 
     def start(self) -> None:
+        if os.environ.get("GALVO_BENCH_WHERE") and not hasattr(self, "sampler"):
+            self.sampler = MainSampler()
         self.last = time.perf_counter()
         self.max_gap = 0.0
         self.long = []
@@ -90,6 +94,52 @@ class StallProbe:
     def stop(self) -> float:
         self.timer.stop()
         return self.max_gap
+
+
+class MainSampler:
+    """With GALVO_BENCH_WHERE set: a thread that samples the GUI thread's Python stack
+    every 5 ms, so a stall can be attributed (the samples taken inside a gap name what the
+    GUI thread ran; none at all means a thread held the GIL in one C call, or the process
+    was not scheduled)."""
+
+    def __init__(self) -> None:
+        import collections
+        import threading
+
+        self.samples: collections.deque = collections.deque(maxlen=400)
+        self.main = threading.main_thread().ident
+        threading.Thread(target=self._run, daemon=True).start()
+
+    def _run(self) -> None:
+        import traceback
+
+        while True:
+            time.sleep(0.005)
+            frames = sys._current_frames()  # noqa: SLF001
+            now = time.perf_counter()
+            st = []
+            for ident, frame in frames.items():
+                tag = "gui" if ident == self.main else "bg"
+                if ident == threading_ident():
+                    continue
+                fr = traceback.extract_stack(frame)[-5:]
+                st.append(tag + ": " + " <- ".join(
+                    f"{x.filename.split('/')[-1]}:{x.lineno} {x.name}" for x in reversed(fr)))
+            self.samples.append((now, st))
+
+    def report(self, t0: float, t1: float, gap: float) -> None:
+        inside = [(t, st) for t, st in self.samples if t0 - 0.006 <= t <= t1 + 0.006]
+        print(f"    gap {gap:.0f} ms, {len(inside)} samples of the GUI thread in it:",
+              file=sys.stderr)
+        for t, st in inside:
+            for line in st:
+                print(f"      {(t - t0) * 1000:6.0f} ms {line}", file=sys.stderr)
+
+
+def threading_ident() -> int:
+    import threading
+
+    return threading.get_ident()
 
 
 def peak_mb() -> float:
@@ -109,6 +159,7 @@ class GuiWork:
     def __init__(self, win) -> None:
         self.apply = 0.0
         self.paint = 0.0
+        self.paint_cpu = 0.0  # the GUI thread's CPU time in the longest paint
         real_apply = win.apply_result
 
         def apply(result) -> None:
@@ -121,9 +172,11 @@ class GuiWork:
             real_paint = v.paintEvent
 
             def paint(ev, real=real_paint) -> None:
-                t = time.perf_counter()
+                t, c = time.perf_counter(), time.thread_time()
                 real(ev)
-                self.paint = max(self.paint, (time.perf_counter() - t) * 1000)
+                ms = (time.perf_counter() - t) * 1000
+                if ms > self.paint:
+                    self.paint, self.paint_cpu = ms, (time.thread_time() - c) * 1000
 
             v.paintEvent = paint
 
@@ -140,6 +193,8 @@ def make_window():
     from app.window import MainWindow
 
     win = MainWindow(restore=False)
+    if os.environ.get("GALVO_BENCH_SWITCH_S"):  # compare the window's switch interval
+        sys.setswitchinterval(float(os.environ["GALVO_BENCH_SWITCH_S"]))
     win.gui_work = GuiWork(win)
     win.resize(*SIZE)
     win.show()
@@ -229,7 +284,7 @@ def latency(files: list[Path], repeats: int, only: list[str] | None = None) -> N
         if only:
             rows = [r for r in rows if any(o in r[0] for o in only)]
         print(f"  {'change':26s} {'wall ms':>9s} {'CPU ms':>8s} {'stall ms':>9s}"
-              f" {'apply/paint ms':>15s}")
+              f" {'apply/paint ms':>15s} {'max wall/CPU ms':>16s}")
         for name, make in rows:
             walls, cpus, stalls, gui = [], [], [], []
             if name.startswith("layer:") and win.params.kerf_mm:
@@ -260,13 +315,13 @@ def latency(files: list[Path], repeats: int, only: list[str] | None = None) -> N
             ap = statistics.median(g[0] for g in gui)
             pa = statistics.median(g[1] for g in gui)
             print(f"  {name:26s} {statistics.median(walls):9.0f} {statistics.median(cpus):8.0f}"
-                  f" {max(stalls):9.0f} {ap:7.0f}/{pa:<7.0f}")
+                  f" {max(stalls):9.0f} {ap:7.0f}/{pa:<7.0f} {max(walls):8.0f}/{max(cpus):<7.0f}")
         win.set_param("kerf_mm", 0.0)
         win.wait_idle(600)
     win.close()
 
 
-def stalls(points: int, big: Path | None) -> None:
+def stalls(points: int, big: Path | None, opens: int = 1) -> None:
     from gen_plt import generate_plt
 
     app, win = make_window()
@@ -282,21 +337,27 @@ def stalls(points: int, big: Path | None) -> None:
 
     def phase(name: str, action: Callable[[], object]) -> None:
         probe.start()
-        t0 = time.perf_counter()
-        action()
-        assert win.wait_idle(1200), name
-        for _ in range(3):
-            app.processEvents()
-        win.original.repaint_now()
-        win.processed.repaint_now()
-        dt = time.perf_counter() - t0
+        # to the views painted with the result (a view that has not painted since is
+        # repainted here; one that has is not painted twice)
+        dt, _ = timed(app, win, action, 1200)
         gap = probe.stop()
+        probe.max_gap = gap
+        pc = win.gui_work.paint_cpu
         ap, pt = win.gui_work.take()
         print(f"{name:34s} {dt:7.1f} {gap:21.0f} {peak_mb():8.0f}   "
-              f"(gaps > 100 ms: {len(probe.long)}; apply {ap:.0f}, paint {pt:.0f})")
+              f"(gaps > 100 ms: {len(probe.long)}; apply {ap:.0f}, paint {pt:.0f}"
+              f" of which CPU {pc:.0f})")
 
     win.gui_work.take()
-    phase("open + process", lambda: win.load_file(big))
+    gaps = []
+    for k in range(opens):
+        # the same file again: the window frees the last one's result as for a new file
+        phase("open + process" if k == 0 else f"open again ({k + 1}/{opens})",
+              lambda: win.load_file(big))
+        gaps.append(probe.max_gap)
+    if opens > 1:
+        print(f"  open + process over {opens} opens: longest stall max {max(gaps):.0f} ms, "
+              f"median {statistics.median(gaps):.0f} ms")
     d = win.drawing
     print(f"  {d.n_points} points, {len(d.paths)} paths, "
           f"{win.result.job.stats['mark_points']} marks, error: {win.run_error}")
@@ -358,6 +419,8 @@ def main(argv: list[str] | None = None) -> int:
     a2 = sub.add_parser("stalls")
     a2.add_argument("--points", type=int, default=1_000_000)
     a2.add_argument("--file", type=Path, default=None)
+    a2.add_argument("--opens", type=int, default=1, help="open the file this many times "
+                    "(the longest stall of each open; max and median)")
     a3 = sub.add_parser("memory")
     a3.add_argument("files", nargs="*", type=Path)
     a3.add_argument("--opens", type=int, default=10)
@@ -383,7 +446,7 @@ def main(argv: list[str] | None = None) -> int:
             files = [f]
         latency(files, a.repeats, [w for w in a.rows.split(",") if w] or None)
     else:
-        stalls(a.points, a.file)
+        stalls(a.points, a.file, a.opens)
     return 0
 
 

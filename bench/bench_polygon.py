@@ -1,4 +1,5 @@
-"""Polygon-mode import speed against ezhpgl (issue 20, brief 20b).
+"""Polygon-mode import speed against ezhpgl (issue 20, briefs 20b and s3: polygon mode in the
+compiled scanner).
 
 Two generated files (numpy, fixed seed) in the styles that use polygon mode, plus two corpus
 files: ours (numba scanner loaded, as in the workstation) vs ezhpgl, CPU time

@@ -16,7 +16,8 @@ done
 TMP=$(mktemp -d)
 .venv/bin/python bench/gen_plt.py 150000 "$TMP/gen_150k.plt"
 .venv/bin/python bench/bench_gui.py latency "$TMP/gen_150k.plt" "${FILES[@]}" "$@"
-.venv/bin/python bench/bench_gui.py stalls --points 1000000
+.venv/bin/python bench/bench_gui.py stalls --points 1000000 --opens 5
+for f in "${FILES[@]}"; do .venv/bin/python bench/bench_gui.py stalls --file "$f" --opens 5; done
 B="$C/straight-coding__gcode-hpgl-viewer__b_fabric_nesting.plt"
 for s in 1 2 3; do .venv/bin/python bench/gen_plt.py 400000 "$TMP/g400k_$s.plt" "$s"; done
 .venv/bin/python bench/gen_plt.py 1000000 "$TMP/g1m.plt"

@@ -88,6 +88,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Iterator, Sequence
+from dataclasses import dataclass, field
 
 import numpy as np
 import shapely
@@ -144,6 +145,37 @@ def compensate(
                               arc_tol_bits=arc_tol_bits, raster_res_bits=raster_res_bits)[0]
 
 
+@dataclass(frozen=True, eq=False)
+class KerfRegions:
+    """What the kerf stage derives from the drawing alone, whatever the kerf width, side,
+    method and field mapping: the closed rings that enclose area, the other paths, and per
+    pen the rings' indices and their even-odd region (:func:`even_odd_region`: about half
+    of a kerf change on the many-ring corpus files). Made by :func:`kerf_regions`; a
+    caller that compensates one drawing at several kerf widths (the GUI's pipeline) keeps
+    it and passes it to :func:`compensate_indexed`."""
+
+    drawing: Drawing
+    rings: tuple[int, ...]
+    passthrough: frozenset[int]
+    pens: tuple[tuple[tuple[int, ...], BaseGeometry], ...]
+    bbox: tuple[float, float, float, float] | None
+    #: per pen (its place in ``pens``), made when first needed: the tree of all its
+    #: rings' segments that maps output vertices back to their source (see
+    #: :class:`_SourceSegments`)
+    segments: dict[int, _SourceSegments] = field(default_factory=dict)
+
+
+def kerf_regions(drawing: Drawing, bbox: tuple[float, float, float, float] | None = None
+                 ) -> KerfRegions:
+    """The kerf-independent part of :func:`compensate_indexed` for ``drawing`` (``bbox``:
+    ``drawing.bbox()`` when at hand)."""
+    rings, passthrough = _split(drawing)
+    pens = tuple((tuple(idx), even_odd_region([drawing.paths[i].points for i in idx]))
+                 for idx in _by_pen(drawing, rings).values())
+    return KerfRegions(drawing, tuple(rings), frozenset(passthrough), pens,
+                       bbox if bbox is not None else drawing.bbox())
+
+
 def compensate_indexed(
     drawing: Drawing,
     *,
@@ -153,10 +185,15 @@ def compensate_indexed(
     fm: FieldMap,
     arc_tol_bits: float = 1.0,
     raster_res_bits: float | None = None,
+    regions: KerfRegions | None = None,
 ) -> tuple[Drawing, tuple[int, ...]]:
     """Like :func:`compensate`, also returning ``origin``: for each output path, the index
-    of the input path it came from (non-decreasing)."""
-    _check(drawing, kerf_mm, side, method, fm, arc_tol_bits, raster_res_bits)
+    of the input path it came from (non-decreasing). ``regions``: :func:`kerf_regions` of
+    ``drawing`` when at hand (the result is the same)."""
+    if regions is not None and regions.drawing is not drawing:
+        raise ValueError("compensate_indexed: regions were made from another drawing")
+    bbox = _check(drawing, kerf_mm, side, method, fm, arc_tol_bits, raster_res_bits,
+                  None if regions is None else regions.bbox)
     n = len(drawing.paths)
     if kerf_mm == 0:
         return drawing, tuple(range(n))
@@ -165,14 +202,16 @@ def compensate_indexed(
     res_auto = raster_res_bits is None
     res = fm.bits_to_units(1.0 if raster_res_bits is None else raster_res_bits)
 
-    rings, passthrough = _split(drawing)
+    if regions is None:
+        regions = kerf_regions(drawing, bbox)
+    rings, passthrough = regions.rings, regions.passthrough
     out_by_src: dict[int, list[np.ndarray]] = {}
     touched: set[int] = set()
-    for idx in _by_pen(drawing, rings).values():
-        region = even_odd_region([drawing.paths[i].points for i in idx])
+    for k, (idx, region) in enumerate(regions.pens):
         result = _apply(region, d, side, method, tol, res, res_auto)
         reach = d + 2 * tol if method == "vector" else 1.5 * d + 2 * res
-        assign, contrib = _assign(result, [drawing.paths[i].points for i in idx], reach)
+        assign, contrib = _assign(result, [drawing.paths[i].points for i in idx], reach,
+                                  regions.segments, k)
         touched.update(idx[j] for j in contrib)
         for ring, j in assign:
             out_by_src.setdefault(idx[j], []).append(ring)
@@ -442,7 +481,11 @@ def compensate_geometry(region: BaseGeometry, d: float, *, side: str, method: st
 
 # --------------------------------------------------------------------------- checks
 def _check(drawing: Drawing, kerf_mm: float, side: str, method: str, fm: FieldMap,
-           arc_tol_bits: float, raster_res_bits: float | None) -> None:
+           arc_tol_bits: float, raster_res_bits: float | None,
+           bbox: tuple[float, float, float, float] | None = None
+           ) -> tuple[float, float, float, float] | None:
+    """Raise ParamError on a bad parameter; returns the drawing's bbox when it was needed
+    (``bbox``, or computed)."""
     if isinstance(kerf_mm, bool) or not isinstance(kerf_mm, (int, float)) \
             or not math.isfinite(kerf_mm):
         raise ParamError(f"kerf_mm must be a finite number, got {kerf_mm!r}")
@@ -461,14 +504,15 @@ def _check(drawing: Drawing, kerf_mm: float, side: str, method: str, fm: FieldMa
         raise ParamError(
             f"raster_res_bits must be a positive finite number, got {raster_res_bits!r}")
     if kerf_mm == 0:
-        return
-    bb = drawing.bbox()
+        return bbox
+    bb = bbox if bbox is not None else drawing.bbox()
     size_mm = 0.0 if bb is None else max(bb[2] - bb[0], bb[3] - bb[1]) * fm.mm_per_unit
     if kerf_mm > size_mm:
         raise ParamError(
             f"kerf_mm = {kerf_mm:g} mm is larger than the drawing itself ({size_mm:.3g} mm on "
             f"the workpiece at magnification {fm.magnification:g}); the kerf is the width of "
             "the laser's trough, typically 0.02-0.2 mm")
+    return bb
 
 
 # --------------------------------------------------------------------------- inputs
@@ -1456,14 +1500,17 @@ def _chunk_tree(a: np.ndarray, b: np.ndarray, sizes: Sequence[int],
 
 
 def _nearest_segment(pts: np.ndarray, a: np.ndarray, b: np.ndarray, sizes: Sequence[int],
-                     reach: float, points: np.ndarray | None = None) -> np.ndarray:
+                     reach: float, points: np.ndarray | None = None,
+                     chunks: tuple[shapely.STRtree, np.ndarray, np.ndarray] | None = None,
+                     fallback: bool = True) -> np.ndarray:
     """Index of the segment (a[k], b[k]) nearest to each point (the lowest index among
     equally near ones). Candidates within ``reach`` come from one bulk STRtree query of
     chunks of segments (much faster than GEOS nearest-neighbour queries); points with
-    none fall back to the nearest-neighbour query. ``points``: ``pts`` as shapely Points,
-    if at hand."""
+    none fall back to the nearest-neighbour query (-1 for them without ``fallback``).
+    ``points``: ``pts`` as shapely Points, if at hand; ``chunks``: :func:`_chunk_tree`
+    of the segments, if at hand."""
     n = len(pts)
-    tree, first, count = _chunk_tree(a, b, sizes)
+    tree, first, count = chunks if chunks is not None else _chunk_tree(a, b, sizes)
     if points is None:
         points = shapely.points(pts)
     pi, ci = tree.query(points, predicate="dwithin", distance=reach)
@@ -1480,14 +1527,44 @@ def _nearest_segment(pts: np.ndarray, a: np.ndarray, b: np.ndarray, sizes: Seque
         np.minimum.at(best, pi[at], si[at])  # ... and the lowest segment at it
     best[best == none_] = -1
     miss = np.nonzero(best < 0)[0]
-    if len(miss):
+    if len(miss) and fallback:
         seg_tree = shapely.STRtree(shapely.linestrings(np.stack([a, b], axis=1)))
         _, seg = seg_tree.query_nearest(shapely.points(pts[miss]), all_matches=False)
         best[miss] = seg
     return best
 
 
-def _nearest_source(pts: np.ndarray, sources: list[np.ndarray], reach: float) -> np.ndarray:
+@dataclass(frozen=True, eq=False)
+class _SourceSegments:
+    """All segments of a pen's source rings, in ring order, with the tree of their chunks
+    (:func:`_chunk_tree`): it does not depend on the kerf, so it is made once per drawing
+    (when most of the segments are needed, as on nested many-ring files: 0.1 s on
+    b_fabric_nesting) and queried at each kerf width."""
+
+    a: np.ndarray
+    b: np.ndarray
+    owner: np.ndarray  # the source ring of each segment
+    tree: shapely.STRtree
+    first: np.ndarray
+    count: np.ndarray
+
+    @staticmethod
+    def of(sources: list[np.ndarray]) -> _SourceSegments:
+        a, b = _segments(sources)
+        sizes = [len(s) - 1 for s in sources]
+        tree, first, count = _chunk_tree(a, b, sizes)
+        return _SourceSegments(a, b, np.repeat(np.arange(len(sources)), sizes), tree,
+                               first, count)
+
+
+#: the tree of all the source segments is made (and kept) once the segments of the
+#: candidate sources are at least this share of them
+SOURCE_TREE_SHARE = 0.5
+
+
+def _nearest_source(pts: np.ndarray, sources: list[np.ndarray], reach: float,
+                    kept: dict[int, _SourceSegments] | None = None, key: int = 0
+                    ) -> np.ndarray:
     """Index of the source ring nearest to each point (every point lies within ``reach`` of
     some source, else the nearest-neighbour fallback finds it). A point within ``reach`` of
     only one source's bounding box has that source as its nearest; the others are settled
@@ -1510,21 +1587,40 @@ def _nearest_source(pts: np.ndarray, sources: list[np.ndarray], reach: float) ->
         cand = np.arange(m)  # a point beyond every box: any source may be nearest
     else:
         cand = np.unique(si[count[pi] > 1])
-    if len(rest):
-        subset = [sources[j] for j in cand.tolist()]
-        a, b = _segments(subset)
-        owner = np.repeat(cand, [len(s) - 1 for s in subset])
-        near[rest] = owner[_nearest_segment(pts[rest], a, b, [len(s) - 1 for s in subset],
-                                            reach, points[rest])]
+    if not len(rest):
+        return near
+    subset = [sources[j] for j in cand.tolist()]
+    sizes = [len(s) - 1 for s in subset]
+    every = kept.get(key) if kept is not None else None
+    if every is None and kept is not None and \
+            sum(sizes) >= SOURCE_TREE_SHARE * (len(pts_all) - m):
+        every = kept[key] = _SourceSegments.of(sources)
+    if every is not None:
+        # the same answer as from the candidates' segments alone: a segment within reach
+        # of a point belongs to a source whose box (grown by reach) holds the point, so to
+        # a candidate; chunks are cut per ring, and segment order follows source order
+        seg = _nearest_segment(pts[rest], every.a, every.b, (), reach, points[rest],
+                               (every.tree, every.first, every.count), fallback=False)
+        found = seg >= 0
+        near[rest[found]] = every.owner[seg[found]]
+        rest = rest[~found]
+        if not len(rest):
+            return near
+    a, b = _segments(subset)
+    owner = np.repeat(cand, sizes)
+    near[rest] = owner[_nearest_segment(pts[rest], a, b, sizes, reach, points[rest])]
     return near
 
 
-def _assign(result: BaseGeometry, sources: list[np.ndarray], reach: float
+def _assign(result: BaseGeometry, sources: list[np.ndarray], reach: float,
+            kept: dict[int, _SourceSegments] | None = None, key: int = 0
             ) -> tuple[list[tuple[np.ndarray, int]], set[int]]:
     """Each output ring with the (local) index of its source ring: the lowest index among
     the source rings nearest to its vertices. Also the set of source rings that some
     output vertex is nearest to. ``reach``: how far output vertices lie from their source
-    (the offset distance plus the method's tolerance), used to find candidates fast."""
+    (the offset distance plus the method's tolerance), used to find candidates fast.
+    ``kept[key]``: the sources' segment tree, kept across calls (see
+    :func:`_nearest_source`)."""
     rings = _geom_rings(result) if not result.is_empty else []
     rings = [r for r in rings if len(r) >= 4]
     if not rings:
@@ -1534,7 +1630,7 @@ def _assign(result: BaseGeometry, sources: list[np.ndarray], reach: float
     # every ASSIGN_STRIDE-th vertex of each output ring (at least one per ring) ...
     pts = np.concatenate([r[:-1:ASSIGN_STRIDE] for r in rings])
     which = np.repeat(np.arange(len(rings)), [len(r[:-1:ASSIGN_STRIDE]) for r in rings])
-    near = _nearest_source(pts, sources, reach)
+    near = _nearest_source(pts, sources, reach, kept, key)
     lowest = np.full(len(rings), np.iinfo(np.int64).max)
     np.minimum.at(lowest, which, near)
     contrib = set(near.tolist())

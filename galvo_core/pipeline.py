@@ -62,6 +62,12 @@ def compensate_indexed(*args: Any, **kw: Any) -> Any:
     return f(*args, **kw)
 
 
+def kerf_regions(*args: Any, **kw: Any) -> Any:
+    from galvo_core.kerf import kerf_regions as f
+
+    return f(*args, **kw)
+
+
 def hatch(*args: Any, **kw: Any) -> Any:
     from galvo_core.fill import hatch as f
 
@@ -232,9 +238,12 @@ class Pipeline:
         run = run or _Run(None)
 
         def make() -> tuple[Drawing, tuple[int, ...]]:
+            # the rings' even-odd regions do not depend on the kerf: once per drawing
+            regions = self._fact(drawing, "kerf_regions",
+                                 lambda: kerf_regions(drawing, self.bbox(drawing)))
             return compensate_indexed(drawing, kerf_mm=params.kerf_mm, side=params.kerf_side,
                                       method=params.kerf_method, fm=fm,
-                                      arc_tol_bits=params.arc_tol_bits)
+                                      arc_tol_bits=params.arc_tol_bits, regions=regions)
 
         return self._cache.get(drawing, ("kerf", self._kerf_key(params, fm)),
                                run.stage("kerf", make))

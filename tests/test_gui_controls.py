@@ -594,3 +594,35 @@ def test_screenshot_cli_with_settings(tmp_path):
         lines = r.stderr.strip().splitlines()
         assert len(lines) == 1 and lines[0].startswith("error: "), r.stderr
     assert json.dumps  # (json imported for job checks above)
+
+
+def test_a_long_warnings_list_is_filled_over_several_passes(qtbot):
+    """A kerf that swallows thousands of rings warns once per ring: the panel lists the
+    first ones at once and the rest over the next event-loop passes (the GUI thread is
+    never held for all of them); a new list stops the old one's filling; all are there
+    to read and click."""
+    from PySide6.QtCore import Qt
+
+    from app.stats import WarningsPanel
+    from galvo_core.drawing import Warning
+
+    panel = WarningsPanel()
+    qtbot.addWidget(panel)
+    many = tuple(Warning(i + 1, 1, f"ring {i} was swallowed") for i in range(1000))
+    seen: list[int] = []
+    panel.activated.connect(seen.append)
+    panel.set_warnings(many)
+    assert panel.list.count() == panel.WARNINGS_PER_PASS
+    qtbot.waitUntil(lambda: panel.list.count() == len(many), timeout=5000)
+    assert panel.list.item(999).text().endswith("ring 999 was swallowed")
+    panel.list.itemClicked.emit(panel.list.item(999))
+    assert seen == [999]
+    panel.set_warnings(many)  # the same warnings again: nothing to redo
+    assert panel.list.count() == len(many)
+    few = many[:3]
+    panel.set_warnings(many[::-1])
+    panel.set_warnings(few, error="out of the field")  # before the long one is filled
+    qtbot.wait(50)
+    assert panel.texts() == ["✖ out of the field"] + [f"⚠ line {w.line}, col 1: {w.message}"
+                                                      for w in few]
+    assert panel.list.item(0).data(Qt.ItemDataRole.UserRole) == -1

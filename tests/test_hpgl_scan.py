@@ -5,6 +5,7 @@ counts, also when its output chunks fill up in the middle of paths and commands.
 from __future__ import annotations
 
 import random
+from collections import Counter
 from unittest import mock
 
 import numpy as np
@@ -132,35 +133,149 @@ def _poly_program(rng: random.Random, n: int) -> bytes:
 
 @pytest.mark.parametrize("seed", range(16))
 def test_compiled_polygon_mode_reads_what_the_general_reader_reads(seed: int) -> None:
-    """Moves inside polygon mode are read by the compiled scanner (scan.scan_poly_moves) and
-    added to the polygon buffer: same sub-polygons, EP/FP paths, warnings and counts."""
+    """Moves inside polygon mode are read by the compiled scanner into its polygon buffer:
+    same sub-polygons, EP/FP paths, warnings and counts."""
     data = _poly_program(random.Random(1000 + seed), 500)
     a = _read(data, True, 8)
     assert_same(a, _read(data, False))
     assert a.commands.get("PM", 0) > 0 and len(a.paths) > 0
 
 
-def test_polygon_mode_moves_are_read_by_the_scanner_in_one_call() -> None:
+def _pm_program(rng: random.Random, n: int) -> bytes:
+    """Random programs dense in polygon mode as files write it (GNU plotutils' open
+    polylines, per-point PD closed by FP, PM1 sub-polygons) mixed with PU/PD/PA/PR/PW, pen
+    changes (SP inside PM too, no SP at all), FP after EP (with and without paths drawn
+    between), EP after FP, and what the compiled scanner hands back to the general reader
+    at that command (PE, CI, EA, LB inside PM, IW, RO, IN, DF, PM0 inside PM, PM1/PM2/EP/FP
+    where they are warned about, junk parameters)."""
+    from galvo_core.hpgl.pe import encode_number
+
+    def nums(k: int) -> bytes:
+        return ",".join(f"{rng.uniform(-500, 500):.{rng.randint(0, 2)}f}"
+                        for _ in range(2 * k)).encode()
+
+    out = [rng.choice([b"IN;SP1;", b"IN;", b"", b"SP2;", b"IN;PW0.5;SP1;"])]
+    for _ in range(n):
+        r = rng.random()
+        if r < 0.12:
+            out.append(rng.choice([b"PM0;", b"PM;", b"PM1;", b"PM2;", b"PM 2;", b"PM0.5;",
+                                   b"PM1,5;", b"PM3;", b"pm2", b"PM-0;", b"PM2\n"]))
+        elif r < 0.22:
+            out.append(rng.choice([b"EP;", b"FP;", b"FP1;", b"EP", b"FP0,2;", b"EP;FP;",
+                                   b"FP;EP;", b"EP;PD1,1;FP;", b"EP;PU;FP;", b"EP;LT;FP;",
+                                   b"EP;PU5,5;FP;", b"ep;fp;", b"EP;SP2;FP;", b"FP:;"]))
+        elif r < 0.30:  # GNU plotutils: an open polyline (PM2 with the pen up)
+            out.append(b"PA%d,%d;PM0;PD;PA%s;PU;PM2;EP;" % (
+                rng.randint(-999, 999), rng.randint(-999, 999), nums(rng.randint(1, 6))))
+        elif r < 0.36:  # per-point PD, closed by FP (and PM1 sub-polygons)
+            body = b"".join((b"PD%s;" % nums(1)) if rng.random() < 0.85 else
+                            rng.choice([b"PM1;", b"PU%s;" % nums(1), b"PU;", b"PD;"])
+                            for _ in range(rng.randint(0, 8)))
+            out.append(b"PU%s;PM0;%sPM2;%s" % (nums(1), body,
+                                               rng.choice([b"FP;", b"EP;", b"FP;EP;", b""])))
+        elif r < 0.48:
+            out.append(b"PU%s;" % nums(rng.randint(0, 2)))
+        elif r < 0.66:
+            out.append(rng.choice([b"PD", b"PA", b"PR", b"pd", b"PD ", b"PA\n"])
+                       + nums(rng.randint(0, 6)) + b";")
+        elif r < 0.74:
+            out.append(rng.choice([b"SP0;", b"SP1;", b"SP2;", b"SP3;", b"PW0.3;", b"PW;",
+                                   b"PR;", b"PA;", b"PD;", b"PU;"]))
+        elif r < 0.82:
+            pe = b"PE" + b"".join(encode_number(rng.randint(-300, 300)) for _ in range(4))
+            out.append(rng.choice([b"CI5;", b"EA50,50;", pe + b";", b"<" + pe[2:] + b";",
+                                   b"LBab\x03", b"IW-400,-400,400,400;", b"IW;", b"RO90;",
+                                   b"RO;", b"SC0,100,0,100;", b"SC;", b"IN;", b"DF;", b"LT;",
+                                   b"PD1:2;", b"PR1.2.3,4;", b"PD1,2,3;"]))
+        elif r < 0.84:  # fill type (recorded, not drawn), as files write it before PM0
+            out.append(rng.choice([b"FT1;", b"FT;", b"FT10,30,45;", b"FT:;", b"ft 3,5",
+                                   b"FT1,2,3,4,5,6;", b"FT1.2.3;"]))
+        elif r < 0.87:
+            out.append(b"\n")
+        else:
+            out.append(b"PD%d,%d" % (rng.randint(0, 99), rng.randint(0, 99)))  # no ';'
+    return b"".join(out)
+
+
+@pytest.mark.parametrize("seed", range(24))
+@pytest.mark.parametrize("small", [True, False])
+def test_compiled_polygon_commands_read_what_the_general_reader_reads(seed: int,
+                                                                     small: bool) -> None:
+    """PM0/PM1/PM2, EP and FP read by the compiled scanner (EP's and FP's paths written as
+    its segments, FP after EP replacing them) give the same paths, pens, closed flags,
+    positions, warnings (the pen-selected count too) and command counts as the general
+    reader; with tiny output chunks and polygon buffers (``small``) they fill up in the
+    middle of commands, polygons, EP and FP."""
+    from galvo_core.hpgl import scan
+
+    data = _pm_program(random.Random(2000 + seed), 400)
+    read_by_scanner = Counter()
+    orig = scan.scan_moves
+
+    def spy(*args):  # type: ignore[no-untyped-def]
+        orig(*args)
+        ist = args[1]
+        read_by_scanner.update(PM=int(ist[scan.I_NPM]), EP=int(ist[scan.I_NEP]),
+                               FP=int(ist[scan.I_NFP]))
+
+    with mock.patch.object(scan, "scan_moves", spy), \
+            mock.patch.object(reader, "_POLY_POINTS", 4 if small else reader._POLY_POINTS):
+        a = _read(data, True, 8 if small else 1 << 16)
+    assert_same(a, _read(data, False))
+    assert read_by_scanner["PM"] > 0 and read_by_scanner["EP"] + read_by_scanner["FP"] > 0
+
+
+@pytest.mark.parametrize("data", [
+    b"IN;SP1;PU0,0;LT;PM0;\nCI3;\nPD10,0,10,10;PM2;EP;FP;PU;PD3,3;",
+    b"IN;SP1;PU0,0;LT;PM0;\nLT;PD10,0,10,10;\nPM2;FP;\nEP;PU;PD3,3;",
+    b"IN;SP1;PU0,0;LT;PM0;PD10,0;\nPD10,10;PM1;PD20,20,30,30;PM2;FP;EP;PA0,0;",
+    b"IN;SP1;PU1,1;PM0;PD5,5;CI3;PD9,9;PM2;EP;LT;FP;PU;PD1,2;",
+])
+def test_polygon_begun_by_the_general_reader_is_finished_by_the_scanner(data: bytes) -> None:
+    """A polygon the general reader began (PM0 after a command the scanner does not read)
+    or added to (CI inside PM) is handed to the scanner with the moves that follow; FP after
+    an EP the scanner wrote is the general reader's when something came between. EP's and
+    FP's paths start at PM0 (line 1) also when the scanner took the polygon over on a later
+    line."""
+    a = _read(data, True)
+    assert_same(a, _read(data, False))
+    at_pm0 = [p for p in a.paths
+              if (p.start.line, p.start.col) == (1, data.index(b"PM0") + 1)]
+    assert at_pm0 and any(len(p.points) >= 3 for p in at_pm0)
+
+
+def test_polygon_mode_is_read_by_the_scanner_in_one_call() -> None:
     """Issue 20, reproducer 1 in polygon mode (GNU plotutils' open polylines,
-    ``PA x0,y0;PM0;PD;PA x1,y1,...;PU;PM2;EP;``): the PD;PA...;PU run between PM0 and PM2
-    is one compiled call, the polylines stay open, as the general reader reads them; a
-    single command with more moves than the move buffer holds (4,999 pairs) too."""
+    ``PA x0,y0;PM0;PD;PA x1,y1,...;PU;PM2;EP;``) and per-point PD in PM closed by FP (FT
+    before it): the whole file is one compiled call (PM0/PM2/EP/FP/FT and the moves), the
+    polylines stay open
+    (PM2 closes them with the pen up: EP does not draw that edge), FP's rings are closed,
+    as the general reader reads them; a single command with more moves than the polygon
+    buffer holds (4,999 pairs) too."""
     lines = [[(k, 0), (k + 100, 50), (k + 200, 0)] for k in range(0, 3000, 300)]
-    body = b"".join(b"PA%d,%d;PM0;PD;PA%s;PU;PM2;EP;" % (
+    body = b"".join(b"PA%d,%d;PM0;PD;PA%s;PU;PM2;EP;\n" % (
         *ln[0], ",".join(f"{x},{y}" for x, y in ln[1:]).encode()) for ln in lines)
+    rings = b"".join(b"PU%d,0;FT1;PM0;PD%d,9;PD%d,0;PM2;FP;\n" % (k, k + 5, k + 9)
+                     for k in range(0, 100, 10))
     big = ",".join(f"{k},{k % 7}" for k in range(1, 5000)).encode()
-    data = b"IN;SP1;" + body + b"PA0,0;PM0;PD;PA" + big + b";PM2;EP;"
+    data = b"IN;SP1;" + body + rings + b"PU;PA0,0;PM0;PD;PA" + big + b";PM2;EP;"
     calls = []
-    run = reader._Reader._compiled_poly_run
-    with mock.patch.object(reader._Reader, "_compiled_poly_run",
+    run = reader._Reader._compiled_run
+    with mock.patch.object(reader._Reader, "_compiled_run",
                            lambda self, i: calls.append(i) or run(self, i)):
         a = _read(data, True)
     assert_same(a, _read(data, False))
-    assert len(calls) == len(lines) + 1
-    assert len(a.paths) == len(lines) + 1
+    assert [c for c in calls if c >= len(b"IN;SP1;")] == [len(b"IN;SP1;")]  # (SP1 first:
+    # the general reader's, no pen was selected)
+    assert a.commands["PM"] == 2 * (len(lines) + 11) and a.commands["EP"] == len(lines) + 1
+    assert a.commands["FT"] == 10
+    assert len(a.paths) == len(lines) + 10 + 1
     for p, ln in zip(a.paths, lines, strict=False):
         np.testing.assert_array_equal(p.points, ln)  # open: no closing edge added
         assert not p.closed
+    for p, k in zip(a.paths[len(lines):], range(0, 100, 10), strict=False):
+        np.testing.assert_array_equal(p.points, [(k, 0), (k + 5, 9), (k + 9, 0), (k, 0)])
+        assert p.closed and p.start.line == len(lines) + 1 + k // 10
     # the last one ends with the pen down: PM2 closes it with a pen-down edge
     assert len(a.paths[-1].points) == 5001 and a.paths[-1].closed
 

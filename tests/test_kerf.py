@@ -701,3 +701,87 @@ def test_odd_crossings_work_is_linear_for_drawings_side_by_side(
         pairs.append(0)
         kerf_mod._odd_crossings(pts, a[rep], b[rep])
     assert pairs[1] < 20 * pairs[0]
+
+
+def _nested_squares(n: int = 12, gap: float = 1.5) -> list[np.ndarray]:
+    """Concentric squares ``gap`` apart, alternate senses, plus a row of small squares
+    inside the innermost one: each output vertex lies in the boxes of several sources, so
+    the mapping back needs the segments of most of them (the kept segment tree)."""
+    rings = [square(i * gap, i * gap, 100 - 2 * i * gap, ccw=i % 2 == 0) for i in range(n)]
+    inner = n * gap + 2.0
+    rings += [square(inner + 6 * k, inner, 4) for k in range(8)]
+    return rings
+
+
+@pytest.mark.parametrize("side", ["outside", "inside"])
+def test_kerf_regions_reused_across_kerf_widths_give_the_same_result(side: str) -> None:
+    """The GUI's pipeline keeps :func:`kerf_regions` of a drawing (its even-odd regions
+    and the tree of its rings' segments) and compensates it at each kerf width the
+    operator tries: every width gives the same paths, origins and warnings as a fresh
+    compensation, and the kept tree is the one these widths used."""
+    from galvo_core.kerf import kerf_regions
+
+    dr = drawing(*_nested_squares(), pens=(1,) * 12 + (2,) * 8)
+    fm = field_for(dr)
+    regions = kerf_regions(dr)
+    for d in (0.2, 0.5, 0.9, 0.3):
+        kw = dict(kerf_mm=kerf_for(fm, d), side=side, method="vector", fm=fm)
+        fresh, origin = compensate_indexed(dr, **kw)
+        kept, kept_origin = compensate_indexed(dr, **kw, regions=regions)
+        assert kept_origin == origin
+        assert [w.message for w in kept.warnings] == [w.message for w in fresh.warnings]
+        assert len(kept.paths) == len(fresh.paths)
+        for p, q in zip(kept.paths, fresh.paths, strict=True):
+            assert np.array_equal(p.points, q.points) and (p.pen, p.start) == (q.pen, q.start)
+    assert 0 in regions.segments  # the nested pen's mapping went through the kept tree
+    with pytest.raises(ValueError, match="another drawing"):
+        compensate_indexed(drawing(square(0, 0, 10)), kerf_mm=0.01, side=side,
+                           method="vector", fm=fm, regions=regions)
+
+
+def test_nearest_source_through_the_kept_tree_matches_the_candidates_alone(
+        monkeypatch: pytest.MonkeyPatch) -> None:
+    """The tree of all the source segments, kept across kerf widths, gives each point the
+    same source as the tree of the candidates' segments made per call, for points near
+    one ring, near several, and beyond reach of all (the nearest-neighbour fallback)."""
+    import galvo_core.kerf as kerf_mod
+
+    rng = np.random.default_rng(11)
+    sources = [kerf_mod._closed(r) for r in _nested_squares(8, 3.0)]
+    pts = np.concatenate([rng.uniform(-10, 110, (600, 2)),
+                          np.concatenate(sources)[rng.integers(0, 40, 300)]
+                          + rng.uniform(-1.0, 1.0, (300, 2))])
+    for reach in (0.8, 2.0, 7.0):
+        plain = kerf_mod._nearest_source(pts, sources, reach)
+        monkeypatch.setattr(kerf_mod, "SOURCE_TREE_SHARE", 0.0)
+        kept: dict = {}
+        assert np.array_equal(kerf_mod._nearest_source(pts, sources, reach, kept, 3), plain)
+        assert np.array_equal(kerf_mod._nearest_source(pts, sources, reach, kept, 3), plain)
+        assert list(kept) == [3]
+        monkeypatch.setattr(kerf_mod, "SOURCE_TREE_SHARE", 0.5)
+
+
+def test_pipeline_computes_the_kerf_regions_once_per_drawing(
+        monkeypatch: pytest.MonkeyPatch) -> None:
+    """A kerf change (or a magnification change with kerf on) recomputes the offset, not
+    the drawing's even-odd regions: those are made once per drawing."""
+    import galvo_core.pipeline as pipeline_mod
+    from galvo_core.params import Params
+
+    made = []
+    real = pipeline_mod.kerf_regions
+    monkeypatch.setattr(pipeline_mod, "kerf_regions",
+                        lambda dr, bbox=None: made.append(dr) or real(dr, bbox))
+    dr = drawing(*_nested_squares())
+    pipe = pipeline_mod.Pipeline()
+    for kerf in (0.02, 0.03, 0.05):
+        params = Params(fit_field=True, kerf_mm=kerf)
+        fm = pipe.field_map(dr, params)
+        work, origin = pipe.compensated(dr, params, fm)
+        fresh = compensate_indexed(dr, kerf_mm=kerf, side=params.kerf_side,
+                                   method=params.kerf_method, fm=fm,
+                                   arc_tol_bits=params.arc_tol_bits)
+        assert origin == fresh[1] and len(work.paths) == len(fresh[0].paths)
+        assert all(np.array_equal(p.points, q.points)
+                   for p, q in zip(work.paths, fresh[0].paths, strict=True))
+    assert made == [dr]

@@ -72,12 +72,13 @@ skipped with a warning naming line and column. Time and memory are linear in the
 Speed
 -----
 Large inputs (from ``_COMPILED_MIN_BYTES``), or any input once numba is loaded, are read by
-the compiled scanner (:mod:`.scan`) wherever a PU/PD/PA/PR/SP command starts, and PE by its
-compiled decoder; inside polygon mode its PU/PD/PA/PR runs are read by the compiled
-scanner too (``scan.scan_poly_moves``: the moves and their pen states, added to the polygon
-buffer a pen-down run at a time); the general reader takes every other command. Smaller
-inputs in a fresh process use the numpy runs of :mod:`.fastrun` (outside polygon mode). All
-three read the same geometry bit for bit
+the compiled scanner (:mod:`.scan`) wherever a PU/PD/PA/PR/SP/PW command starts, and PE by
+its compiled decoder. Once running, the scanner reads FT and polygon mode too (PM0/PM1/PM2
+into its own polygon buffer, EP's and FP's paths written as its segments); it hands the
+buffer back to the general reader (``_poly_from_scanner``) at anything else (PE, CI, LB...
+inside PM; IW or RO in force; FP after an EP it did not write). The general reader takes
+every other command. Smaller inputs in a fresh process use the numpy runs of
+:mod:`.fastrun` (outside polygon mode). All three read the same geometry bit for bit
 (tests/test_hpgl_scan.py, tests/test_hpgl_fuzz.py).
 """
 
@@ -144,6 +145,7 @@ _FAST_PIECE_BYTES = 1 << 13  # longer runs are read in pieces of at most this si
 #: ``process``), so that ``galvo-core info small.plt`` does not pay numba's import
 _COMPILED_MIN_BYTES = 1 << 20
 _CHUNK_POINTS = 1 << 16  # points per output chunk of the compiled scanner
+_POLY_POINTS = 1 << 10  # points of the compiled scanner's first polygon buffer
 _BLOCK_POINTS = 1 << 12  # the general reader's paths are gathered into blocks of about
 _BLOCK_PATHS = 1 << 9  # this many points or paths
 _PE_MESSAGES = {  # scan.PE_* problem codes -> the messages of pe.decode_pe
@@ -157,8 +159,8 @@ _PE_MESSAGES = {  # scan.PE_* problem codes -> the messages of pe.decode_pe
 #: restores the pen position it found
 _LABEL_ORIGINS = frozenset((*range(1, 10), *range(11, 20), 21))
 _LO_CONCATENATE = frozenset((1, 2, 3, 11, 12, 13, 21))
-_SCAN_CMDS = frozenset((b"PU", b"PD", b"PA", b"PR", b"SP", b"PW"))  # what the scanner reads
-_POLY_SCAN_CMDS = frozenset((b"PU", b"PD", b"PA", b"PR", b"PW"))  # ... in polygon mode
+#: where the compiled scanner is started (it reads PM, EP, FP and FT too once it runs)
+_SCAN_CMDS = frozenset((b"PU", b"PD", b"PA", b"PR", b"SP", b"PW"))
 
 
 def _is_letter_or_esc(c: int) -> bool:
@@ -327,15 +329,20 @@ class _Reader:
         self.ct_tol = False
         self.term = ETX
         self.poly: list[list[tuple[float, float]]] | None = None  # rings while in PM
+        # the sub-polygon being drawn (its edges are pen-down: a pen-up move ends it)
         self.poly_ring: list[tuple[float, float]] = []
-        self.poly_down: list[bool] = []  # pen state of each edge of poly_ring
-        # sub-polygons: points, pen-down flag of each edge (the closing edge last)
-        self.poly_buffer: list[tuple[list[tuple[float, float]], list[bool]]] = []
+        # sub-polygons: points and the pen state of the closing edge (back to the first
+        # point); every other edge is pen-down
+        self.poly_buffer: list[tuple[list[tuple[float, float]], bool]] = []
         self.poly_emitted = True
         # EP's paths: self.paths range and general path numbers (FP may replace them)
         self.poly_edged: tuple[int, int, int, int] | None = None
         self.poly_fresh = False
         self.poly_offset = 0
+        self.poly_lc: tuple[int, int, int] | None = None  # offset, line, column of PM0
+        # an edged polygon whose points are still only in the scanner's buffer (points,
+        # rings): read back when an FP needs them (see _poly_from_scanner)
+        self.poly_lazy: tuple[int, int] | None = None
         self.tick = (0.5, 0.5)
         self.char_size: tuple[float, float] | None = None  # SI: width, height (plotter units)
         self.char_rel: tuple[float, float] | None = None  # SR: % of P2-P1
@@ -526,9 +533,8 @@ class _Reader:
         if self.poly is not None:
             self._poly_close_ring(self.pen_down)
             ring = [tuple(p) for p in ring_pts.tolist()]
-            self.poly_buffer.append((ring, [True] * (len(ring) - 1) + [True]))
+            self.poly_buffer.append((ring, True))
             self.poly_ring = [(self.x, self.y)]
-            self.poly_down = []
             return
         self.emit(ring_pts, offset, closed=len(ring_pts) >= 4)
 
@@ -553,7 +559,6 @@ class _Reader:
             if self.pen_down and not self.poly_fresh:
                 # pen-down moves only append (what _poly_move does point by point)
                 self.poly_ring.extend(zip(pts[:, 0].tolist(), pts[:, 1].tolist(), strict=True))
-                self.poly_down.extend([True] * len(pts))
             else:
                 for px, py in pts.tolist():
                     self._poly_move(px, py)
@@ -623,18 +628,15 @@ class _Reader:
             # whatever the pen state (HP-GL/2 PM; hp2xx and ezhpgl read it so too)
             self.poly_fresh = False
             self.poly_ring = [(x, y)]
-            self.poly_down = []
             return
         if self.pen_down:
             self.poly_ring.append((x, y))
-            self.poly_down.append(True)
         else:
             # a pen-up move ends the sub-polygon (its closing edge is a pen-up edge); the
             # fill region of each piece is its own ring, not one ring joined by pen-up edges
             if len(self.poly_ring) > 1:
                 self._poly_close_ring(False)
             self.poly_ring = [(x, y)]
-            self.poly_down = []
 
     def _poly_close_ring(self, down: bool) -> None:
         """End the current sub-polygon; its closing edge has pen state ``down`` (PM1/PM2
@@ -642,9 +644,8 @@ class _Reader:
         boundary but EP does not draw it)."""
         ring = self.poly_ring
         if len(ring) > 1:
-            self.poly_buffer.append((ring, self.poly_down + [down]))
+            self.poly_buffer.append((ring, down))
         self.poly_ring = [(self.x, self.y)]
-        self.poly_down = []
 
     def do_pm(self, v: list[float], offset: int) -> None:
         mode = int(v[0]) if v else 0
@@ -655,11 +656,12 @@ class _Reader:
             self.poly = []
             self.poly_buffer = []
             self.poly_ring = [(self.x, self.y)]
-            self.poly_down = []
             self.poly_fresh = False
             self.poly_emitted = False
             self.poly_edged = None
             self.poly_offset = offset
+            self.poly_lc = None
+            self.poly_lazy = None
         elif mode == 1:
             if self.poly is None:
                 self.warn(offset, "PM1 outside polygon mode ignored")
@@ -690,21 +692,26 @@ class _Reader:
             first = len(self.paths)
             gfirst = self.gen_base + len(self.gen)
             self.poly_edged = (first, first, gfirst, gfirst)  # (not gathered from gfirst)
-            for ring, downs in self.poly_buffer:
-                for run in _pen_down_runs(ring, downs):
+            for ring, closing in self.poly_buffer:
+                if len(ring) >= 2:  # its pen-down edges: all but maybe the closing one
+                    run = [*ring, ring[0]] if closing and ring[0] != ring[-1] else ring
                     self.emit(np.array(run, dtype=np.float64), self.poly_offset)
             self.poly_edged = (first, len(self.paths), gfirst, self.gen_base + len(self.gen))
             return
         if self.poly_emitted and self.poly_edged is None:
             return  # filled already
+        if self.poly_lazy is not None:
+            self._poly_buffer_from_scanner(*self.poly_lazy)
         rings = []
-        for ring, _downs in self.poly_buffer:
+        for ring, _closing in self.poly_buffer:
             closed_ring = ring if ring[0] == ring[-1] else ring + [ring[0]]
             rings.append(np.array(closed_ring, dtype=np.float64))
         if self.poly_edged is not None:
             a, b, ga, gb = self.poly_edged
             self.poly_edged = None
             tail = self.paths[b:]
+            # EP's paths, the compiled scanner's batches among them, are replaced
+            self.batched -= sum(len(p.starts) for p in self.paths[a:b] if p is not None)
             del self.paths[a:]
             gtail = self.gen[gb - self.gen_base :]
             del self.gen[ga - self.gen_base :]
@@ -932,11 +939,7 @@ class _Reader:
             if self.compiled:
                 m = cmd_match(data, i)
                 if m is not None:
-                    mn2 = m.group(1).upper()
-                    if self.poly is None:
-                        j = self._compiled_run(i) if mn2 in _SCAN_CMDS else i
-                    else:
-                        j = self._compiled_poly_run(i) if mn2 in _POLY_SCAN_CMDS else i
+                    j = self._compiled_run(i) if m.group(1).upper() in _SCAN_CMDS else i
                     if j != i:
                         i = j
                         continue
@@ -1059,125 +1062,175 @@ class _Reader:
         return line, last_nl
 
     def _compiled_run(self, i: int) -> int:
-        """Read the PU/PD/PA/PR/SP commands from ``i`` on with the compiled scanner; returns
-        the offset where it stopped (``i`` when the next command is not one it reads)."""
+        """Read the PU/PD/PA/PR/SP/PW commands (and PM/EP/FP/FT) from ``i`` on with the
+        compiled scanner; returns the offset where it stopped (``i`` when the next command
+        is not one it reads)."""
         scan = self._scanner()
         ist, fst = self._ist, self._fst
         line, last_nl = self._line_at(i)
+        # the scanner's polygon buffer holds the reader's (or one PM0 made in this run)
+        buffered = self._poly_to_scanner(i, line, last_nl)
+        nmove = scan.N_MOVE_STATE
         while True:
             ch = self._chunk
             if ch is None or len(ch.pts) - ch.npts < 2 or len(ch.seg_start) - ch.nseg < 3:
                 ch = self._new_chunk(0, i)
             was_open = self.pen_down and bool(self.cur or self.cur_parts)
-            # the state in slot order (see scan.I_*)
-            ist[:] = (i, self.pen_down, self.absolute, was_open, ch.npts, ch.nseg,
-                      0, 0, 0, 0, 0, 0, 0, self.pen, self.hpgl2, 0, self.pen_selected,
-                      line, last_nl, 0)
+            # the move state in slot order (see scan.I_*); the polygon slots stay
+            ist[:nmove] = (i, self.pen_down, self.absolute, was_open, ch.npts, ch.nseg,
+                           0, 0, 0, 0, 0, 0, 0, self.pen, self.hpgl2, 0, self.pen_selected,
+                           line, last_nl, 0)
             sc = self.sc
             fst[:] = (self.x, self.y, 0.0, 0.0, 0.0, 0.0, 0.0) if sc is None else \
                 (self.x, self.y, sc[0], sc[1], sc[2], sc[3], 1.0)
+            pb, rs, rcl = self._pbuf
             scan.scan_moves(self._u8, ist, fst, ch.pts, ch.seg_start, ch.seg_off, ch.seg_pen,
-                            ch.seg_line, ch.seg_col, _POW10, scan.CLASS)
+                            ch.seg_line, ch.seg_col, pb, rs, rcl, _POW10, scan.CLASS)
             out = ist.tolist()
+            buffered = buffered or out[scan.I_NPM] > 0
             self._take_segments(ch, out)
+            if out[scan.I_EDGED] == 1:
+                ist[scan.I_EDGED] = 2  # EP's paths are in self.paths now (poly_edged)
             self.x, self.y = fst[0].item(), fst[1].item()
             self.pen_down = bool(out[scan.I_PEN])
             self.absolute = bool(out[scan.I_ABS])
             self.pen = out[scan.I_PENNO]
-            counts = out[scan.I_NU : scan.I_NR + 1] + [out[scan.I_NSP], out[scan.I_NPW]]
+            counts = out[scan.I_NU : scan.I_NR + 1] + [out[scan.I_NSP], out[scan.I_NPW]] + \
+                out[scan.I_NPM : scan.I_NFP + 1] + [out[scan.I_NFT]]
             self.hpgl2 = bool(out[scan.I_HPGL2])
             if any(counts):
-                for name, c in zip(("PU", "PD", "PA", "PR", "SP", "PW"), counts, strict=True):
+                for name, c in zip(("PU", "PD", "PA", "PR", "SP", "PW", "PM", "EP", "FP", "FT"),
+                                   counts, strict=True):
                     if c:
                         self.commands[name] += c
                 self.recognised += sum(counts)
+            if out[scan.I_DROP] and not self.pen_selected:
+                self.unselected_paths += out[scan.I_DROP]  # as when FP replaces EP's paths
             i = out[scan.I_POS]
             self._lc = (i, out[scan.I_LINE], out[scan.I_LASTNL])
-            if not out[scan.I_FULL]:
+            full = out[scan.I_FULL]
+            if not full:
+                self._poly_from_scanner(out, buffered)
                 return i
             line, last_nl = out[scan.I_LINE], out[scan.I_LASTNL]
-            self._new_chunk(out[scan.I_NEED], i)
+            if full == scan.FULL_POLY:
+                self._grow_poly_buffer(out[scan.I_NEED])
+            else:
+                self._new_chunk(out[scan.I_NEED], i)
 
-    def _compiled_poly_run(self, i: int) -> int:
-        """Polygon mode: read the PU/PD/PA/PR/PW commands from ``i`` on with the compiled
-        scanner (scan.scan_poly_moves) and add their moves to the polygon buffer as
-        :meth:`_poly_move` would; returns the offset where it stopped."""
-        scan = self._scanner()
-        ist, fst = self._ist, self._fst
-        line, last_nl = self._line_at(i)
-        moves = getattr(self, "_pm_moves", None)
-        if moves is None:
-            moves = self._pm_moves = (np.empty(4096), np.empty(4096), np.empty(4096, np.int8))
-        while True:
-            mx, my, md = moves
-            ist[:] = (i, self.pen_down, self.absolute, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0,
-                      self.pen, self.hpgl2, 0, self.pen_selected, line, last_nl, 0)
-            sc = self.sc
-            fst[:] = (self.x, self.y, 0.0, 0.0, 0.0, 0.0, 0.0) if sc is None else \
-                (self.x, self.y, sc[0], sc[1], sc[2], sc[3], 1.0)
-            scan.scan_poly_moves(self._u8, ist, fst, mx, my, md, _POW10, scan.CLASS)
-            out = ist.tolist()
-            nm = out[scan.I_NPTS]
-            if nm:
-                self._poly_moves(mx[:nm], my[:nm], md[:nm])
-            self.x, self.y = fst[0].item(), fst[1].item()
-            self.pen_down = bool(out[scan.I_PEN])
-            self.absolute = bool(out[scan.I_ABS])
-            self.hpgl2 = bool(out[scan.I_HPGL2])
-            counts = out[scan.I_NU : scan.I_NR + 1] + [out[scan.I_NPW]]
-            if any(counts):
-                for name, c in zip(("PU", "PD", "PA", "PR", "PW"), counts, strict=True):
-                    if c:
-                        self.commands[name] += c
-                self.recognised += sum(counts)
-            i = out[scan.I_POS]
-            line, last_nl = out[scan.I_LINE], out[scan.I_LASTNL]
-            self._lc = (i, line, last_nl)
-            if not out[scan.I_FULL]:
-                return i
-            cap = max(out[scan.I_NEED], 2 * len(mx))
-            moves = self._pm_moves = (np.empty(cap), np.empty(cap), np.empty(cap, np.int8))
+    def _grow_poly_buffer(self, need: int) -> None:
+        """The scanner's polygon buffer (points, ring starts, closing flags), made to hold
+        at least ``need`` points, keeping what it holds."""
+        old = getattr(self, "_pbuf", None)
+        cap = max(need, 2 * len(old[0]) if old is not None else _POLY_POINTS)
+        pb = np.empty((cap, 2), dtype=np.float64)
+        rs = np.zeros(cap // 2 + 2, dtype=np.int64)  # (a ring has two points but the
+        rcl = np.zeros(cap // 2 + 2, dtype=np.int8)  # reader's one-point figures; checked)
+        if old is not None:
+            pb[: len(old[0])] = old[0]
+            rs[: len(old[1])] = old[1]
+            rcl[: len(old[2])] = old[2]
+        self._pbuf = (pb, rs, rcl)
 
-    def _poly_moves(self, mx: np.ndarray, my: np.ndarray, md: np.ndarray) -> None:
-        """:meth:`_poly_move` for each move (plotter point, pen state it was made with), a
-        run of pen-down moves at a time."""
-        xs = mx.tolist()
-        ys = my.tolist()
-        n = len(xs)
-        a = 0
-        if self.poly_fresh:
-            self.poly_fresh = False
-            self.poly_ring = [(xs[0], ys[0])]
-            self.poly_down = []
-            a = 1
+    def _poly_to_scanner(self, i: int, line: int, last_nl: int) -> bool:
+        """Polygon-mode state into the scanner's slots and buffer (see scan.scan_moves);
+        False when the buffer is not handed over (no polygon, or one edged or filled: the
+        scanner needs its points only for FP after EP, which it leaves to the reader when
+        EP was not its own)."""
+        scan = self._scan
+        if not hasattr(self, "_pbuf"):
+            self._grow_poly_buffer(0)
+        ok = self.window is None and self.rot == 0
+        edged = 0 if self.poly_edged is None else 2
+        # slots I_POLY .. I_POLYOK in one assignment (see scan.I_*)
+        if self.poly is None and self.poly_emitted:
+            self._ist[scan.I_POLY : scan.I_POLYOK + 1] = (
+                0, 0, 1, edged, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, ok)
+            return False
+        rings = self.poly_buffer
         ring = self.poly_ring
-        downs = self.poly_down
-        for u in (np.flatnonzero(md[a:] == 0) + a).tolist() + [n]:
-            if u > a:
-                ring.extend(zip(xs[a:u], ys[a:u], strict=True))
-                downs.extend([True] * (u - a))
-            if u == n:
-                break
-            # a pen-up move ends the sub-polygon (see _poly_move)
-            if len(ring) > 1:
-                self.poly_buffer.append((ring, downs + [False]))
-            ring = [(xs[u], ys[u])]
-            downs = []
-            a = u + 1
-        self.poly_ring = ring
-        self.poly_down = downs
+        npb = sum(len(r) for r, _c in rings) + len(ring)
+        if npb + 1 > len(self._pbuf[0]) or len(rings) + 2 > len(self._pbuf[1]):
+            self._grow_poly_buffer(2 * (npb + len(rings)) + 2)
+        pb, rs, rcl = self._pbuf
+        if rings:
+            pb[:npb] = [p for r, _c in rings for p in r] + ring
+            rs[1 : len(rings) + 1] = np.cumsum([len(r) for r, _c in rings])
+            rcl[: len(rings)] = [c for _r, c in rings]
+        elif len(ring) == 1:
+            pb[0] = ring[0]
+        elif ring:
+            pb[:npb] = ring
+        rs[0] = 0
+        off = self.poly_offset
+        lc = self.poly_lc
+        if lc is None and off <= i and self.data.count(b"\n", off, i) == 0:
+            lc = self.poly_lc = (off, line, off - last_nl)  # PM0 on the line of i
+        # without PM0's line and column the general reader writes EP's and FP's paths
+        plc = lc is not None and lc[0] == off
+        self._ist[scan.I_POLY : scan.I_POLYOK + 1] = (
+            self.poly is not None, self.poly_fresh, self.poly_emitted, edged, 0, 0, 0, 0, off,
+            lc[1] if plc else 0, lc[2] if plc else 0, plc, npb, len(rings), ok)
+        return True
+
+    def _poly_from_scanner(self, out: list[int], buffered: bool) -> None:
+        """Polygon-mode state back from the scanner's slots and buffer (``buffered``: the
+        scanner's buffer is the polygon's, see :meth:`_poly_to_scanner`)."""
+        scan = self._scan
+        self.poly_fresh = bool(out[scan.I_FRESH])
+        self.poly_emitted = bool(out[scan.I_EMITTED])
+        if out[scan.I_EDGED] == 0:
+            self.poly_edged = None
+        in_poly = out[scan.I_POLY]
+        self.poly = [] if in_poly else None
+        if not in_poly and self.poly_emitted and self.poly_edged is None:
+            # no polygon, or one filled: its points no longer matter
+            self.poly_buffer = []
+            self.poly_ring = [(self.x, self.y)]
+            self.poly_lazy = None
+            return
+        if not buffered:
+            return  # the reader's edged polygon, untouched
+        off = self.poly_offset = out[scan.I_POFF]
+        if out[scan.I_PLC]:
+            self.poly_lc = (off, out[scan.I_PLINE], out[scan.I_PCOL])
+        npb, nr = out[scan.I_NPB], out[scan.I_NRING]
+        if not in_poly and self.poly_emitted:
+            # edged: its points matter only to an FP the general reader reads (it replaces
+            # EP's paths); until then they stay in the scanner's buffer, which only a new
+            # polygon overwrites
+            self.poly_buffer = []
+            self.poly_lazy = (npb, nr)
+            return
+        self._poly_buffer_from_scanner(npb, nr)
+
+    def _poly_buffer_from_scanner(self, npb: int, nr: int) -> None:
+        """The polygon buffer as lists from the scanner's arrays (``npb`` points, ``nr``
+        completed rings)."""
+        pb, rs, rcl = self._pbuf
+        xs = pb[:npb, 0].tolist()
+        ys = pb[:npb, 1].tolist()
+        bounds = rs[: nr + 1].tolist()
+        flags = rcl[:nr].tolist()
+        self.poly_buffer = [(list(zip(xs[a:e], ys[a:e], strict=True)), bool(c))
+                            for a, e, c in zip(bounds, bounds[1:], flags, strict=False)]
+        a = bounds[nr]
+        self.poly_ring = list(zip(xs[a:], ys[a:], strict=True))
+        self.poly_lazy = None
 
     def _take_segments(self, ch: _Chunk, ist: list[int]) -> None:
         scan = self._scan
         s0, s1 = ch.nseg, ist[scan.I_NSEG]
         p1 = ist[scan.I_NPTS]
         ch.nseg, ch.npts = s1, p1
-        if s1 == s0:
+        edged = ist[scan.I_EDGED] == 1
+        if s1 == s0 and not edged:
             return
         starts = ch.seg_start[s0:s1].astype(np.int64)
         ends = np.empty_like(starts)
         ends[:-1] = starts[1:]
-        ends[-1] = p1
+        if s1 > s0:
+            ends[-1] = p1
         offs = ch.seg_off[s0:s1]
         pens = ch.seg_pen[s0:s1]
         lines = ch.seg_line[s0:s1]
@@ -1197,9 +1250,22 @@ class _Reader:
         open_last = still_open and b > a
         if open_last:
             b -= 1
-        if b > a:
-            self._add_batch(ch, starts[a:b], ends[a:b], offs[a:b], pens[a:b], lines[a:b],
-                            cols[a:b])
+        # EP's segments (when EP was read in this call): a batch of their own, so that a
+        # later FP read by the general reader can replace them (poly_edged)
+        cuts = [a, b]
+        if edged:
+            e0, e1 = ist[scan.I_EDGE_S0] - s0, ist[scan.I_EDGE_S1] - s0
+            cuts = [a, e0, e1, b]
+        for k in range(len(cuts) - 1):
+            if edged and k == 1:
+                g = self.gen_base + len(self.gen)
+                first = len(self.paths)
+            u, v = cuts[k], cuts[k + 1]
+            if v > u:
+                self._add_batch(ch, starts[u:v], ends[u:v], offs[u:v], pens[u:v], lines[u:v],
+                                cols[u:v])
+            if edged and k == 1:
+                self.poly_edged = (first, len(self.paths), g, g)
         if open_last:
             self.cur = []
             self.cur_parts = [ch.pts[int(starts[b]) : int(ends[b])]]
@@ -1751,40 +1817,6 @@ _SPECIAL: dict[str, Callable[[_Reader, int], int]] = {
     "PE": _Reader.pe,
     "SM": _Reader.sm,
 }
-
-
-def _pen_down_runs(ring: list[tuple[float, float]],
-                   downs: list[bool]) -> list[list[tuple[float, float]]]:
-    """The pieces of a sub-polygon that EP draws: runs of pen-down edges.
-
-    ``downs[k]`` is the pen state of the edge from ``ring[k]`` to ``ring[k + 1]``; the last
-    entry is the closing edge back to ``ring[0]`` (none when the ring already ends there).
-    A ring whose edges are all pen-down comes back as one closed run.
-    """
-    if len(downs) >= len(ring) >= 2 and all(downs[: len(ring) - 1]):
-        # every edge of the ring is pen-down (always so for rings from polygon mode): one
-        # run, closed when the closing edge is pen-down too
-        if ring[0] != ring[-1] and downs[-1]:
-            return [[*ring, ring[0]]]
-        return [ring]
-    pts = list(ring)
-    flags = list(downs[: len(ring) - 1])
-    if ring[0] != ring[-1]:
-        pts.append(ring[0])
-        flags.append(downs[-1] if len(downs) >= len(ring) else False)
-    runs: list[list[tuple[float, float]]] = []
-    cur: list[tuple[float, float]] = []
-    for k, down in enumerate(flags):
-        if down:
-            if not cur:
-                cur = [pts[k]]
-            cur.append(pts[k + 1])
-        elif cur:
-            runs.append(cur)
-            cur = []
-    if cur:
-        runs.append(cur)
-    return runs
 
 
 def _near(a: np.ndarray, b: np.ndarray) -> bool:
