@@ -20,8 +20,10 @@ and fill setting (off; ``zigzag`` with kerf and optimized order), it measures:
   order, the remaining glue of ``Pipeline.run`` (strokes, stats), write (.gjob), load (.gjob):
   wall and CPU (``time.process_time``) and the peak RSS reached by the end of the stage.
 
-Each number is the median of ``--runs`` runs (3 by default) up to 100 k points, one run
-above. The growth exponent of a stage between two sizes is log(t2/t1)/log(n2/n1) of its
+Each number is the median of ``--runs`` runs (3 by default) up to 100 k points,
+``--runs-1m`` (3) up to 1 M, ``--runs-5m`` (1) above; ``--section`` names the RESULTS.md
+heading written (the fourth round wrote "## Pipeline throughput, fourth round (issue 21,
+s3)"). The growth exponent of a stage between two sizes is log(t2/t1)/log(n2/n1) of its
 CPU time; the table gives it from 100 k to the largest size (stages under 20 ms at both ends
 are not rated: their times are noise). The machine is shared: CPU times are the ones to
 compare.
@@ -50,6 +52,7 @@ CORPUS = Path("/work/shared/corpus")
 SAMPLES = ROOT / "resources" / "samples"
 PY = sys.executable
 
+SECTION = "## Pipeline throughput (issue 21)"
 STAGES = ("read", "kerf", "fit", "sample", "fill", "hatch_marks", "order", "glue", "write",
           "load")
 FILL_PARAMS = {"fill": "zigzag", "hatch_spacing_mm": 0.1, "kerf_mm": 0.05,
@@ -303,7 +306,10 @@ def main(argv: list[str] | None = None) -> int:
                     help="largest size run with fill on (default 1 M)")
     ap.add_argument("--runs", type=int, default=3)
     ap.add_argument("--runs-1m", type=int, default=3,
-                    help="runs above 100 k up to 1 M points (5 M: one)")
+                    help="runs above 100 k up to 1 M points")
+    ap.add_argument("--runs-5m", type=int, default=1, help="runs above 1 M points")
+    ap.add_argument("--section", default=SECTION,
+                    help=f"the RESULTS.md heading to write (default {SECTION!r})")
     ap.add_argument("--no-write", action="store_true")
     ap.add_argument("--io-marks", type=int, default=5_000_000,
                     help="marks of the job-file write/load measurement (0: skip)")
@@ -331,13 +337,13 @@ def main(argv: list[str] | None = None) -> int:
         saves = [json.loads(Path(f).read_text()) for f in a.from_json]
         rows = [r for sv in saves for r in sv["results"]]
         io_s = next((sv["io"] for sv in reversed(saves) if sv.get("io")), None)
-        text = report(rows, io_s, saves[-1].get("meta"))
+        text = report(rows, io_s, saves[-1].get("meta"), a.section)
         print(text)
         if not a.no_write:
             sys.path.insert(0, str(HERE))
             from results_md import replace_section
 
-            replace_section("## Pipeline throughput (issue 21)", text)
+            replace_section(a.section, text)
         return 0
     OUT.mkdir(parents=True, exist_ok=True)
     # every measurement in a fresh child of this small process: a child's peak RSS
@@ -357,7 +363,7 @@ def main(argv: list[str] | None = None) -> int:
                     continue
                 src = Path(_child([PY, str(Path(__file__).resolve()), "--gen-worker", kind,
                                    str(n)])["stdout"].strip())  # type: ignore[union-attr]
-                runs = a.runs if n <= 100_000 else (a.runs_1m if n <= 1_000_000 else 1)
+                runs = a.runs if n <= 100_000 else (a.runs_1m if n <= 1_000_000 else a.runs_5m)
                 on = fill == "on"
                 e2e = [cli_run(src, OUT / "job.gjob", on) for _ in range(runs)]
                 # the v1 JSON end to end only without fill (the same stages but the writer)
@@ -384,13 +390,13 @@ def main(argv: list[str] | None = None) -> int:
                       flush=True)
                 (OUT / "results.json").write_text(json.dumps(
                     {"results": results, "io": io, "meta": meta()}, indent=1))
-    text = report(results, io, meta())
+    text = report(results, io, meta(), a.section)
     print(text)
     if not a.no_write:
         sys.path.insert(0, str(HERE))
         from results_md import replace_section
 
-        replace_section("## Pipeline throughput (issue 21)", text)
+        replace_section(a.section, text)
     return 0
 
 
@@ -427,10 +433,15 @@ def _exponent_rows(kind: str, fill: str, a: dict, b: dict,  # type: ignore[type-
 
 
 def report(results: list[dict], io: dict[str, float] | None,  # type: ignore[type-arg]
-           m: dict[str, str] | None = None) -> str:
+           m: dict[str, str] | None = None, section: str = "") -> str:
     m = m or meta()
+    by_size: dict[int, set[int]] = {}
+    for r in results:
+        by_size.setdefault(r["n"], set()).add(r["runs"])
+    runs_text = ", ".join(f"{'/'.join(map(str, sorted(v)))} at {n:,}"
+                          for n, v in sorted(by_size.items()))
     lines = [
-        "## Pipeline throughput (issue 21)",
+        section or SECTION,
         "",
         f"`python bench/bench_pipeline.py` on {m['date']}, Python {m['python']}, numpy "
         f"{m['numpy']}, {m['cores']} cores shared with other sessions (load average "
@@ -439,7 +450,7 @@ def report(results: list[dict], io: dict[str, float] | None,  # type: ignore[typ
         "`galvo-core process FILE -o JOB.gjob|JOB.json --fit-field` in a fresh process "
         "(child's wall, user + system CPU, peak RSS); fill on = `" + " ".join(FILL_ARGS) +
         "` (its .json column repeats the .gjob run: not measured separately). Median of the "
-        "runs given (3 up to 1 M points, 1 at 5 M).",
+        f"runs given (runs per size: {runs_text} points).",
         "",
         "### End to end through the CLI",
         "",

@@ -26,6 +26,7 @@ and never a half-written one. :func:`load_job` validates what readers rely on an
 from __future__ import annotations
 
 import contextlib
+import dataclasses
 import gc
 import json
 import math
@@ -35,6 +36,7 @@ import tempfile
 from collections.abc import Iterable, Iterator, Sequence
 from dataclasses import dataclass
 from dataclasses import field as dc_field
+from operator import attrgetter
 from typing import Any
 
 import numpy as np
@@ -216,6 +218,62 @@ class Stroke:
 
 
 @dataclass(frozen=True, eq=False)
+class StrokeColumns:
+    """A job's strokes as columns (one array per field, the strokes' arrays joined in order):
+    what the version 2 file stores, so writing it is a few array copies, not a Python loop
+    over 10^5-10^6 strokes.
+
+    ``strokes``: the tuple these columns describe (:meth:`Job.stroke_columns` uses them only
+    for that very tuple). Per stroke (S rows): ``kind`` (0 contour, 1 hatch), ``closed``,
+    ``pen``, ``source_index`` and the counts ``mark_count``, ``segment_count``,
+    ``point_count``; joined: ``marks`` (M, 2) galvo bits, ``is_cubic`` (G,), ``points``
+    (C, 2) input units.
+    """
+
+    strokes: tuple[Stroke, ...]
+    kind: np.ndarray
+    closed: np.ndarray
+    pen: np.ndarray
+    source_index: np.ndarray
+    mark_count: np.ndarray
+    marks: np.ndarray
+    segment_count: np.ndarray
+    is_cubic: np.ndarray
+    point_count: np.ndarray
+    points: np.ndarray
+
+    @classmethod
+    def of(cls, strokes: Sequence[Stroke]) -> StrokeColumns:
+        """The columns of any strokes (a pass over them: what the pipeline avoids by
+        giving its jobs columns made from its own arrays)."""
+        from galvo_core.timing import joined_marks
+
+        st = tuple(strokes)
+        n = len(st)
+        bad = set(map(attrgetter("kind"), st)) - set(_STROKE_KINDS)
+        if bad:
+            raise ValueError(f"stroke kind {sorted(bad)[0]!r} is not 'contour' or 'hatch'")
+        # the marks, counts, sources and kinds joined once per strokes tuple (the pipeline's
+        # stats and the preview ask for the same)
+        jm = joined_marks(st)
+        segs = list(map(attrgetter("segments"), st))
+        return cls(
+            st,
+            kind=jm.hatch.astype(np.uint8),
+            closed=np.fromiter(map(bool, map(attrgetter("closed"), st)), dtype=bool, count=n),
+            pen=np.fromiter(map(int, map(attrgetter("pen"), st)), dtype=np.int64, count=n),
+            source_index=jm.source,
+            mark_count=jm.lens,
+            marks=jm.marks,
+            segment_count=np.fromiter(map(len, segs), dtype=np.int64, count=n),
+            is_cubic=_cat(list(map(attrgetter("is_cubic"), segs)), bool, 0),
+            point_count=np.fromiter(map(len, map(attrgetter("points"), segs)), dtype=np.int64,
+                                    count=n),
+            points=_cat(list(map(attrgetter("points"), segs)), np.float64, 2),
+        )
+
+
+@dataclass(frozen=True, eq=False)
 class Job:
     source_name: str
     source_sha256: str
@@ -231,6 +289,34 @@ class Job:
     layers: tuple[dict[str, Any], ...] = ()
     laser_source: str = "fiber"
     field_correction: dict[str, Any] | None = None
+    # the strokes as columns when whoever made the job had them as arrays (the pipeline,
+    # the .gjob loader): kept by dataclasses.replace() while the strokes stay the same
+    # tuple, dropped when they change (and never pickled)
+    columns: StrokeColumns | None = dc_field(default=None, repr=False)
+
+    def __post_init__(self) -> None:
+        if self.columns is not None and self.columns.strokes is not self.strokes:
+            object.__setattr__(self, "columns", None)  # other strokes: not ours
+
+    def __getstate__(self) -> dict[str, Any]:
+        state = dict(self.__dict__)
+        state["columns"] = None  # they hold the strokes tuple: pickled strokes stay out
+        return state
+
+    def with_columns(self, columns: StrokeColumns) -> Job:
+        """This job with ``columns`` (which must describe its very strokes tuple) kept for
+        :meth:`stroke_columns`."""
+        if columns.strokes is not self.strokes:
+            raise ValueError("the columns describe other strokes than the job's")
+        return dataclasses.replace(self, columns=columns)
+
+    def stroke_columns(self) -> StrokeColumns:
+        """The strokes as :class:`StrokeColumns`: the ones given with the job when they
+        describe its strokes, else made from the strokes (not kept)."""
+        c = self.columns
+        if c is not None and c.strokes is self.strokes:
+            return c
+        return StrokeColumns.of(self.strokes)
 
     def header_json(self, version: int = VERSION) -> dict[str, Any]:
         """Every top-level key of the file but the strokes (shared by both forms; keys
@@ -401,9 +487,9 @@ _ALIGN = 8
 _PREFIX = struct.Struct("<8sII")  # magic, version, header length
 
 
-def _starts(counts: list[int]) -> np.ndarray:
+def _starts(counts: np.ndarray) -> np.ndarray:
     out = np.zeros(len(counts) + 1, dtype=np.int64)
-    if counts:
+    if len(counts):
         np.cumsum(counts, out=out[1:])
     return out
 
@@ -414,25 +500,25 @@ def _cat(parts: list[np.ndarray], dtype: Any, cols: int) -> np.ndarray:
 
 
 def compact_job_parts(job: Job) -> list[bytes | np.ndarray]:
-    """The version 2 file as a list of buffers (see docs/job-format.md)."""
-    st = job.strokes
-    marks = [np.asarray(s.marks).reshape(-1, 2) for s in st]
-    segs = [s.segments for s in st]
+    """The version 2 file as a list of buffers (see docs/job-format.md), from the job's
+    columns (:meth:`Job.stroke_columns`): no loop over the strokes when it has them."""
+    col = job.stroke_columns()
+    st = col.strokes
     arrays: dict[str, np.ndarray] = {
-        "stroke_kind": np.array([_STROKE_KINDS.index(s.kind) for s in st], dtype="|u1"),
-        "stroke_closed": np.array([bool(s.closed) for s in st], dtype="|u1"),
-        "stroke_pen": np.array([int(s.pen) for s in st], dtype="<i4"),
-        "stroke_source_index": np.array([int(s.source_index) for s in st], dtype="<i8"),
-        "stroke_mark_start": _starts([len(m) for m in marks]),
-        "stroke_segment_start": _starts([len(g) for g in segs]),
-        "stroke_point_start": _starts([len(g.points) for g in segs]),
+        "stroke_kind": col.kind,
+        "stroke_closed": col.closed,
+        "stroke_pen": col.pen,
+        "stroke_source_index": col.source_index,
+        "stroke_mark_start": _starts(col.mark_count),
+        "stroke_segment_start": _starts(col.segment_count),
+        "stroke_point_start": _starts(col.point_count),
     }
-    allm = _cat(marks, np.int64, 2)
+    allm = col.marks
     if len(allm) and (allm.min() < -(2**31) or allm.max() >= 2**31):
         raise ValueError("marks beyond the 32-bit range cannot be written to a .gjob file")
     arrays["marks"] = allm.astype("<i4")
-    arrays["segment_is_cubic"] = _cat([g.is_cubic for g in segs], "|u1", 0)
-    pts = _cat([g.points for g in segs], "<f8", 2)
+    arrays["segment_is_cubic"] = col.is_cubic
+    pts = col.points
     if not np.isfinite(pts).all():
         raise ValueError("segment points: not a finite number")
     arrays["points"] = pts
@@ -712,4 +798,11 @@ def _strokes_from_arrays(arr: dict[str, np.ndarray], n: int, fm: FieldMap,
                 if ss[i + 1] > ss[i] else empty)
         strokes.append(Stroke(kinds[i], src[i], closed[i], marks[ms[i]:ms[i + 1]], segs,
                               pen[i]))
-    return _finish(doc, fm, strokes, name)
+    job = _finish(doc, fm, strokes, name)
+    # the arrays just read are the job's columns: writing it again needs no stroke loop
+    return job.with_columns(StrokeColumns(
+        job.strokes, kind=kind.copy(), closed=arr["stroke_closed"].astype(bool),
+        pen=arr["stroke_pen"].astype(np.int64),
+        source_index=arr["stroke_source_index"].astype(np.int64),
+        mark_count=np.diff(mstart), marks=marks, segment_count=np.diff(sstart),
+        is_cubic=is_cubic, point_count=np.diff(pstart), points=pts))

@@ -26,20 +26,18 @@ import time
 from collections import OrderedDict
 from collections.abc import Callable, Hashable, Sequence
 from dataclasses import dataclass, field
-from typing import Any, TypeVar
+from operator import attrgetter
+from typing import TYPE_CHECKING, Any, TypeVar
 
 import numpy as np
 
 from galvo_core.drawing import Drawing, Warning
 from galvo_core.errors import Cancelled
 from galvo_core.field import FieldMap, check_in_field, make_field
-from galvo_core.fill import HatchStroke, hatch
-from galvo_core.fit import FittedPath, control_points, fit_drawing, with_source_index
-from galvo_core.job import Job, Segments, Stroke, gc_paused
-from galvo_core.kerf import compensate_indexed, kerf_regions
-from galvo_core.order import order_job_strokes
+from galvo_core.fit import FittedPath, fit_drawing, with_source_index
+from galvo_core.job import Job, Segments, Stroke, StrokeColumns, gc_paused
 from galvo_core.params import UNITS_PER_MM, Params
-from galvo_core.precision import path_quanta
+from galvo_core.precision import drawing_quantum, path_quanta
 from galvo_core.sample import (
     ROUNDING_BOUND_BITS,
     SampleReport,
@@ -49,7 +47,40 @@ from galvo_core.sample import (
 )
 from galvo_core.timing import estimate_with_dwell, joined_marks
 
+if TYPE_CHECKING:
+    from galvo_core.fill import HatchStroke
+
 __all__ = ["Cancelled", "Pipeline", "RunResult", "coordinate_quantum", "process"]
+
+
+# kerf, fill and order (and shapely, 0.1 s of a process's start) are imported when a run
+# first needs them, not for every job: these are their functions under the names the
+# stages call (and benchmarks wrap)
+def compensate_indexed(*args: Any, **kw: Any) -> Any:
+    from galvo_core.kerf import compensate_indexed as f
+
+    return f(*args, **kw)
+
+
+def kerf_regions(*args: Any, **kw: Any) -> Any:
+    from galvo_core.kerf import kerf_regions as f
+
+    return f(*args, **kw)
+
+
+def hatch(*args: Any, **kw: Any) -> Any:
+    from galvo_core.fill import hatch as f
+
+    return f(*args, **kw)
+
+
+def order_job_strokes(strokes: Sequence[Stroke], fm: FieldMap, *, method: str,
+                      **kw: Any) -> list[Stroke]:
+    if method == "file":  # as made: nothing to import
+        return list(strokes)
+    from galvo_core.order import order_job_strokes as f
+
+    return f(strokes, fm, method=method, **kw)  # type: ignore[return-value]
 
 T = TypeVar("T")
 #: the fit stage's batches end at this many input points (cancel is checked between them:
@@ -159,7 +190,26 @@ class Pipeline:
 
     def bbox(self, drawing: Drawing) -> tuple[float, float, float, float] | None:
         """``drawing.bbox()``, cached."""
-        return self._fact(drawing, "bbox", drawing.bbox)
+        return self._fact(drawing, "bbox", lambda: _bbox(_joined(_point_arrays(drawing))))
+
+    def _input_facts(self, drawing: Drawing) -> None:
+        """The input drawing's bounding box, point count, coordinate grid and each path's
+        grid from one pass over its paths and one join of their points (each alone passes
+        over them again: 10-300 ms each at 1 M points, more for many paths); the arrays are
+        not kept. Made by :meth:`run` (a worker), not by :meth:`field_map` or :meth:`bbox`,
+        which a window may call on its own thread."""
+        if self._facts.peek(drawing, "path quanta") is not None:
+            return
+        arrs = _point_arrays(drawing)
+        allp = _joined(arrs)
+        # drawing.quantum(): drawing_quantum of the paths, which joins them the same way
+        facts: dict[str, Any] = {
+            "n_points": len(allp), "bbox": _bbox(allp),
+            "quantum": (float(drawing_quantum([allp])[0]) if len(allp) else 0.0,)}
+        del allp
+        facts["path quanta"] = path_quanta(arrs)
+        for name, value in facts.items():
+            self._fact(drawing, name, _const(value))
 
     # ---------------------------------------------------------------- stages
     def field_map(self, drawing: Drawing, params: Params) -> FieldMap:
@@ -213,8 +263,8 @@ class Pipeline:
                                      cancel=run.cancel, quantum_units=quanta))
 
         def make() -> tuple[FittedPath, ...]:
-            if work is drawing:
-                return fit(work)
+            if work is drawing:  # the grids the stats report too: detected once
+                return fit(work, self.input_quanta(drawing))
             # the kerf's paths keep the grid of the input path they came from: the file's
             # precision, not the offset's floats (a path the kerf passes through is fitted
             # as without kerf; an offset ring of rounded input is as uncertain as its input)
@@ -229,7 +279,7 @@ class Pipeline:
 
     def input_quanta(self, drawing: Drawing) -> np.ndarray:
         """Each input path's grid (:func:`galvo_core.precision.path_quanta`), cached."""
-        return self._fact(drawing, "path quanta", lambda: path_quanta(drawing.paths))
+        return self._fact(drawing, "path quanta", lambda: path_quanta(_point_arrays(drawing)))
 
     @staticmethod
     def _refit_changed(drawing: Drawing, work: Drawing, origin: Sequence[int],
@@ -277,6 +327,7 @@ class Pipeline:
                 if params.interpolation == "raw" else None,
                 cancel=run.cancel,
                 geometry=self._fact(fitted, "sample_geometry", lambda: sample_geometry(fitted)),
+                keep_chunks=False,  # only the marks and the report are kept
             )
             return _Marks(tuple(res.marks), res.report)
 
@@ -313,6 +364,7 @@ class Pipeline:
         drawing that leaves the field without ``clamp``), Cancelled when ``cancel()`` says so."""
         t0 = time.perf_counter()
         run = _Run(cancel)
+        self._input_facts(drawing)
         fm = self.field_map(drawing, params)
         work, origin = self.compensated(drawing, params, fm, run)
         fitted = self.fitted(drawing, params, fm, run)
@@ -328,8 +380,8 @@ class Pipeline:
         # its edge by up to the fit's bound: those marks are clamped, never left outside
         rep = sampled.report
         bulge = not params.clamp and not out_msg and rep is not None and rep.outside_points > 0
-        strokes, clamped = self._strokes(work, origin, fitted, sampled, hatched, params, fm,
-                                         clamp=params.clamp or bulge)
+        strokes, clamped, cols = self._strokes(work, origin, fitted, sampled, hatched, params,
+                                               fm, clamp=params.clamp or bulge)
         run.check()
         t1 = time.perf_counter()
         ordered: tuple[Stroke, ...] = tuple(order_job_strokes(  # type: ignore[arg-type]
@@ -349,6 +401,8 @@ class Pipeline:
         job_params["quantum_units"] = stats["quantum_units"]  # detected, not set
         job = Job(drawing.name, drawing.sha256, fm, job_params,
                   params.laser.as_dict(), ordered, stats, tuple(warnings))
+        if params.scan_order == "file":  # the strokes as made: their columns are known
+            job = job.with_columns(cols.finish(ordered))
         t3 = time.perf_counter()
         run.timings["order"] = t2 - t1
         run.timings["stats"] = t3 - t2
@@ -358,9 +412,10 @@ class Pipeline:
     def _strokes(self, work: Drawing, origin: tuple[int, ...], fitted: tuple[FittedPath, ...],
                  sampled: _Marks, hatched: tuple[tuple[HatchStroke, np.ndarray], ...],
                  params: Params, fm: FieldMap, *, clamp: bool = False
-                 ) -> tuple[list[Stroke], int]:
+                 ) -> tuple[list[Stroke], int, _Columns]:
         """The job's strokes in the stages' order (contours, then hatch), clamped to the field
-        when ``clamp``; and how many marks were clamped."""
+        when ``clamp``; how many marks were clamped; and their columns but the marks (from
+        the stages' arrays: no pass over the strokes)."""
         clamped = 0
         marks: list[np.ndarray] = list(sampled.marks)
         keep = [i for i, m in enumerate(marks) if len(m)] if not all(map(len, marks)) \
@@ -382,12 +437,36 @@ class Pipeline:
                 src, closed, pens = [src[i] for i in keep], [closed[i] for i in keep], \
                     [pens[i] for i in keep]
             strokes = _new_strokes("contour", src, closed, marks, segs, pens)
+            hatch_pens = [work.paths[h.source_index].pen for h, _ in hatched]
             if hatched:
                 strokes += _new_strokes(
                     "hatch", [origin[h.source_index] for h, _ in hatched],
                     [False] * len(hatched), hatch_marks, [Segments.empty()] * len(hatched),
-                    [work.paths[h.source_index].pen for h, _ in hatched])
-        return strokes, clamped
+                    hatch_pens)
+        return strokes, clamped, self._columns(fitted, keep, hatch_pens)
+
+    def _columns(self, fitted: tuple[FittedPath, ...], keep: list[int] | None,
+                 hatch_pens: list[int]) -> _Columns:
+        """The columns of :meth:`_strokes`' strokes but the marks: the contours' from the
+        fit's arrays (the sampler's gathered geometry), the hatch strokes' appended."""
+        geo = self._fact(fitted, "sample_geometry", lambda: sample_geometry(fitted))
+        closed, pens = self._fact(fitted, "stroke column arrays", lambda: (
+            np.fromiter((fp.closed for fp in fitted), dtype=bool, count=len(fitted)),
+            np.fromiter((fp.pen for fp in fitted), dtype=np.int64, count=len(fitted))))
+        nseg, npts, is_cubic, points = geo.path_n, geo.path_npts, geo.is_cubic, geo.points
+        if keep is not None:  # paths without marks make no stroke
+            on = np.zeros(len(fitted), dtype=bool)
+            on[keep] = True
+            is_cubic = is_cubic[np.repeat(on, nseg)]
+            points = points[np.repeat(on, npts)]
+            closed, pens, nseg, npts = closed[on], pens[on], nseg[on], npts[on]
+        nh = len(hatch_pens)
+        if nh:
+            closed = np.concatenate([closed, np.zeros(nh, dtype=bool)])
+            pens = np.concatenate([pens, np.array(hatch_pens, dtype=np.int64)])
+            nseg = np.concatenate([nseg, np.zeros(nh, dtype=np.int64)])
+            npts = np.concatenate([npts, np.zeros(nh, dtype=np.int64)])
+        return _Columns(closed, pens, nseg, is_cubic, npts, points)
 
     def stats(self, drawing: Drawing, params: Params, fitted: tuple[FittedPath, ...],
               fm: FieldMap, strokes: Sequence[Stroke], report: SampleReport | None,
@@ -400,15 +479,13 @@ class Pipeline:
         # simulation reuse them)
         t, dwell = estimate_with_dwell(joined_marks(strokes), params.laser, fm.mm_per_bit)
         n_input = self._fact(drawing, "n_points", lambda: drawing.n_points)
-        quantum = self._fact(drawing, "quantum", lambda: coordinate_quantum(drawing)) or 0.0
+        quantum = self._fact(drawing, "quantum", lambda: (drawing.quantum(),))[0] or 0.0
         # the fit uses each input path's own grid (a kerf path its input path's): its bound
         # is the largest path's
         path_q = float(self.input_quanta(drawing).max(initial=0.0))
         fit_err, n_control, n_lines, n_cubics = self._fact(fitted, "counts", lambda: (
-            max((f.max_error for f in fitted), default=0.0),
-            sum(control_points(f) for f in fitted),
-            sum(f.n_lines for f in fitted),
-            sum(f.n_cubics for f in fitted)))
+            _fit_counts(fitted, self._fact(fitted, "sample_geometry",
+                                           lambda: sample_geometry(fitted)))))
         out: dict[str, Any] = {
             "input_points": n_input,
             # the file's coordinate grid (0: exact) and the fit's bound from the input
@@ -450,6 +527,71 @@ class Pipeline:
                 "outside_points": report.outside_points,
             })
         return out
+
+
+@dataclass(frozen=True, eq=False)
+class _Columns:
+    """:class:`~galvo_core.job.StrokeColumns` of the strokes made by a run, but what the
+    strokes' tuple gives at once (marks, kinds, sources: :func:`joined_marks`, made for the
+    stats anyway)."""
+
+    closed: np.ndarray
+    pen: np.ndarray
+    segment_count: np.ndarray
+    is_cubic: np.ndarray
+    point_count: np.ndarray
+    points: np.ndarray
+
+    def finish(self, strokes: tuple[Stroke, ...]) -> StrokeColumns:
+        jm = joined_marks(strokes)
+        return StrokeColumns(strokes, kind=jm.hatch.astype(np.uint8), closed=self.closed,
+                             pen=self.pen, source_index=jm.source, mark_count=jm.lens,
+                             marks=jm.marks, segment_count=self.segment_count,
+                             is_cubic=self.is_cubic, point_count=self.point_count,
+                             points=self.points)
+
+
+def _const(value: T) -> Callable[[], T]:
+    return lambda: value
+
+
+def _point_arrays(drawing: Drawing) -> list[np.ndarray]:
+    """Each path's points as an (N, 2) float64 array (the path's own when it is one)."""
+    out = []
+    for p in drawing.paths:
+        a = np.asarray(p.points, dtype=np.float64)
+        out.append(a if a.ndim == 2 and a.shape[1] == 2 else a.reshape(-1, 2))
+    return out
+
+
+def _joined(arrs: list[np.ndarray]) -> np.ndarray:
+    """Every point of a drawing's paths (their (N, 2) arrays), in one array."""
+    return np.concatenate(arrs) if arrs else np.zeros((0, 2))
+
+
+def _bbox(allp: np.ndarray) -> tuple[float, float, float, float] | None:
+    """:meth:`Drawing.bbox` of the joined points (None without points)."""
+    if not len(allp):
+        return None
+    x, y = allp[:, 0], allp[:, 1]
+    return float(x.min()), float(y.min()), float(x.max()), float(y.max())
+
+
+def _fit_counts(fitted: Sequence[FittedPath], geo: Any) -> tuple[float, int, int, int]:
+    """The largest fit error, the control points (:func:`galvo_core.fit.control_points`
+    summed), lines and cubics of a fit, from the sampler's gathered arrays ``geo``."""
+    n = len(fitted)
+    err = np.fromiter(map(attrgetter("max_error"), fitted), dtype=np.float64, count=n)
+    nseg, npts = geo.path_n, geo.path_npts
+    # control_points: 0 without segments, 1 for a dot (one line from a point to itself),
+    # else the stored points
+    one = np.flatnonzero(nseg == 1)
+    first = (np.cumsum(npts) - npts)[one]
+    dot = ~geo.is_cubic[geo.path_first[one]] & (
+        geo.points[first] == geo.points[first + 1]).all(axis=1)
+    n_control = int(npts[nseg > 0].sum()) - int((npts[one[dot]] - 1).sum())
+    n_cubics = int(np.count_nonzero(geo.is_cubic))
+    return (float(err.max()) if n else 0.0, n_control, len(geo.is_cubic) - n_cubics, n_cubics)
 
 
 def _clamped(marks: list[np.ndarray], max_bit: int) -> tuple[list[np.ndarray], int]:

@@ -989,6 +989,9 @@ class _Geometry:
             self.is_cubic = np.zeros(0, dtype=bool)
             self.points = np.zeros((0, 2))
             self.row = np.zeros(0, dtype=np.int64)
+            npts = np.zeros(len(fitted), dtype=np.int64)
+        #: control points per path (rows of ``points``; 0 for a path without segments)
+        self.path_npts = npts
         self._fielded: OrderedDict[tuple[float, ...], tuple[Any, ...]] = OrderedDict()
         self._lock = threading.Lock()
 
@@ -1102,6 +1105,7 @@ def sample_paths(
     raw_points: Sequence[np.ndarray] | None = None,
     cancel: Callable[[], bool] | None = None,
     geometry: _Geometry | None = None,
+    keep_chunks: bool = True,
 ) -> SampleResult:
     """Marks of many fitted paths at once (one stroke each, (M, 2) int64 bits, in the
     direction of the segments; empty for a path without segments), and what was measured.
@@ -1111,6 +1115,9 @@ def sample_paths(
     ``raw``). The steps: the marks' curve parameters (cubics by the search or paper 001's
     fixed step, lines by their ends), merged in path order; the minimum step; rounding to
     whole bits; every chord measured against the true curve; one stroke per path.
+    ``keep_chunks=False``: the result without the float marks and parameters behind
+    :attr:`SampleResult.float_marks` and :attr:`SampleResult.params` (32 bytes per mark
+    fewer held while sampling, for callers that keep only the marks: the pipeline).
     """
     if interpolation not in ("adaptive", "fixed", "raw"):
         raise ParamError(f"interpolation must be adaptive, fixed or raw; got {interpolation!r}")
@@ -1172,7 +1179,8 @@ def sample_paths(
         pc = np.searchsorted(mk.pid, np.arange(p1 - p0 + 1))
         pc[-1] = len(mk.pid)
         res.marks += _split_rows(r, pc)
-        res.chunks.append((mk.pos, mk.sid, mk.st, g0, pc))
+        if keep_chunks:
+            res.chunks.append((mk.pos, mk.sid, mk.st, g0, pc))
     report.chords = chords
     report.max_chord_height_bits = max(hmax, default=0.0)
     report.max_chord_height_int_bits = max(himax, default=0.0)

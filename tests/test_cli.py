@@ -214,3 +214,27 @@ def test_one_blas_thread_unless_the_user_chose_otherwise():
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
                          env=env, timeout=120, check=True).stdout.split()
     assert out == ["2", "1"]
+
+
+def test_a_plain_process_run_imports_no_kerf_fill_or_order(tmp_path):
+    """`process` without kerf, fill or a scan order does not import them (nor shapely, a
+    tenth of a second of every start); with them, it does."""
+    import subprocess
+    import sys
+
+    from _util import ROOT, SAMPLES
+
+    code = ("import sys; from galvo_core.cli import main; rc = main(sys.argv[1:]); "
+            "print(rc, sorted(m for m in ('shapely', 'galvo_core.kerf', 'galvo_core.fill', "
+            "'galvo_core.order') if m in sys.modules))")
+    src = str(SAMPLES / "seal.plt")
+    plain = subprocess.run([sys.executable, "-c", code, "process", src, "-o",
+                            str(tmp_path / "a.gjob"), "--fit-field"], capture_output=True,
+                           text=True, cwd=ROOT, check=True)
+    assert plain.stdout.splitlines()[-1] == "0 []"
+    full = subprocess.run([sys.executable, "-c", code, "process", src, "-o",
+                           str(tmp_path / "b.gjob"), "--fit-field", "--kerf-mm", "0.1",
+                           "--fill", "zigzag", "--scan-order", "greedy"], capture_output=True,
+                          text=True, cwd=ROOT, check=True)
+    assert full.stdout.splitlines()[-1] == ("0 ['galvo_core.fill', 'galvo_core.kerf', "
+                                            "'galvo_core.order', 'shapely']")

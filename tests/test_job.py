@@ -259,3 +259,92 @@ def test_a_run_and_both_writers_build_no_object_per_segment(tmp_path):
     fitted = p.fitted(d, Params(fit_field=True, e_per=0.75))
     assert all(fp._segments is None for fp in fitted)  # no Segment objects were built
     assert sum(len(s.segments) for s in job.strokes) == sum(fp.n_segments for fp in fitted)
+
+
+def _same_columns(a, b) -> None:
+    assert a.strokes is b.strokes
+    for name in ("kind", "closed", "pen", "source_index", "mark_count", "marks",
+                 "segment_count", "is_cubic", "point_count", "points"):
+        x, y = getattr(a, name), getattr(b, name)
+        assert x.shape == y.shape and np.array_equal(x, y), name
+
+
+def test_a_pipeline_job_carries_its_strokes_as_columns(tmp_path):
+    """A job in file order gets the columns of its strokes from the stages' arrays (the
+    .gjob writer then copies arrays instead of looping over the strokes): they are exactly
+    the strokes' own, and the file is byte for byte the one written from the strokes."""
+    import dataclasses
+
+    from galvo_core.job import StrokeColumns
+
+    d = read_file(SAMPLES / "seal.plt")
+    p = Pipeline()
+    runs = [Params(fit_field=True, e_per=0.75),
+            Params(fit_field=True, e_per=0.75, fill="zigzag", hatch_spacing_mm=0.5,
+                   kerf_mm=0.1),
+            Params(magnification=100.0, clamp=True, e_per=0.75)]
+    for params in runs:
+        job = p.run(d, params).job
+        assert job.columns is not None
+        _same_columns(job.columns, StrokeColumns.of(job.strokes))
+        bare = dataclasses.replace(job, columns=None)
+        assert bare.columns is None
+        assert compact_job_bytes(job) == compact_job_bytes(bare)
+    assert {s.kind for s in job.strokes} == {"contour"}
+    assert runs[2].clamp and "clamped" in " ".join(w.message for w in job.warnings)
+    # ordered strokes are not the stages' order: the writer makes the columns itself
+    greedy = p.run(d, Params(fit_field=True, e_per=0.75, scan_order="greedy")).job
+    assert greedy.columns is None
+    write_job(greedy, tmp_path / "g.gjob")
+    _same_job(load_job(tmp_path / "g.gjob"), greedy)
+
+
+def test_columns_of_a_run_with_a_path_without_marks(monkeypatch):
+    """A path the sampler gives no marks makes no stroke: its segments and control points
+    leave the columns too."""
+    import galvo_core.pipeline as pl
+    from galvo_core.job import StrokeColumns
+
+    real = pl.sample_paths
+
+    def one_empty(fitted, *a, **k):  # type: ignore[no-untyped-def]
+        res = real(fitted, *a, **k)
+        res.marks[1] = res.marks[1][:0]
+        return res
+
+    monkeypatch.setattr(pl, "sample_paths", one_empty)
+    d = read_file(SAMPLES / "seal.plt")
+    p = Pipeline()
+    job = p.run(d, Params(fit_field=True, e_per=0.75)).job
+    fitted = p.fitted(d, Params(fit_field=True, e_per=0.75))
+    assert len(job.strokes) == len(fitted) - 1 and fitted[1].n_segments > 0
+    _same_columns(job.columns, StrokeColumns.of(job.strokes))
+
+
+def test_writing_a_job_with_columns_makes_no_pass_over_its_strokes(tmp_path, monkeypatch):
+    """The .gjob of a pipeline job, and of a job loaded from a .gjob, is written from its
+    columns alone; columns never describe other strokes (replace, pickle)."""
+    import dataclasses
+    import pickle
+
+    import galvo_core.job as jobmod
+
+    d = read_file(SAMPLES / "seal.plt")
+    job = Pipeline().run(d, Params(fit_field=True, e_per=0.75)).job
+    want = compact_job_bytes(job)
+
+    def refuse(strokes):  # type: ignore[no-untyped-def]
+        raise AssertionError("a pass over the strokes")
+
+    monkeypatch.setattr(jobmod.StrokeColumns, "of", classmethod(lambda cls, s: refuse(s)))
+    write_job(job, tmp_path / "a.gjob")
+    assert (tmp_path / "a.gjob").read_bytes() == want
+    loaded = load_job(tmp_path / "a.gjob")
+    write_job(loaded, tmp_path / "b.gjob")
+    assert (tmp_path / "b.gjob").read_bytes() == want
+    # the same strokes keep their columns, other strokes drop them
+    assert dataclasses.replace(job, laser_source="co2").columns is job.columns
+    assert dataclasses.replace(job, strokes=job.strokes[1:]).columns is None
+    assert pickle.loads(pickle.dumps(job)).columns is None
+    with pytest.raises(ValueError):
+        job.with_columns(loaded.columns)

@@ -110,31 +110,33 @@ def test_empty_drawing_gives_an_empty_job():
 
 
 def test_facts_of_a_drawing_are_computed_once(circle, monkeypatch):
-    """The coordinate quantum and the bbox (every point of the drawing) are kept per
-    drawing: a re-sample does not scan the points again."""
+    """The drawing's points are joined once for its bbox and coordinate grid, and each
+    path's grid is detected once for the fit and the stats; all kept per drawing: a
+    re-sample does not scan the points again. The facts are the drawing's own."""
     import galvo_core.pipeline as pl
 
-    calls = {"quantum": 0, "bbox": 0}
-    real_q = pl.coordinate_quantum
+    calls = {"join": 0, "path_quanta": 0}
+    real_join, real_pq = pl._joined, pl.path_quanta
 
-    def counting_q(d):
-        calls["quantum"] += 1
-        return real_q(d)
+    def counting_join(arrs):  # type: ignore[no-untyped-def]
+        calls["join"] += 1
+        return real_join(arrs)
 
-    monkeypatch.setattr(pl, "coordinate_quantum", counting_q)
-    real_bbox = Drawing.bbox
+    def counting_pq(paths):  # type: ignore[no-untyped-def]
+        calls["path_quanta"] += 1
+        return real_pq(paths)
 
-    def counting_bbox(self):
-        calls["bbox"] += 1
-        return real_bbox(self)
-
-    monkeypatch.setattr(Drawing, "bbox", counting_bbox)
+    monkeypatch.setattr(pl, "_joined", counting_join)
+    monkeypatch.setattr(pl, "path_quanta", counting_pq)
     pipe = Pipeline()
     jobs = [pipe.run(circle, Params(magnification=m, chord_tol_bits=c)).job
             for m in (10.0, 12.0) for c in (1.0, 0.5)]
-    assert calls == {"quantum": 1, "bbox": 1}
+    assert calls == {"join": 1, "path_quanta": 1}
     fresh = Pipeline().run(circle, Params(magnification=12.0, chord_tol_bits=0.5)).job
     assert jobs[-1].stats == fresh.stats and jobs[-1].warnings == fresh.warnings
+    assert pipe.bbox(circle) == circle.bbox()
+    assert fresh.stats["quantum_units"] == circle.quantum()
+    assert fresh.stats["input_points"] == circle.n_points
 
 
 @pytest.mark.parametrize("name", ["seal.plt", "dense_logo.plt", "curve_1181.plt",
@@ -195,3 +197,24 @@ def test_marks_of_a_curve_bulging_past_the_field_edge_are_clamped_not_left_outsi
     assert all(((s.marks >= 0) & (s.marks <= top)).all() for s in res.job.strokes)
     if res.sample_report.outside_points:  # the case this guards: say what was done
         assert any("clamped" in w.message for w in res.job.warnings)
+
+
+def test_fit_counts_in_the_stats_are_the_fitted_paths_own():
+    """The control points, lines, cubics and largest fit error of the stats (counted on the
+    fit's joined arrays) are those of the fitted paths one by one, dots included."""
+    from galvo_core.fit import control_points
+
+    dots = b"IN;SP1;PU0,0;PD0,0;PU9000,9000;PD9000,9000;PU;"
+    seen = []
+    for d in (read_bytes(dots + (SAMPLES / "seal.plt").read_bytes(), "dots.plt"),
+              read_file(SAMPLES / "arcs_circles.plt")):
+        pipe = Pipeline()
+        params = Params(fit_field=True)
+        st = pipe.run(d, params).job.stats
+        fitted = pipe.fitted(d, params)
+        assert st["control_points"] == sum(control_points(f) for f in fitted)
+        assert st["lines"] == sum(f.n_lines for f in fitted)
+        assert st["cubics"] == sum(f.n_cubics for f in fitted)
+        assert st["max_fit_error"] == max(f.max_error for f in fitted)
+        seen.append((sum(control_points(f) == 1 for f in fitted), st["cubics"]))
+    assert seen[0][0] == 2 and seen[0][1] > 0 and seen[1][1] > 0

@@ -629,3 +629,21 @@ def test_chunks_of_paths_give_what_one_batch_gives(monkeypatch, interpolation):
         assert np.array_equal(sa, sb) and np.array_equal(ta, tb)
     assert one.report == many.report
     assert one.report.min_step_overrides > 0 and one.report.chords > 0, one.report
+
+
+def test_sampling_without_the_chunks_gives_the_same_marks_and_report():
+    """``keep_chunks=False`` (the pipeline's call) drops only the float marks and
+    parameters kept for tests: the marks and what was measured are the same."""
+    from galvo_core.sample import sample_geometry
+
+    d = read_file(SAMPLES / "seal.plt")
+    p = Pipeline()
+    params = Params(fit_field=True)
+    fm = p.field_map(d, params)
+    fitted = p.fitted(d, params, fm)
+    full = sample_paths(fitted, fm, geometry=sample_geometry(fitted))
+    lean = sample_paths(fitted, fm, geometry=sample_geometry(fitted), keep_chunks=False)
+    assert full.chunks and not lean.chunks
+    assert len(full.marks) == len(lean.marks) == len(fitted)
+    assert all(np.array_equal(a, b) for a, b in zip(full.marks, lean.marks, strict=True))
+    assert full.report == lean.report
