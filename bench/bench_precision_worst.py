@@ -231,7 +231,7 @@ def worst_places(style: str, top: int, em: float = 1000.0):
     cands.sort(key=lambda c: -c[0])
     rows = []
     used = []
-    for e, ci, p, sgi, apos, segs, seglens, F, T, Rp in cands:
+    for _e, ci, p, sgi, apos, segs, seglens, F, T, Rp in cands:
         if any(u[0] == ci and math.hypot(*(p - u[1])) < SEP for u in used):
             continue
         used.append((ci, p))
