@@ -1471,6 +1471,7 @@ def _fit_concatenated(
         Q, tlen, np.asarray(closed)[todo], rounding=rounding, return_smooth=True
     )
     arc = _arc_per_path(W, wlen)
+    move_q = None
     if rounding is not None:
         # the vertices move onto the design where the rounding is a fair share of the bound
         slack = rounding[:, 1] * _HALF_DIAGONAL
@@ -1500,6 +1501,12 @@ def _fit_concatenated(
         la, lpts, lfirst, llast, lerr, lkey = _valid_lines(
             W, K, Q, la, lb, lpts, lfirst, llast, lerr, np.repeat(rounding[:, 0], tlen)
         )
+        for _ in range(_BULGE_ROUNDS if (move_q > 0.0).any() else 0):
+            la, lpts, lfirst, llast, lerr, lkey, more = _split_bulging_lines(
+                W, arc, la, lpts, lfirst, llast, lerr, lkey, np.repeat(move_q, tlen),
+                np.repeat(rounding[:, 0], tlen))
+            if not more:
+                break
     lpts.setflags(write=False)
     worst = np.zeros(len(todo))
     np.fmax.at(worst, owner[la], lerr)  # NaN (overflow) ignored, as max() did
@@ -1539,6 +1546,75 @@ def _fit_concatenated(
     for x in (is_cubic, points, first, last):
         x.setflags(write=False)
     return is_cubic, points, first, last, seg_cut.tolist(), pt_cut.tolist(), worst.tolist()
+
+
+#: rounded input: a line over at least this many input points is checked for a bulge
+_BULGE_POINTS = 8
+#: ... and split where the design estimate at its middle is this many quanta off it
+_BULGE_SHARE = 0.35
+#: rounds of that split (a half may bulge again)
+_BULGE_ROUNDS = 2
+
+
+def _split_bulging_lines(W, arc, la, lpts, lfirst, llast, lerr, lkey, quant, eps):
+    """Rounded input: a line over a gently curved stretch of the design may keep within
+    its bound of the rounded points while the design bulges up to that bound away from it
+    (a thinned line along a staircase). Per line over at least ``_BULGE_POINTS`` input
+    points of a rounded path: the least-squares quadratic of its input points (the design
+    estimate of :func:`_on_the_design`) at its middle input point; where that lies more
+    than ``_BULGE_SHARE`` quanta from the line, the line is split there into two lines
+    meeting at the estimate (kept inside the middle point's rounding square), or at the
+    middle input point where the two lines from the estimate would miss their points by
+    more than ``eps`` (the line's bound); not split where both miss. Returns the lines as
+    :func:`_valid_lines` does (a split line's two halves in order under its sort key) and
+    whether any line was split."""
+    q = quant[la]
+    m = (lfirst + llast) // 2
+    cand = np.flatnonzero((q > 0.0) & (llast - lfirst + 1 >= _BULGE_POINTS))
+    if len(cand) == 0:
+        return la, lpts, lfirst, llast, lerr, lkey, False
+    pos, _, ok = _local_fits(W, arc, lfirst[cand], llast[cand], m[cand])
+    p0, p1 = lpts[cand, 0], lpts[cand, 1]
+    d = point_segment_distance(pos, p0, p1)
+    hit = ok & (d > _BULGE_SHARE * q[cand])
+    if not hit.any():
+        return la, lpts, lfirst, llast, lerr, lkey, False
+    c = cand[hit]
+    mc = m[c]
+    h = 0.5 * q[c][:, None]
+    v = np.clip(pos[hit], W[mc] - h, W[mc] + h)
+    e = eps[la[c]] * (1.0 + 1e-9)
+    for attempt in range(2):
+        a_pts = np.stack([lpts[c, 0], v], axis=1)
+        b_pts = np.stack([v, lpts[c, 1]], axis=1)
+        ea = _line_errors(W, a_pts, lfirst[c], mc)
+        eb = _line_errors(W, b_pts, mc, llast[c])
+        fine = (ea <= e) & (eb <= e)
+        if attempt == 0:
+            v = np.where(fine[:, None], v, W[mc])
+    keep = fine
+    c, a_pts, b_pts, ea, eb, mc = c[keep], a_pts[keep], b_pts[keep], ea[keep], eb[keep], mc[keep]
+    if len(c) == 0:
+        return la, lpts, lfirst, llast, lerr, lkey, False
+    # the split lines' first halves in their place, the second halves right after them
+    n = len(la)
+    rep = np.ones(n, dtype=np.intp)
+    rep[c] = 2
+    pos_new = np.cumsum(rep) - rep  # each old line's first row
+    la2 = np.repeat(la, rep)
+    key2 = np.repeat(lkey, rep)
+    pts2 = np.repeat(lpts, rep, axis=0)
+    f2 = np.repeat(lfirst, rep)
+    l2 = np.repeat(llast, rep)
+    e2 = np.repeat(lerr, rep)
+    r = pos_new[c]
+    pts2[r] = a_pts
+    pts2[r + 1] = b_pts
+    l2[r] = mc
+    f2[r + 1] = mc
+    e2[r] = ea
+    e2[r + 1] = eb
+    return la2, pts2, f2, l2, e2, key2, True
 
 
 def _valid_lines(W, K, Q, la, lb, lpts, lfirst, llast, lerr, eps):
