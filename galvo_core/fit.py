@@ -2044,6 +2044,10 @@ _SIDE_POINTS = 20
 #: a corner's two sides meet at this angle or more (sine): their fitted lines are
 #: intersected; below, the corner is the mean of the two sides' estimates
 _CORNER_SINE = 0.25
+#: a corner's sides are fitted over at least this many input points (a curve side; a line
+#: side is its thinned segment): the position at a sharp tip between two curves is then
+#: nearer the design (sans-bold "8": 0.64 -> under 0.63 from the true curve)
+_CORNER_POINTS = _SIDE_POINTS
 
 
 def _corners_on_the_design(W, K, Q, arc, smooth, rnd, first, last, quant, eps) -> None:
@@ -2051,7 +2055,8 @@ def _corners_on_the_design(W, K, Q, arc, smooth, rnd, first, last, quant, eps) -
     seam too) move inside their rounding squares onto an estimate of the design's corner.
     Per side, the input points of the thinned segment on that side give a position and a
     tangent at the corner: their least-squares line where the segment is a line (its
-    other end a corner too), else a least-squares quadratic. The corner is the
+    other end a corner too), else a least-squares quadratic (over at least
+    ``_CORNER_POINTS`` input points of the path). The corner is the
     intersection of the two tangent lines where they cross at an angle, else the mean of
     the two positions. A corner stays where a line from it to a neighbouring thinned point
     would miss its input points by more than ``eps`` (per thinned point), so the lines
@@ -2072,8 +2077,13 @@ def _corners_on_the_design(W, K, Q, arc, smooth, rnd, first, last, quant, eps) -
     if len(vo) == 0:
         return
     k = K[vo]
-    p_in, t_in, ok_in = _local_fits(W, arc, K[vi - 1], K[vi], K[vi])
-    p_out, t_out, ok_out = _local_fits(W, arc, k, K[vo + 1], k)
+    # a curve side: over at least _CORNER_POINTS input points (within the path)
+    pid_i = np.searchsorted(last, vi)
+    pid_o = np.searchsorted(last, vo)
+    lo_i = np.minimum(K[vi - 1], np.maximum(K[vi] - _CORNER_POINTS + 1, K[first[pid_i]]))
+    hi_o = np.maximum(K[vo + 1], np.minimum(k + _CORNER_POINTS - 1, K[last[pid_o]]))
+    p_in, t_in, ok_in = _local_fits(W, arc, lo_i, K[vi], K[vi])
+    p_out, t_out, ok_out = _local_fits(W, arc, k, hi_o, k)
     # a side that is a line (its other end a corner too): its least-squares line
     lin = ~smooth[vi - 1]
     if lin.any():
