@@ -1543,9 +1543,46 @@ def _fit_concatenated(
         points[tail[crow] + j] = ctrl[cidx, j + 1]
     pt_cut = np.r_[0, np.cumsum(np.bincount(seg_owner, weights=step, minlength=len(todo))
                                 .astype(np.int64) + 1)]
+    if move_q is not None and (move_q > 0.0).any():
+        worst = _moved_ends_error(W, points, is_cubic, tail, step, first + o_w[seg_owner],
+                                  last + o_w[seg_owner], seg_owner, worst)
     for x in (is_cubic, points, first, last):
         x.setflags(write=False)
     return is_cubic, points, first, last, seg_cut.tolist(), pt_cut.tolist(), worst.tolist()
+
+
+def _moved_ends_error(W, points, is_cubic, tail, step, gfirst, glast, seg_owner, worst):
+    """Rounded input: ``max_error`` with the input points of moved vertices (segment ends
+    moved off their input point; the segments' errors count their inside points only):
+    such a point's distance to the nearer of the segments that end there (as
+    :func:`check_fit` measures a boundary point), per path the larger of it and ``worst``
+    (a list, per path)."""
+    start = points[tail - 1]
+    end = points[tail + step - 1]
+    ms = np.flatnonzero((start != W[gfirst]).any(axis=1))
+    me = np.flatnonzero((end != W[glast]).any(axis=1))
+    if len(ms) == 0 and len(me) == 0:
+        return worst
+    seg = np.concatenate([ms, me])
+    idx = np.concatenate([gfirst[ms], glast[me]])
+    d = np.empty(len(seg))
+    ln = ~is_cubic[seg]
+    if ln.any():
+        s = seg[ln]
+        d[ln] = point_segment_distance(W[idx[ln]], points[tail[s] - 1], points[tail[s]])
+    if (~ln).any():
+        s = seg[~ln]
+        ctrl = np.stack([points[tail[s] - 1 + j] for j in range(4)], axis=1)
+        _, d[~ln] = nearest_on_cubic_each(ctrl, np.arange(len(s)), W[idx[~ln]], seeds=128,
+                                          iters=10)
+    near = np.full(len(W), np.inf)
+    np.minimum.at(near, idx, d)
+    out = np.asarray(worst, dtype=np.float64).copy()
+    u = np.unique(idx)
+    own = np.zeros(len(W), dtype=np.intp)
+    own[idx] = seg_owner[seg]
+    np.fmax.at(out, own[u], near[u])
+    return out
 
 
 #: rounded input: a line over at least this many input points is checked for a bulge
