@@ -1588,7 +1588,7 @@ def _moved_ends_error(W, points, is_cubic, tail, step, gfirst, glast, seg_owner,
 #: rounded input: a line over at least this many input points is checked for a bulge
 _BULGE_POINTS = 8
 #: ... and split where the design estimate at its middle is this many quanta off it
-_BULGE_SHARE = 0.35
+_BULGE_SHARE = 0.5
 #: rounds of that split (a half may bulge again)
 _BULGE_ROUNDS = 2
 
