@@ -59,6 +59,9 @@ cubic is screened first (a coarse dichotomy on a few points) and a range that fa
 not tried again. Rounded input: corners move inside their rounding squares onto the
 intersection of the two sides' least-squares lines (or quadratics), and a long input
 segment (over ``_LONG_SEGMENT`` quanta) leaves a curve only part of the slack beside it.
+The vertices move onto the design only on paths where q/√2 is at least ``_MOVE_SHARE`` of
+e_per (a move gains at most q/√2); there a line over a bulging stretch of the design is
+split on the design estimate (:func:`_split_bulging_lines`).
 
 ``eps_sum`` default: 0.002 input units (one tenth of the paper's e_per). The paper gives no
 value; it only decides when the bisection stops, the acceptance is decided by ``e_per``. A
