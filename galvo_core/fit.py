@@ -146,7 +146,7 @@ _RESPLIT_LINES = 2
 #: rounded input: the vertices move onto the design (:func:`_on_the_design`) only on paths
 #: whose rounding half diagonal q/√2 is at least this share of e_per. Below, a move (at most
 #: q/√2) is small against the tolerance the user asked for: on typeface outlines rounded to
-#: 0.01 unit (e_per 0.02) the moves gave 9 % more segments and no nearer a fit (0.029 against
+#: 0.01 unit (e_per 0.02) the moves gave 10 % more segments and no nearer a fit (0.029 against
 #: 0.028 unit from the true curve), and they were a third of the fit's time on a 1 M-point
 #: file at q = 0.01 (bench/RESULTS.md, "Precision, third round"); at q = 0.02 (share 0.71)
 #: they bring the fit nearer (0.034 against 0.040)
