@@ -7,8 +7,13 @@ refit of the corpus's fabric nesting file (40,705 paths) at e_per 0.05 and 0.02.
 ``--code DIR`` imports galvo_core from another checkout (e.g. ``git worktree add /tmp/wt-66c
 66c99cd``), to measure two versions side by side in the same minutes (alternate the runs).
 
+``--plt FILE`` (issue 16, third round): ``fit_drawing`` on that file's drawing (e.g.
+``python bench/gen_plt.py 1000000 /tmp/g1m.plt``), best of N after a warm-up, the module
+actually imported and a hash of the fitted arrays (kinds, points, first/last, max_error,
+counts: equal hashes = the same fit bit for bit). ``--profile`` adds a cProfile of one run.
+
 Usage: python bench/bench_precision_speed.py [--reps 3] [--code DIR] [--only exact|whole]
-       [--nesting]
+       [--nesting] [--plt FILE [--profile]]
 """
 
 from __future__ import annotations
@@ -31,6 +36,8 @@ def main() -> None:
     ap.add_argument("--code", help="import galvo_core from this checkout")
     ap.add_argument("--only", choices=("exact", "whole"))
     ap.add_argument("--nesting", action="store_true", help="the nesting refit only")
+    ap.add_argument("--plt", help="fit_drawing on this file only")
+    ap.add_argument("--profile", action="store_true", help="with --plt: cProfile one run")
     a = ap.parse_args()
     root = os.path.abspath(a.code) if a.code else os.path.join(HERE, "..")
     sys.path.insert(0, root)
@@ -45,6 +52,48 @@ def main() -> None:
 
     warm_up()
     tag = a.code or "this checkout"
+    if a.plt:
+        import hashlib
+
+        import galvo_core
+        from galvo_core import hpgl
+
+        d = hpgl.read_file(a.plt)
+        n = sum(len(p.points) for p in d.paths)
+        times = []
+        for _ in range(a.reps):
+            t0 = time.process_time()
+            f = fit_drawing(d)
+            times.append(time.process_time() - t0)
+        h = hashlib.sha256()
+        for x in f:
+            if hasattr(x, "is_cubic"):
+                arrs = (x.is_cubic, x.points, x.first, x.last)
+            else:  # (older code: segments only)
+                arrs = (np.array([s.kind == "cubic" for s in x.segments]),
+                        np.concatenate([s.points for s in x.segments]) if x.segments
+                        else np.zeros((0, 2)),
+                        np.array([s.first for s in x.segments], dtype=np.int64),
+                        np.array([s.last for s in x.segments], dtype=np.int64))
+            for arr in arrs:
+                h.update(np.ascontiguousarray(arr).tobytes())
+            h.update(np.float64(x.max_error).tobytes())
+            h.update(np.int64([x.n_input, x.n_thinned]).tobytes())
+        best = min(times)
+        print(f"{galvo_core.__file__}: {os.path.basename(a.plt)} {len(d.paths)} paths {n} "
+              f"points  best {best:.3f} s CPU (all: {' '.join(f'{t:.3f}' for t in times)})  "
+              f"{n / best / 1e3:.0f} k points/s  {segments(f)} segments  "
+              f"sha256 {h.hexdigest()[:16]}  load {os.getloadavg()[0]:.1f}", flush=True)
+        if a.profile:
+            import cProfile
+            import pstats
+
+            pr = cProfile.Profile()
+            pr.enable()
+            fit_drawing(d)
+            pr.disable()
+            pstats.Stats(pr).sort_stats("tottime").print_stats(25)
+        return
     if a.nesting:
         from galvo_core import hpgl
 

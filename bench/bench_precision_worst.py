@@ -1,0 +1,289 @@
+"""Where the distance to the true curve comes from (issue 16, third round): per style, the
+worst places of our fit on whole-unit typeface outlines, what the design has there, and what
+is reachable.
+
+For each place (a point of the plane where our fit is far from the true design curve):
+* kind: what the design has there (the design segment nearest to the place, and the joint
+  within ``JOINT`` units along it: line-line / curve-line / curve-curve, corner (turn > 7°)
+  or smooth, or inside a line / a curve);
+* fit: the local both-ways distance between our fit and the true curve (the true curve's
+  points within ``R`` units of the place to the whole fit, the fit's points within ``R`` to
+  the whole true curve);
+* poly: the same for the polyline through the rounded input points;
+* oracle: a lower bound for any method that sees only the input, where one exists. At a
+  design vertex between two lines (each written as its two rounded ends), every position
+  of that vertex inside the rounding square of its input point gives the same input: for
+  any output O and any two such designs D', D'', max(H(O, D'), H(O, D'')) >= H(D', D'')/2
+  (triangle inequality of the Hausdorff distance H), so no method can be closer than half
+  the largest H between two designs of that family, in the worst case over the designs
+  consistent with the input. Measured with the vertex (and, on a line between two such
+  vertices, both of its vertices) at the corners and centre of their squares, H local
+  (the moved segments, sampled every 0.01 unit). Elsewhere "–" (curves: the dense points
+  pin the design down to well under the rounding, no simple bound).
+
+Usage: python bench/bench_precision_worst.py [--styles sans,...] [--top 10] [--json F]
+"""
+
+from __future__ import annotations
+
+import argparse
+import itertools
+import json
+import math
+import os
+import sys
+
+import numpy as np
+
+sys.path.insert(0, os.path.join(os.path.dirname(__file__), ".."))
+sys.path.insert(0, os.path.dirname(__file__))
+
+from bench_precision import fitted_dense  # noqa: E402
+from fonts import FONT_DIR, STYLES, TEXT, _flatten_quad, contours, glyph_set  # noqa: E402
+
+from galvo_core import fit as fitmod  # noqa: E402
+from galvo_core.geometry import point_polyline_distance  # noqa: E402
+
+R = 2.0  # local window radius (units)
+JOINT = 3.0  # a place within this arc length of a design joint is "at" it
+SEP = 6.0  # two places at least this far apart
+
+
+def labelled_truth(segs):
+    """The true curve (chord 1e-3) and per vertex its design segment index."""
+    pts, lab = [], []
+    for i, s in enumerate(segs):
+        p = np.array([s[1], s[2]]) if s[0] == "line" else _flatten_quad(s[1], s[2], s[3], 1e-3)
+        if i:
+            p = p[1:]
+        pts.append(p)
+        lab.append(np.full(len(p), i))
+    return np.vstack(pts), np.concatenate(lab)
+
+
+def tangent(s, end: bool) -> np.ndarray:
+    if s[0] == "line":
+        d = s[2] - s[1]
+    else:
+        d = (s[3] - s[2]) if end else (s[2] - s[1])
+    n = math.hypot(*d)
+    return d / n if n else d
+
+
+def seg_len(s) -> float:
+    if s[0] == "line":
+        return float(math.hypot(*(s[2] - s[1])))
+    p = _flatten_quad(s[1], s[2], s[3], 1e-3)
+    return float(np.hypot(*np.diff(p, axis=0).T).sum())
+
+
+def turn_deg(a, b) -> float:
+    ta, tb = tangent(a, True), tangent(b, False)
+    c = float(np.clip(ta @ tb, -1, 1))
+    return math.degrees(math.acos(c))
+
+
+def local_dist(place, A, B) -> float:
+    """Both-ways distance of A and B near ``place``: A's points within R to B, B's to A
+    (both resampled every 0.05 unit or closer)."""
+    out = 0.0
+    for X, Y in ((A, B), (B, A)):
+        X = X[_near(X, place, R + 1.0)]
+        if len(X) < 2:
+            continue
+        X = _sample(X, 0.05)
+        near = X[np.hypot(*(X - place).T) <= R]
+        if len(near):
+            out = max(out, float(point_polyline_distance(near, Y).max()))
+    return out
+
+
+def _near(poly, place, r):
+    """Vertices of ``poly`` of the segments that come within r of ``place`` (a run)."""
+    a, b = poly[:-1], poly[1:]
+    ab = b - a
+    den = np.maximum((ab * ab).sum(axis=1), 1e-300)
+    t = np.clip(((place - a) * ab).sum(axis=1) / den, 0, 1)
+    d = np.hypot(*(a + t[:, None] * ab - place).T)
+    hit = np.flatnonzero(d <= r)
+    keep = np.zeros(len(poly), dtype=bool)
+    keep[hit] = True
+    keep[hit + 1] = True
+    return keep
+
+
+def _sample(poly, step=0.01):
+    parts = []
+    for a, b in zip(poly[:-1], poly[1:], strict=True):
+        n = max(1, math.ceil(math.hypot(*(b - a)) / step))
+        t = np.linspace(0, 1, n + 1)[:, None]
+        parts.append(a + t * (b - a))
+    return np.vstack(parts)
+
+
+def _hausdorff(P, Q) -> float:
+    a = float(point_polyline_distance(_sample(P), Q).max())
+    b = float(point_polyline_distance(_sample(Q), P).max())
+    return max(a, b)
+
+
+def oracle_vertex_moves(segs, verts) -> float:
+    """Half the largest local Hausdorff distance between two designs that differ only in
+    the positions of the design vertices ``verts`` (joint indices j: between segs[j-1] and
+    segs[j], both lines) inside the rounding squares of their rounded positions."""
+    n = len(segs)
+    verts = sorted(set(verts))
+    # the polyline of the moved vertices and their neighbours
+    chain = sorted(set(v for v in verts) | {(v - 1) % n for v in verts} | {(v + 1) % n
+                                                                          for v in verts})
+    pos = {j: segs[j][1] for j in chain}  # joint j = start of segs[j]
+
+    def design(moves):
+        p = dict(pos)
+        for v, d in zip(verts, moves, strict=True):
+            p[v] = pos[v] + d
+        # local polylines: each moved vertex with its two neighbours
+        return [np.array([p[(v - 1) % n], p[v], p[(v + 1) % n]]) for v in verts]
+
+    rng = []
+    for v in verts:
+        c = np.round(pos[v])
+        ds = [c + np.array(s) * (0.5 - 1e-9) - pos[v]
+              for s in itertools.product((-1, 1), repeat=2)] + [c - pos[v]]
+        rng.append(ds)
+    confs = list(itertools.product(*rng))
+    polys = [design(m) for m in confs]
+    best = 0.0
+    for i in range(len(polys)):
+        for j in range(i + 1, len(polys)):
+            h = max(_hausdorff(a, b) for a, b in zip(polys[i], polys[j], strict=True))
+            best = max(best, h)
+    return 0.5 * best
+
+
+def classify(segs, lab_seg, arc_pos, seglens):
+    """Kind of the place on design segment ``lab_seg`` at arc ``arc_pos`` from its start,
+    and the line-line vertices an oracle bound can move (joint indices)."""
+    n = len(segs)
+    s = segs[lab_seg]
+    L = seglens[lab_seg]
+    joints = []
+    if arc_pos <= JOINT:
+        joints.append(lab_seg)
+    if L - arc_pos <= JOINT:
+        joints.append((lab_seg + 1) % n)
+    if joints:
+        j = min(joints, key=lambda j: arc_pos if j == lab_seg else L - arc_pos)
+        a, b = segs[(j - 1) % n], segs[j]
+        t = turn_deg(a, b)
+        ka = "line" if a[0] == "line" else "curve"
+        kb = "line" if b[0] == "line" else "curve"
+        kind = "-".join(sorted([ka, kb])).replace("line-curve", "curve-line")
+        short = min(seglens[(j - 1) % n], seglens[j])
+        what = f"{kind} {'corner' if t > 7 else 'smooth'} {t:.0f}° (shorter side {short:.1f})"
+        orc = [j] if (a[0] == "line" and b[0] == "line") else []
+        return what, orc
+    if s[0] == "line":
+        d = s[2] - s[1]
+        ang = math.degrees(math.atan2(d[1], d[0])) % 180
+        ends = [j for j in (lab_seg, (lab_seg + 1) % n)
+                if segs[(j - 1) % n][0] == "line" and segs[j][0] == "line"]
+        return f"inside a 2-point design line (length {L:.1f}, {ang:.0f}°)", ends
+    return "inside a curve", []
+
+
+def worst_places(style: str, top: int, em: float = 1000.0):
+    gs = glyph_set(style, em=em, whole=True)
+    cs = contours(os.path.join(FONT_DIR, STYLES[style]), TEXT, em)
+    fps = fitmod.fit_paths(gs.points, [True] * len(gs.points))
+    cands = []
+    for ci, (segs, fp, pts) in enumerate(zip(cs, fps, gs.points, strict=True)):
+        T, lab = labelled_truth(segs)
+        F = fitted_dense(fp)
+        Rp = np.vstack([pts, pts[:1]]) if (pts[0] != pts[-1]).any() else pts
+        dT = point_polyline_distance(T, F)
+        dF = point_polyline_distance(F, T)
+        locs = np.vstack([T, F])
+        errs = np.concatenate([dT, dF])
+        order = np.argsort(-errs)
+        chosen = []
+        for k in order[:4000]:
+            if errs[k] < 0.3:
+                break
+            p = locs[k]
+            if any(math.hypot(*(p - c[1])) < SEP for c in chosen):
+                continue
+            chosen.append((errs[k], p))
+            if len(chosen) >= top:
+                break
+        seglens = [seg_len(s) for s in segs]
+        for e, p in chosen:
+            # the nearest point of the true curve: its polyline segment and arc position
+            a, ab = T[:-1], np.diff(T, axis=0)
+            den = np.maximum((ab * ab).sum(axis=1), 1e-300)
+            t = np.clip(((p - a) * ab).sum(axis=1) / den, 0, 1)
+            it = int(np.argmin(np.hypot(*(a + t[:, None] * ab - p).T)))
+            sgi = int(lab[it + 1])
+            arc = np.r_[0, np.cumsum(np.hypot(*ab.T))]
+            s0 = int(np.flatnonzero(lab == sgi)[0]) - (1 if sgi else 0)
+            apos = arc[it] + t[it] * math.sqrt(den[it]) - arc[max(s0, 0)]
+            cands.append((float(e), ci, p, sgi, float(apos), segs, seglens, F, T, Rp))
+    cands.sort(key=lambda c: -c[0])
+    rows = []
+    used = []
+    for _e, ci, p, sgi, apos, segs, seglens, F, T, Rp in cands:
+        if any(u[0] == ci and math.hypot(*(p - u[1])) < SEP for u in used):
+            continue
+        used.append((ci, p))
+        kind, orc = classify(segs, sgi, apos, seglens)
+        rows.append({
+            "style": style, "contour": ci, "x": float(p[0]), "y": float(p[1]), "kind": kind,
+            "fit": local_dist(p, F, T), "poly": local_dist(p, Rp, T),
+            "oracle": oracle_vertex_moves(segs, orc) if orc else None,
+        })
+        if len(rows) >= top:
+            break
+    return rows
+
+
+def glyph_of(x: float, style: str, em: float = 1000.0) -> str:
+    from fontTools.ttLib import TTFont
+
+    font = TTFont(os.path.join(FONT_DIR, STYLES[style]))
+    gs = font.getGlyphSet()
+    cmap = font.getBestCmap()
+    scale = em / font["head"].unitsPerEm
+    x0 = 0.0
+    for ch in TEXT:
+        w = gs[cmap[ord(ch)]].width * scale
+        if x < x0 + w:
+            return ch
+        x0 += w
+    return TEXT[-1]
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--styles", default=",".join(STYLES))
+    ap.add_argument("--top", type=int, default=10)
+    ap.add_argument("--json")
+    a = ap.parse_args()
+    fitmod.warm_up()
+    allrows = []
+    print("| style | glyph | at (x, y) | kind | fit | rounded polyline | oracle bound |")
+    print("| --- | --- | --- | --- | ---: | ---: | ---: |")
+    for st in a.styles.split(","):
+        rows = worst_places(st, a.top)
+        for r in rows:
+            r["glyph"] = glyph_of(r["x"], st)
+            o = "–" if r["oracle"] is None else f"{r['oracle']:.3f}"
+            print(f"| {st} | {r['glyph']} | {r['x']:.1f}, {r['y']:.1f} | {r['kind']} | "
+                  f"{r['fit']:.3f} | {r['poly']:.3f} | {o} |", flush=True)
+        allrows += rows
+    if a.json:
+        with open(a.json, "w") as f:
+            json.dump(allrows, f, indent=1)
+
+
+if __name__ == "__main__":
+    main()
