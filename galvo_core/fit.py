@@ -1504,7 +1504,8 @@ def _fit_concatenated(
         la, lpts, lfirst, llast, lerr, lkey = _valid_lines(
             W, K, Q, la, lb, lpts, lfirst, llast, lerr, np.repeat(rounding[:, 0], tlen)
         )
-        for _ in range(_BULGE_ROUNDS if (move_q > 0.0).any() else 0):
+        assert move_q is not None  # set with rounding above
+        for _ in range(_BULGE_ROUNDS if bool((move_q > 0.0).any()) else 0):
             la, lpts, lfirst, llast, lerr, lkey, more = _split_bulging_lines(
                 W, arc, la, lpts, lfirst, llast, lerr, lkey, np.repeat(move_q, tlen),
                 np.repeat(rounding[:, 0], tlen))

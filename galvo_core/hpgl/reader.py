@@ -1180,9 +1180,10 @@ class _Reader:
             lc = self.poly_lc = (off, line, off - last_nl)  # PM0 on the line of i
         # without PM0's line and column the general reader writes EP's and FP's paths
         plc = lc is not None and lc[0] == off
+        pline, pcol = (lc[1], lc[2]) if lc is not None and plc else (0, 0)
         self._ist[scan.I_POLY : scan.I_POLYOK + 1] = (
             self.poly is not None, self.poly_fresh, self.poly_emitted, edged, 0, 0, 0, 0, off,
-            lc[1] if plc else 0, lc[2] if plc else 0, plc, npb, len(rings), ok)
+            pline, pcol, plc, npb, len(rings), ok)
         return True
 
     def _poly_from_scanner(self, out: list[int], buffered: bool) -> None:
