@@ -49,7 +49,8 @@ class Warning:  # noqa: A001 - a drawing's warning, deliberately short name insi
     message: str
 
     def as_dict(self) -> dict[str, object]:
-        return {"line": self.line, "col": self.col, "message": self.message}
+        """JSON-ready (plain int and str, whatever numpy scalars it was made with)."""
+        return {"line": int(self.line), "col": int(self.col), "message": str(self.message)}
 
     def __str__(self) -> str:
         if self.line:

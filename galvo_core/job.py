@@ -321,7 +321,8 @@ class Job:
     def header_json(self, version: int = VERSION) -> dict[str, Any]:
         """Every top-level key of the file but the strokes (shared by both forms; keys
         added here appear in both)."""
-        stats = dict(self.stats)
+        stats = _jsonable(self.stats)
+        # (10^4 warnings on big kerf jobs: made JSON-ready directly, not walked by _jsonable)
         stats["warnings"] = [w.as_dict() for w in self.warnings]
         fm = self.field_map
         out: dict[str, Any] = {
@@ -335,7 +336,7 @@ class Job:
             "params": _jsonable(self.params),
             "laser": dict(self.laser),
             "strokes": [],
-            "stats": _jsonable(stats),
+            "stats": stats,
         }
         if self.layers:
             out["layers"] = _jsonable(list(self.layers))

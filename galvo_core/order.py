@@ -1053,8 +1053,11 @@ def _reverse_segments(segs: Sequence[tuple[str, np.ndarray]]) -> tuple[
 
 
 def apply_to_strokes(strokes: Sequence[object], placements: Sequence[Placement],
-                     fm: object) -> list[object]:
-    """Job strokes in the new order, marks and segments reversed / rotated to match."""
+                     fm: object, *, moves: list[tuple[int, int, bool]] | None = None
+                     ) -> list[object]:
+    """Job strokes in the new order, marks and segments reversed / rotated to match.
+    ``moves``: if given, gets per new stroke (old index, the segment its segments now start
+    at, reversed) — what :meth:`galvo_core.job.StrokeColumns` need to follow the order."""
     from dataclasses import replace
 
     from galvo_core.job import Stroke
@@ -1067,6 +1070,7 @@ def apply_to_strokes(strokes: Sequence[object], placements: Sequence[Placement],
         arrays = hasattr(segs, "rotated")  # job.Segments: turned without per-segment objects
         if not arrays:
             segs = tuple(segs)
+        t = 0
         if pl.rotate and s.closed:  # type: ignore[attr-defined]
             marks = apply_placement(marks, True, Placement(pl.index, False, pl.rotate))
             if len(segs):
@@ -1075,6 +1079,8 @@ def apply_to_strokes(strokes: Sequence[object], placements: Sequence[Placement],
                 if len(hit):
                     t = int(hit[0])
                     segs = segs.rotated(t) if arrays else segs[t:] + segs[:t]
+        if moves is not None:
+            moves.append((pl.index, t % len(segs) if len(segs) else 0, bool(pl.reverse)))
         if pl.reverse:
             marks = marks[::-1].copy()
             segs = segs.reversed() if arrays else _reverse_segments(segs)
@@ -1089,10 +1095,14 @@ def apply_to_strokes(strokes: Sequence[object], placements: Sequence[Placement],
 
 def order_job_strokes(strokes: Sequence[object], fm: object, *, method: str,
                       time_budget_s: float = 1.0, inner_first: bool = True,
-                      hatch_first: bool = True) -> list[object]:
+                      hatch_first: bool = True,
+                      moves: list[tuple[int, int, bool]] | None = None) -> list[object]:
     """Order a job's strokes (contour and hatch :class:`~galvo_core.job.Stroke`) in place of
-    the pipeline's order stage; closed contours start only at segment joints."""
+    the pipeline's order stage; closed contours start only at segment joints. ``moves``: see
+    :func:`apply_to_strokes`."""
     if method == "file":
+        if moves is not None:
+            moves.extend((i, 0, False) for i in range(len(strokes)))
         return list(strokes)
     marks = [np.asarray(s.marks) for s in strokes]  # type: ignore[attr-defined]
     closed = [bool(s.closed) for s in strokes]  # type: ignore[attr-defined]
@@ -1104,4 +1114,4 @@ def order_job_strokes(strokes: Sequence[object], fm: object, *, method: str,
               for m, s, c in zip(marks, strokes, closed, strict=True)]
     pls = order_strokes(marks, method=method, time_budget_s=time_budget_s, closed=closed,
                         before=before, starts=starts)
-    return apply_to_strokes(strokes, pls, fm)
+    return apply_to_strokes(strokes, pls, fm, moves=moves)

@@ -384,8 +384,10 @@ class Pipeline:
                                                fm, clamp=params.clamp or bulge)
         run.check()
         t1 = time.perf_counter()
+        moves: list[tuple[int, int, bool]] = []
         ordered: tuple[Stroke, ...] = tuple(order_job_strokes(  # type: ignore[arg-type]
-            strokes, fm, method=params.scan_order, time_budget_s=params.order_time_budget_s))
+            strokes, fm, method=params.scan_order, time_budget_s=params.order_time_budget_s,
+            moves=moves))
         t2 = time.perf_counter()
         stats = self.stats(drawing, params, fitted, fm, ordered, sampled.report, work)
         if clamped:
@@ -401,8 +403,9 @@ class Pipeline:
         job_params["quantum_units"] = stats["quantum_units"]  # detected, not set
         job = Job(drawing.name, drawing.sha256, fm, job_params,
                   params.laser.as_dict(), ordered, stats, tuple(warnings))
-        if params.scan_order == "file":  # the strokes as made: their columns are known
-            job = job.with_columns(cols.finish(ordered))
+        # the columns of the strokes as made, in the order's order (rotated, reversed)
+        job = job.with_columns((cols if params.scan_order == "file"
+                                else cols.moved(moves)).finish(ordered))
         t3 = time.perf_counter()
         run.timings["order"] = t2 - t1
         run.timings["stats"] = t3 - t2
@@ -541,6 +544,37 @@ class _Columns:
     is_cubic: np.ndarray
     point_count: np.ndarray
     points: np.ndarray
+
+    def moved(self, moves: Sequence[tuple[int, int, bool]]) -> _Columns:
+        """These columns for the strokes reordered by the order stage: per new stroke (old
+        index, first segment after the rotation, reversed), as
+        :func:`galvo_core.order.apply_to_strokes` turns each stroke's segments (rotated
+        first, then reversed), gathered by index arrays instead of per stroke."""
+        mv = np.array(moves, dtype=np.int64).reshape(-1, 3)
+        idx, rot, rev = mv[:, 0], mv[:, 1], mv[:, 2].astype(bool)
+        nseg, npts = self.segment_count[idx], self.point_count[idx]
+        seg0 = np.cumsum(self.segment_count) - self.segment_count  # old first rows
+        pt0 = np.cumsum(self.point_count) - self.point_count
+        # each old segment's first point row within its stroke (Segments.offsets)
+        step = np.where(self.is_cubic, 3, 1)
+        at = np.cumsum(step) - step
+        has = nseg > 0
+        o = np.zeros(len(idx), dtype=np.int64)  # the rotation's first point within the stroke
+        o[has] = at[seg0[idx[has]] + rot[has]] - at[seg0[idx[has]]]
+        # segments: new row i of a stroke is old (rot + i) mod n, i counted from the end
+        # when reversed
+        i = np.arange(int(nseg.sum()), dtype=np.int64) - np.repeat(np.cumsum(nseg) - nseg, nseg)
+        n = np.repeat(nseg, nseg)
+        i = np.where(np.repeat(rev, nseg), n - 1 - i, i)
+        segs = np.repeat(seg0[idx], nseg) + (np.repeat(rot, nseg) + i) % np.maximum(n, 1)
+        # points: a rotation by o is points[o:] + points[1:o + 1] (Segments.rotated)
+        j = np.arange(int(npts.sum()), dtype=np.int64) - np.repeat(np.cumsum(npts) - npts, npts)
+        m, oo = np.repeat(npts, npts), np.repeat(o, npts)
+        j = np.where(np.repeat(rev, npts), m - 1 - j, j)
+        j = np.where(j < m - oo, oo + j, j - (m - oo) + 1)
+        pts = np.repeat(pt0[idx], npts) + j
+        return _Columns(self.closed[idx], self.pen[idx], nseg, self.is_cubic[segs], npts,
+                        self.points[pts])
 
     def finish(self, strokes: tuple[Stroke, ...]) -> StrokeColumns:
         jm = joined_marks(strokes)

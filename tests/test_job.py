@@ -292,11 +292,60 @@ def test_a_pipeline_job_carries_its_strokes_as_columns(tmp_path):
         assert compact_job_bytes(job) == compact_job_bytes(bare)
     assert {s.kind for s in job.strokes} == {"contour"}
     assert runs[2].clamp and "clamped" in " ".join(w.message for w in job.warnings)
-    # ordered strokes are not the stages' order: the writer makes the columns itself
+    # ordered strokes: the columns follow the order (strokes moved, closed ones started
+    # at another joint, some reversed)
     greedy = p.run(d, Params(fit_field=True, e_per=0.75, scan_order="greedy")).job
-    assert greedy.columns is None
+    assert greedy.columns is not None
+    _same_columns(greedy.columns, StrokeColumns.of(greedy.strokes))
     write_job(greedy, tmp_path / "g.gjob")
     _same_job(load_job(tmp_path / "g.gjob"), greedy)
+
+
+def test_an_ordered_job_carries_its_columns_in_the_order(monkeypatch):
+    """The order stage moves strokes, starts closed ones at another segment joint and
+    reverses others; the job's columns (what the .gjob writer copies) follow every move:
+    they equal the columns made from the ordered strokes themselves, with and without fill,
+    on a drawing where the order rotates and reverses."""
+    import galvo_core.order as order
+    from galvo_core.job import StrokeColumns
+
+    seen: list[tuple[int, int, bool]] = []
+    real = order.apply_to_strokes
+
+    def spy(strokes, placements, fm, *, moves=None):  # type: ignore[no-untyped-def]
+        out = real(strokes, placements, fm, moves=moves)
+        seen.extend(moves or [])
+        return out
+
+    monkeypatch.setattr(order, "apply_to_strokes", spy)
+    # open strokes a line then an arc, stacked: the nearest end of the next is its far end,
+    # so the order reverses every other one (a line-then-cubics stroke is not a palindrome)
+    prog = ["IN;SP1;"]
+    for k in range(8):
+        y = 800 * k
+        arc = [(700 + 300 * np.cos(a), y + 300 * np.sin(a)) for a in np.linspace(np.pi, 0, 60)]
+        pts = [(0.0, y), (200.0, y), (400.0, y)] + arc
+        prog.append(f"PU{pts[0][0]:.0f},{pts[0][1]:.0f};PD"
+                    + ",".join(f"{x:.0f},{yy:.0f}" for x, yy in pts[1:]) + ";")
+    from galvo_core.hpgl import read_bytes
+
+    drawings = [read_bytes("".join(prog).encode(), "line_arcs.plt")]
+    drawings += [read_file(SAMPLES / n) for n in ("seal.plt", "dense_logo.plt",
+                                                  "arcs_circles.plt")]
+    p = Pipeline()
+    for d in drawings:
+        for params in (Params(fit_field=True, scan_order="greedy"),
+                       Params(fit_field=True, scan_order="optimized", order_time_budget_s=0.2,
+                              fill="zigzag", hatch_spacing_mm=0.3, kerf_mm=0.05)):
+            job = p.run(d, params).job
+            assert job.columns is not None and job.columns.strokes is job.strokes
+            _same_columns(job.columns, StrokeColumns.of(job.strokes))
+    # the runs did move, rotate and reverse strokes (else this test would prove little)
+    assert any(i != k for k, (i, _t, _r) in enumerate(seen))
+    assert sum(t > 0 for _i, t, _r in seen) >= 5
+    assert sum(r for _i, _t, r in seen) >= 5
+    asym = [i for i, _t, r in seen[:16] if r]  # reversed among the line-arc drawing's first
+    assert len(asym) >= 4
 
 
 def test_columns_of_a_run_with_a_path_without_marks(monkeypatch):
