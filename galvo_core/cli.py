@@ -89,10 +89,15 @@ def cmd_process(a: argparse.Namespace) -> int:
     from galvo_core.pipeline import Pipeline
 
     params = _params_from_args(a)
+    t0 = time.perf_counter()
     d = read_file(a.file)
-    job = Pipeline().run(d, params).job
-    job = cli_lmc.prepare_job(job, a)  # pens, field correction; LMC files checked
+    t1 = time.perf_counter()
+    res = Pipeline().run(d, params)
+    job = cli_lmc.prepare_job(res.job, a)  # pens, field correction; LMC files checked
+    t2 = time.perf_counter()
     write_job(job, a.output)
+    # wall seconds per stage: the file read, each stage the pipeline ran, the job written
+    timings = {"read": t1 - t0, **res.timings, "write": time.perf_counter() - t2}
     if a.plt:
         write_plt(job, a.plt, what=a.plt_what)
     if a.svg:
@@ -104,6 +109,7 @@ def cmd_process(a: argparse.Namespace) -> int:
         "magnification": job.field_map.magnification,
         "stats": job.stats,
         "warnings": [w.as_dict() for w in job.warnings],
+        "timings_s": {k: round(v, 6) for k, v in timings.items()},
         **controller,
     })
     return 0

@@ -79,6 +79,10 @@ def test_process_writes_a_job_per_spec(tmp_path):
     assert r.returncode == 0, r.stderr
     summary = json.loads(r.stdout)
     assert summary["stats"]["mark_points"] > 0
+    # where the time went, per stage (wall seconds): the read, the stages run, the write
+    t = summary["timings_s"]
+    assert list(t)[0] == "read" and list(t)[-1] == "write"
+    assert {"fit", "sample"} <= set(t) and all(v >= 0 for v in t.values())
     doc = json.loads(out.read_text("utf-8"))
     assert doc["format"] == "galvo-job" and doc["version"] == 1
     assert doc["magnification"] == 36.0
