@@ -1548,6 +1548,14 @@ def _fit_concatenated(
     pt_cut = np.r_[0, np.cumsum(np.bincount(seg_owner, weights=step, minlength=len(todo))
                                 .astype(np.int64) + 1)]
     if move_q is not None and (move_q > 0.0).any():
+        gf = first + o_w[seg_owner]
+        gl = last + o_w[seg_owner]
+        bound = np.minimum(e_per, rounding[:, 0])
+        changed = _joints_on_the_design(W, arc, points, is_cubic, tail, step, gf, gl,
+                                        seg_owner, move_q, bound)
+        if changed.any():
+            worst = _changed_errors(W, points, is_cubic, tail, gf, gl, seg_owner, changed,
+                                    worst)
         worst = _moved_ends_error(W, points, is_cubic, tail, step, first + o_w[seg_owner],
                                   last + o_w[seg_owner], seg_owner, worst)
     for x in (is_cubic, points, first, last):
@@ -1587,6 +1595,157 @@ def _moved_ends_error(W, points, is_cubic, tail, step, gfirst, glast, seg_owner,
     own[idx] = seg_owner[seg]
     np.fmax.at(out, own[u], near[u])
     return out
+
+
+#: rounded input: a joint's design estimate is a least-squares quadratic over this many
+#: input points on each side of it
+_JOINT_SIDE = 8
+#: ... kept only where every one of those points lies within this many quanta of it (a
+#: rounded smooth stretch: up to q/√2 plus the estimate's own error; a corner misses more)
+_JOINT_SMOOTH = 1.0
+#: ... and the joint moved there only when it is this many quanta or more away
+_JOINT_MOVE = 0.15
+#: ... by this share of the way to it, the first that keeps both segments within the bound
+_JOINT_SHARES = (1.0, 2.0 / 3.0, 1.0 / 3.0)
+#: curve-to-polyline checks sample the moved segments at most this far apart (units of q)
+_JOINT_STEP = 0.05
+
+
+def _joint_estimates(W, arc, g, ps, pe, k):
+    """Least-squares quadratics x(s), y(s) in arc length over the input points g - k ..
+    g + k (clipped to ps..pe, global indices) of each joint ``g``: (position at g (V, 2),
+    unit tangent (V, 2), the largest distance of a window point to its quadratic (V,),
+    ok (V,): at least 4 points on each side and a well-conditioned fit)."""
+    off = np.arange(-k, k + 1)
+    idx = g[:, None] + off[None, :]
+    m = (idx >= ps[:, None]) & (idx <= pe[:, None])
+    idx = np.clip(idx, ps[:, None], pe[:, None])
+    s = (arc[idx] - arc[g][:, None]) * m
+    ok = (m[:, :k].sum(axis=1) >= 4) & (m[:, k + 1:].sum(axis=1) >= 4)
+    wm = m.astype(np.float64)
+    V = np.stack([wm, s * wm, s * s * wm], axis=2)  # (V, 2k+1, 3)
+    A = np.einsum("vni,vnj->vij", V, V)
+    P = W[idx] - W[g][:, None, :]
+    rhs = np.einsum("vni,vnc->vic", V, P)
+    det = np.linalg.det(A)
+    good = ok & (np.abs(det) > 1e-12 * np.maximum(np.abs(A).max(axis=(1, 2)), 1.0) ** 3)
+    coef = np.zeros((len(g), 3, 2))
+    if good.any():
+        coef[good] = np.linalg.solve(A[good], rhs[good])
+    fitv = coef[:, 0, None, :] + s[:, :, None] * coef[:, 1, None, :] \
+        + (s * s)[:, :, None] * coef[:, 2, None, :]
+    res = np.where(m, np.hypot(*(fitv - P).transpose(2, 0, 1)), 0.0).max(axis=1)
+    t = coef[:, 1]
+    ln = np.hypot(t[:, 0], t[:, 1])
+    good &= ln > 0.0
+    tan = t / np.where(ln > 0.0, ln, 1.0)[:, None]
+    return W[g] + coef[:, 0], tan, res, good
+
+
+def _joints_on_the_design(W, arc, points, is_cubic, tail, step, gfirst, glast, seg_owner,
+                          quant, bound):
+    """Rounded input: the joints between two segments of a path that still sit on their
+    input point inside a smooth stretch (the points around lie within ``_JOINT_SMOOTH``
+    quanta of their least-squares quadratic) move onto that design estimate (inside the
+    point's rounding square), the segments' inner control points moved along with them,
+    where both segments then stay within ``bound`` (per path) of their input points and of
+    their input polyline. ``quant`` per path (0: not moved). Joints of even and of odd
+    segment index in two rounds (two moves never share a segment). In place on
+    ``points``; returns the segments changed."""
+    ns = len(is_cubic)
+    changed = np.zeros(ns, dtype=bool)
+    if ns < 2:
+        return changed
+    j = np.flatnonzero(seg_owner[1:] == seg_owner[:-1]) + 1  # segment j starts at a joint
+    j = j[quant[seg_owner[j]] > 0.0]
+    g = gfirst[j]
+    j = j[(points[tail[j] - 1] == W[g]).all(axis=1)]
+    if len(j) == 0:
+        return changed
+    g = gfirst[j]
+    own = seg_owner[j]
+    ps = gfirst[np.searchsorted(seg_owner, own)]
+    pe = glast[np.searchsorted(seg_owner, own, side="right") - 1]
+    q = quant[own]
+    est, tan, res, ok = _joint_estimates(W, arc, g, ps, pe, _JOINT_SIDE)
+    h = 0.5 * q[:, None]
+    v = np.clip(est, W[g] - h, W[g] + h)
+    mv = np.hypot(*(v - W[g]).T)
+    keep = ok & (res <= _JOINT_SMOOTH * q) & (mv >= _JOINT_MOVE * q)
+    j, g, v, q, own = j[keep], g[keep], v[keep], q[keep], own[keep]
+    for parity in (0, 1):
+        for i in np.flatnonzero(j % 2 == parity).tolist():
+            _try_joint(W, points, is_cubic, tail, step, gfirst, glast, int(j[i]), v[i],
+                       float(bound[own[i]]), float(q[i]), changed)
+    return changed
+
+
+def _changed_errors(W, points, is_cubic, tail, gfirst, glast, seg_owner, changed, worst):
+    """``worst`` (per path) raised to the largest input-point error of the changed segments
+    (their points first..last, true distances)."""
+    out = np.asarray(worst, dtype=np.float64).copy()
+    s = np.flatnonzero(changed & ~is_cubic)
+    if len(s):
+        pts = np.stack([points[tail[s] - 1], points[tail[s]]], axis=1)
+        np.fmax.at(out, seg_owner[s], _line_errors(W, pts, gfirst[s], glast[s]))
+    s = np.flatnonzero(changed & is_cubic)
+    if len(s):
+        ctrl = np.stack([points[tail[s] - 1 + k] for k in range(4)], axis=1)
+        cnt = glast[s] - gfirst[s] + 1
+        starts = np.cumsum(cnt) - cnt
+        pid = np.repeat(np.arange(len(s)), cnt)
+        idx = gfirst[s][pid] + np.arange(int(cnt.sum())) - starts[pid]
+        _, d = nearest_on_cubic_each(ctrl, pid, W[idx])
+        np.fmax.at(out, seg_owner[s], np.maximum.reduceat(d, starts))
+    return out
+
+
+def _seg_ctrl(points, is_cubic, tail, s):
+    r = tail[s] - 1
+    return points[r:r + (4 if is_cubic[s] else 2)].copy()
+
+
+def _seg_fits(W, ctrl, first, last, bound, h) -> bool:
+    """Whether the segment ``ctrl`` (2 or 4 points) stays within ``bound`` of the input
+    points first..last and its samples (at most h apart; the check keeps h / 2 spare)
+    within ``bound`` of their polyline."""
+    loc = W[first:last + 1]
+    if len(ctrl) == 2:
+        d = point_segment_distance(loc, ctrl[0], ctrl[1])
+        length = float(np.hypot(*(ctrl[1] - ctrl[0])))
+        m = max(2, math.ceil(length / h) + 1)
+        samp = ctrl[0] + np.linspace(0.0, 1.0, m)[:, None] * (ctrl[1] - ctrl[0])
+    else:
+        _, d = nearest_on_cubic(ctrl, loc, seeds=64, iters=8)
+        length = float(np.hypot(*np.diff(ctrl, axis=0).T).sum())  # >= the arc length
+        m = max(16, math.ceil(length / h) + 1)
+        samp = cubic_eval(ctrl, np.linspace(0.0, 1.0, m))
+    if d.max() > bound:
+        return False
+    return bool(point_polyline_distance(samp, loc).max() <= bound - 0.5 * h)
+
+
+def _try_joint(W, points, is_cubic, tail, step, gfirst, glast, j, v, bound, q, changed):
+    a, b = j - 1, j
+    c0a = _seg_ctrl(points, is_cubic, tail, a)
+    c0b = _seg_ctrl(points, is_cubic, tail, b)
+    h = _JOINT_STEP * q
+    for share in _JOINT_SHARES:
+        dv = share * (v - c0b[0])
+        ca = c0a.copy()
+        cb = c0b.copy()
+        ca[-1] += dv
+        cb[0] += dv
+        if is_cubic[a]:
+            ca[2] += dv
+        if is_cubic[b]:
+            cb[1] += dv
+        if (_seg_fits(W, ca, gfirst[a], glast[a], bound, h)
+                and _seg_fits(W, cb, gfirst[b], glast[b], bound, h)):
+            points[tail[a] - 1:tail[a] - 1 + len(ca)] = ca
+            points[tail[b] - 1:tail[b] - 1 + len(cb)] = cb
+            changed[a] = changed[b] = True
+            return
 
 
 #: rounded input: a line over at least this many input points is checked for a bulge
