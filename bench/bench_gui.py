@@ -435,6 +435,7 @@ def holders(files: list[Path], min_ms: float) -> None:
         win.set_params(Params(), run=False)
         steps: list[tuple[str, Callable[[], object]]] = [
             ("open", lambda f=f: win.load_file(f)),
+            ("open again", lambda f=f: win.load_file(f)),
             ("e_per", release(win, "e_per", 0.07)),
             ("kerf", release(win, "kerf_mm", 0.03)),
             ("kerf 2", release(win, "kerf_mm", 0.035)),
@@ -454,8 +455,13 @@ def holders(files: list[Path], min_ms: float) -> None:
             _, cpu = timed(app, win, act, 1200)
             probe.on = False
             found = probe.take()
+            reaper = getattr(win, "_reaper", None)
+            freeing = ""
+            if reaper is not None:
+                freeing = f"; longest freeing pass {reaper.longest_s * 1000:.1f} ms CPU"
+                reaper.longest_s = 0.0
             print(f"  {name:16s} CPU {cpu * 1000:6.0f} ms; GIL held > {min_ms:.0f} ms: "
-                  f"{len(found)}", flush=True)
+                  f"{len(found)}{freeing}", flush=True)
             for tag, d, gap, before, after in found:
                 print(f"    {tag} {d:5.0f} ms CPU in a {gap:4.0f} ms gap\n"
                       f"      before: {before}\n      after:  {after}", flush=True)
