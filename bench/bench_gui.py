@@ -19,6 +19,12 @@ Driven through the window's scripting surface, offscreen (software rasteriser), 
     .venv/bin/python bench/bench_gui.py latency [FILES...] [--points 150000] [--repeats 5]
     .venv/bin/python bench/bench_gui.py stalls [--points 1000000 | --file F] [--opens 5]
     .venv/bin/python bench/bench_gui.py memory [FILES...] [--opens 10]
+    .venv/bin/python bench/bench_gui.py holders [FILES...] [--points 1000000] [--min-ms 30]
+
+``holders`` opens each file (twice) and changes e_per, kerf and magnification, listing each
+stretch over ``--min-ms`` in which one thread held the GIL alone (its CPU time advanced
+while a 1 ms sampler could not run), with that thread's Python stack before and after: the
+long C calls that stall the GUI thread, told apart from a busy machine.
 
 Without FILES, ``latency`` uses a generated ``--points`` file (bench/gen_plt.py); give the
 corpus files (``../shared/corpus/plt/...``) to measure them. ``stalls --opens N`` opens the
