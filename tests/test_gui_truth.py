@@ -296,6 +296,7 @@ def test_the_previous_file_is_freed_when_the_next_one_is_shown(win, qtbot, tmp_p
     assert win.load_file(b, wait=True) and win.drawing.name == "b.plt"
     # (let go a moment after the new result, in an event-loop pass of their own)
     qtbot.wait(window_mod.RELEASE_DELAY_MS + 50)
+    qtbot.waitUntil(lambda: not win._reaper.busy(), timeout=5000)  # its short passes
     assert gc.isenabled()  # no collection asked for: reference counting frees them
     assert [r() is None for r in refs] == [True] * len(refs)
 
