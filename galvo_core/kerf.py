@@ -733,7 +733,7 @@ def _geos_c() -> ctypes.CDLL | None:
                 _GEOS_C = lib
             except (OSError, AttributeError):
                 _GEOS_C = False
-        return _GEOS_C or None
+        return _GEOS_C if isinstance(_GEOS_C, ctypes.CDLL) else None
 
 
 def _polygonize(lines: np.ndarray) -> np.ndarray:
