@@ -25,6 +25,7 @@ from PySide6.QtCore import (
     QByteArray,
     QFileSystemWatcher,
     QIODevice,
+    QObject,
     QSettings,
     Qt,
     QTimer,
@@ -114,6 +115,10 @@ SWITCH_INTERVAL_S = 0.001
 #: this long after (ms): freeing 40 k paths with their fits, strokes and display data takes
 #: the GUI thread 10-20 ms, which then no longer adds to the new result's apply and paint.
 RELEASE_DELAY_MS = 150
+#: ...and in event-loop passes of at most about this long each (s): dropping the last
+#: reference to a file's result frees it in one C-level cascade that holds the GIL (23-45 ms
+#: of the GUI thread on 40 k-path files, a stall of its own); see :class:`_Reaper`.
+RELEASE_STEP_S = 0.004
 #: The processed view paints after the original (see MainWindow._stagger_paints), at the
 #: latest this long after a result (ms).
 STAGGER_MAX_MS = 80
@@ -271,6 +276,58 @@ def _swatch(key: str) -> QIcon:
         p.drawLine(1, 7, 21, 7)
     p.end()
     return QIcon(pm)
+
+
+class _Reaper:
+    """Frees objects in short event-loop passes (:data:`RELEASE_STEP_S` each) instead of in
+    one cascade: an object that only the reaper holds is opened up first (its referents,
+    ``gc.get_referents``, are taken over, so dropping it frees nothing else), the items of
+    a big container (more than 64 referents: the tuples of 40 k paths, strokes, fits) are
+    dropped a few at a time, each freeing its own small subtree. Objects that something
+    else still references are merely let go (never changed: a result may share its drawing
+    with the one on screen)."""
+
+    def __init__(self, parent: QObject) -> None:
+        import collections
+
+        self.queue: collections.deque[tuple[object, bool]] = collections.deque()
+        self.timer = QTimer(parent)
+        self.timer.setSingleShot(True)
+        self.timer.setInterval(0)
+        self.timer.timeout.connect(self.step)
+        self.longest_s = 0.0  # the longest pass, GUI-thread CPU time (benchmarks)
+
+    def add(self, objs: list[object]) -> None:
+        self.queue.extend((o, True) for o in objs)
+        del objs[:]
+        if self.queue and not self.timer.isActive():
+            self.timer.start()
+
+    def step(self) -> None:
+        import gc
+
+        c0 = time.thread_time()
+        end = time.perf_counter() + RELEASE_STEP_S
+        q = self.queue
+        n = 0
+        while q:
+            o, expand = q.popleft()
+            # 3 references: this frame's, getrefcount's argument and the caller's tuple's
+            # (already gone: unpacked) -> 2 when nothing else holds it
+            if expand and sys.getrefcount(o) <= 2:
+                kids = gc.get_referents(o)
+                q.extendleft((k, len(kids) <= 64) for k in reversed(kids))
+                del kids
+            del o
+            n += 1
+            if not n & 15 and time.perf_counter() > end:
+                break
+        self.longest_s = max(self.longest_s, time.thread_time() - c0)
+        if q:
+            self.timer.start()
+
+    def busy(self) -> bool:
+        return bool(self.queue)
 
 
 class MainWindow(QMainWindow):
@@ -501,10 +558,11 @@ class MainWindow(QMainWindow):
         self.exporter.busy_changed.connect(self._on_busy_changed)
         self._export_target: tuple[str, FsPath] | None = None
         self._released: list[object] = []
+        self._reaper = _Reaper(self)
         self._release_timer = QTimer(self)
         self._release_timer.setSingleShot(True)
         self._release_timer.setInterval(RELEASE_DELAY_MS)
-        self._release_timer.timeout.connect(self._released.clear)
+        self._release_timer.timeout.connect(self._hand_to_reaper)
         self._throttle = QTimer(self)
         self._throttle.setSingleShot(True)
         self._throttle.setInterval(THROTTLE_MS)
@@ -1129,6 +1187,10 @@ class MainWindow(QMainWindow):
         self._released.extend(o for o in objs if o is not None)
         if self._released and not self._release_timer.isActive():
             self._release_timer.start()
+
+    def _hand_to_reaper(self) -> None:
+        objs, self._released[:] = list(self._released), []
+        self._reaper.add(objs)
 
     def _fresh_caches(self, pipeline: Pipeline | None = None) -> None:
         """Empty caches for a new file: they hold the stages, display geometry and item

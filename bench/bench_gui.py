@@ -19,6 +19,12 @@ Driven through the window's scripting surface, offscreen (software rasteriser), 
     .venv/bin/python bench/bench_gui.py latency [FILES...] [--points 150000] [--repeats 5]
     .venv/bin/python bench/bench_gui.py stalls [--points 1000000 | --file F] [--opens 5]
     .venv/bin/python bench/bench_gui.py memory [FILES...] [--opens 10]
+    .venv/bin/python bench/bench_gui.py holders [FILES...] [--points 1000000] [--min-ms 30]
+
+``holders`` opens each file (twice) and changes e_per, kerf and magnification, listing each
+stretch over ``--min-ms`` in which one thread held the GIL alone (its CPU time advanced
+while a 1 ms sampler could not run), with that thread's Python stack before and after: the
+long C calls that stall the GUI thread, told apart from a busy machine.
 
 Without FILES, ``latency`` uses a generated ``--points`` file (bench/gen_plt.py); give the
 corpus files (``../shared/corpus/plt/...``) to measure them. ``stalls --opens N`` opens the
@@ -369,6 +375,105 @@ def stalls(points: int, big: Path | None, opens: int = 1) -> None:
     win.close()
 
 
+class GilHolders:
+    """A thread that wakes every 1 ms and reads every other thread's CPU clock: when it
+    could not run for more than ``min_ms`` while another thread's CPU time advanced by as
+    much, that thread held the GIL (one long C call that does not release it); its Python
+    stack before and after the gap names the call. Independent of the machine's load (a
+    thread that merely was not scheduled has no CPU time to show)."""
+
+    def __init__(self, min_ms: float = 30.0) -> None:
+        import threading
+
+        self.min_s = min_ms / 1000.0
+        self.main = threading.main_thread().ident
+        self.found: list[tuple[str, float, float, str, str]] = []
+        self.on = False
+        threading.Thread(target=self._run, daemon=True).start()
+
+    @staticmethod
+    def _stack(frame) -> str:
+        import traceback
+
+        fr = traceback.extract_stack(frame)[-4:]
+        return " <- ".join(f"{x.filename.split('/')[-1]}:{x.lineno} {x.name}"
+                           for x in reversed(fr))
+
+    def _run(self) -> None:
+        me = threading_ident()
+        last_cpu: dict[int, float] = {}
+        last_stack: dict[int, str] = {}
+        last = time.perf_counter()
+        while True:
+            time.sleep(0.001)
+            now = time.perf_counter()
+            for ident, frame in sys._current_frames().items():  # noqa: SLF001
+                if ident == me:
+                    continue
+                try:
+                    cpu = time.clock_gettime(time.pthread_getcpuclockid(ident))
+                except (OSError, OverflowError):
+                    continue
+                d = cpu - last_cpu.get(ident, cpu)
+                st = self._stack(frame)
+                if self.on and d > self.min_s and now - last > self.min_s:
+                    tag = "gui" if ident == self.main else "worker"
+                    self.found.append((tag, d * 1000, (now - last) * 1000,
+                                       last_stack.get(ident, "?"), st))
+                last_cpu[ident] = cpu
+                last_stack[ident] = st
+            last = now
+
+    def take(self) -> list[tuple[str, float, float, str, str]]:
+        out, self.found = self.found, []
+        return out
+
+
+def holders(files: list[Path], min_ms: float) -> None:
+    """Each file opened, then e_per, kerf and magnification changed: every stretch over
+    ``min_ms`` in which one thread held the GIL alone (:class:`GilHolders`)."""
+    app, win = make_window()
+    probe = GilHolders(min_ms)
+    print(machine())
+    from galvo_core.params import Params
+
+    for f in files:
+        win.set_params(Params(), run=False)
+        steps: list[tuple[str, Callable[[], object]]] = [
+            ("open", lambda f=f: win.load_file(f)),
+            ("open again", lambda f=f: win.load_file(f)),
+            ("e_per", release(win, "e_per", 0.07)),
+            ("kerf", release(win, "kerf_mm", 0.03)),
+            ("kerf 2", release(win, "kerf_mm", 0.035)),
+            ("magnification", lambda: win.set_param(
+                "magnification", round(win.result.job.field_map.magnification * 0.95, 4))),
+            ("kerf off", release(win, "kerf_mm", 0.0)),
+            ("magnification 2", lambda: win.set_param(
+                "magnification", round(win.result.job.field_map.magnification * 0.95, 4))),
+        ]
+        print(f"\n{f.name}")
+        for name, act in steps:
+            if name.startswith("magnification"):
+                win.set_param("fit_field", False)
+                assert win.wait_idle(600)
+            probe.take()
+            probe.on = True
+            _, cpu = timed(app, win, act, 1200)
+            probe.on = False
+            found = probe.take()
+            reaper = getattr(win, "_reaper", None)
+            freeing = ""
+            if reaper is not None:
+                freeing = f"; longest freeing pass {reaper.longest_s * 1000:.1f} ms CPU"
+                reaper.longest_s = 0.0
+            print(f"  {name:16s} CPU {cpu * 1000:6.0f} ms; GIL held > {min_ms:.0f} ms: "
+                  f"{len(found)}{freeing}", flush=True)
+            for tag, d, gap, before, after in found:
+                print(f"    {tag} {d:5.0f} ms CPU in a {gap:4.0f} ms gap\n"
+                      f"      before: {before}\n      after:  {after}", flush=True)
+    win.close()
+
+
 def rss_mb() -> float:
     """The resident set size now (MB), from /proc (Linux)."""
     with open("/proc/self/statm") as fh:
@@ -424,7 +529,21 @@ def main(argv: list[str] | None = None) -> int:
     a3 = sub.add_parser("memory")
     a3.add_argument("files", nargs="*", type=Path)
     a3.add_argument("--opens", type=int, default=10)
+    a4 = sub.add_parser("holders")
+    a4.add_argument("files", nargs="*", type=Path)
+    a4.add_argument("--points", type=int, default=1_000_000)
+    a4.add_argument("--min-ms", type=float, default=30.0)
     a = ap.parse_args(argv)
+    if a.cmd == "holders":
+        files = list(a.files)
+        if not files:
+            from gen_plt import generate_plt
+
+            f = Path(tempfile.mkdtemp(prefix="galvo-bench-")) / f"gen_{a.points}.plt"
+            f.write_bytes(generate_plt(a.points, seed=0))
+            files = [f]
+        holders(files, a.min_ms)
+        return 0
     if a.cmd == "memory":
         files = list(a.files)
         if not files:

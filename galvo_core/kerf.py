@@ -86,7 +86,11 @@ the vertex nearest to the source ring's first point.
 
 from __future__ import annotations
 
+import ctypes
+import glob
 import math
+import os
+import threading
 from collections.abc import Iterator, Sequence
 from dataclasses import dataclass, field
 
@@ -667,7 +671,7 @@ def _even_odd_general(rings: list[np.ndarray]) -> BaseGeometry:
     except shapely.errors.GEOSException:  # noding failed to converge: snap to a fine grid
         x0, y0, x1, y1 = shapely.total_bounds(lines)
         noded = shapely.union_all(lines, grid_size=1e-9 * max(x1 - x0, y1 - y0, 1.0))
-    faces = shapely.get_parts(shapely.polygonize(shapely.get_parts(noded)))
+    faces = _polygonize(shapely.get_parts(noded))
     faces = faces[shapely.area(faces) > 0]
     if len(faces) == 0:
         return shapely.Polygon()
@@ -684,6 +688,84 @@ def _even_odd_general(rings: list[np.ndarray]) -> BaseGeometry:
     if not shapely.is_valid(out):
         out = shapely.make_valid(shapely.union_all(faces[odd]))
     return _polygonal(out)
+
+
+#: GEOS's C API through ctypes (which releases the GIL during the call), or False when
+#: shapely's GEOS library cannot be found; None until first asked for
+_GEOS_C: ctypes.CDLL | bool | None = None
+_GEOS_LOCK = threading.Lock()
+
+
+def _geos_c() -> ctypes.CDLL | None:
+    """shapely's own libgeos_c (the same library, so the same results), with the few
+    functions :func:`_polygonize` calls declared; None when it cannot be loaded."""
+    global _GEOS_C
+    with _GEOS_LOCK:
+        if _GEOS_C is None:
+            _GEOS_C = False
+            base = os.path.dirname(os.path.dirname(shapely.__file__))
+            libs = sorted(glob.glob(os.path.join(base, "shapely.libs", "libgeos_c*.so*")))
+            try:
+                if len(libs) != 1 or not hasattr(shapely.Point(0, 0), "_geom"):
+                    raise OSError("no single bundled libgeos_c")
+                lib = ctypes.CDLL(libs[0])
+                vp, sz = ctypes.c_void_p, ctypes.c_size_t
+                lib.GEOS_init_r.restype = vp
+                lib.GEOS_init_r.argtypes = []
+                lib.GEOS_finish_r.argtypes = [vp]
+                lib.GEOS_finish_r.restype = None
+                lib.GEOSPolygonize_r.restype = vp
+                lib.GEOSPolygonize_r.argtypes = [vp, ctypes.POINTER(vp), ctypes.c_uint]
+                lib.GEOSWKBWriter_create_r.restype = vp
+                lib.GEOSWKBWriter_create_r.argtypes = [vp]
+                lib.GEOSWKBWriter_destroy_r.argtypes = [vp, vp]
+                lib.GEOSWKBWriter_destroy_r.restype = None
+                lib.GEOSWKBWriter_write_r.restype = vp
+                lib.GEOSWKBWriter_write_r.argtypes = [vp, vp, vp, ctypes.POINTER(sz)]
+                lib.GEOSFree_r.argtypes = [vp, vp]
+                lib.GEOSFree_r.restype = None
+                lib.GEOSGeom_destroy_r.argtypes = [vp, vp]
+                lib.GEOSGeom_destroy_r.restype = None
+                lib.GEOSversion.restype = ctypes.c_char_p
+                if not lib.GEOSversion().decode().startswith(
+                        ".".join(map(str, shapely.geos_version))):
+                    raise OSError("libgeos_c is not shapely's version")
+                _GEOS_C = lib
+            except (OSError, AttributeError):
+                _GEOS_C = False
+        return _GEOS_C if isinstance(_GEOS_C, ctypes.CDLL) else None
+
+
+def _polygonize(lines: np.ndarray) -> np.ndarray:
+    """The faces of ``shapely.polygonize(lines)`` (noded linework), identical, but with the
+    interpreter lock released during GEOS's polygonizer: shapely's ``polygonize`` holds it
+    for the whole call (40-45 ms on the 5,500 lines of b_fabric_nesting), which stalls the
+    window's GUI thread when this runs on its worker. The same GEOS function of the same
+    library is called through ctypes on the lines' own GEOS geometries and its result
+    comes back as WKB (exact doubles). Falls back to shapely when the library is not at
+    hand or GEOS fails (shapely then raises its own error)."""
+    lib = _geos_c()
+    if lib is None or len(lines) == 0:
+        return shapely.get_parts(shapely.polygonize(lines))
+    vp = ctypes.c_void_p
+    ptrs = (vp * len(lines))(*[g._geom for g in lines.tolist()])  # noqa: SLF001
+    ctx = lib.GEOS_init_r()
+    try:
+        res = lib.GEOSPolygonize_r(ctx, ptrs, len(lines))  # GIL released (ctypes)
+        if not res:
+            return shapely.get_parts(shapely.polygonize(lines))
+        writer = lib.GEOSWKBWriter_create_r(ctx)
+        size = ctypes.c_size_t()
+        buf = lib.GEOSWKBWriter_write_r(ctx, writer, res, ctypes.byref(size))
+        lib.GEOSWKBWriter_destroy_r(ctx, writer)
+        lib.GEOSGeom_destroy_r(ctx, res)
+        if not buf:
+            return shapely.get_parts(shapely.polygonize(lines))
+        wkb = ctypes.string_at(buf, size.value)
+        lib.GEOSFree_r(ctx, buf)
+    finally:
+        lib.GEOS_finish_r(ctx)
+    return shapely.get_parts(shapely.from_wkb(wkb))
 
 
 def _sharing_an_edge(faces: np.ndarray) -> np.ndarray:

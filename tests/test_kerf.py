@@ -785,3 +785,28 @@ def test_pipeline_computes_the_kerf_regions_once_per_drawing(
         assert all(np.array_equal(p.points, q.points)
                    for p, q in zip(work.paths, fresh[0].paths, strict=True))
     assert made == [dr]
+
+
+def test_polygonize_without_the_gil_gives_shapelys_faces(monkeypatch):
+    """The kerf's polygonize step calls GEOS through ctypes (GIL released, issue 18): the
+    faces are shapely.polygonize's, the same polygons in the same order with the same
+    coordinates, on crossing random rings (and the same again through the fallback)."""
+    import shapely
+
+    from galvo_core import kerf as kmod
+
+    rng = np.random.default_rng(7)
+    rings = []
+    for _ in range(60):
+        c = rng.uniform(0, 400, 2)
+        t = np.sort(rng.uniform(0, 2 * np.pi, int(rng.integers(3, 12))))
+        r = rng.uniform(5, 60, len(t))
+        pts = np.round(c + np.c_[r * np.cos(t), r * np.sin(t)], 1)
+        rings.append(np.vstack([pts, pts[:1]]))
+    lines = shapely.get_parts(shapely.union_all([shapely.linestrings(r) for r in rings]))
+    want = shapely.to_wkb(shapely.get_parts(shapely.polygonize(lines))).tolist()
+    assert len(want) > 60
+    assert kmod._geos_c() is not None  # shapely's bundled GEOS is found here
+    assert shapely.to_wkb(kmod._polygonize(lines)).tolist() == want
+    monkeypatch.setattr(kmod, "_geos_c", lambda: None)
+    assert shapely.to_wkb(kmod._polygonize(lines)).tolist() == want
