@@ -1550,6 +1550,7 @@ def _fit_concatenated(
     if move_q is not None and (move_q > 0.0).any():
         gf = first + o_w[seg_owner]
         gl = last + o_w[seg_owner]
+        assert rounding is not None  # move_q is set with rounding
         bound = np.minimum(e_per, rounding[:, 0])
         changed = _joints_on_the_design(W, arc, points, is_cubic, tail, step, gf, gl,
                                         seg_owner, move_q, bound)
