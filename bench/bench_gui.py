@@ -512,6 +512,15 @@ def memory(files: list[Path], opens: int) -> None:
     win.close()
 
 
+
+def _generated(points: int) -> Path:
+    """A gen_plt file of ``points`` points (seed 0) in a fresh temporary folder."""
+    from gen_plt import generate_plt
+
+    f = Path(tempfile.mkdtemp(prefix="galvo-bench-")) / f"gen_{points}.plt"
+    f.write_bytes(generate_plt(points, seed=0))
+    return f
+
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     sub = ap.add_subparsers(dest="cmd", required=True)
@@ -535,14 +544,7 @@ def main(argv: list[str] | None = None) -> int:
     a4.add_argument("--min-ms", type=float, default=30.0)
     a = ap.parse_args(argv)
     if a.cmd == "holders":
-        files = list(a.files)
-        if not files:
-            from gen_plt import generate_plt
-
-            f = Path(tempfile.mkdtemp(prefix="galvo-bench-")) / f"gen_{a.points}.plt"
-            f.write_bytes(generate_plt(a.points, seed=0))
-            files = [f]
-        holders(files, a.min_ms)
+        holders(list(a.files) or [_generated(a.points)], a.min_ms)
         return 0
     if a.cmd == "memory":
         files = list(a.files)
@@ -556,14 +558,8 @@ def main(argv: list[str] | None = None) -> int:
                 files.append(f)
         memory(files, a.opens)
     elif a.cmd == "latency":
-        files = list(a.files)
-        if not files:
-            from gen_plt import generate_plt
-
-            f = Path(tempfile.mkdtemp(prefix="galvo-bench-")) / f"gen_{a.points}.plt"
-            f.write_bytes(generate_plt(a.points, seed=0))
-            files = [f]
-        latency(files, a.repeats, [w for w in a.rows.split(",") if w] or None)
+        latency(list(a.files) or [_generated(a.points)], a.repeats,
+                [w for w in a.rows.split(",") if w] or None)
     else:
         stalls(a.points, a.file, a.opens)
     return 0

@@ -141,6 +141,12 @@ def test_compiled_polygon_mode_reads_what_the_general_reader_reads(seed: int) ->
     assert a.commands.get("PM", 0) > 0 and len(a.paths) > 0
 
 
+def _nums(rng: random.Random, k: int) -> bytes:
+    """``k`` random coordinate pairs (0-2 decimals) as one parameter list."""
+    return ",".join(f"{rng.uniform(-500, 500):.{rng.randint(0, 2)}f}"
+                    for _ in range(2 * k)).encode()
+
+
 def _pm_program(rng: random.Random, n: int) -> bytes:
     """Random programs dense in polygon mode as files write it (GNU plotutils' open
     polylines, per-point PD closed by FP, PM1 sub-polygons) mixed with PU/PD/PA/PR/PW, pen
@@ -151,9 +157,7 @@ def _pm_program(rng: random.Random, n: int) -> bytes:
     from galvo_core.hpgl.pe import encode_number
 
     def nums(k: int) -> bytes:
-        return ",".join(f"{rng.uniform(-500, 500):.{rng.randint(0, 2)}f}"
-                        for _ in range(2 * k)).encode()
-
+        return _nums(rng, k)
     out = [rng.choice([b"IN;SP1;", b"IN;", b"", b"SP2;", b"IN;PW0.5;SP1;"])]
     for _ in range(n):
         r = rng.random()
@@ -378,9 +382,7 @@ def _pe_program(rng: random.Random, n: int) -> bytes:
     """Random programs with PE in and out of polygon mode, mixed with moves, PM0/PM1/PM2,
     EP/FP, pen selects, scaling, RF/FT and what the scanner hands back (IW, RO, CI, LB)."""
     def nums(k: int) -> bytes:
-        return ",".join(f"{rng.uniform(-500, 500):.{rng.randint(0, 2)}f}"
-                        for _ in range(2 * k)).encode()
-
+        return _nums(rng, k)
     out = [rng.choice([b"IN;SP1;", b"IN;", b"", b"SP2;", b"IN;SC0,100,0,100;SP1;"])]
     for _ in range(n):
         r = rng.random()
