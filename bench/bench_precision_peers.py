@@ -232,16 +232,19 @@ def print_font(rows):
               f"{r['secs']:.2f} |", flush=True)
 
 
-def print_corpus_row(r, peers):
-    def cell(p):
-        q = r["peers"].get(p)
-        if q is None:
-            return "–"
-        if "segments" not in q:
-            return f"over {q['timeout']:g} s"
-        return f"{q['segments']} / {q['dist_input']:.3f} / {q['over']}"
+def _peer_cell(r, p) -> str:
+    """A corpus row's cell for peer ``p``: segments / distance to the input / paths over the
+    bound, "over N s" when it timed out, "–" when it did not run."""
+    q = r["peers"].get(p)
+    if q is None:
+        return "–"
+    if "segments" not in q:
+        return f"over {q['timeout']:g} s"
+    return f"{q['segments']} / {q['dist_input']:.3f} / {q['over']}"
 
-    ps = " | ".join(cell(p) for p in peers)
+
+def print_corpus_row(r, peers):
+    ps = " | ".join(_peer_cell(r, p) for p in peers)
     print(f"| {r['file']} | {r['quantum']:g} | {r['points']} | {r['segments']} | "
           f"{r['worst']:.3f} / {r['bound']:.3f} | {r['corners']} | {ps} |", flush=True)
 
@@ -355,15 +358,9 @@ def corpus_table(rows, peers=("paper", "fit-curve", "fontforge", "inkscape")) ->
           + " | ".join(f"{p}: segments / dist / paths over" for p in peers) + " |")
     print("| --- | ---: | ---: | ---: | ---: | " + " | ".join("---:" for _ in peers) + " |")
     for r in rows:
-        def cell(p, r=r):
-            q = r["peers"].get(p)
-            if q is None:
-                return "–"
-            if "segments" not in q:
-                return f"over {q['timeout']:g} s"
-            return f"{q['segments']} / {q['dist_input']:.3f} / {q['over']}"
         print(f"| {r['file']} | {r['quantum']:g} | {r['points']} | {r['segments']} | "
-              f"{r['worst']:.3f} / {r['bound']:.3f} | " + " | ".join(map(cell, peers)) + " |")
+              f"{r['worst']:.3f} / {r['bound']:.3f} | "
+              + " | ".join(_peer_cell(r, p) for p in peers) + " |")
     tot = [str(sum(r["segments"] for r in rows))]
     for p in peers:
         ok = [r for r in rows if "segments" in r["peers"].get(p, {})]
