@@ -563,6 +563,14 @@ def _halves(a: np.ndarray, b: np.ndarray, k: np.ndarray) -> np.ndarray:
     return np.stack([np.stack([a, k], axis=1), np.stack([k, b], axis=1)], axis=1).reshape(-1, 2)
 
 
+def _chain_phase(idx: np.ndarray, k: int) -> np.ndarray:
+    """Per sorted index its position mod ``k`` within its run of consecutive indices (the
+    merge rounds take one phase at a time, so no two picks of a run overlap)."""
+    brk = np.r_[True, idx[1:] != idx[:-1] + 1]
+    chain_start = np.maximum.accumulate(np.where(brk, np.arange(len(idx)), 0))
+    return (np.arange(len(idx)) - chain_start) % k
+
+
 class _BatchFitter:
     """Fits curve pieces together (of one path, or of many concatenated paths: ``work`` the
     input points, ``kept`` the thinned indices into it, ``arc`` the cumulative arc length
@@ -837,9 +845,7 @@ class _BatchFitter:
             tri = (adj[:-1] & adj[1:] & (nl <= _RESPLIT_LINES)
                    & ~fixed[:-2] & ~fixed[1:-1] & ~fixed[2:])
             idx = np.flatnonzero(tri)
-            brk = np.r_[True, idx[1:] != idx[:-1] + 1]
-            chain_start = np.maximum.accumulate(np.where(brk, np.arange(len(idx)), 0))
-            pos = (np.arange(len(idx)) - chain_start) % 3
+            pos = _chain_phase(idx, 3)
             self._triples = (A, idx, pos)
         if len(idx) == 0:
             return False
@@ -980,9 +986,7 @@ class _BatchFitter:
             adj = ((B[:-1] == A[1:]) & ~fixed[:-1] & ~fixed[1:]
                    & self._barely_turns[B[:-1]])
             idx = np.flatnonzero(adj)
-            brk = np.r_[True, idx[1:] != idx[:-1] + 1]
-            chain_start = np.maximum.accumulate(np.where(brk, np.arange(len(idx)), 0))
-            pos = (np.arange(len(idx)) - chain_start) % 2
+            pos = _chain_phase(idx, 2)
             self._pairs = (A, idx, pos)
         if len(idx) == 0:
             return False
