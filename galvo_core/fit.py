@@ -143,6 +143,10 @@ _RESPLIT_CANDIDATES = 3
 _RESPLIT_ORDER = (1, 0, 2)
 #: ... and the most lines among the three
 _RESPLIT_LINES = 2
+#: chains of this many adjacent cubics or more are fitted again greedily (farthest reach)
+_GREEDY_MIN = 3
+#: ... each new cubic reaching at most this many old ones on
+_GREEDY_SPAN = 3
 #: rounded input: the vertices move onto the design (:func:`_on_the_design`) only on paths
 #: whose rounding half diagonal q/√2 is at least this share of e_per. Below, a move (at most
 #: q/√2) is small against the tolerance the user asked for: on typeface outlines rounded to
@@ -824,6 +828,101 @@ class _BatchFitter:
         for _ in range(_RESPLIT_ROUNDS):
             if not (self._resplit_round(0) | self._resplit_round(1) | self._resplit_round(2)):
                 break
+        self._greedy_round()
+
+    def _greedy_round(self) -> bool:
+        """Chains of at least ``_GREEDY_MIN`` adjacent cubics meeting at smooth vertices
+        (one tangent at the joint: no corner between them) are fitted again from the
+        chain's start, each cubic reaching the farthest thinned point where one passes the
+        same test (binary search over at most ``_GREEDY_SPAN`` old segments on), and
+        replaced where that takes fewer cubics. The dichotomy splits a failing piece at the
+        data's worst point, not at the design's joints, and the merge rounds only join
+        neighbours: a chain of n design pieces could stay at n + 1 or more cubics, each
+        joint a little off the design's. Reaching as far as possible each time takes the
+        fewest pieces when a cubic that fits a range fits every range inside it. All
+        chains are searched together (one :meth:`_try` per step); a chain stops as soon as
+        it cannot end with fewer cubics than it had. True when something changed."""
+        A, B, C, E, isl = self._all_segments()
+        n = len(A)
+        if n < _GREEDY_MIN:
+            return False
+        cub = ~isl
+        adj = (cub[:-1] & cub[1:] & (B[:-1] == A[1:])
+               & (self.t_in[B[:-1]] == self.t_out[B[:-1]]).all(axis=1))
+        head = np.r_[True, ~adj]  # a segment that starts a chain
+        cid = np.cumsum(head) - 1
+        size = np.bincount(cid)
+        first = np.flatnonzero(head)
+        last = first + size - 1
+        pick = np.flatnonzero((size >= _GREEDY_MIN) & cub[first])
+        if len(pick) == 0:
+            return False
+        old = size[pick]
+        cur = A[first[pick]].copy()
+        end = B[last[pick]]
+        lastseg = last[pick]
+        def cap(c, i):  # the farthest end tried from c: _GREEDY_SPAN old segments on
+            cs = np.searchsorted(A, c, side="right") - 1
+            return B[np.minimum(cs + _GREEDY_SPAN - 1, lastseg[i])]
+
+        bnd = cap(cur, np.arange(len(cur)))
+        lo = cur.copy()  # the farthest end found to pass from cur (cur: none yet)
+        hi = bnd + 1  # the nearest end known to fail (bnd + 1: none)
+        made = np.zeros(len(pick), dtype=np.intp)  # cubics finished so far
+        live = np.ones(len(pick), dtype=bool)
+        done = np.zeros(len(pick), dtype=bool)
+        best_c = np.zeros((len(pick), 4, 2))
+        best_e = np.zeros(len(pick))
+        out_k: list[np.ndarray] = []
+        out_a: list[np.ndarray] = []
+        out_b: list[np.ndarray] = []
+        out_c: list[np.ndarray] = []
+        out_e: list[np.ndarray] = []
+        while live.any():
+            w = np.flatnonzero(live)
+            # the first try of a cubic is its farthest end; then halve the bracket
+            mid = np.where(hi[w] > bnd[w], bnd[w], (lo[w] + hi[w]) // 2)
+            ok, ctrl, em = self._try(cur[w], mid)
+            g = w[ok]
+            lo[g] = mid[ok]
+            best_c[g] = ctrl[ok]
+            best_e[g] = em[ok]
+            hi[w[~ok]] = mid[~ok]
+            settled = w[(hi[w] - lo[w] <= 1) | (lo[w] == bnd[w])]
+            if len(settled) == 0:
+                continue
+            none = settled[lo[settled] == cur[settled]]
+            live[none] = False  # not even the next thinned point: the chain stays
+            s = settled[lo[settled] > cur[settled]]
+            out_k.append(s)
+            out_a.append(cur[s].copy())
+            out_b.append(lo[s].copy())
+            out_c.append(best_c[s].copy())
+            out_e.append(best_e[s].copy())
+            made[s] += 1
+            fin = s[lo[s] == end[s]]
+            done[fin] = made[fin] < old[fin]
+            live[fin] = False
+            go = s[lo[s] < end[s]]
+            live[go[made[go] + 1 >= old[go]]] = False  # cannot end below the old count
+            go = go[live[go]]
+            cur[go] = lo[go]
+            bnd[go] = cap(cur[go], go)
+            hi[go] = bnd[go] + 1
+        if not done.any():
+            return False
+        k = np.concatenate(out_k)
+        keep_new = done[k]
+        drop = np.isin(cid, pick[done])
+        nk = int(keep_new.sum())
+        A2 = np.concatenate([A[~drop], np.concatenate(out_a)[keep_new]])
+        B2 = np.concatenate([B[~drop], np.concatenate(out_b)[keep_new]])
+        C2 = np.concatenate([C[~drop], np.concatenate(out_c)[keep_new]])
+        E2 = np.concatenate([E[~drop], np.concatenate(out_e)[keep_new]])
+        L2 = np.concatenate([isl[~drop], np.zeros(nk, dtype=bool)])
+        o = np.argsort(A2, kind="stable")
+        self._store(A2[o], B2[o], C2[o], E2[o], L2[o])
+        return True
 
     def _resplit_round(self, phase: int) -> bool:
         """Three adjacent segments (cubics, at most ``_RESPLIT_LINES`` lines, no line of the
