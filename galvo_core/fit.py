@@ -832,10 +832,12 @@ class _BatchFitter:
 
     def _greedy_round(self) -> bool:
         """Chains of at least ``_GREEDY_MIN`` adjacent cubics meeting at smooth vertices
-        (one tangent at the joint: no corner between them) are fitted again from the
+        (one tangent at the joint: no corner between them; on rounded input also lines
+        that are not the design's, at vertices that barely turn) are fitted again from the
         chain's start, each cubic reaching the farthest thinned point where one passes the
-        same test (binary search over at most ``_GREEDY_SPAN`` old segments on), and
-        replaced where that takes fewer cubics. The dichotomy splits a failing piece at the
+        same test (binary search over at most ``_GREEDY_SPAN`` old segments on; where none
+        passes from an old joint, the old segment from there stays), and replaced where
+        that takes fewer segments. The dichotomy splits a failing piece at the
         data's worst point, not at the design's joints, and the merge rounds only join
         neighbours: a chain of n design pieces could stay at n + 1 or more cubics, each
         joint a little off the design's. Reaching as far as possible each time takes the
@@ -847,14 +849,22 @@ class _BatchFitter:
         if n < _GREEDY_MIN:
             return False
         cub = ~isl
-        adj = (cub[:-1] & cub[1:] & (B[:-1] == A[1:])
-               & (self.t_in[B[:-1]] == self.t_out[B[:-1]]).all(axis=1))
+        smooth = (self.t_in[B[:-1]] == self.t_out[B[:-1]]).all(axis=1)
+        adj = cub[:-1] & cub[1:] & (B[:-1] == A[1:]) & smooth
+        if self.quant is not None:
+            # rounded input: lines (not the design's) at vertices that barely turn too
+            if self._barely_turns is None:
+                cosv = (self.t_in * self.t_out).sum(axis=1)
+                self._barely_turns = cosv > math.cos(_ABSORB_TURN)
+            free = ~self._fixed_lines(A, B, isl)
+            adj |= ((B[:-1] == A[1:]) & free[:-1] & free[1:]
+                    & (self.quant[B[:-1]] > 0.0) & (smooth | self._barely_turns[B[:-1]]))
         head = np.r_[True, ~adj]  # a segment that starts a chain
         cid = np.cumsum(head) - 1
         size = np.bincount(cid)
         first = np.flatnonzero(head)
         last = first + size - 1
-        pick = np.flatnonzero((size >= _GREEDY_MIN) & cub[first])
+        pick = np.flatnonzero(size >= _GREEDY_MIN)
         if len(pick) == 0:
             return False
         old = size[pick]
@@ -878,6 +888,7 @@ class _BatchFitter:
         out_b: list[np.ndarray] = []
         out_c: list[np.ndarray] = []
         out_e: list[np.ndarray] = []
+        out_l: list[np.ndarray] = []
         while live.any():
             w = np.flatnonzero(live)
             # the first try of a cubic is its farthest end; then halve the bracket
@@ -892,13 +903,23 @@ class _BatchFitter:
             if len(settled) == 0:
                 continue
             none = settled[lo[settled] == cur[settled]]
-            live[none] = False  # not even the next thinned point: the chain stays
+            # no cubic from cur: the old segment starting there stays (else the chain)
+            os_ = np.searchsorted(A, cur[none])
+            has = (os_ < n) & (A[np.minimum(os_, n - 1)] == cur[none])
+            live[none[~has]] = False
+            none, os_ = none[has], os_[has]
+            lo[none] = B[os_]
+            best_c[none] = C[os_]
+            best_e[none] = E[os_]
             s = settled[lo[settled] > cur[settled]]
+            line = np.zeros(len(s), dtype=bool)
+            line[np.searchsorted(s, none)] = isl[os_]
             out_k.append(s)
             out_a.append(cur[s].copy())
             out_b.append(lo[s].copy())
             out_c.append(best_c[s].copy())
             out_e.append(best_e[s].copy())
+            out_l.append(line)
             made[s] += 1
             fin = s[lo[s] == end[s]]
             done[fin] = made[fin] < old[fin]
@@ -914,12 +935,11 @@ class _BatchFitter:
         k = np.concatenate(out_k)
         keep_new = done[k]
         drop = np.isin(cid, pick[done])
-        nk = int(keep_new.sum())
         A2 = np.concatenate([A[~drop], np.concatenate(out_a)[keep_new]])
         B2 = np.concatenate([B[~drop], np.concatenate(out_b)[keep_new]])
         C2 = np.concatenate([C[~drop], np.concatenate(out_c)[keep_new]])
         E2 = np.concatenate([E[~drop], np.concatenate(out_e)[keep_new]])
-        L2 = np.concatenate([isl[~drop], np.zeros(nk, dtype=bool)])
+        L2 = np.concatenate([isl[~drop], np.concatenate(out_l)[keep_new]])
         o = np.argsort(A2, kind="stable")
         self._store(A2[o], B2[o], C2[o], E2[o], L2[o])
         return True
