@@ -20,11 +20,15 @@ fonts-inconsolata, fonts-cantarell).
 from __future__ import annotations
 
 import contextlib
+import logging
 import math
 import os
 from dataclasses import dataclass
 
 import numpy as np
+
+# Inconsolata has a few (unused) glyphs with a negative advance: fontTools warns on load
+logging.getLogger("fontTools.ttLib.tables._h_m_t_x").setLevel(logging.ERROR)
 
 FONT_DIR = "/usr/share/fonts/truetype/dejavu"
 #: name -> file: several styles (serif, sans, bold, italic, condensed bold italic, light)
