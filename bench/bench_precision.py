@@ -1,7 +1,11 @@
 """Precision-aware fit on typeface outlines (issue 16): segments against the typeface's own
 count, distance to the true (unrounded) design curve both ways, violations of the bound, time.
 
-Usage: python bench/bench_precision.py [--em 1000] [--styles sans,serif] [--json out.json]
+Usage: python bench/bench_precision.py [--styles sans,serif] [--json out.json]
+       python bench/bench_precision.py --set heldout      # typefaces the fit was not tuned on
+       python bench/bench_precision.py --font F.otf [--font G.ttf] [--text T] [--em 700,1500]
+(default: the six DejaVu STYLES, TEXT, em 1000; --set heldout: HELDOUT typefaces, incl. two
+OpenType/CFF ones with cubic outlines, HELDOUT_TEXT, ems 700 and 1500; see fonts.py)
 """
 
 from __future__ import annotations
@@ -17,7 +21,16 @@ import numpy as np
 sys.path.insert(0, os.path.join(os.path.dirname(__file__), ".."))
 sys.path.insert(0, os.path.dirname(__file__))
 
-from fonts import STYLES, curve_distance, glyph_set  # noqa: E402
+from fonts import (  # noqa: E402
+    TEXT,
+    add_font_options,
+    curve_distance,
+    font_errors,
+    font_options,
+    glyph_set,
+    run_label,
+    style_name,
+)
 
 from galvo_core import fit as fitmod  # noqa: E402
 from galvo_core.geometry import flatten_cubic  # noqa: E402
@@ -30,8 +43,8 @@ def fitted_dense(fp, h: float = 0.002) -> np.ndarray:
     return np.vstack([parts[0]] + [p[1:] for p in parts[1:]])
 
 
-def run(style: str, whole: bool, em: float, **kw) -> dict:
-    gs = glyph_set(style, em=em, whole=whole)
+def run(style: str, whole: bool, em: float, text: str = TEXT, **kw) -> dict:
+    gs = glyph_set(style, em=em, whole=whole, text=text)
     fitmod.warm_up()
     t0 = time.process_time()
     fps = fitmod.fit_paths(gs.points, [True] * len(gs.points), **kw)
@@ -48,7 +61,8 @@ def run(style: str, whole: bool, em: float, **kw) -> dict:
             worst_excess = max(worst_excess, max(rep["max_in_to_curve"],
                                                  rep["max_curve_to_polyline"]) - rep["bound"])
     return {
-        "style": style, "whole": whole, "em": em, "points": int(sum(len(p) for p in gs.points)),
+        "style": gs.style, "text": text, "whole": whole, "em": em,
+        "points": int(sum(len(p) for p in gs.points)),
         "own": gs.own_segments, "segments": nseg, "ratio": nseg / gs.own_segments,
         "dist_true": dist, "violations": viol, "excess": worst_excess, "cpu_s": secs,
     }
@@ -56,28 +70,34 @@ def run(style: str, whole: bool, em: float, **kw) -> dict:
 
 def main() -> None:
     ap = argparse.ArgumentParser()
-    ap.add_argument("--em", type=float, default=1000.0)
-    ap.add_argument("--styles", default=",".join(STYLES))
+    add_font_options(ap)
     ap.add_argument("--json")
     ap.add_argument("--e-per", type=float)
     ap.add_argument("--eps-line", type=float)
     a = ap.parse_args()
+    styles, text, ems = font_options(a)
     kw = {}
     if a.e_per:
         kw["e_per"] = a.e_per
     if a.eps_line:
         kw["eps_line"] = a.eps_line
     rows = []
+    label = run_label(text, ems)
+    if label:
+        print(label)
     print("| style | input | points | own | segments | x own | to true curve "
           "| violations | cpu s |")
     print("| --- | --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: |")
     for whole in (True, False):
-        for st in a.styles.split(","):
-            r = run(st, whole, a.em, **kw)
-            rows.append(r)
-            print(f"| {st} | {'whole' if whole else 'exact'} | {r['points']} | {r['own']} | "
-                  f"{r['segments']} | {r['ratio']:.2f} | {r['dist_true']:.3f} | "
-                  f"{r['violations']} | {r['cpu_s']:.2f} |", flush=True)
+        for em in ems:
+            for st in styles:
+                with font_errors(st):
+                    r = run(st, whole, em, text, **kw)
+                rows.append(r)
+                name = style_name(st) + (f" em {em:g}" if len(ems) > 1 else "")
+                print(f"| {name} | {'whole' if whole else 'exact'} | {r['points']} | {r['own']} | "
+                      f"{r['segments']} | {r['ratio']:.2f} | {r['dist_true']:.3f} | "
+                      f"{r['violations']} | {r['cpu_s']:.2f} |", flush=True)
     if a.json:
         with open(a.json, "w") as f:
             json.dump(rows, f, indent=1)

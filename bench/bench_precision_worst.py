@@ -22,6 +22,8 @@ For each place (a point of the plane where our fit is far from the true design c
   pin the design down to well under the rounding, no simple bound).
 
 Usage: python bench/bench_precision_worst.py [--styles sans,...] [--top 10] [--json F]
+       python bench/bench_precision_worst.py --set heldout [--em 700] [--text T] [--font F.otf]
+(the font options as in bench_precision.py; see fonts.py)
 """
 
 from __future__ import annotations
@@ -39,7 +41,18 @@ sys.path.insert(0, os.path.join(os.path.dirname(__file__), ".."))
 sys.path.insert(0, os.path.dirname(__file__))
 
 from bench_precision import fitted_dense  # noqa: E402
-from fonts import FONT_DIR, STYLES, TEXT, _flatten_quad, contours, glyph_set  # noqa: E402
+from fonts import (  # noqa: E402
+    TEXT,
+    add_font_options,
+    contours,
+    flatten_segment,
+    font_errors,
+    font_file,
+    font_options,
+    glyph_set,
+    run_label,
+    style_name,
+)
 
 from galvo_core import fit as fitmod  # noqa: E402
 from galvo_core.geometry import point_polyline_distance  # noqa: E402
@@ -53,7 +66,7 @@ def labelled_truth(segs):
     """The true curve (chord 1e-3) and per vertex its design segment index."""
     pts, lab = [], []
     for i, s in enumerate(segs):
-        p = np.array([s[1], s[2]]) if s[0] == "line" else _flatten_quad(s[1], s[2], s[3], 1e-3)
+        p = flatten_segment(s, 1e-3)
         if i:
             p = p[1:]
         pts.append(p)
@@ -62,10 +75,16 @@ def labelled_truth(segs):
 
 
 def tangent(s, end: bool) -> np.ndarray:
-    if s[0] == "line":
-        d = s[2] - s[1]
-    else:
-        d = (s[3] - s[2]) if end else (s[2] - s[1])
+    """The unit tangent at the segment's end (or start): the first control point that is
+    not on the end point gives it (a curve's control point may coincide with its end)."""
+    pts = list(s[1:])
+    if end:
+        pts = pts[::-1]
+    d = np.zeros(2)
+    for q in pts[1:]:
+        d = (pts[0] - q) if end else (q - pts[0])
+        if d.any():
+            break
     n = math.hypot(*d)
     return d / n if n else d
 
@@ -73,7 +92,7 @@ def tangent(s, end: bool) -> np.ndarray:
 def seg_len(s) -> float:
     if s[0] == "line":
         return float(math.hypot(*(s[2] - s[1])))
-    p = _flatten_quad(s[1], s[2], s[3], 1e-3)
+    p = flatten_segment(s, 1e-3)
     return float(np.hypot(*np.diff(p, axis=0).T).sum())
 
 
@@ -192,9 +211,9 @@ def classify(segs, lab_seg, arc_pos, seglens):
     return "inside a curve", []
 
 
-def worst_places(style: str, top: int, em: float = 1000.0):
-    gs = glyph_set(style, em=em, whole=True)
-    cs = contours(os.path.join(FONT_DIR, STYLES[style]), TEXT, em)
+def worst_places(style: str, top: int, em: float = 1000.0, text: str = TEXT):
+    gs = glyph_set(style, em=em, whole=True, text=text)
+    cs = contours(font_file(style), text, em)
     fps = fitmod.fit_paths(gs.points, [True] * len(gs.points))
     cands = []
     for ci, (segs, fp, pts) in enumerate(zip(cs, fps, gs.points, strict=True)):
@@ -237,7 +256,8 @@ def worst_places(style: str, top: int, em: float = 1000.0):
         used.append((ci, p))
         kind, orc = classify(segs, sgi, apos, seglens)
         rows.append({
-            "style": style, "contour": ci, "x": float(p[0]), "y": float(p[1]), "kind": kind,
+            "style": gs.style, "em": em, "contour": ci, "x": float(p[0]), "y": float(p[1]),
+            "kind": kind,
             "fit": local_dist(p, F, T), "poly": local_dist(p, Rp, T),
             "oracle": oracle_vertex_moves(segs, orc) if orc else None,
         })
@@ -246,38 +266,44 @@ def worst_places(style: str, top: int, em: float = 1000.0):
     return rows
 
 
-def glyph_of(x: float, style: str, em: float = 1000.0) -> str:
+def glyph_of(x: float, style: str, em: float = 1000.0, text: str = TEXT) -> str:
     from fontTools.ttLib import TTFont
 
-    font = TTFont(os.path.join(FONT_DIR, STYLES[style]))
+    font = TTFont(font_file(style))
     gs = font.getGlyphSet()
     cmap = font.getBestCmap()
     scale = em / font["head"].unitsPerEm
     x0 = 0.0
-    for ch in TEXT:
+    for ch in text:
         w = gs[cmap[ord(ch)]].width * scale
         if x < x0 + w:
             return ch
         x0 += w
-    return TEXT[-1]
+    return text[-1]
 
 
 def main() -> None:
     ap = argparse.ArgumentParser()
-    ap.add_argument("--styles", default=",".join(STYLES))
+    add_font_options(ap)
     ap.add_argument("--top", type=int, default=10)
     ap.add_argument("--json")
     a = ap.parse_args()
+    styles, text, ems = font_options(a)
     fitmod.warm_up()
     allrows = []
+    label = run_label(text, ems)
+    if label:
+        print(label)
     print("| style | glyph | at (x, y) | kind | fit | rounded polyline | oracle bound |")
     print("| --- | --- | --- | --- | ---: | ---: | ---: |")
-    for st in a.styles.split(","):
-        rows = worst_places(st, a.top)
+    for em, st in itertools.product(ems, styles):
+        with font_errors(st):
+            rows = worst_places(st, a.top, em, text)
+        name = style_name(st) + (f" em {em:g}" if len(ems) > 1 else "")
         for r in rows:
-            r["glyph"] = glyph_of(r["x"], st)
+            r["glyph"] = glyph_of(r["x"], st, em, text)
             o = "–" if r["oracle"] is None else f"{r['oracle']:.3f}"
-            print(f"| {st} | {r['glyph']} | {r['x']:.1f}, {r['y']:.1f} | {r['kind']} | "
+            print(f"| {name} | {r['glyph']} | {r['x']:.1f}, {r['y']:.1f} | {r['kind']} | "
                   f"{r['fit']:.3f} | {r['poly']:.3f} | {o} |", flush=True)
         allrows += rows
     if a.json:
