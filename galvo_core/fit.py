@@ -2255,6 +2255,36 @@ _CORNER_SINE = 0.25
 _CORNER_POINTS = _SIDE_POINTS
 
 
+#: a side written as its two rounded ends only gives the corner a direction where it is at
+#: least this many quanta long (the direction then within about 1/this radian)
+_LONE_LENGTH = 8.0
+#: ... and meets the curve's tangent there at this angle or more (sine): the intersection
+#: then; below, an error in the line's offset would move it far along the line
+_LONE_SINE = 0.9
+
+
+def _lone_sides(W, K, smooth, v, w, quant, p, t, ok, ok_other, after=False) -> None:
+    """:func:`_corners_on_the_design`'s sides (position ``p``, tangent ``t``, ``ok``, in
+    place) at the corners ``v`` (the vertex as the end of the side, the next one's start
+    ``w``) whose side before them (``after``: after them) is a line over two input points
+    (its ends, no least-squares line) while the other side is a curve (its fit ``ok_other``):
+    the line through those two rounded ends, where it is at least ``_LONE_LENGTH`` quanta
+    long. Its intersection with the curve's tangent puts the corner where the design line
+    meets the design curve, up to the rounding of the line's offset."""
+    near = v
+    far, other = (v + 1, w - 1) if after else (v - 1, w + 1)
+    sel = ~ok & ok_other & ~smooth[far] & smooth[other] & (np.abs(K[near] - K[far]) == 1)
+    if not sel.any():
+        return sel
+    a, b = W[K[far][sel]], W[K[near][sel]]
+    d = (b - a) if not after else (a - b)
+    ln = np.hypot(d[:, 0], d[:, 1])
+    p[sel] = b
+    t[sel] = d / np.maximum(ln, 1e-300)[:, None]
+    ok[sel] = ln >= _LONE_LENGTH * quant[near][sel]
+    return sel & ok
+
+
 def _corners_on_the_design(W, K, Q, arc, smooth, rnd, first, last, quant, eps) -> None:
     """Rounded input: the corners (thinned vertices that are not smooth; a closed path's
     seam too) move inside their rounding squares onto an estimate of the design's corner.
@@ -2298,9 +2328,19 @@ def _corners_on_the_design(W, K, Q, arc, smooth, rnd, first, last, quant, eps) -
     if lin.any():
         p, t, ok = _local_lines(W, k[lin], K[vo + 1][lin], k[lin])
         p_out[lin], t_out[lin], ok_out[lin] = p, t, ok
+    # a side that is a line written as its two ends only (no least-squares line) beside a
+    # curve side: the line through those two rounded ends, long enough to give a direction
+    # (the curve side of such a corner is not checked as a line below: the fitter checks
+    # its cubics against the bound, and a line there is made valid by _valid_lines)
+    lone_in = _lone_sides(W, K, smooth, vi, vo, quant, p_in, t_in, ok_in, ok_out)
+    lone_out = _lone_sides(W, K, smooth, vo, vi, quant, p_out, t_out, ok_out, ok_in,
+                           after=True)
     both = ok_in & ok_out
     est = 0.5 * (p_in + p_out)
     cr = t_in[:, 0] * t_out[:, 1] - t_in[:, 1] * t_out[:, 0]
+    lone = lone_in | lone_out
+    # a side of two points meeting a curve at a middling angle: neither estimate is good
+    both &= ~lone | (np.abs(cr) >= _LONE_SINE) | (np.abs(cr) < _CORNER_SINE)
     sharp = both & (np.abs(cr) >= _CORNER_SINE)
     if sharp.any():
         d = p_out[sharp] - p_in[sharp]
@@ -2308,6 +2348,7 @@ def _corners_on_the_design(W, K, Q, arc, smooth, rnd, first, last, quant, eps) -
         s = (d[:, 0] * to[:, 1] - d[:, 1] * to[:, 0]) / cr[sharp]
         est[sharp] = p_in[sharp] + s[:, None] * ti
     vi, vo, est = vi[both], vo[both], est[both]
+    lone_in, lone_out = lone_in[both], lone_out[both]
     wk = W[K[vo]]
     h = 0.5 * quant[vo][:, None]
     new = np.clip(est, wk - h, wk + h)
@@ -2322,7 +2363,7 @@ def _corners_on_the_design(W, K, Q, arc, smooth, rnd, first, last, quant, eps) -
     moved[vi] = True
     for _ in range(3):
         # the thinned segments next to a moved corner, as lines: within eps of their points?
-        seg = np.unique(np.concatenate([vi - 1, vo]))
+        seg = np.unique(np.concatenate([vi[~lone_out] - 1, vo[~lone_in]]))
         seg = seg[moved[seg] | moved[seg + 1]]
         if len(seg) == 0:
             break
@@ -2342,6 +2383,7 @@ def _corners_on_the_design(W, K, Q, arc, smooth, rnd, first, last, quant, eps) -
         moved[vi[back]] = False
         keep = ~back
         vi, vo, old = vi[keep], vo[keep], old[keep]
+        lone_in, lone_out = lone_in[keep], lone_out[keep]
 
 
 def _arc_per_path(W: np.ndarray, wlen: np.ndarray) -> np.ndarray:

@@ -167,7 +167,8 @@ def _vertex_rules(
         # a turn below ~1e-12 rad is numerically straight: no sign
         sign[1:-1] = np.where(inner & (np.abs(cr) > 1e-12 * la * lb), np.sign(cr), 0.0)
         if rounding is not None:
-            _rounded_rules(smooth, sign, rounding, inner, dot, cr, la, lb, length_ratio)
+            _rounded_rules(smooth, sign, rounding, inner, dot, cr, la, lb, length_ratio,
+                           cos_join, s)
     return smooth, turn, sign
 
 
@@ -178,7 +179,13 @@ _ROUNDED_TURN_MARGIN = 1.5
 _ROUNDED_TURN_CAP = math.radians(50.0)
 
 
-def _rounded_rules(smooth, sign, rounding, inner, dot, cr, la, lb, length_ratio) -> None:
+#: rounded input: a thinned segment up to this many quanta long between a curve run and a
+#: corner is the run's end, not a line (see :func:`_rounded_rules`)
+_SHORT_END = 16.0
+
+
+def _rounded_rules(smooth, sign, rounding, inner, dot, cr, la, lb, length_ratio,
+                   cos_join=0.95, seg=None) -> None:
     """The vertex rules on rounded input (quantum q > 0, thinned with tolerance eps), in
     place. Thinning a smooth curve of radius R with eps leaves chords of sagitta about eps,
     so each turns about l / R <= 8 eps / l: on a tight curve the chords turn more than
@@ -186,7 +193,11 @@ def _rounded_rules(smooth, sign, rounding, inner, dot, cr, la, lb, length_ratio)
     ``_ROUNDED_TURN_MARGIN`` times (la + lb) 4 eps / max(la, lb)^2 (and at most
     ``_ROUNDED_TURN_CAP``) is smooth too, if its segments pass the length rule; a real
     corner turns more than that. A turn smaller than the rounding can make it (q / the
-    longer segment) has no sign: rounding wiggles are not inflections."""
+    longer segment) has no sign: rounding wiggles are not inflections. A segment of up to
+    ``_SHORT_END`` quanta between a curve run (the vertex on its other side smooth) and a
+    corner is what the thinning leaves of the curve's end before the corner: the vertex
+    between it and the run is smooth when it turns as a smooth vertex may (the length
+    rule aside), so that the run ends at the corner."""
     eps = rounding[1:-1, 0]
     qq = rounding[1:-1, 1]
     rnd = inner & (qq > 0.0)
@@ -202,6 +213,42 @@ def _rounded_rules(smooth, sign, rounding, inner, dot, cr, la, lb, length_ratio)
         flat = rnd & (ang < qq / lmax)
     smooth[1:-1] |= add
     sign[1:-1][flat] = 0.0
+    # a short segment between a run and a corner whose other side is not a curve: the
+    # run's end (see above)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        turn_ok = (dot > cos_join * la * lb) | (ang <= lim)
+    sm = np.concatenate([[False, False], smooth, [False, False]])  # sm[k + 2] = smooth[k]
+    prev_s, next_s = sm[2:-4], sm[4:-2]
+    prev2, next2 = sm[1:-5], sm[5:-1]
+    cur = sm[3:-3]
+    end_b = (lb <= _SHORT_END * qq) & (lb < la) & prev_s & ~next_s & ~next2
+    end_a = (la <= _SHORT_END * qq) & (la < lb) & next_s & ~prev_s & ~prev2
+    ext = rnd & ~cur & turn_ok & (end_a | end_b)
+    # a short segment between two corners inside a curve (a rounding wiggle: the vertices
+    # on its both sides smooth) whose neighbouring segments meet as a smooth vertex would:
+    # both of its ends smooth, unsigned
+    if seg is not None and len(la) >= 3:
+        sv = seg
+        a_, c_ = sv[:-2], sv[2:]  # per vertex k (< last - 1): segments k - 1 and k + 1
+        lc = np.r_[lb[1:], np.nan]
+        la2 = la
+        with np.errstate(invalid="ignore", divide="ignore"):
+            dot2 = np.r_[(a_ * c_).sum(axis=1), np.nan]
+            cr2 = np.r_[a_[:, 0] * c_[:, 1] - a_[:, 1] * c_[:, 0], np.nan]
+            lmax2 = np.maximum(la2, lc)
+            lim2 = np.minimum(_ROUNDED_TURN_MARGIN * (la2 + lc) * 4.0 * eps / (lmax2 * lmax2),
+                              _ROUNDED_TURN_CAP)
+            ok2 = ((dot2 > cos_join * la2 * lc) | (np.abs(np.arctan2(cr2, dot2)) <= lim2))
+            ok2 &= (lc <= length_ratio * la2) & (la2 <= length_ratio * lc)
+        wig = (rnd & (lb <= _SHORT_END * qq) & ~cur & ~next_s & prev_s & next2 & ok2
+               & (lb < la) & (lb < lc))
+        if wig.any():
+            j = np.flatnonzero(wig)
+            ext[j] = True
+            ext[j[j + 1 < len(ext)] + 1] = True
+            sign[1:-1][j] = 0.0
+            sign[1:-1][j[j + 1 < len(ext)] + 1] = 0.0
+    smooth[1:-1] |= ext
 
 
 def _runs(smooth: np.ndarray, sign: np.ndarray, lay: _Layout) -> tuple[np.ndarray, np.ndarray]:
