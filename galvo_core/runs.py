@@ -225,6 +225,7 @@ def _rounded_rules(smooth, sign, rounding, inner, dot, cr, la, lb, length_ratio,
     end_a = (la <= _SHORT_END * qq) & (la < lb) & next_s & ~prev_s & ~prev2
     ext = rnd & ~cur & turn_ok & (end_a | end_b)
     smooth[1:-1] |= ext
+    sign[1:-1][ext] = 0.0  # (its turn is the short segment's rounding: no inflection)
 
 
 def _runs(smooth: np.ndarray, sign: np.ndarray, lay: _Layout) -> tuple[np.ndarray, np.ndarray]:
