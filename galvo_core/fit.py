@@ -564,11 +564,15 @@ def _halves(a: np.ndarray, b: np.ndarray, k: np.ndarray) -> np.ndarray:
 
 
 def _chain_phase(idx: np.ndarray, k: int) -> np.ndarray:
-    """Per sorted index its position mod ``k`` within its run of consecutive indices (the
-    merge rounds take one phase at a time, so no two picks of a run overlap)."""
-    brk = np.r_[True, idx[1:] != idx[:-1] + 1]
+    """Per sorted index of a group of ``k`` consecutive segments (idx .. idx + k - 1) its
+    offset mod ``k`` from the first index of its chain (indices less than ``k`` apart, so
+    whose groups overlap): the merge rounds take one phase at a time, so no two picks
+    overlap. (Chains of consecutive indices alone would let two triples two apart, with
+    the one between them not a candidate, both be picked and share a segment: a range of
+    the path was then lost.)"""
+    brk = np.r_[True, idx[1:] >= idx[:-1] + k]
     chain_start = np.maximum.accumulate(np.where(brk, np.arange(len(idx)), 0))
-    return (np.arange(len(idx)) - chain_start) % k
+    return (idx - idx[chain_start]) % k
 
 
 class _BatchFitter:
