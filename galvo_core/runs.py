@@ -168,7 +168,7 @@ def _vertex_rules(
         sign[1:-1] = np.where(inner & (np.abs(cr) > 1e-12 * la * lb), np.sign(cr), 0.0)
         if rounding is not None:
             _rounded_rules(smooth, sign, rounding, inner, dot, cr, la, lb, length_ratio,
-                           cos_join)
+                           cos_join, s)
     return smooth, turn, sign
 
 
@@ -185,7 +185,7 @@ _SHORT_END = 16.0
 
 
 def _rounded_rules(smooth, sign, rounding, inner, dot, cr, la, lb, length_ratio,
-                   cos_join=0.95) -> None:
+                   cos_join=0.95, seg=None) -> None:
     """The vertex rules on rounded input (quantum q > 0, thinned with tolerance eps), in
     place. Thinning a smooth curve of radius R with eps leaves chords of sagitta about eps,
     so each turns about l / R <= 8 eps / l: on a tight curve the chords turn more than
@@ -224,6 +224,30 @@ def _rounded_rules(smooth, sign, rounding, inner, dot, cr, la, lb, length_ratio,
     end_b = (lb <= _SHORT_END * qq) & (lb < la) & prev_s & ~next_s & ~next2
     end_a = (la <= _SHORT_END * qq) & (la < lb) & next_s & ~prev_s & ~prev2
     ext = rnd & ~cur & turn_ok & (end_a | end_b)
+    # a short segment between two corners inside a curve (a rounding wiggle: the vertices
+    # on its both sides smooth) whose neighbouring segments meet as a smooth vertex would:
+    # both of its ends smooth, unsigned
+    if seg is not None and len(la) >= 3:
+        sv = seg
+        a_, c_ = sv[:-2], sv[2:]  # per vertex k (< last - 1): segments k - 1 and k + 1
+        lc = np.r_[lb[1:], np.nan]
+        la2 = la
+        with np.errstate(invalid="ignore", divide="ignore"):
+            dot2 = np.r_[(a_ * c_).sum(axis=1), np.nan]
+            cr2 = np.r_[a_[:, 0] * c_[:, 1] - a_[:, 1] * c_[:, 0], np.nan]
+            lmax2 = np.maximum(la2, lc)
+            lim2 = np.minimum(_ROUNDED_TURN_MARGIN * (la2 + lc) * 4.0 * eps / (lmax2 * lmax2),
+                              _ROUNDED_TURN_CAP)
+            ok2 = ((dot2 > cos_join * la2 * lc) | (np.abs(np.arctan2(cr2, dot2)) <= lim2))
+            ok2 &= (lc <= length_ratio * la2) & (la2 <= length_ratio * lc)
+        wig = (rnd & (lb <= _SHORT_END * qq) & ~cur & ~next_s & prev_s & next2 & ok2
+               & (lb < la) & (lb < lc))
+        if wig.any():
+            j = np.flatnonzero(wig)
+            ext[j] = True
+            ext[j[j + 1 < len(ext)] + 1] = True
+            sign[1:-1][j] = 0.0
+            sign[1:-1][j[j + 1 < len(ext)] + 1] = 0.0
     smooth[1:-1] |= ext
     sign[1:-1][ext] = 0.0  # (its turn is the short segment's rounding: no inflection)
 
