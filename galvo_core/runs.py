@@ -185,7 +185,7 @@ _SHORT_END = 16.0
 
 
 def _rounded_rules(smooth, sign, rounding, inner, dot, cr, la, lb, length_ratio,
-                   cos_join=0.95, seg=None) -> None:
+                   cos_join, seg) -> None:
     """The vertex rules on rounded input (quantum q > 0, thinned with tolerance eps), in
     place. Thinning a smooth curve of radius R with eps leaves chords of sagitta about eps,
     so each turns about l / R <= 8 eps / l: on a tight curve the chords turn more than
@@ -197,7 +197,12 @@ def _rounded_rules(smooth, sign, rounding, inner, dot, cr, la, lb, length_ratio,
     ``_SHORT_END`` quanta between a curve run (the vertex on its other side smooth) and a
     corner is what the thinning leaves of the curve's end before the corner: the vertex
     between it and the run is smooth when it turns as a smooth vertex may (the length
-    rule aside), so that the run ends at the corner."""
+    rule aside), so that the run ends at the corner; where the corner's other side is a
+    curve too, the segment is rather a wiggle of the rounding inside one curve (the
+    thinning cut a curve's stretch into long, short, long): both of its ends are smooth
+    where the two long segments around it meet as a smooth vertex may. Such vertices have
+    no sign (their turn is the rounding's). ``cos_join``: the plain rule's threshold;
+    ``seg``: the segment vectors of the points."""
     eps = rounding[1:-1, 0]
     qq = rounding[1:-1, 1]
     rnd = inner & (qq > 0.0)
@@ -214,10 +219,10 @@ def _rounded_rules(smooth, sign, rounding, inner, dot, cr, la, lb, length_ratio,
     smooth[1:-1] |= add
     sign[1:-1][flat] = 0.0
     # a short segment between a run and a corner whose other side is not a curve: the
-    # run's end (see above)
+    # run's end (see above; sm[k + 2] is smooth[k], False beyond the ends)
     with np.errstate(invalid="ignore", divide="ignore"):
         turn_ok = (dot > cos_join * la * lb) | (ang <= lim)
-    sm = np.concatenate([[False, False], smooth, [False, False]])  # sm[k + 2] = smooth[k]
+    sm = np.concatenate([[False, False], smooth, [False, False]])
     prev_s, next_s = sm[2:-4], sm[4:-2]
     prev2, next2 = sm[1:-5], sm[5:-1]
     cur = sm[3:-3]
@@ -225,31 +230,25 @@ def _rounded_rules(smooth, sign, rounding, inner, dot, cr, la, lb, length_ratio,
     end_a = (la <= _SHORT_END * qq) & (la < lb) & next_s & ~prev_s & ~prev2
     ext = rnd & ~cur & turn_ok & (end_a | end_b)
     # a short segment between two corners inside a curve (a rounding wiggle: the vertices
-    # on its both sides smooth) whose neighbouring segments meet as a smooth vertex would:
-    # both of its ends smooth, unsigned
-    if seg is not None and len(la) >= 3:
-        sv = seg
-        a_, c_ = sv[:-2], sv[2:]  # per vertex k (< last - 1): segments k - 1 and k + 1
+    # beyond its ends smooth) whose neighbouring segments meet as a smooth vertex would:
+    # both of its ends smooth (see above)
+    if len(la) >= 3:
+        a_, c_ = seg[:-2], seg[2:]  # per vertex k (< last - 1): segments k - 1 and k + 1
         lc = np.r_[lb[1:], np.nan]
-        la2 = la
         with np.errstate(invalid="ignore", divide="ignore"):
             dot2 = np.r_[(a_ * c_).sum(axis=1), np.nan]
             cr2 = np.r_[a_[:, 0] * c_[:, 1] - a_[:, 1] * c_[:, 0], np.nan]
-            lmax2 = np.maximum(la2, lc)
-            lim2 = np.minimum(_ROUNDED_TURN_MARGIN * (la2 + lc) * 4.0 * eps / (lmax2 * lmax2),
+            lmax2 = np.maximum(la, lc)
+            lim2 = np.minimum(_ROUNDED_TURN_MARGIN * (la + lc) * 4.0 * eps / (lmax2 * lmax2),
                               _ROUNDED_TURN_CAP)
-            ok2 = ((dot2 > cos_join * la2 * lc) | (np.abs(np.arctan2(cr2, dot2)) <= lim2))
-            ok2 &= (lc <= length_ratio * la2) & (la2 <= length_ratio * lc)
-        wig = (rnd & (lb <= _SHORT_END * qq) & ~cur & ~next_s & prev_s & next2 & ok2
-               & (lb < la) & (lb < lc))
-        if wig.any():
-            j = np.flatnonzero(wig)
-            ext[j] = True
-            ext[j[j + 1 < len(ext)] + 1] = True
-            sign[1:-1][j] = 0.0
-            sign[1:-1][j[j + 1 < len(ext)] + 1] = 0.0
+            ok2 = (dot2 > cos_join * la * lc) | (np.abs(np.arctan2(cr2, dot2)) <= lim2)
+            ok2 &= (lc <= length_ratio * la) & (la <= length_ratio * lc)
+        wig = np.flatnonzero(rnd & (lb <= _SHORT_END * qq) & ~cur & ~next_s & prev_s & next2
+                             & ok2 & (lb < la) & (lb < lc))
+        ext[wig] = True
+        ext[wig + 1] = True  # (next2: vertex k + 1 is inside the path)
     smooth[1:-1] |= ext
-    sign[1:-1][ext] = 0.0  # (its turn is the short segment's rounding: no inflection)
+    sign[1:-1][ext] = 0.0
 
 
 def _runs(smooth: np.ndarray, sign: np.ndarray, lay: _Layout) -> tuple[np.ndarray, np.ndarray]:
