@@ -2297,9 +2297,16 @@ def _corners_on_the_design(W, K, Q, arc, smooth, rnd, first, last, quant, eps) -
     other end a corner too), else a least-squares quadratic (over at least
     ``_CORNER_POINTS`` input points of the path). The corner is the
     intersection of the two tangent lines where they cross at an angle, else the mean of
-    the two positions. A corner stays where a line from it to a neighbouring thinned point
-    would miss its input points by more than ``eps`` (per thinned point), so the lines
-    keep their bound. In place on ``Q``."""
+    the two positions. A side that is a line over two input points only (no least-squares
+    line) beside a curve side is the line through its two rounded ends
+    (:func:`_lone_sides`), intersected with the curve's tangent where they cross at
+    ``_LONE_SINE`` or more; at a middling angle (``_CORNER_SINE`` to ``_LONE_SINE``: an
+    error in the line's offset would move the intersection far) the corner stays. A corner
+    stays where a line from it to a neighbouring thinned point would miss its input points
+    by more than ``eps`` (per thinned point), so the lines keep their bound (the curve side
+    of a corner with a two-point side is not held to that: the fitter tests its cubics
+    against the bound, and a line there is made valid by :func:`_valid_lines`). In place
+    on ``Q``."""
     n = len(Q)
     is_first = np.zeros(n, dtype=bool)
     is_first[first] = True
