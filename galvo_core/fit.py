@@ -2206,6 +2206,13 @@ def _local_lines(
     return pos, tan, ok
 
 
+#: rounded input: a smooth vertex's design estimate is fitted over at least this many input
+#: points on each side of it
+_SMOOTH_HALF = 6
+#: ... on a side whose thinned segment is at most this many quanta long
+_SMOOTH_SHORT = 4.0
+
+
 def _on_the_design(W, K, Q, arc, t_in, t_out, smooth, quant, tlen, eps) -> None:
     """Rounded input (per thinned point its path's quantum ``quant``): the smooth thinned
     vertices (inside curve runs) moved onto a least-squares estimate of the design curve
@@ -2225,6 +2232,16 @@ def _on_the_design(W, K, Q, arc, t_in, t_out, smooth, quant, tlen, eps) -> None:
     if len(sm):
         lo = (K[sm - 1] + K[sm] + 1) // 2
         hi = (K[sm] + K[sm + 1]) // 2
+        # beside a thinned segment of a few quanta (a rounding wiggle): at least
+        # _SMOOTH_HALF input points on that side, up to the thinned point beyond it
+        ln = np.hypot(*(W[K[1:]] - W[K[:-1]]).T)
+        short = _SMOOTH_SHORT * quant[sm]
+        lo_min = np.where(smooth[sm - 1], K[np.maximum(sm - 2, 0)], K[sm - 1])
+        hi_max = np.where(smooth[sm + 1], K[np.minimum(sm + 2, n - 1)], K[sm + 1])
+        lo = np.where(ln[sm - 1] <= short,
+                      np.maximum(lo_min, np.minimum(lo, K[sm] - _SMOOTH_HALF)), lo)
+        hi = np.where(ln[sm] <= short,
+                      np.minimum(hi_max, np.maximum(hi, K[sm] + _SMOOTH_HALF)), hi)
         pos, tan, ok = _local_fits(W, arc, np.minimum(lo, K[sm]), np.maximum(hi, K[sm]), K[sm])
         k = sm[ok]
         h = 0.5 * quant[k][:, None]

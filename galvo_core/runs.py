@@ -182,6 +182,7 @@ _ROUNDED_TURN_CAP = math.radians(50.0)
 #: rounded input: a thinned segment up to this many quanta long between a curve run and a
 #: corner is the run's end, not a line (see :func:`_rounded_rules`)
 _SHORT_END = 16.0
+_WIGGLE = True  # (the rounding-wiggle rule below; False: off, for measurements)
 
 
 def _rounded_rules(smooth, sign, rounding, inner, dot, cr, la, lb, length_ratio,
@@ -232,7 +233,7 @@ def _rounded_rules(smooth, sign, rounding, inner, dot, cr, la, lb, length_ratio,
     # a short segment between two corners inside a curve (a rounding wiggle: the vertices
     # beyond its ends smooth) whose neighbouring segments meet as a smooth vertex would:
     # both of its ends smooth (see above)
-    if len(la) >= 3:
+    if _WIGGLE and len(la) >= 3:
         a_, c_ = seg[:-2], seg[2:]  # per vertex k (< last - 1): segments k - 1 and k + 1
         lc = np.r_[lb[1:], np.nan]
         with np.errstate(invalid="ignore", divide="ignore"):
