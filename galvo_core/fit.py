@@ -2282,6 +2282,9 @@ _LONE_LENGTH = 8.0
 #: ... and meets the curve's tangent there at this angle or more (sine): the intersection
 #: then; below, an error in the line's offset would move it far along the line
 _LONE_SINE = 0.9
+#: ... and moves it by at least this many half quanta (less is within the estimate's
+#: own error: the input point stays)
+_LONE_MIN_MOVE = 0.2
 
 
 def _lone_sides(W, K, smooth, v, w, quant, p, t, ok, ok_other, after=False) -> None:
@@ -2382,6 +2385,8 @@ def _corners_on_the_design(W, K, Q, arc, smooth, rnd, first, last, quant, eps) -
     new = np.clip(est, wk - h, wk + h)
     # an estimate on the input point up to rounding errors is the input point
     same = np.abs(new - wk).max(axis=1) <= 1e-9 * (h[:, 0] + np.abs(wk).max(axis=1))
+    # ... and so is one by a side of two points moving it less than its own uncertainty
+    same |= (lone_in | lone_out) & (np.hypot(*(new - wk).T) < _LONE_MIN_MOVE * h[:, 0])
     new[same] = wk[same]
     old = Q[vo].copy()
     Q[vo] = new
