@@ -219,36 +219,43 @@ def _rounded_rules(smooth, sign, rounding, inner, dot, cr, la, lb, length_ratio,
         flat = rnd & (ang < qq / lmax)
     smooth[1:-1] |= add
     sign[1:-1][flat] = 0.0
-    # a short segment between a run and a corner whose other side is not a curve: the
-    # run's end (see above; sm[k + 2] is smooth[k], False beyond the ends)
-    with np.errstate(invalid="ignore", divide="ignore"):
-        turn_ok = (dot > cos_join * la * lb) | (ang <= lim)
+    # the vertices beside a short segment that is not smooth yet (few: the rest of this on
+    # those only; sm[k + 2] is smooth[k], False beyond the ends)
+    short_b = rnd & (lb <= _SHORT_END * qq) & ~smooth[1:-1]
+    short_a = rnd & (la <= _SHORT_END * qq) & ~smooth[1:-1]
+    cand = np.flatnonzero(short_a | short_b)
+    if len(cand) == 0:
+        return
     sm = np.concatenate([[False, False], smooth, [False, False]])
-    prev_s, next_s = sm[2:-4], sm[4:-2]
-    prev2, next2 = sm[1:-5], sm[5:-1]
-    cur = sm[3:-3]
-    end_b = (lb <= _SHORT_END * qq) & (lb < la) & prev_s & ~next_s & ~next2
-    end_a = (la <= _SHORT_END * qq) & (la < lb) & next_s & ~prev_s & ~prev2
-    ext = rnd & ~cur & turn_ok & (end_a | end_b)
+    prev_s, next_s = sm[cand + 2], sm[cand + 4]
+    prev2, next2 = sm[cand + 1], sm[cand + 5]
+    ca, cb = la[cand], lb[cand]
+    # a short segment between a run and a corner whose other side is not a curve: the
+    # run's end (see above)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        turn_ok = (dot[cand] > cos_join * ca * cb) | (ang[cand] <= lim[cand])
+    end_b = short_b[cand] & (cb < ca) & prev_s & ~next_s & ~next2
+    end_a = short_a[cand] & (ca < cb) & next_s & ~prev_s & ~prev2
+    ext = cand[turn_ok & (end_a | end_b)]
     # a short segment between two corners inside a curve (a rounding wiggle: the vertices
     # beyond its ends smooth) whose neighbouring segments meet as a smooth vertex would:
     # both of its ends smooth (see above)
-    if _WIGGLE and len(la) >= 3:
-        a_, c_ = seg[:-2], seg[2:]  # per vertex k (< last - 1): segments k - 1 and k + 1
-        lc = np.r_[lb[1:], np.nan]
+    w = np.flatnonzero(short_b[cand] & ~next_s & prev_s & next2 & (cb < ca))
+    if _WIGGLE and len(w):
+        k = cand[w]  # vertex index - 1; next2 true: segment k + 2 exists
+        a_, c_ = seg[k], seg[k + 2]  # segments before the vertex and after the next one
+        wa, wc = la[k], lb[k + 1]
         with np.errstate(invalid="ignore", divide="ignore"):
-            dot2 = np.r_[(a_ * c_).sum(axis=1), np.nan]
-            cr2 = np.r_[a_[:, 0] * c_[:, 1] - a_[:, 1] * c_[:, 0], np.nan]
-            lmax2 = np.maximum(la, lc)
-            lim2 = np.minimum(_ROUNDED_TURN_MARGIN * (la + lc) * 4.0 * eps / (lmax2 * lmax2),
+            dot2 = (a_ * c_).sum(axis=1)
+            cr2 = a_[:, 0] * c_[:, 1] - a_[:, 1] * c_[:, 0]
+            lmax2 = np.maximum(wa, wc)
+            lim2 = np.minimum(_ROUNDED_TURN_MARGIN * (wa + wc) * 4.0 * eps[k] / (lmax2 * lmax2),
                               _ROUNDED_TURN_CAP)
-            ok2 = (dot2 > cos_join * la * lc) | (np.abs(np.arctan2(cr2, dot2)) <= lim2)
-            ok2 &= (lc <= length_ratio * la) & (la <= length_ratio * lc)
-        wig = np.flatnonzero(rnd & (lb <= _SHORT_END * qq) & ~cur & ~next_s & prev_s & next2
-                             & ok2 & (lb < la) & (lb < lc))
-        ext[wig] = True
-        ext[wig + 1] = True  # (next2: vertex k + 1 is inside the path)
-    smooth[1:-1] |= ext
+            ok2 = (dot2 > cos_join * wa * wc) | (np.abs(np.arctan2(cr2, dot2)) <= lim2)
+            ok2 &= (wc <= length_ratio * wa) & (wa <= length_ratio * wc) & (lb[k] < wc)
+        k = k[ok2]
+        ext = np.concatenate([ext, k, k + 1])
+    smooth[1:-1][ext] = True
     sign[1:-1][ext] = 0.0
 
 
