@@ -568,11 +568,15 @@ def _halves(a: np.ndarray, b: np.ndarray, k: np.ndarray) -> np.ndarray:
 
 
 def _chain_phase(idx: np.ndarray, k: int) -> np.ndarray:
-    """Per sorted index its position mod ``k`` within its run of consecutive indices (the
-    merge rounds take one phase at a time, so no two picks of a run overlap)."""
-    brk = np.r_[True, idx[1:] != idx[:-1] + 1]
+    """Per sorted index of a group of ``k`` consecutive segments (idx .. idx + k - 1) its
+    offset mod ``k`` from the first index of its chain (indices less than ``k`` apart, so
+    whose groups overlap): the merge rounds take one phase at a time, so no two picks
+    overlap. (Chains of consecutive indices alone would let two triples two apart, with
+    the one between them not a candidate, both be picked and share a segment: a range of
+    the path was then lost.)"""
+    brk = np.r_[True, idx[1:] >= idx[:-1] + k]
     chain_start = np.maximum.accumulate(np.where(brk, np.arange(len(idx)), 0))
-    return (np.arange(len(idx)) - chain_start) % k
+    return (idx - idx[chain_start]) % k
 
 
 class _BatchFitter:
@@ -2328,6 +2332,13 @@ def _local_lines(
     return pos, tan, ok
 
 
+#: rounded input: a smooth vertex's design estimate is fitted over at least this many input
+#: points on each side of it
+_SMOOTH_HALF = 6
+#: ... on a side whose thinned segment is at most this many quanta long
+_SMOOTH_SHORT = 4.0
+
+
 def _on_the_design(W, K, Q, arc, t_in, t_out, smooth, quant, tlen, eps) -> None:
     """Rounded input (per thinned point its path's quantum ``quant``): the smooth thinned
     vertices (inside curve runs) moved onto a least-squares estimate of the design curve
@@ -2347,6 +2358,16 @@ def _on_the_design(W, K, Q, arc, t_in, t_out, smooth, quant, tlen, eps) -> None:
     if len(sm):
         lo = (K[sm - 1] + K[sm] + 1) // 2
         hi = (K[sm] + K[sm + 1]) // 2
+        # beside a thinned segment of a few quanta (a rounding wiggle): at least
+        # _SMOOTH_HALF input points on that side, up to the thinned point beyond it
+        ln = np.hypot(*(W[K[1:]] - W[K[:-1]]).T)
+        short = _SMOOTH_SHORT * quant[sm]
+        lo_min = np.where(smooth[sm - 1], K[np.maximum(sm - 2, 0)], K[sm - 1])
+        hi_max = np.where(smooth[sm + 1], K[np.minimum(sm + 2, n - 1)], K[sm + 1])
+        lo = np.where(ln[sm - 1] <= short,
+                      np.maximum(lo_min, np.minimum(lo, K[sm] - _SMOOTH_HALF)), lo)
+        hi = np.where(ln[sm] <= short,
+                      np.minimum(hi_max, np.maximum(hi, K[sm] + _SMOOTH_HALF)), hi)
         pos, tan, ok = _local_fits(W, arc, np.minimum(lo, K[sm]), np.maximum(hi, K[sm]), K[sm])
         k = sm[ok]
         h = 0.5 * quant[k][:, None]
@@ -2381,6 +2402,39 @@ _CORNER_SINE = 0.25
 _CORNER_POINTS = _SIDE_POINTS
 
 
+#: a side written as its two rounded ends only gives the corner a direction where it is at
+#: least this many quanta long (the direction then within about 1/this radian)
+_LONE_LENGTH = 8.0
+#: ... and meets the curve's tangent there at this angle or more (sine): the intersection
+#: then; below, an error in the line's offset would move it far along the line
+_LONE_SINE = 0.9
+#: ... and moves it by at least this many half quanta (less is within the estimate's
+#: own error: the input point stays)
+_LONE_MIN_MOVE = 0.2
+
+
+def _lone_sides(W, K, smooth, v, w, quant, p, t, ok, ok_other, after=False) -> None:
+    """:func:`_corners_on_the_design`'s sides (position ``p``, tangent ``t``, ``ok``, in
+    place) at the corners ``v`` (the vertex as the end of the side, the next one's start
+    ``w``) whose side before them (``after``: after them) is a line over two input points
+    (its ends, no least-squares line) while the other side is a curve (its fit ``ok_other``):
+    the line through those two rounded ends, where it is at least ``_LONE_LENGTH`` quanta
+    long. Its intersection with the curve's tangent puts the corner where the design line
+    meets the design curve, up to the rounding of the line's offset."""
+    near = v
+    far, other = (v + 1, w - 1) if after else (v - 1, w + 1)
+    sel = ~ok & ok_other & ~smooth[far] & smooth[other] & (np.abs(K[near] - K[far]) == 1)
+    if not sel.any():
+        return sel
+    a, b = W[K[far][sel]], W[K[near][sel]]
+    d = (b - a) if not after else (a - b)
+    ln = np.hypot(d[:, 0], d[:, 1])
+    p[sel] = b
+    t[sel] = d / np.maximum(ln, 1e-300)[:, None]
+    ok[sel] = ln >= _LONE_LENGTH * quant[near][sel]
+    return sel & ok
+
+
 def _corners_on_the_design(W, K, Q, arc, smooth, rnd, first, last, quant, eps) -> None:
     """Rounded input: the corners (thinned vertices that are not smooth; a closed path's
     seam too) move inside their rounding squares onto an estimate of the design's corner.
@@ -2389,9 +2443,16 @@ def _corners_on_the_design(W, K, Q, arc, smooth, rnd, first, last, quant, eps) -
     other end a corner too), else a least-squares quadratic (over at least
     ``_CORNER_POINTS`` input points of the path). The corner is the
     intersection of the two tangent lines where they cross at an angle, else the mean of
-    the two positions. A corner stays where a line from it to a neighbouring thinned point
-    would miss its input points by more than ``eps`` (per thinned point), so the lines
-    keep their bound. In place on ``Q``."""
+    the two positions. A side that is a line over two input points only (no least-squares
+    line) beside a curve side is the line through its two rounded ends
+    (:func:`_lone_sides`), intersected with the curve's tangent where they cross at
+    ``_LONE_SINE`` or more; at a middling angle (``_CORNER_SINE`` to ``_LONE_SINE``: an
+    error in the line's offset would move the intersection far) the corner stays. A corner
+    stays where a line from it to a neighbouring thinned point would miss its input points
+    by more than ``eps`` (per thinned point), so the lines keep their bound (the curve side
+    of a corner with a two-point side is not held to that: the fitter tests its cubics
+    against the bound, and a line there is made valid by :func:`_valid_lines`). In place
+    on ``Q``."""
     n = len(Q)
     is_first = np.zeros(n, dtype=bool)
     is_first[first] = True
@@ -2424,9 +2485,19 @@ def _corners_on_the_design(W, K, Q, arc, smooth, rnd, first, last, quant, eps) -
     if lin.any():
         p, t, ok = _local_lines(W, k[lin], K[vo + 1][lin], k[lin])
         p_out[lin], t_out[lin], ok_out[lin] = p, t, ok
+    # a side that is a line written as its two ends only (no least-squares line) beside a
+    # curve side: the line through those two rounded ends, long enough to give a direction
+    # (the curve side of such a corner is not checked as a line below: the fitter checks
+    # its cubics against the bound, and a line there is made valid by _valid_lines)
+    lone_in = _lone_sides(W, K, smooth, vi, vo, quant, p_in, t_in, ok_in, ok_out)
+    lone_out = _lone_sides(W, K, smooth, vo, vi, quant, p_out, t_out, ok_out, ok_in,
+                           after=True)
     both = ok_in & ok_out
     est = 0.5 * (p_in + p_out)
     cr = t_in[:, 0] * t_out[:, 1] - t_in[:, 1] * t_out[:, 0]
+    lone = lone_in | lone_out
+    # a side of two points meeting a curve at a middling angle: neither estimate is good
+    both &= ~lone | (np.abs(cr) >= _LONE_SINE) | (np.abs(cr) < _CORNER_SINE)
     sharp = both & (np.abs(cr) >= _CORNER_SINE)
     if sharp.any():
         d = p_out[sharp] - p_in[sharp]
@@ -2434,11 +2505,14 @@ def _corners_on_the_design(W, K, Q, arc, smooth, rnd, first, last, quant, eps) -
         s = (d[:, 0] * to[:, 1] - d[:, 1] * to[:, 0]) / cr[sharp]
         est[sharp] = p_in[sharp] + s[:, None] * ti
     vi, vo, est = vi[both], vo[both], est[both]
+    lone_in, lone_out = lone_in[both], lone_out[both]
     wk = W[K[vo]]
     h = 0.5 * quant[vo][:, None]
     new = np.clip(est, wk - h, wk + h)
     # an estimate on the input point up to rounding errors is the input point
     same = np.abs(new - wk).max(axis=1) <= 1e-9 * (h[:, 0] + np.abs(wk).max(axis=1))
+    # ... and so is one by a side of two points moving it less than its own uncertainty
+    same |= (lone_in | lone_out) & (np.hypot(*(new - wk).T) < _LONE_MIN_MOVE * h[:, 0])
     new[same] = wk[same]
     old = Q[vo].copy()
     Q[vo] = new
@@ -2448,7 +2522,7 @@ def _corners_on_the_design(W, K, Q, arc, smooth, rnd, first, last, quant, eps) -
     moved[vi] = True
     for _ in range(3):
         # the thinned segments next to a moved corner, as lines: within eps of their points?
-        seg = np.unique(np.concatenate([vi - 1, vo]))
+        seg = np.unique(np.concatenate([vi[~lone_out] - 1, vo[~lone_in]]))
         seg = seg[moved[seg] | moved[seg + 1]]
         if len(seg) == 0:
             break
@@ -2468,6 +2542,7 @@ def _corners_on_the_design(W, K, Q, arc, smooth, rnd, first, last, quant, eps) -
         moved[vi[back]] = False
         keep = ~back
         vi, vo, old = vi[keep], vo[keep], old[keep]
+        lone_in, lone_out = lone_in[keep], lone_out[keep]
 
 
 def _arc_per_path(W: np.ndarray, wlen: np.ndarray) -> np.ndarray:

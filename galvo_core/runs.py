@@ -167,7 +167,8 @@ def _vertex_rules(
         # a turn below ~1e-12 rad is numerically straight: no sign
         sign[1:-1] = np.where(inner & (np.abs(cr) > 1e-12 * la * lb), np.sign(cr), 0.0)
         if rounding is not None:
-            _rounded_rules(smooth, sign, rounding, inner, dot, cr, la, lb, length_ratio)
+            _rounded_rules(smooth, sign, rounding, inner, dot, cr, la, lb, length_ratio,
+                           cos_join, s)
     return smooth, turn, sign
 
 
@@ -178,7 +179,14 @@ _ROUNDED_TURN_MARGIN = 1.5
 _ROUNDED_TURN_CAP = math.radians(50.0)
 
 
-def _rounded_rules(smooth, sign, rounding, inner, dot, cr, la, lb, length_ratio) -> None:
+#: rounded input: a thinned segment up to this many quanta long between a curve run and a
+#: corner is the run's end, not a line (see :func:`_rounded_rules`)
+_SHORT_END = 16.0
+_WIGGLE = True  # (the rounding-wiggle rule below; False: off, for measurements)
+
+
+def _rounded_rules(smooth, sign, rounding, inner, dot, cr, la, lb, length_ratio,
+                   cos_join, seg) -> None:
     """The vertex rules on rounded input (quantum q > 0, thinned with tolerance eps), in
     place. Thinning a smooth curve of radius R with eps leaves chords of sagitta about eps,
     so each turns about l / R <= 8 eps / l: on a tight curve the chords turn more than
@@ -186,7 +194,16 @@ def _rounded_rules(smooth, sign, rounding, inner, dot, cr, la, lb, length_ratio)
     ``_ROUNDED_TURN_MARGIN`` times (la + lb) 4 eps / max(la, lb)^2 (and at most
     ``_ROUNDED_TURN_CAP``) is smooth too, if its segments pass the length rule; a real
     corner turns more than that. A turn smaller than the rounding can make it (q / the
-    longer segment) has no sign: rounding wiggles are not inflections."""
+    longer segment) has no sign: rounding wiggles are not inflections. A segment of up to
+    ``_SHORT_END`` quanta between a curve run (the vertex on its other side smooth) and a
+    corner is what the thinning leaves of the curve's end before the corner: the vertex
+    between it and the run is smooth when it turns as a smooth vertex may (the length
+    rule aside), so that the run ends at the corner; where the corner's other side is a
+    curve too, the segment is rather a wiggle of the rounding inside one curve (the
+    thinning cut a curve's stretch into long, short, long): both of its ends are smooth
+    where the two long segments around it meet as a smooth vertex may. Such vertices have
+    no sign (their turn is the rounding's). ``cos_join``: the plain rule's threshold;
+    ``seg``: the segment vectors of the points."""
     eps = rounding[1:-1, 0]
     qq = rounding[1:-1, 1]
     rnd = inner & (qq > 0.0)
@@ -202,6 +219,44 @@ def _rounded_rules(smooth, sign, rounding, inner, dot, cr, la, lb, length_ratio)
         flat = rnd & (ang < qq / lmax)
     smooth[1:-1] |= add
     sign[1:-1][flat] = 0.0
+    # the vertices beside a short segment that is not smooth yet (few: the rest of this on
+    # those only; sm[k + 2] is smooth[k], False beyond the ends)
+    short_b = rnd & (lb <= _SHORT_END * qq) & ~smooth[1:-1]
+    short_a = rnd & (la <= _SHORT_END * qq) & ~smooth[1:-1]
+    cand = np.flatnonzero(short_a | short_b)
+    if len(cand) == 0:
+        return
+    sm = np.concatenate([[False, False], smooth, [False, False]])
+    prev_s, next_s = sm[cand + 2], sm[cand + 4]
+    prev2, next2 = sm[cand + 1], sm[cand + 5]
+    ca, cb = la[cand], lb[cand]
+    # a short segment between a run and a corner whose other side is not a curve: the
+    # run's end (see above)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        turn_ok = (dot[cand] > cos_join * ca * cb) | (ang[cand] <= lim[cand])
+    end_b = short_b[cand] & (cb < ca) & prev_s & ~next_s & ~next2
+    end_a = short_a[cand] & (ca < cb) & next_s & ~prev_s & ~prev2
+    ext = cand[turn_ok & (end_a | end_b)]
+    # a short segment between two corners inside a curve (a rounding wiggle: the vertices
+    # beyond its ends smooth) whose neighbouring segments meet as a smooth vertex would:
+    # both of its ends smooth (see above)
+    w = np.flatnonzero(short_b[cand] & ~next_s & prev_s & next2 & (cb < ca))
+    if _WIGGLE and len(w):
+        k = cand[w]  # vertex index - 1; next2 true: segment k + 2 exists
+        a_, c_ = seg[k], seg[k + 2]  # segments before the vertex and after the next one
+        wa, wc = la[k], lb[k + 1]
+        with np.errstate(invalid="ignore", divide="ignore"):
+            dot2 = (a_ * c_).sum(axis=1)
+            cr2 = a_[:, 0] * c_[:, 1] - a_[:, 1] * c_[:, 0]
+            lmax2 = np.maximum(wa, wc)
+            lim2 = np.minimum(_ROUNDED_TURN_MARGIN * (wa + wc) * 4.0 * eps[k] / (lmax2 * lmax2),
+                              _ROUNDED_TURN_CAP)
+            ok2 = (dot2 > cos_join * wa * wc) | (np.abs(np.arctan2(cr2, dot2)) <= lim2)
+            ok2 &= (wc <= length_ratio * wa) & (wa <= length_ratio * wc) & (lb[k] < wc)
+        k = k[ok2]
+        ext = np.concatenate([ext, k, k + 1])
+    smooth[1:-1][ext] = True
+    sign[1:-1][ext] = 0.0
 
 
 def _runs(smooth: np.ndarray, sign: np.ndarray, lay: _Layout) -> tuple[np.ndarray, np.ndarray]:
