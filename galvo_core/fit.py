@@ -2413,7 +2413,7 @@ _LONE_SINE = 0.9
 _LONE_MIN_MOVE = 0.2
 
 
-def _lone_sides(W, K, smooth, v, w, quant, p, t, ok, ok_other, after=False) -> None:
+def _lone_sides(W, K, smooth, v, w, quant, p, t, ok, ok_other, after=False) -> np.ndarray:
     """:func:`_corners_on_the_design`'s sides (position ``p``, tangent ``t``, ``ok``, in
     place) at the corners ``v`` (the vertex as the end of the side, the next one's start
     ``w``) whose side before them (``after``: after them) is a line over two input points
