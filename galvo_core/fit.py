@@ -606,9 +606,6 @@ class _BatchFitter:
         self.q = work[kept] if q is None else q
         #: per thinned point its path's quantum (None: exact input everywhere)
         self.quant: np.ndarray | None = None
-        #: per thinned point its path's quantum where the rounding is a fair share of the
-        #: bound (the vertices move onto the design there), else 0 (None: none)
-        self.move_q: np.ndarray | None = None
         self.t_in = t_in
         self.t_out = t_out
         # the bound of a piece starting at thinned point k (its path's): e_per + rounding
@@ -839,9 +836,7 @@ class _BatchFitter:
 
     def _greedy_round(self) -> bool:
         """Chains of at least ``_GREEDY_MIN`` adjacent cubics meeting at smooth vertices
-        (one tangent at the joint: no corner between them; on rounded input whose rounding
-        is a fair share of the bound also lines that are not the design's, at vertices
-        that barely turn) are fitted again from the
+        (one tangent at the joint: no corner between them) are fitted again from the
         chain's start, each cubic reaching the farthest thinned point where one passes the
         same test (binary search over at most ``_GREEDY_SPAN`` old segments on; where none
         passes from an old joint, the old segment from there stays), and replaced where
@@ -859,15 +854,6 @@ class _BatchFitter:
         cub = ~isl
         smooth = (self.t_in[B[:-1]] == self.t_out[B[:-1]]).all(axis=1)
         adj = cub[:-1] & cub[1:] & (B[:-1] == A[1:]) & smooth
-        if self.move_q is not None:
-            # rounded input (where the rounding is a fair share of the bound): lines (not
-            # the design's) at vertices that barely turn too
-            if self._barely_turns is None:
-                cosv = (self.t_in * self.t_out).sum(axis=1)
-                self._barely_turns = cosv > math.cos(_ABSORB_TURN)
-            free = ~self._fixed_lines(A, B, isl)
-            adj |= ((B[:-1] == A[1:]) & free[:-1] & free[1:]
-                    & (self.move_q[B[:-1]] > 0.0) & (smooth | self._barely_turns[B[:-1]]))
         head = np.r_[True, ~adj]  # a segment that starts a chain
         cid = np.cumsum(head) - 1
         size = np.bincount(cid)
@@ -1618,8 +1604,6 @@ def _fit_concatenated(
     fitter = _BatchFitter(W, K, t_in, t_out, np.repeat(e_per, tlen), eps_sum, arc, q=Q)
     if rounding is not None and (rounding[:, 1] > 0.0).any():
         fitter.quant = np.repeat(rounding[:, 1], tlen)
-        assert move_q is not None  # set with rounding above
-        fitter.move_q = np.repeat(move_q, tlen)
     with np.errstate(invalid="ignore", divide="ignore"):
         fitter.fit(np.stack([pa[curve], pb[curve]], axis=1), pa[~curve])
     ca, cb, ctrl, bound, fla = fitter.results()
