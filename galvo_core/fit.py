@@ -1394,8 +1394,11 @@ class _BatchFitter:
                 da = (x1 * c22 - x2 * c12) / det
                 db = (c11 * x2 - c12 * x1) / det
             step = np.isfinite(da) & np.isfinite(db) & (np.abs(det) > 1e-12 * (c11 * c22 + 1e-300))
-            al = np.where(step, al + da, al)
-            be = np.where(step, be + db, be)
+            # damped: at most a quarter chord per round, a handle at most halved (rounded
+            # input, a poor start: full steps overshoot and oscillate)
+            lim = 0.25 * chord
+            al = np.where(step, np.maximum(al + np.clip(da, -lim, lim), 0.5 * al), al)
+            be = np.where(step, np.maximum(be + np.clip(db, -lim, lim), 0.5 * be), be)
         ok = np.isfinite(al) & np.isfinite(be) & (al > 0) & (be > 0)
         ok &= (al < 2.0 * chord) & (be < 2.0 * chord)
         al = np.where(ok, al, chord / 3.0)
@@ -1480,7 +1483,8 @@ class _BatchFitter:
         """Per piece starting at thinned point A: True on exact input (no rounding)."""
         if self.quant is None:
             return np.ones(len(A), dtype=bool)
-        return self.quant[A] == 0.0
+        assert self.move_q is not None  # set with quant
+        return (self.quant[A] == 0.0) | (self.move_q[A] > 0.0)
 
     def _prefer_least_squares(self, rq, A, B, ctrl, good, emax, dist, starts) -> None:
         """Rounded input: where the least-squares cubic (:meth:`_least_squares`) passes the
