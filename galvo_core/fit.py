@@ -807,7 +807,18 @@ class _BatchFitter:
                 break
             A, B = ab[:, 0], ab[:, 1]
             ok, p0, qq, p3, sig = self._triangle(A, B)
-            # no triangle (tangents do not meet in front of both ends): split in the middle
+            # no triangle (tangents do not meet in front of both ends): the second candidate
+            # (it needs none), else split in the middle
+            nt = np.flatnonzero(~ok)
+            nt = nt[self._exact(A[nt])]
+            if len(nt):
+                g2, c2, e2 = self._second_candidate(A[nt], B[nt])
+                if g2.any():
+                    self._cubics.append((A[nt[g2]], B[nt[g2]], c2[g2], e2[g2]))
+                    keep = np.ones(len(A), dtype=bool)
+                    keep[nt[g2]] = False
+                    A, B, p0, qq, p3, sig, ok = (A[keep], B[keep], p0[keep], qq[keep],
+                                                 p3[keep], sig[keep], ok[keep])
             todo = [_halves(A[~ok], B[~ok], (A[~ok] + B[~ok]) // 2)]
             A, B = A[ok], B[ok]
             if len(A):
@@ -1153,7 +1164,8 @@ class _BatchFitter:
         ok &= fresh
         w = np.flatnonzero(ok)
         if len(w) == 0:
-            self._remember_failed(key[fresh])
+            self._second_try(A, B, fresh, fresh, passed, ctrl_all, em_all)
+            self._remember_failed(key[fresh & ~passed])
             return passed, ctrl_all, em_all
         a, b = A[w], B[w]
         i0, i1 = self.kept[a], self.kept[b]
@@ -1165,7 +1177,7 @@ class _BatchFitter:
         if not hope.all():
             w, a, b, i0, i1 = w[hope], a[hope], b[hope], i0[hope], i1[hope]
             if len(w) == 0:
-                self._second_try(A, B, fresh, ok, passed, ctrl_all, em_all)
+                self._second_try(A, B, fresh, fresh, passed, ctrl_all, em_all)
                 self._remember_failed(key[fresh & ~passed])
                 return passed, ctrl_all, em_all
         ctrl = self._dichotomy(p0[w], qq[w], p3[w], sig[w], i0, i1, _MERGE_SAMPLE)
@@ -1174,7 +1186,7 @@ class _BatchFitter:
         if self.quant is not None:
             lk |= self.quant[a] > 0.0  # (the least-squares cubic may pass where this fails)
         if not lk.any():
-            self._second_try(A, B, fresh, ok, passed, ctrl_all, em_all)
+            self._second_try(A, B, fresh, fresh, passed, ctrl_all, em_all)
             self._remember_failed(key[fresh & ~passed])
             return passed, ctrl_all, em_all
         w, a, b, i0, i1, ctrl = w[lk], a[lk], b[lk], i0[lk], i1[lk], ctrl[lk]
@@ -1186,13 +1198,13 @@ class _BatchFitter:
         passed[w] = good
         ctrl_all[w] = ctrl
         em_all[w] = emax
-        self._second_try(A, B, fresh, ok, passed, ctrl_all, em_all)
+        self._second_try(A, B, fresh, fresh, passed, ctrl_all, em_all)
         self._remember_failed(key[fresh & ~passed])
         return passed, ctrl_all, em_all
 
     def _second_try(self, A, B, fresh, ok, passed, ctrl_all, em_all) -> None:
-        """:meth:`_try`'s exact pieces whose triangle cubic failed (at the screening or the
-        test; the triangle exists): the second candidate, in place."""
+        """:meth:`_try`'s exact pieces whose triangle cubic failed (no triangle, or at the
+        screening or the test): the second candidate, in place."""
         sc = np.flatnonzero(fresh & ok & ~passed & self._exact(A))
         if len(sc):
             g2, c2, e2 = self._second_candidate(A[sc], B[sc])
