@@ -140,6 +140,9 @@ _ABSORB_ROUNDS = 3
 _RESPLIT_ROUNDS = 1
 #: Gauss-Newton rounds of the second candidate cubic (:meth:`_BatchFitter._gauss_newton`)
 _GN_ROUNDS = 4
+#: rounded input: the candidate with free end tangents too, each turned at most this much
+_GN_FREE = True
+_GN_TURN = math.radians(5.0)
 _RESPLIT_CANDIDATES = 3
 #: ... in this order (the middle one first)
 _RESPLIT_ORDER = (1, 0, 2)
@@ -1466,6 +1469,62 @@ class _BatchFitter:
         out[cand[passed]] = True
         return out
 
+    def _gauss_newton_free(self, A, B, i0, i1, ctrl, rounds: int = _GN_ROUNDS):
+        """Rounded input: from ``ctrl`` (:meth:`_gauss_newton`), both inner control points
+        free (the end tangents too: they are estimates from rounded points), Gauss-Newton on
+        the normal distances; ok where each end tangent turned at most ``_GN_TURN``."""
+        m = len(A)
+        L = i1 - i0 - 1
+        stride = np.maximum(1, -(-L // _BISECT_SAMPLE))
+        cnt = -(-L // stride)
+        pid, off = _ragged(np.zeros(m, dtype=np.intp), cnt)
+        idx = i0[pid] + 1 + stride[pid] * off
+        pts = self.work[idx]
+        span = self.arc[i1] - self.arc[i0]
+        u = (self.arc[idx] - self.arc[i0][pid]) / np.where(span > 0, span, 1.0)[pid]
+        ctrl = ctrl.copy()
+        chord = np.hypot(*(ctrl[:, 3] - ctrl[:, 0]).T)
+        for _ in range(rounds):
+            cf = gather_coeffs(power_coeffs_many(ctrl), pid)
+            u, _ = newton_nearest_many(cf, pts.T, u, 2)
+            bx = ((cf[0, 0] * u + cf[1, 0]) * u + cf[2, 0]) * u + cf[3, 0] - pts[:, 0]
+            by = ((cf[0, 1] * u + cf[1, 1]) * u + cf[2, 1]) * u + cf[3, 1] - pts[:, 1]
+            dx = (3.0 * cf[0, 0] * u + 2.0 * cf[1, 0]) * u + cf[2, 0]
+            dy = (3.0 * cf[0, 1] * u + 2.0 * cf[1, 1]) * u + cf[2, 1]
+            dn = np.hypot(dx, dy)
+            dn = np.where(dn > 0.0, dn, 1.0)
+            nx, ny = -dy / dn, dx / dn
+            res = nx * bx + ny * by
+            s = 1.0 - u
+            b1, b2 = 3 * s * s * u, 3 * s * u * u
+            J = np.stack([b1 * nx, b1 * ny, b2 * nx, b2 * ny], axis=1)  # (K, 4)
+            N = np.zeros((m, 4, 4))
+            for i in range(4):
+                for j in range(i, 4):
+                    N[:, i, j] = N[:, j, i] = np.bincount(pid, J[:, i] * J[:, j], m)
+            g = np.stack([-np.bincount(pid, J[:, i] * res, m) for i in range(4)], axis=1)
+            N = np.where(np.isfinite(N), N, 0.0)
+            g = np.where(np.isfinite(g), g, 0.0)
+            N += (1e-9 * np.trace(N, axis1=1, axis2=2) + 1e-12)[:, None, None] * np.eye(4)
+            with np.errstate(divide="ignore", invalid="ignore"):
+                d = np.linalg.solve(N, g[:, :, None])[:, :, 0]
+            d = np.where(np.isfinite(d), d, 0.0)
+            lim = 0.25 * chord[:, None]
+            d = np.clip(d, -lim, lim)
+            ctrl[:, 1] += d[:, :2]
+            ctrl[:, 2] += d[:, 2:]
+        h0 = ctrl[:, 1] - ctrl[:, 0]
+        h3 = ctrl[:, 3] - ctrl[:, 2]
+        t0, t3 = self.t_out[A], self.t_in[B]
+        n0 = np.hypot(*h0.T)
+        n3 = np.hypot(*h3.T)
+        cos_turn = math.cos(_GN_TURN)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            ok = ((h0 * t0).sum(1) >= cos_turn * n0) & ((h3 * t3).sum(1) >= cos_turn * n3)
+        ok &= (n0 > 0) & (n3 > 0) & (n0 < 2.0 * chord) & (n3 < 2.0 * chord)
+        ok &= np.isfinite(ctrl).all(axis=(1, 2))
+        return ctrl, ok
+
     def _second_candidate(self, A: np.ndarray, B: np.ndarray):
         """Per piece A..B (its triangle cubic failed): (passed, ctrl, bound) of the
         Gauss-Newton cubic (:meth:`_gauss_newton`: two free handle lengths; the paper's
@@ -1489,6 +1548,19 @@ class _BatchFitter:
             passed[w] = True
             ctrl_all[w] = cg[w]
             em_all[w] = e[g]
+        if _GN_FREE and self.quant is not None:
+            v = np.flatnonzero(okg & ~passed & (self.quant[A] > 0.0))
+            if len(v):
+                cf_, okf = self._gauss_newton_free(A[v], B[v], i0[v], i1[v], cg[v])
+                v, cf_ = v[okf], cf_[okf]
+                if len(v):
+                    sk = self._sample_ok(cf_, i0[v], i1[v], self.e_per[A[v]])
+                    v, cf_ = v[sk], cf_[sk]
+                if len(v):
+                    g, e, _, _ = self._accept(cf_, i0[v], i1[v], self.e_per[A[v]], A[v])
+                    passed[v[g]] = True
+                    ctrl_all[v[g]] = cf_[g]
+                    em_all[v[g]] = e[g]
         return passed, ctrl_all, em_all
 
     def _exact(self, A: np.ndarray) -> np.ndarray:
