@@ -559,6 +559,14 @@ def _ssum_kernel(cfm, pid, sel, every, pxy, ustate, tiny, chxy, sg, out):  # pra
             out[pid[i]] += w[j]
 
 
+def _handles_in_order(ctrl: np.ndarray) -> np.ndarray:
+    """Per cubic: its inner control points come in order along the chord (P1 before P2: the
+    handles do not cross, no zigzag or cusp; a least-squares cubic over a corner may cross
+    them and still pass the bound, farther from the design than the lines)."""
+    ch = ctrl[:, 3] - ctrl[:, 0]
+    return ((ctrl[:, 2] - ctrl[:, 1]) * ch).sum(axis=1) > 0.0
+
+
 def _ragged(starts: np.ndarray, counts: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """(owner, offset) of the flattened ranges: item j of range r -> (r, j)."""
     total = int(counts.sum())
@@ -1539,6 +1547,7 @@ class _BatchFitter:
             return passed, ctrl_all, em_all
         i0, i1 = self.kept[A], self.kept[B]
         cg, okg = self._gauss_newton(A, B, i0, i1)
+        okg &= _handles_in_order(cg)
         w = np.flatnonzero(okg)
         if len(w):
             w = w[self._sample_ok(cg[w], i0[w], i1[w], self.e_per[A[w]])]
@@ -1552,6 +1561,7 @@ class _BatchFitter:
             v = np.flatnonzero(okg & ~passed & (self.quant[A] > 0.0))
             if len(v):
                 cf_, okf = self._gauss_newton_free(A[v], B[v], i0[v], i1[v], cg[v])
+                okf &= _handles_in_order(cf_)
                 v, cf_ = v[okf], cf_[okf]
                 if len(v):
                     sk = self._sample_ok(cf_, i0[v], i1[v], self.e_per[A[v]])
