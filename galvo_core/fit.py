@@ -25,6 +25,13 @@ Guarantee (checked for every cubic before it is accepted, and by :func:`check_fi
   bulge between sparse points. A line replacing thinned points is within ``eps_line`` of the
   polyline by construction of the thinning.
 
+Where the triangle's cubic fails (or the tangents do not meet), a second candidate is tried
+under the same test: the cubic with two free handle lengths minimising the points' squared
+distances, by Gauss-Newton on the distances along the normal (a typeface's cubic whose two
+handles are different fractions of its triangle is not in the one-parameter family); on
+rounded input whose rounding is a fair share of the bound, also one whose end tangents may
+turn a few degrees (they are estimates from rounded points).
+
 A piece that fails is split at the crossing of data and curve (the interior thinned point
 with the smallest error, away from the ends) and both halves are fitted again; a piece of
 two thinned points is a line (always within ``eps_line``). So the guarantee holds whatever
