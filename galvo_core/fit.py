@@ -1581,11 +1581,14 @@ class _BatchFitter:
         return passed, ctrl_all, em_all
 
     def _exact(self, A: np.ndarray) -> np.ndarray:
-        """Per piece starting at thinned point A: True on exact input (no rounding)."""
+        """Per piece starting at thinned point A: True on exact input (no rounding) and on
+        rounded input whose rounding is a fair share of the bound (``_MOVE_SHARE``)."""
         if self.quant is None:
             return np.ones(len(A), dtype=bool)
-        assert self.move_q is not None  # set with quant
-        return (self.quant[A] == 0.0) | (self.move_q[A] > 0.0)
+        # (as the vertices' moves onto the design: the bound here is e_per + q/√2)
+        q = self.quant[A]
+        sl = q * _HALF_DIAGONAL
+        return (q == 0.0) | ((q > 0.0) & (sl >= _MOVE_SHARE * (self.e_per[A] - sl)))
 
     def _prefer_least_squares(self, rq, A, B, ctrl, good, emax, dist, starts) -> None:
         """Rounded input: where the least-squares cubic (:meth:`_least_squares`) passes the
