@@ -568,9 +568,9 @@ def _ssum_kernel(cfm, pid, sel, every, pxy, ustate, tiny, chxy, sg, out):  # pra
 
 def _handles_in_order(ctrl: np.ndarray) -> np.ndarray:
     """Per cubic: its inner control points come in order along the chord (P1 before P2: the
-    handles do not cross). Asked of the candidate with free end tangents: over a short
-    corner it may cross them (a zigzag) and still pass the bound, farther from the design
-    than the lines (serif-cond-italic "z", em 700: 0.618 against 0.612)."""
+    handles do not cross). Asked of both least-squares candidates: over a short corner
+    they may cross them (a zigzag) and still pass the bound, farther from the design than
+    the lines (serif-cond-italic "z", em 700: 0.618 against 0.612)."""
     ch = ctrl[:, 3] - ctrl[:, 0]
     return ((ctrl[:, 2] - ctrl[:, 1]) * ch).sum(axis=1) > 0.0
 
@@ -1555,6 +1555,7 @@ class _BatchFitter:
             return passed, ctrl_all, em_all
         i0, i1 = self.kept[A], self.kept[B]
         cg, okg = self._gauss_newton(A, B, i0, i1)
+        okg &= _handles_in_order(cg)
         w = np.flatnonzero(okg)
         if len(w):
             w = w[self._sample_ok(cg[w], i0[w], i1[w], self.e_per[A[w]])]
