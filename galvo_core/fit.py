@@ -600,6 +600,42 @@ def _chain_phase(idx: np.ndarray, k: int) -> np.ndarray:
     return (idx - idx[chain_start]) % k
 
 
+def _handle_lengths(u, pid, pts, p0, p3, t0, t3, m):
+    """Schneider's handle lengths per piece: the cubic p0, p0 + al t0, p3 - be t3, p3 nearest
+    (least squares) to the points ``pts`` at the parameters ``u`` (piece ``pid`` each):
+    (al, be, det, c11, c22) of the 2x2 normal equations (al, be inf/NaN where det is 0)."""
+    s = 1.0 - u
+    b0, b1, b2, b3 = s * s * s, 3 * s * s * u, 3 * s * u * u, u * u * u
+    a1 = b1[:, None] * t0[pid]
+    a2 = -b2[:, None] * t3[pid]
+    r = pts - (b0 + b1)[:, None] * p0[pid] - (b2 + b3)[:, None] * p3[pid]
+    c11 = np.bincount(pid, (a1 * a1).sum(1), m)
+    c12 = np.bincount(pid, (a1 * a2).sum(1), m)
+    c22 = np.bincount(pid, (a2 * a2).sum(1), m)
+    x1 = np.bincount(pid, (r * a1).sum(1), m)
+    x2 = np.bincount(pid, (r * a2).sum(1), m)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        det = c11 * c22 - c12 * c12
+        al = (x1 * c22 - x2 * c12) / det
+        be = (c11 * x2 - c12 * x1) / det
+    return al, be, det, c11, c22
+
+
+def _normal_residuals(ctrl, pid, pts, u):
+    """Each point's nearest parameter on its cubic (Newton from ``u``), the unit normal
+    there and the point's signed distance along it: (u, nx, ny, res), for Gauss-Newton."""
+    cf = gather_coeffs(power_coeffs_many(ctrl), pid)
+    u, _ = newton_nearest_many(cf, pts.T, u, 2)
+    bx = ((cf[0, 0] * u + cf[1, 0]) * u + cf[2, 0]) * u + cf[3, 0] - pts[:, 0]
+    by = ((cf[0, 1] * u + cf[1, 1]) * u + cf[2, 1]) * u + cf[3, 1] - pts[:, 1]
+    dx = (3.0 * cf[0, 0] * u + 2.0 * cf[1, 0]) * u + cf[2, 0]
+    dy = (3.0 * cf[0, 1] * u + 2.0 * cf[1, 1]) * u + cf[2, 1]
+    dn = np.hypot(dx, dy)
+    dn = np.where(dn > 0.0, dn, 1.0)
+    nx, ny = -dy / dn, dx / dn
+    return u, nx, ny, nx * bx + ny * by
+
+
 class _BatchFitter:
     """Fits curve pieces together (of one path, or of many concatenated paths: ``work`` the
     input points, ``kept`` the thinned indices into it, ``arc`` the cumulative arc length
@@ -1305,6 +1341,19 @@ class _BatchFitter:
         self._cubics = [(A[keep], B[keep], C[keep], E[keep])]
         return True
 
+    def _piece_sample(self, i0: np.ndarray, i1: np.ndarray):
+        """The input points strictly inside each piece i0..i1 (at most ``_BISECT_SAMPLE``,
+        evenly strided) for the least-squares fits: (piece of each (K,), points (K, 2),
+        chord-length parameters (K,))."""
+        L = i1 - i0 - 1
+        stride = np.maximum(1, -(-L // _BISECT_SAMPLE))
+        cnt = -(-L // stride)
+        pid, off = _ragged(np.zeros(len(i0), dtype=np.intp), cnt)
+        idx = i0[pid] + 1 + stride[pid] * off
+        span = self.arc[i1] - self.arc[i0]
+        u = (self.arc[idx] - self.arc[i0][pid]) / np.where(span > 0, span, 1.0)[pid]
+        return pid, self.work[idx], u
+
     def _least_squares(self, A: np.ndarray, B: np.ndarray, i0: np.ndarray, i1: np.ndarray):
         """Per piece: the cubic with the piece's end points and end tangents whose two
         handle lengths minimise the squared distances of (a sample of) its input points at
@@ -1313,32 +1362,12 @@ class _BatchFitter:
         m = len(A)
         p0, p3 = self.q[A], self.q[B]
         t0, t3 = self.t_out[A], self.t_in[B]
-        L = i1 - i0 - 1
-        stride = np.maximum(1, -(-L // _BISECT_SAMPLE))
-        cnt = -(-L // stride)
-        pid, off = _ragged(np.zeros(m, dtype=np.intp), cnt)
-        idx = i0[pid] + 1 + stride[pid] * off
-        pts = self.work[idx]
-        span = self.arc[i1] - self.arc[i0]
-        u = (self.arc[idx] - self.arc[i0][pid]) / np.where(span > 0, span, 1.0)[pid]
+        pid, pts, u = self._piece_sample(i0, i1)
         chord = np.hypot(*(p3 - p0).T)
         ctrl = np.zeros((m, 4, 2))
         ok = np.zeros(m, dtype=bool)
         for it in range(3):
-            s = 1.0 - u
-            b0, b1, b2, b3 = s * s * s, 3 * s * s * u, 3 * s * u * u, u * u * u
-            a1 = b1[:, None] * t0[pid]
-            a2 = -b2[:, None] * t3[pid]
-            r = pts - (b0 + b1)[:, None] * p0[pid] - (b2 + b3)[:, None] * p3[pid]
-            c11 = np.bincount(pid, (a1 * a1).sum(1), m)
-            c12 = np.bincount(pid, (a1 * a2).sum(1), m)
-            c22 = np.bincount(pid, (a2 * a2).sum(1), m)
-            x1 = np.bincount(pid, (r * a1).sum(1), m)
-            x2 = np.bincount(pid, (r * a2).sum(1), m)
-            det = c11 * c22 - c12 * c12
-            with np.errstate(divide="ignore", invalid="ignore"):
-                al = (x1 * c22 - x2 * c12) / det
-                be = (c11 * x2 - c12 * x1) / det
+            al, be, det, c11, c22 = _handle_lengths(u, pid, pts, p0, p3, t0, t3, m)
             ok = (np.abs(det) > 1e-12 * (c11 * c22 + 1e-300)) & (al > 0) & (be > 0)
             ok &= (al < 2.0 * chord) & (be < 2.0 * chord)
             al = np.where(ok, al, chord / 3.0)
@@ -1363,45 +1392,16 @@ class _BatchFitter:
         m = len(A)
         p0, p3 = self.q[A], self.q[B]
         t0, t3 = self.t_out[A], self.t_in[B]
-        L = i1 - i0 - 1
-        stride = np.maximum(1, -(-L // _BISECT_SAMPLE))
-        cnt = -(-L // stride)
-        pid, off = _ragged(np.zeros(m, dtype=np.intp), cnt)
-        idx = i0[pid] + 1 + stride[pid] * off
-        pts = self.work[idx]
-        span = self.arc[i1] - self.arc[i0]
-        u = (self.arc[idx] - self.arc[i0][pid]) / np.where(span > 0, span, 1.0)[pid]
+        pid, pts, u = self._piece_sample(i0, i1)
         chord = np.hypot(*(p3 - p0).T)
         # start: Schneider's handles at chord-length parameters
-        s = 1.0 - u
-        b1, b2 = 3 * s * s * u, 3 * s * u * u
-        a1 = b1[:, None] * t0[pid]
-        a2 = -b2[:, None] * t3[pid]
-        r = pts - (s * s * s + b1)[:, None] * p0[pid] - (b2 + u * u * u)[:, None] * p3[pid]
-        c11 = np.bincount(pid, (a1 * a1).sum(1), m)
-        c12 = np.bincount(pid, (a1 * a2).sum(1), m)
-        c22 = np.bincount(pid, (a2 * a2).sum(1), m)
-        x1 = np.bincount(pid, (r * a1).sum(1), m)
-        x2 = np.bincount(pid, (r * a2).sum(1), m)
-        with np.errstate(divide="ignore", invalid="ignore"):
-            det = c11 * c22 - c12 * c12
-            al = (x1 * c22 - x2 * c12) / det
-            be = (c11 * x2 - c12 * x1) / det
+        al, be, _, _, _ = _handle_lengths(u, pid, pts, p0, p3, t0, t3, m)
         bad = ~((al > 0) & (be > 0) & (al < 2.0 * chord) & (be < 2.0 * chord))
         al = np.where(bad, chord / 3.0, al)
         be = np.where(bad, chord / 3.0, be)
         for _ in range(rounds):
             ctrl = np.stack([p0, p0 + al[:, None] * t0, p3 - be[:, None] * t3, p3], axis=1)
-            cf = gather_coeffs(power_coeffs_many(ctrl), pid)
-            u, _ = newton_nearest_many(cf, pts.T, u, 2)
-            bx = ((cf[0, 0] * u + cf[1, 0]) * u + cf[2, 0]) * u + cf[3, 0] - pts[:, 0]
-            by = ((cf[0, 1] * u + cf[1, 1]) * u + cf[2, 1]) * u + cf[3, 1] - pts[:, 1]
-            dx = (3.0 * cf[0, 0] * u + 2.0 * cf[1, 0]) * u + cf[2, 0]
-            dy = (3.0 * cf[0, 1] * u + 2.0 * cf[1, 1]) * u + cf[2, 1]
-            dn = np.hypot(dx, dy)
-            dn = np.where(dn > 0.0, dn, 1.0)
-            nx, ny = -dy / dn, dx / dn
-            res = nx * bx + ny * by
+            u, nx, ny, res = _normal_residuals(ctrl, pid, pts, u)
             s = 1.0 - u
             j1 = 3 * s * s * u * (nx * t0[pid, 0] + ny * t0[pid, 1])
             j2 = -3 * s * u * u * (nx * t3[pid, 0] + ny * t3[pid, 1])
@@ -1480,27 +1480,11 @@ class _BatchFitter:
         free (the end tangents too: they are estimates from rounded points), Gauss-Newton on
         the normal distances; ok where each end tangent turned at most ``_GN_TURN``."""
         m = len(A)
-        L = i1 - i0 - 1
-        stride = np.maximum(1, -(-L // _BISECT_SAMPLE))
-        cnt = -(-L // stride)
-        pid, off = _ragged(np.zeros(m, dtype=np.intp), cnt)
-        idx = i0[pid] + 1 + stride[pid] * off
-        pts = self.work[idx]
-        span = self.arc[i1] - self.arc[i0]
-        u = (self.arc[idx] - self.arc[i0][pid]) / np.where(span > 0, span, 1.0)[pid]
+        pid, pts, u = self._piece_sample(i0, i1)
         ctrl = ctrl.copy()
         chord = np.hypot(*(ctrl[:, 3] - ctrl[:, 0]).T)
         for _ in range(rounds):
-            cf = gather_coeffs(power_coeffs_many(ctrl), pid)
-            u, _ = newton_nearest_many(cf, pts.T, u, 2)
-            bx = ((cf[0, 0] * u + cf[1, 0]) * u + cf[2, 0]) * u + cf[3, 0] - pts[:, 0]
-            by = ((cf[0, 1] * u + cf[1, 1]) * u + cf[2, 1]) * u + cf[3, 1] - pts[:, 1]
-            dx = (3.0 * cf[0, 0] * u + 2.0 * cf[1, 0]) * u + cf[2, 0]
-            dy = (3.0 * cf[0, 1] * u + 2.0 * cf[1, 1]) * u + cf[2, 1]
-            dn = np.hypot(dx, dy)
-            dn = np.where(dn > 0.0, dn, 1.0)
-            nx, ny = -dy / dn, dx / dn
-            res = nx * bx + ny * by
+            u, nx, ny, res = _normal_residuals(ctrl, pid, pts, u)
             s = 1.0 - u
             b1, b2 = 3 * s * s * u, 3 * s * u * u
             J = np.stack([b1 * nx, b1 * ny, b2 * nx, b2 * ny], axis=1)  # (K, 4)
