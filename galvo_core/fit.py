@@ -957,7 +957,6 @@ class _BatchFitter:
         out_b: list[np.ndarray] = []
         out_c: list[np.ndarray] = []
         out_e: list[np.ndarray] = []
-        out_l: list[np.ndarray] = []
         while live.any():
             w = np.flatnonzero(live)
             # the first try of a cubic is its farthest end; then halve the bracket
@@ -981,14 +980,11 @@ class _BatchFitter:
             best_c[none] = C[os_]
             best_e[none] = E[os_]
             s = settled[lo[settled] > cur[settled]]
-            line = np.zeros(len(s), dtype=bool)
-            line[np.searchsorted(s, none)] = isl[os_]
             out_k.append(s)
             out_a.append(cur[s].copy())
             out_b.append(lo[s].copy())
             out_c.append(best_c[s].copy())
             out_e.append(best_e[s].copy())
-            out_l.append(line)
             made[s] += 1
             fin = s[lo[s] == end[s]]
             done[fin] = made[fin] < old[fin]
@@ -1008,7 +1004,8 @@ class _BatchFitter:
         B2 = np.concatenate([B[~drop], np.concatenate(out_b)[keep_new]])
         C2 = np.concatenate([C[~drop], np.concatenate(out_c)[keep_new]])
         E2 = np.concatenate([E[~drop], np.concatenate(out_e)[keep_new]])
-        L2 = np.concatenate([isl[~drop], np.concatenate(out_l)[keep_new]])
+        # (every segment of a chain, new or kept, is a cubic)
+        L2 = np.concatenate([isl[~drop], np.zeros(int(keep_new.sum()), dtype=bool)])
         o = np.argsort(A2, kind="stable")
         self._store(A2[o], B2[o], C2[o], E2[o], L2[o])
         return True
