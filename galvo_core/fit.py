@@ -429,71 +429,242 @@ def _bound_kernel(cf, a, b, u0, u1, out) -> None:  # pragma: no cover (compiled)
     """:func:`_curve_to_polyline_bound_many`'s maths, one pair at a time (compiled)."""
     uu = np.empty(7)
     for k in range(len(out)):
-        ax = cf[0, 0, k]
-        ay = cf[0, 1, k]
-        bx = cf[1, 0, k]
-        by = cf[1, 1, k]
-        dx = cf[2, 0, k]
-        dy = cf[2, 1, k]
-        ex = cf[3, 0, k]
-        ey = cf[3, 1, k]
-        lo = min(u0[k], u1[k])
-        hi = max(u0[k], u1[k])
-        a0 = a[k, 0]
-        a1 = a[k, 1]
-        abx = b[k, 0] - a0
-        aby = b[k, 1] - a1
-        ln = math.hypot(abx, aby)
-        good = ln > 0.0
-        inv = 1.0 / ln if good else 1.0
-        tx = abx * inv
-        ty = aby * inv
-        nx = -ty
-        ny = tx
-        uu[0] = lo
-        uu[1] = hi
-        uu[2] = 0.5 * (lo + hi)
-        j = 3
-        for row in range(2):
-            vx = nx if row == 0 else tx
-            vy = ny if row == 0 else ty
-            qa = 3.0 * (ax * vx + ay * vy)
-            qb = 2.0 * (bx * vx + by * vy)
-            qc = dx * vx + dy * vy
-            disc = qb * qb - 4.0 * qa * qc
-            sq = math.sqrt(max(disc, 0.0))
-            lin = abs(qa) <= 1e-14 * (abs(qb) + abs(qc) + 1e-300)
-            for sg in (1.0, -1.0):
-                if lin:
-                    r = -qc / qb
-                else:
-                    r = (-qb + sg * sq) / (2.0 * qa)
-                    if not (np.isfinite(r) and disc >= 0.0):
-                        r = lo
-                if np.isnan(r):
-                    r = 0.0
-                uu[j] = min(max(r, lo), hi)
-                j += 1
-        perp = 0.0
-        over = 0.0
-        for i in range(7):
-            u = uu[i]
-            px = ((ax * u + bx) * u + dx) * u + ex - a0
-            py = ((ay * u + by) * u + dy) * u + ey - a1
-            if good:
-                sa = px * tx + py * ty
-                pp = abs(px * nx + py * ny)
-                oo = max(max(-sa, sa - ln), 0.0)
+        out[k] = _bound_pair(cf[0, 0, k], cf[0, 1, k], cf[1, 0, k], cf[1, 1, k], cf[2, 0, k],
+                             cf[2, 1, k], cf[3, 0, k], cf[3, 1, k], a[k, 0], a[k, 1], b[k, 0],
+                             b[k, 1], u0[k], u1[k], uu)
+
+
+@njit(cache=True, nogil=True, error_model="numpy", inline="always")
+def _bound_pair(ax, ay, bx, by, dx, dy, ex, ey, a0, a1, b0, b1, u0, u1,
+                uu):  # pragma: no cover (compiled)
+    """:func:`_bound_kernel` for one pair: the cubic ((a u + b) u + d) u + e between u0 and
+    u1 against the segment (a0, a1)-(b0, b1); ``uu`` a work array of 7."""
+    lo = min(u0, u1)
+    hi = max(u0, u1)
+    abx = b0 - a0
+    aby = b1 - a1
+    ln = math.hypot(abx, aby)
+    good = ln > 0.0
+    inv = 1.0 / ln if good else 1.0
+    tx = abx * inv
+    ty = aby * inv
+    nx = -ty
+    ny = tx
+    uu[0] = lo
+    uu[1] = hi
+    uu[2] = 0.5 * (lo + hi)
+    j = 3
+    for row in range(2):
+        vx = nx if row == 0 else tx
+        vy = ny if row == 0 else ty
+        qa = 3.0 * (ax * vx + ay * vy)
+        qb = 2.0 * (bx * vx + by * vy)
+        qc = dx * vx + dy * vy
+        disc = qb * qb - 4.0 * qa * qc
+        sq = math.sqrt(max(disc, 0.0))
+        lin = abs(qa) <= 1e-14 * (abs(qb) + abs(qc) + 1e-300)
+        for sg in (1.0, -1.0):
+            if lin:
+                r = -qc / qb
             else:
-                pp = math.hypot(px, py)
-                oo = 0.0
-            perp = max(perp, pp)
-            over = max(over, oo)
-        out[k] = math.sqrt(perp * perp + over * over)
+                r = (-qb + sg * sq) / (2.0 * qa)
+                if not (np.isfinite(r) and disc >= 0.0):
+                    r = lo
+            if np.isnan(r):
+                r = 0.0
+            uu[j] = min(max(r, lo), hi)
+            j += 1
+    perp = 0.0
+    over = 0.0
+    for i in range(7):
+        u = uu[i]
+        px = ((ax * u + bx) * u + dx) * u + ex - a0
+        py = ((ay * u + by) * u + dy) * u + ey - a1
+        if good:
+            sa = px * tx + py * ty
+            pp = abs(px * nx + py * ny)
+            oo = max(max(-sa, sa - ln), 0.0)
+        else:
+            pp = math.hypot(px, py)
+            oo = 0.0
+        perp = max(perp, pp)
+        over = max(over, oo)
+    return math.sqrt(perp * perp + over * over)
+
+
+@njit(cache=True, nogil=True, error_model="numpy", inline="always")
+def _pair_within(ax, ay, bx, by, dx, dy, ex, ey, a0, a1, b0, b1, u0, u1,
+                 lim) -> bool:  # pragma: no cover (compiled)
+    """True when a cheap upper bound of :func:`_bound_pair` is within ``lim`` (False
+    proves nothing). Over u0..u1 the cubic keeps within S = (u1 - u0)² / 8 · max |B''| of
+    its chord (B'' is linear in u: its largest length is at an end), and along the chord
+    both the perpendicular distance to the segment's line and the overshoot beyond its ends
+    are largest at the chord's ends; so each of the two maxima that :func:`_bound_pair`
+    combines is at most its value at u0 or u1 plus S. (A margin covers the rounding.)"""
+    abx = b0 - a0
+    aby = b1 - a1
+    ln = math.hypot(abx, aby)
+    if not ln > 0.0:
+        return False
+    tx = abx / ln
+    ty = aby / ln
+    px0 = ((ax * u0 + bx) * u0 + dx) * u0 + ex - a0
+    py0 = ((ay * u0 + by) * u0 + dy) * u0 + ey - a1
+    px1 = ((ax * u1 + bx) * u1 + dx) * u1 + ex - a0
+    py1 = ((ay * u1 + by) * u1 + dy) * u1 + ey - a1
+    perp = max(abs(py0 * tx - px0 * ty), abs(py1 * tx - px1 * ty))
+    sa0 = px0 * tx + py0 * ty
+    sa1 = px1 * tx + py1 * ty
+    over = max(max(-sa0, sa0 - ln), max(-sa1, sa1 - ln), 0.0)
+    c0x = 6.0 * ax * u0 + 2.0 * bx
+    c0y = 6.0 * ay * u0 + 2.0 * by
+    c1x = 6.0 * ax * u1 + 2.0 * bx
+    c1y = 6.0 * ay * u1 + 2.0 * by
+    du = u1 - u0
+    sag = 0.125 * du * du * math.sqrt(max(c0x * c0x + c0y * c0y, c1x * c1x + c1y * c1y))
+    marg = 1e-9 * (1.0 + abs(a0) + abs(a1) + abs(ex) + abs(ey) + ln) + 1e-6 * sag
+    perp += sag + marg
+    over += sag + marg
+    return perp * perp + over * over <= lim * lim
+
+
+@njit(cache=True, nogil=True)
+def _accept_points(cm, i0, i1, starts, work, arc, e2, u, dist, emax0,
+                   far) -> int:  # pragma: no cover (compiled)
+    """:meth:`_BatchFitter._accept`'s point side (compiled): per piece r (power
+    coefficients ``cm[r]`` (4, 2), input points i0[r] .. i1[r], flat from ``starts[r]``) each
+    interior point's parameter (6 Newton steps from arc length, as :func:`_newton_kernel`,
+    bit for bit) and distance into ``u``, ``dist`` (the ends: 0 and 1, distance 0), the
+    piece's largest distance into ``emax0`` (NaN if any is), and the flat indices of the
+    points over ``e2[r]`` in pieces within 4 e2[r] into ``far``; returns their number."""
+    nfar = 0
+    ub = np.empty(_ACCEPT_CHUNK)
+    qxb = np.empty(_ACCEPT_CHUNK)
+    qyb = np.empty(_ACCEPT_CHUNK)
+    db = np.empty(_ACCEPT_CHUNK)
+    for r in range(len(i0)):
+        ax = cm[r, 0, 0]
+        ay = cm[r, 0, 1]
+        bx = cm[r, 1, 0]
+        by = cm[r, 1, 1]
+        dx = cm[r, 2, 0]
+        dy = cm[r, 2, 1]
+        ex = cm[r, 3, 0]
+        ey = cm[r, 3, 1]
+        base = i0[r]
+        s = starts[r]
+        cnt = i1[r] - base + 1
+        span = arc[i1[r]] - arc[base]
+        den = span if span > 0 else 1.0
+        u[s] = 0.0
+        dist[s] = 0.0
+        u[s + cnt - 1] = 1.0
+        dist[s + cnt - 1] = 0.0
+        worst = 0.0
+        nan = False
+        for c0 in range(1, cnt - 1, _ACCEPT_CHUNK):
+            c1 = min(cnt - 1, c0 + _ACCEPT_CHUNK)
+            n = c1 - c0
+            for j in range(n):
+                k = base + c0 + j
+                qxb[j] = work[k, 0] - ex
+                qyb[j] = work[k, 1] - ey
+                ub[j] = (arc[k] - arc[base]) / den
+            for _ in range(6):  # (step by step over the chunk: the loop vectorises)
+                for j in range(n):
+                    uk = ub[j]
+                    rx = ((ax * uk + bx) * uk + dx) * uk - qxb[j]
+                    ry = ((ay * uk + by) * uk + dy) * uk - qyb[j]
+                    d1x = (3.0 * ax * uk + 2.0 * bx) * uk + dx
+                    d1y = (3.0 * ay * uk + 2.0 * by) * uk + dy
+                    f = d1x * rx + d1y * ry
+                    fp = (6.0 * ax * uk + 2.0 * bx) * rx + (6.0 * ay * uk + 2.0 * by) * ry
+                    fp += d1x * d1x
+                    fp += d1y * d1y
+                    if not fp <= 0.0:  # (not convex here: no step)
+                        uk -= f / fp
+                    ub[j] = min(max(uk, 0.0), 1.0)
+            for j in range(n):
+                k = base + c0 + j
+                uk = ub[j]
+                rx = ((ax * uk + bx) * uk + dx) * uk - (work[k, 0] - ex)
+                ry = ((ay * uk + by) * uk + dy) * uk - (work[k, 1] - ey)
+                db[j] = math.sqrt(rx * rx + ry * ry)
+            for j in range(n):
+                d = db[j]
+                u[s + c0 + j] = ub[j]
+                dist[s + c0 + j] = d
+                if d > worst:
+                    worst = d
+                elif d != d:
+                    nan = True
+        emax0[r] = np.nan if nan else worst
+        lim = e2[r]
+        if not nan and worst > lim and worst <= 4.0 * lim:
+            for j in range(1, cnt - 1):
+                if dist[s + j] > lim:
+                    far[nfar] = s + j
+                    nfar += 1
+    return nfar
+
+
+@njit(cache=True, nogil=True, error_model="numpy")
+def _accept_pairs(cm, i0, i1, starts, work, u, e2, qa, ok) -> None:  # pragma: no cover
+    """:meth:`_BatchFitter._accept`'s curve-to-polyline side (compiled): for each piece r
+    still ``ok``, the bound (:func:`_bound_pair`) of every pair of consecutive input
+    points, plus on rounded input (``qa[r]`` > 0, else qa of length 0) the rounding slack
+    the curve may not use beside a long input segment; ``ok[r]`` False at the first pair
+    over ``e2[r]``."""
+    uu = np.empty(7)
+    quant = len(qa) > 0
+    for r in range(len(i0)):
+        if not ok[r]:
+            continue
+        base = i0[r]
+        s = starts[r]
+        lim = e2[r]
+        q = qa[r] if quant else 0.0
+        sl = q * _HALF_DIAGONAL
+        ax = cm[r, 0, 0]
+        ay = cm[r, 0, 1]
+        bx = cm[r, 1, 0]
+        by = cm[r, 1, 1]
+        dx = cm[r, 2, 0]
+        dy = cm[r, 2, 1]
+        ex = cm[r, 3, 0]
+        ey = cm[r, 3, 1]
+        for j in range(i1[r] - base):
+            k = base + j
+            a0 = work[k, 0]
+            a1 = work[k, 1]
+            b0 = work[k + 1, 0]
+            b1 = work[k + 1, 1]
+            u0 = u[s + j]
+            u1 = u[s + j + 1]
+            slack = 0.0
+            if quant:
+                f = 1.0
+                if q > 0.0:
+                    f = min(max(_LONG_SEGMENT * q / math.hypot(b0 - a0, b1 - a1),
+                                _LONG_FLOOR), 1.0)
+                slack = sl * (1.0 - f)
+            if _pair_within(ax, ay, bx, by, dx, dy, ex, ey, a0, a1, b0, b1, u0, u1,
+                            lim - slack):
+                continue  # (a cheap upper bound passes: the exact one would)
+            bnd = _bound_pair(ax, ay, bx, by, dx, dy, ex, ey, a0, a1, b0, b1, u0, u1, uu)
+            if quant:
+                bnd = bnd + slack
+            if not (bnd <= lim):
+                ok[r] = False
+                break
 
 
 #: an empty index array (:func:`_ssum_kernel` on every point)
 _NO_POINTS = np.zeros(0, dtype=np.intp)
+#: points per chunk of :func:`_accept_points` (its Newton steps run over a chunk at a time)
+_ACCEPT_CHUNK = 512
+#: no quanta (:func:`_accept_pairs` on exact input)
+_NO_QUANTA = np.zeros(0)
 #: points per chunk of :func:`_ssum_kernel`
 _SSUM_CHUNK = 512
 
@@ -788,57 +959,47 @@ class _BatchFitter:
     def _accept(self, ctrl: np.ndarray, i0: np.ndarray, i1: np.ndarray, e2: np.ndarray,
                 A: np.ndarray | None = None):
         """Per piece: bound of the max input-point error, pass/fail of both sides of the
-        guarantee, and the flat per-point errors (with the offsets of each piece)."""
+        guarantee, and the flat per-point errors (with the offsets of each piece).
+
+        Points: 6 Newton steps from arc length per point (the ends are the curve's ends).
+        Newton may stop in a local minimum: a seeded search for the points over the bound,
+        in pieces that miss it by little (a piece far off is a bad fit anyway; the check
+        only decides between keeping and splitting, never weakens the guarantee). Then the
+        curve-to-polyline side for the pieces that passed so far; on rounded input a long
+        input segment is the design up to the rounding of its ends, so the curve keeps
+        closer to it than the rounding allows. Both sides compiled, one piece at a time
+        (:func:`_accept_points`, :func:`_accept_pairs`); a piece stops at its first pair
+        over the bound."""
         m = len(ctrl)
+        i0 = np.ascontiguousarray(i0, dtype=np.intp)
+        i1 = np.ascontiguousarray(i1, dtype=np.intp)
+        e2 = np.ascontiguousarray(e2, dtype=np.float64)
         cnt = i1 - i0 + 1
-        pid, off = _ragged(np.zeros(m, dtype=np.intp), cnt)
         starts = np.cumsum(cnt) - cnt
-        idx = i0[pid] + off
-        pts = self.work[idx]
-        span = self.arc[i1] - self.arc[i0]
-        u = (self.arc[idx] - self.arc[i0][pid]) / np.where(span > 0, span, 1.0)[pid]
-        cf = gather_coeffs(power_coeffs_many(ctrl), pid)
-        u, d2 = newton_nearest_many(cf, pts.T, u, 6)
-        # ends of each piece are the curve's ends
-        ends = np.concatenate([starts, starts + cnt - 1])
-        u[starts] = 0.0
-        u[starts + cnt - 1] = 1.0
-        d2[ends] = 0.0
-        dist = np.sqrt(d2)
-        # Newton may have stopped in a local minimum: seeded search for the points over the
-        # bound, in pieces that miss it by little (a piece far off is a bad fit anyway; the
-        # check only decides between keeping and splitting, never weakens the guarantee)
-        emax0 = np.maximum.reduceat(dist, starts)
-        e2p = e2[pid]
-        far = np.flatnonzero((dist > e2p) & (emax0[pid] <= 4.0 * e2p))
-        if len(far):
-            used, inv = np.unique(pid[far], return_inverse=True)  # (only their cubics)
-            tu, td = nearest_on_cubics(ctrl[used], inv, pts[far])
+        total = int(cnt.sum())
+        cm = power_coeffs_many(ctrl)
+        u = np.empty(total)
+        dist = np.empty(total)
+        emax0 = np.empty(m)
+        far = np.empty(total, dtype=np.intp)
+        nfar = _accept_points(cm, i0, i1, starts, self.work, self.arc, e2, u, dist, emax0,
+                              far)
+        emax = emax0
+        if nfar:
+            far = far[:nfar]
+            pid = np.searchsorted(starts, far, side="right") - 1
+            pts = self.work[i0[pid] + far - starts[pid]]
+            used, inv = np.unique(pid, return_inverse=True)  # (only their cubics)
+            tu, td = nearest_on_cubics(ctrl[used], inv, pts)
             better = td < dist[far]
             u[far[better]] = tu[better]
             dist[far[better]] = td[better]
-        emax = np.maximum.reduceat(dist, starts)
+            emax = np.maximum.reduceat(dist, starts)
         ok = emax <= e2
-        # curve-to-polyline side, for the pieces that passed so far
-        pair = np.ones(len(idx), dtype=bool)
-        pair[starts + cnt - 1] = False
-        pair &= ok[pid]
-        j = np.flatnonzero(pair)
-        if len(j):
-            bnd = _curve_to_polyline_bound_many(cf[:, :, j], pts[j], pts[j + 1], u[j], u[j + 1])
-            if self.quant is not None and A is not None:
-                # rounded input: a long input segment is the design up to the rounding of
-                # its ends, so the curve keeps closer to it than the rounding allows
-                qa = self.quant[A][pid[j]]
-                sl = qa * _HALF_DIAGONAL
-                ln = np.hypot(*(pts[j + 1] - pts[j]).T)
-                with np.errstate(divide="ignore", invalid="ignore"):
-                    f = np.clip(_LONG_SEGMENT * qa / ln, _LONG_FLOOR, 1.0)
-                f = np.where(qa > 0.0, f, 1.0)
-                bnd = bnd + sl * (1.0 - f)
-            worst = np.zeros(m)
-            np.maximum.at(worst, pid[j], bnd)
-            ok &= worst <= e2
+        qa = _NO_QUANTA
+        if self.quant is not None and A is not None:
+            qa = np.ascontiguousarray(self.quant[A], dtype=np.float64)
+        _accept_pairs(cm, i0, i1, starts, self.work, u, e2, qa, ok)
         return ok, emax, dist, starts
 
     def fit(self, curve_pieces: np.ndarray, line_pieces: np.ndarray | None = None) -> None:
