@@ -792,6 +792,99 @@ def _handle_lengths(u, pid, pts, p0, p3, t0, t3, m):
     return al, be, det, c11, c22
 
 
+@njit(cache=True, nogil=True, error_model="numpy")
+def _gn_rounds(ps, pts, u, p0, p3, t0, t3, al, be, chord, rounds) -> None:  # pragma: no cover
+    """:meth:`_BatchFitter._gauss_newton`'s rounds (compiled), in place on the handle
+    lengths ``al``, ``be`` and the sample points' parameters ``u``: piece r's sample points
+    are ps[r] .. ps[r + 1] - 1 of ``pts``. Per round and piece: the cubic's power
+    coefficients, 2 Newton steps per point (as :func:`_newton_kernel`), the unit normal at
+    the nearest point and the signed distance along it, the 2x2 normal equations of the
+    handle lengths, a damped step (the numbers of the former numpy version, bit for bit)."""
+    for r in range(len(al)):
+        p0x = p0[r, 0]
+        p0y = p0[r, 1]
+        p3x = p3[r, 0]
+        p3y = p3[r, 1]
+        t0x = t0[r, 0]
+        t0y = t0[r, 1]
+        t3x = t3[r, 0]
+        t3y = t3[r, 1]
+        lim = 0.25 * chord[r]
+        a_ = al[r]
+        b_ = be[r]
+        for _ in range(rounds):
+            p1x = p0x + a_ * t0x
+            p1y = p0y + a_ * t0y
+            p2x = p3x - b_ * t3x
+            p2y = p3y - b_ * t3y
+            ax = -p0x + 3.0 * (p1x - p2x)
+            ax += p3x
+            ay = -p0y + 3.0 * (p1y - p2y)
+            ay += p3y
+            bx = 3.0 * (p0x + p2x) - 6.0 * p1x
+            by = 3.0 * (p0y + p2y) - 6.0 * p1y
+            dx = 3.0 * (p1x - p0x)
+            dy = 3.0 * (p1y - p0y)
+            ex = p0x
+            ey = p0y
+            c11 = 0.0
+            c12 = 0.0
+            c22 = 0.0
+            x1 = 0.0
+            x2 = 0.0
+            for k in range(ps[r], ps[r + 1]):
+                qx = pts[k, 0] - ex
+                qy = pts[k, 1] - ey
+                uk = u[k]
+                for _i in range(2):
+                    rx = ((ax * uk + bx) * uk + dx) * uk - qx
+                    ry = ((ay * uk + by) * uk + dy) * uk - qy
+                    d1x = (3.0 * ax * uk + 2.0 * bx) * uk + dx
+                    d1y = (3.0 * ay * uk + 2.0 * by) * uk + dy
+                    f = d1x * rx + d1y * ry
+                    fp = (6.0 * ax * uk + 2.0 * bx) * rx + (6.0 * ay * uk + 2.0 * by) * ry
+                    fp += d1x * d1x
+                    fp += d1y * d1y
+                    if not fp <= 0.0:  # (not convex here: no step)
+                        uk -= f / fp
+                    uk = min(max(uk, 0.0), 1.0)
+                u[k] = uk
+                rx = ((ax * uk + bx) * uk + dx) * uk + ex - pts[k, 0]
+                ry = ((ay * uk + by) * uk + dy) * uk + ey - pts[k, 1]
+                d1x = (3.0 * ax * uk + 2.0 * bx) * uk + dx
+                d1y = (3.0 * ay * uk + 2.0 * by) * uk + dy
+                dn = math.hypot(d1x, d1y)
+                if not dn > 0.0:
+                    dn = 1.0
+                nx = -d1y / dn
+                ny = d1x / dn
+                res = nx * rx + ny * ry
+                sk = 1.0 - uk
+                j1 = 3 * sk * sk * uk * (nx * t0x + ny * t0y)
+                j2 = -3 * sk * uk * uk * (nx * t3x + ny * t3y)
+                c11 += j1 * j1
+                c12 += j1 * j2
+                c22 += j2 * j2
+                x1 += j1 * res
+                x2 += j2 * res
+            x1 = -x1
+            x2 = -x2
+            det = c11 * c22 - c12 * c12
+            da = (x1 * c22 - x2 * c12) / det
+            db = (c11 * x2 - c12 * x1) / det
+            if (np.isfinite(da) and np.isfinite(db)
+                    and abs(det) > 1e-12 * (c11 * c22 + 1e-300)):
+                # damped: at most a quarter chord per round, a handle at most halved
+                v = a_ + min(max(da, -lim), lim)
+                h = 0.5 * a_
+                a_ = v if (v >= h or v != v) else h
+                v = b_ + min(max(db, -lim), lim)
+                h = 0.5 * b_
+                b_ = v if (v >= h or v != v) else h
+        al[r] = a_
+        be[r] = b_
+
+
 def _normal_residuals(ctrl, pid, pts, u):
     """Each point's nearest parameter on its cubic (Newton from ``u``), the unit normal
     there and the point's signed distance along it: (u, nx, ny, res), for Gauss-Newton."""
@@ -1557,27 +1650,14 @@ class _BatchFitter:
         bad = ~((al > 0) & (be > 0) & (al < 2.0 * chord) & (be < 2.0 * chord))
         al = np.where(bad, chord / 3.0, al)
         be = np.where(bad, chord / 3.0, be)
-        for _ in range(rounds):
-            ctrl = np.stack([p0, p0 + al[:, None] * t0, p3 - be[:, None] * t3, p3], axis=1)
-            u, nx, ny, res = _normal_residuals(ctrl, pid, pts, u)
-            s = 1.0 - u
-            j1 = 3 * s * s * u * (nx * t0[pid, 0] + ny * t0[pid, 1])
-            j2 = -3 * s * u * u * (nx * t3[pid, 0] + ny * t3[pid, 1])
-            c11 = np.bincount(pid, j1 * j1, m)
-            c12 = np.bincount(pid, j1 * j2, m)
-            c22 = np.bincount(pid, j2 * j2, m)
-            x1 = -np.bincount(pid, j1 * res, m)
-            x2 = -np.bincount(pid, j2 * res, m)
-            with np.errstate(divide="ignore", invalid="ignore"):
-                det = c11 * c22 - c12 * c12
-                da = (x1 * c22 - x2 * c12) / det
-                db = (c11 * x2 - c12 * x1) / det
-            step = np.isfinite(da) & np.isfinite(db) & (np.abs(det) > 1e-12 * (c11 * c22 + 1e-300))
-            # damped: at most a quarter chord per round, a handle at most halved (rounded
-            # input, a poor start: full steps overshoot and oscillate)
-            lim = 0.25 * chord
-            al = np.where(step, np.maximum(al + np.clip(da, -lim, lim), 0.5 * al), al)
-            be = np.where(step, np.maximum(be + np.clip(db, -lim, lim), 0.5 * be), be)
+        ps = np.r_[0, np.cumsum(np.bincount(pid, minlength=m))]
+        al = np.ascontiguousarray(al, dtype=np.float64)
+        be = np.ascontiguousarray(be, dtype=np.float64)
+        _gn_rounds(ps, np.ascontiguousarray(pts, dtype=np.float64),
+                   np.ascontiguousarray(u, dtype=np.float64), np.ascontiguousarray(p0),
+                   np.ascontiguousarray(p3), np.ascontiguousarray(t0, dtype=np.float64),
+                   np.ascontiguousarray(t3, dtype=np.float64), al, be,
+                   np.ascontiguousarray(chord), rounds)
         ok = np.isfinite(al) & np.isfinite(be) & (al > 0) & (be > 0)
         ok &= (al < 2.0 * chord) & (be < 2.0 * chord)
         al = np.where(ok, al, chord / 3.0)
