@@ -16,6 +16,8 @@ pairwise table could otherwise grow large.
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 from numba import njit
 
@@ -594,20 +596,63 @@ def nearest_on_cubics(
     s = 1.0 - su
     basis = np.stack([s**3, 3.0 * s * s * su, 3.0 * s * su * su, su**3], axis=1)  # (S, 4)
     samp = np.einsum("sk,mkd->msd", basis, c)  # (M, S, 2)
-    cf = gather_coeffs(power_coeffs_many(c), pid)
     t_out = np.empty(k)
     d_out = np.empty(k)
-    rows = max(1, _CHUNK_CELLS // (seeds + 1))
-    for s0 in range(0, k, rows):
-        sl = slice(s0, s0 + rows)
-        q = p[sl]
-        sp = samp[pid[sl]]
-        d2 = (q[:, 0:1] - sp[:, :, 0]) ** 2 + (q[:, 1:2] - sp[:, :, 1]) ** 2
-        j = np.argmin(d2, axis=1)
-        best = d2[np.arange(len(q)), j]
-        u0 = su[j]
-        u, dn = newton_nearest_many(cf[:, :, sl], q.T, u0, iters)
-        better = dn < best
-        t_out[sl] = np.where(better, u, u0)
-        d_out[sl] = np.sqrt(np.where(better, dn, best))
+    _seeded_kernel(power_coeffs_many(c), np.ascontiguousarray(pid, dtype=np.intp),
+                   np.ascontiguousarray(p), samp, su, iters, t_out, d_out)
     return t_out, d_out
+
+
+@njit(cache=True, nogil=True)
+def _seeded_kernel(cm, pid, p, samp, su, iters, t_out, d_out):  # type: ignore[no-untyped-def]
+    """:func:`nearest_on_cubics` per point (compiled): the nearest of the cubic's samples
+    ``samp[pid[k]]`` (at parameters ``su``; the first on ties, or the first NaN), Newton
+    from there (as :func:`_newton_kernel`, bit for bit), the better of both."""
+    for k in range(len(pid)):
+        m = pid[k]
+        px = p[k, 0]
+        py = p[k, 1]
+        j = 0
+        best = np.inf
+        for i in range(samp.shape[1]):
+            ex = px - samp[m, i, 0]
+            ey = py - samp[m, i, 1]
+            v = ex * ex + ey * ey
+            if v != v:
+                j = i
+                best = v
+                break
+            if i == 0 or v < best:
+                j = i
+                best = v
+        ax = cm[m, 0, 0]
+        ay = cm[m, 0, 1]
+        bx = cm[m, 1, 0]
+        by = cm[m, 1, 1]
+        dx = cm[m, 2, 0]
+        dy = cm[m, 2, 1]
+        qx = px - cm[m, 3, 0]
+        qy = py - cm[m, 3, 1]
+        u0 = su[j]
+        uk = u0
+        for _ in range(iters):
+            rx = ((ax * uk + bx) * uk + dx) * uk - qx
+            ry = ((ay * uk + by) * uk + dy) * uk - qy
+            d1x = (3.0 * ax * uk + 2.0 * bx) * uk + dx
+            d1y = (3.0 * ay * uk + 2.0 * by) * uk + dy
+            f = d1x * rx + d1y * ry
+            fp = (6.0 * ax * uk + 2.0 * bx) * rx + (6.0 * ay * uk + 2.0 * by) * ry
+            fp += d1x * d1x
+            fp += d1y * d1y
+            if not fp <= 0.0:
+                uk -= f / fp
+            uk = min(max(uk, 0.0), 1.0)
+        rx = ((ax * uk + bx) * uk + dx) * uk - (px - cm[m, 3, 0])
+        ry = ((ay * uk + by) * uk + dy) * uk - (py - cm[m, 3, 1])
+        dn = rx * rx + ry * ry
+        if dn < best:
+            t_out[k] = uk
+            d_out[k] = math.sqrt(dn)
+        else:
+            t_out[k] = u0
+            d_out[k] = math.sqrt(best)
