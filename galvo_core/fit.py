@@ -800,6 +800,20 @@ def _gn_rounds(ps, pts, u, p0, p3, t0, t3, al, be, chord, rounds) -> None:  # pr
     coefficients, 2 Newton steps per point (as :func:`_newton_kernel`), the unit normal at
     the nearest point and the signed distance along it, the 2x2 normal equations of the
     handle lengths, a damped step (the numbers of the former numpy version, bit for bit)."""
+    nmax = 0
+    for r in range(len(al)):
+        nmax = max(nmax, ps[r + 1] - ps[r])
+    ub = np.empty(nmax)
+    qxb = np.empty(nmax)
+    qyb = np.empty(nmax)
+    rxb = np.empty(nmax)
+    ryb = np.empty(nmax)
+    txb = np.empty(nmax)
+    tyb = np.empty(nmax)
+    nb = np.empty(nmax)
+    resb = np.empty(nmax)
+    j1b = np.empty(nmax)
+    j2b = np.empty(nmax)
     for r in range(len(al)):
         p0x = p0[r, 0]
         p0y = p0[r, 1]
@@ -832,13 +846,17 @@ def _gn_rounds(ps, pts, u, p0, p3, t0, t3, al, be, chord, rounds) -> None:  # pr
             c22 = 0.0
             x1 = 0.0
             x2 = 0.0
-            for k in range(ps[r], ps[r + 1]):
-                qx = pts[k, 0] - ex
-                qy = pts[k, 1] - ey
-                uk = u[k]
-                for _i in range(2):
-                    rx = ((ax * uk + bx) * uk + dx) * uk - qx
-                    ry = ((ay * uk + by) * uk + dy) * uk - qy
+            k0 = ps[r]
+            n = ps[r + 1] - k0
+            for j in range(n):  # (step by step over the piece's points: vectorises)
+                qxb[j] = pts[k0 + j, 0] - ex
+                qyb[j] = pts[k0 + j, 1] - ey
+                ub[j] = u[k0 + j]
+            for _i in range(2):
+                for j in range(n):
+                    uk = ub[j]
+                    rx = ((ax * uk + bx) * uk + dx) * uk - qxb[j]
+                    ry = ((ay * uk + by) * uk + dy) * uk - qyb[j]
                     d1x = (3.0 * ax * uk + 2.0 * bx) * uk + dx
                     d1y = (3.0 * ay * uk + 2.0 * by) * uk + dy
                     f = d1x * rx + d1y * ry
@@ -847,21 +865,30 @@ def _gn_rounds(ps, pts, u, p0, p3, t0, t3, al, be, chord, rounds) -> None:  # pr
                     fp += d1y * d1y
                     if not fp <= 0.0:  # (not convex here: no step)
                         uk -= f / fp
-                    uk = min(max(uk, 0.0), 1.0)
-                u[k] = uk
-                rx = ((ax * uk + bx) * uk + dx) * uk + ex - pts[k, 0]
-                ry = ((ay * uk + by) * uk + dy) * uk + ey - pts[k, 1]
-                d1x = (3.0 * ax * uk + 2.0 * bx) * uk + dx
-                d1y = (3.0 * ay * uk + 2.0 * by) * uk + dy
-                dn = math.hypot(d1x, d1y)
-                if not dn > 0.0:
-                    dn = 1.0
-                nx = -d1y / dn
-                ny = d1x / dn
-                res = nx * rx + ny * ry
+                    ub[j] = min(max(uk, 0.0), 1.0)
+            for j in range(n):
+                uk = ub[j]
+                u[k0 + j] = uk
+                rxb[j] = ((ax * uk + bx) * uk + dx) * uk + ex - pts[k0 + j, 0]
+                ryb[j] = ((ay * uk + by) * uk + dy) * uk + ey - pts[k0 + j, 1]
+                txb[j] = (3.0 * ax * uk + 2.0 * bx) * uk + dx
+                tyb[j] = (3.0 * ay * uk + 2.0 * by) * uk + dy
+            for j in range(n):
+                dn = math.hypot(txb[j], tyb[j])
+                nb[j] = dn if dn > 0.0 else 1.0
+            for j in range(n):
+                uk = ub[j]
+                dn = nb[j]
+                nx = -tyb[j] / dn
+                ny = txb[j] / dn
+                resb[j] = nx * rxb[j] + ny * ryb[j]
                 sk = 1.0 - uk
-                j1 = 3 * sk * sk * uk * (nx * t0x + ny * t0y)
-                j2 = -3 * sk * uk * uk * (nx * t3x + ny * t3y)
+                j1b[j] = 3 * sk * sk * uk * (nx * t0x + ny * t0y)
+                j2b[j] = -3 * sk * uk * uk * (nx * t3x + ny * t3y)
+            for j in range(n):
+                j1 = j1b[j]
+                j2 = j2b[j]
+                res = resb[j]
                 c11 += j1 * j1
                 c12 += j1 * j2
                 c22 += j2 * j2
