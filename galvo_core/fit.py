@@ -90,7 +90,6 @@ from numba import njit
 from galvo_core.drawing import Drawing, Path
 from galvo_core.errors import Cancelled, ParamError
 from galvo_core.geometry import (
-    _newton_step,
     cubic_eval,
     cubic_length,
     gather_coeffs,
@@ -100,7 +99,6 @@ from galvo_core.geometry import (
     newton_nearest_many,
     point_polyline_distance,
     point_segment_distance,
-    power_coeffs_into,
     power_coeffs_many,
 )
 from galvo_core.job import gc_paused
@@ -659,82 +657,160 @@ def _accept_pairs(cm, i0, i1, starts, work, u, e2, qa, ok) -> None:  # pragma: n
                 break
 
 
-#: an empty index array (:func:`_ssum_kernel` on every point)
-_NO_POINTS = np.zeros(0, dtype=np.intp)
 #: points per chunk of :func:`_accept_points` (its Newton steps run over a chunk at a time)
 _ACCEPT_CHUNK = 512
 #: no quanta (:func:`_accept_pairs` on exact input)
 _NO_QUANTA = np.zeros(0)
-#: points per chunk of :func:`_ssum_kernel`
-_SSUM_CHUNK = 512
 
 
-@njit(cache=True, nogil=True)
-def _ssum_kernel(cfm, pid, sel, every, pxy, ustate, tiny, chxy, sg, out):  # pragma: no cover
-    """The dichotomy's signed error sums (compiled): for each sample point i (all, or those
-    in ``sel``) of piece pid[i], 3 Newton steps from ustate[i] on the piece's cubic (``cfm``
-    (4, 2, m) power coefficients), ustate[i] updated; its distance signed by the side of the
-    curve it lies on (the chord's direction where the tangent vanishes) times the piece's
-    orientation sg[i], summed per piece into ``out`` in the order of the points (the
-    numbers of the former numpy version, bit for bit)."""
-    n = pid.shape[0] if every else sel.shape[0]
-    ch = _SSUM_CHUNK
-    cf = np.empty((4, 2, ch))
-    p = np.empty((2, ch))
-    u = np.empty(ch)
-    w = np.empty(ch)
-    lo = np.zeros(1)
-    hi = np.ones(1)
-    for c0 in range(0, n, ch):
-        ln = min(n, c0 + ch) - c0
-        for j in range(ln):
-            i = c0 + j if every else sel[c0 + j]
-            r = pid[i]
-            for a in range(4):
-                cf[a, 0, j] = cfm[a, 0, r]
-                cf[a, 1, j] = cfm[a, 1, r]
-            p[0, j] = pxy[0, i]
-            p[1, j] = pxy[1, i]
-            u[j] = ustate[i]
-        for _ in range(3):
-            _newton_step(cf, p, u, 0, ln, lo, hi, True, True, False)
-        for j in range(ln):
-            i = c0 + j if every else sel[c0 + j]
-            uk = u[j]
-            ustate[i] = uk
-            ax = cf[0, 0, j]
-            ay = cf[0, 1, j]
-            bx = cf[1, 0, j]
-            by = cf[1, 1, j]
-            dx = cf[2, 0, j]
-            dy = cf[2, 1, j]
-            ex = cf[3, 0, j]
-            ey = cf[3, 1, j]
-            px = p[0, j]
-            py = p[1, j]
-            nx = ((ax * uk + bx) * uk + dx) * uk - (px - ex)  # (Newton's squared distance)
-            ny = ((ay * uk + by) * uk + dy) * uk - (py - ey)
-            d2 = nx * nx + ny * ny
-            tgx = (3.0 * ax * uk + 2.0 * bx) * uk + dx
-            tgy = (3.0 * ay * uk + 2.0 * by) * uk + dy
-            if tgx * tgx + tgy * tgy <= tiny[i]:
-                tgx = chxy[0, i]
-                tgy = chxy[1, i]
-            rx = px - (((ax * uk + bx) * uk + dx) * uk + ex)
-            ry = py - (((ay * uk + by) * uk + dy) * uk + ey)
-            cr = tgx * ry - tgy * rx
-            if cr > 0.0:
-                side = 1.0
-            elif cr < 0.0:
-                side = -1.0
-            elif cr == 0.0:
-                side = 0.0
+@njit(cache=True, nogil=True, error_model="numpy")
+def _dichotomy_kernel(p0, qq, p3, sig, i0, i1, work, arc, sample, max_iter, eps_s,
+                      t_out) -> None:  # pragma: no cover (compiled)
+    """:meth:`_BatchFitter._dichotomy` one piece at a time (compiled): the Illinois false
+    position on t of each piece (its own iterations, as the batch's were), its signed error
+    sums over its sample points: 3 Newton steps per evaluation from each point's last
+    parameter, its distance signed by the side of the curve it lies on (the chord's
+    direction where the tangent vanishes) times the piece's orientation ``sig``, summed in
+    the order of the points (the numbers of the former batch version, bit for bit)."""
+    ub = np.empty(sample)
+    u0 = np.empty(sample)
+    pxb = np.empty(sample)
+    pyb = np.empty(sample)
+    qxb = np.empty(sample)
+    qyb = np.empty(sample)
+    wb = np.empty(sample)
+    for r in range(len(i0)):
+        a = i0[r]
+        L = i1[r] - a - 1
+        stride = max(1, -(-L // sample))
+        n = -(-L // stride)
+        span = arc[i1[r]] - arc[a]
+        den = span if span > 0 else 1.0
+        for j in range(n):
+            k = a + 1 + stride * j
+            pxb[j] = work[k, 0]
+            pyb[j] = work[k, 1]
+            u0[j] = (arc[k] - arc[a]) / den
+            ub[j] = u0[j]
+        p0x = p0[r, 0]
+        p0y = p0[r, 1]
+        p3x = p3[r, 0]
+        p3y = p3[r, 1]
+        q0x = qq[r, 0] - p0x
+        q0y = qq[r, 1] - p0y
+        q3x = qq[r, 0] - p3x
+        q3y = qq[r, 1] - p3y
+        chx = p3x - p0x
+        chy = p3y - p0y
+        tiny = 1e-18 * (chx * chx + chy * chy)
+        sg = sig[r]
+        tl = 0.0
+        th = 1.0
+        sl = 0.0
+        sh = 0.0
+        hside = 0
+        t = 0.0
+        for e in range(2 + max_iter):
+            if e == 0:
+                t = 0.0
+            elif e == 1:
+                t = 1.0
             else:
-                side = cr  # (NaN)
-            w[j] = sg[i] * side * math.sqrt(d2)
-        for j in range(ln):
-            i = c0 + j if every else sel[c0 + j]
-            out[pid[i]] += w[j]
+                tn = (tl * sh - th * sl) / (sh - sl)
+                if not (tl < tn and tn < th):
+                    tn = 0.5 * (tl + th)
+                t = tn
+            # the signed error sum at t
+            p1x = p0x + t * q0x
+            p1y = p0y + t * q0y
+            p2x = p3x + t * q3x
+            p2y = p3y + t * q3y
+            ax = -p0x + 3.0 * (p1x - p2x)
+            ax += p3x
+            ay = -p0y + 3.0 * (p1y - p2y)
+            ay += p3y
+            bx = 3.0 * (p0x + p2x) - 6.0 * p1x
+            by = 3.0 * (p0y + p2y) - 6.0 * p1y
+            dx = 3.0 * (p1x - p0x)
+            dy = 3.0 * (p1y - p0y)
+            ex = p0x
+            ey = p0y
+            for j in range(n):
+                qxb[j] = pxb[j] - ex
+                qyb[j] = pyb[j] - ey
+            for _ in range(3):
+                for j in range(n):
+                    uk = ub[j]
+                    rx = ((ax * uk + bx) * uk + dx) * uk - qxb[j]
+                    ry = ((ay * uk + by) * uk + dy) * uk - qyb[j]
+                    d1x = (3.0 * ax * uk + 2.0 * bx) * uk + dx
+                    d1y = (3.0 * ay * uk + 2.0 * by) * uk + dy
+                    f = d1x * rx + d1y * ry
+                    fp = (6.0 * ax * uk + 2.0 * bx) * rx + (6.0 * ay * uk + 2.0 * by) * ry
+                    fp += d1x * d1x
+                    fp += d1y * d1y
+                    if not fp <= 0.0:  # (not convex here: no step)
+                        uk -= f / fp
+                    ub[j] = min(max(uk, 0.0), 1.0)
+            for j in range(n):
+                uk = ub[j]
+                px = pxb[j]
+                py = pyb[j]
+                nx = ((ax * uk + bx) * uk + dx) * uk - (px - ex)
+                ny = ((ay * uk + by) * uk + dy) * uk - (py - ey)
+                d2 = nx * nx + ny * ny
+                tgx = (3.0 * ax * uk + 2.0 * bx) * uk + dx
+                tgy = (3.0 * ay * uk + 2.0 * by) * uk + dy
+                if tgx * tgx + tgy * tgy <= tiny:
+                    tgx = chx
+                    tgy = chy
+                rx = px - (((ax * uk + bx) * uk + dx) * uk + ex)
+                ry = py - (((ay * uk + by) * uk + dy) * uk + ey)
+                cr = tgx * ry - tgy * rx
+                if cr > 0.0:
+                    side = 1.0
+                elif cr < 0.0:
+                    side = -1.0
+                elif cr == 0.0:
+                    side = 0.0
+                else:
+                    side = cr  # (NaN)
+                wb[j] = sg * side * math.sqrt(d2)
+            acc = 0.0
+            for j in range(n):
+                acc += wb[j]
+            sv = -acc
+            if e == 0:
+                sl = sv
+                continue
+            if e == 1:
+                sh = sv
+                for j in range(n):
+                    ub[j] = u0[j]
+                t = 0.5
+                if sl <= 0.0:
+                    t = 0.0
+                    break
+                if sh >= 0.0:
+                    t = 1.0
+                    break
+                hside = 0
+                continue
+            if abs(sv) < eps_s or th - tl < 1e-9:
+                break
+            if sv > 0.0:
+                if hside == 1:
+                    sh = 0.5 * sh
+                tl = t
+                sl = sv
+                hside = 1
+            else:
+                if hside == -1:
+                    sl = 0.5 * sl
+                th = t
+                sh = sv
+                hside = -1
+        t_out[r] = t
 
 
 def _handles_in_order(ctrl: np.ndarray) -> np.ndarray:
@@ -1003,77 +1079,16 @@ class _BatchFitter:
     def _dichotomy(self, p0, qq, p3, sig, i0, i1, sample: int = _BISECT_SAMPLE,
                    max_iter: int = _MAX_BISECT, eps_sum: float | None = None) -> np.ndarray:
         """t per piece: the signed error sum over a sample of each piece's input points
-        crosses zero (Illinois false position inside the bracket [0, 1])."""
-        m = len(p0)
-        L = i1 - i0 - 1
-        stride = np.maximum(1, -(-L // sample))
-        cnt = -(-L // stride)
-        pid, off = _ragged(np.zeros(m, dtype=np.intp), cnt)
-        idx = i0[pid] + 1 + stride[pid] * off
-        pxy = self.work[idx].T.copy()  # (2, K)
-        span = self.arc[i1] - self.arc[i0]
-        u = (self.arc[idx] - self.arc[i0][pid]) / np.where(span > 0, span, 1.0)[pid]
-        chord = p3 - p0
-        chxy = chord.T[:, pid]
-        tiny = 1e-18 * (chord * chord).sum(axis=1)[pid]
-        sg = sig[pid]
-        ustate = u.copy()
-        # per piece: P1 = P0 + t (Q - P0), P2 = P3 + t (Q - P3); their power coefficients
-        # in a (4, 2, m) block, gathered per point
-        cfm = np.empty((4, 2, m))
-        p0t = p0.T
-        p3t = p3.T
-        q0 = (qq - p0).T
-        q3 = (qq - p3).T
-
-        def ssum(t: np.ndarray, pm: np.ndarray | None = None) -> np.ndarray:
-            """Signed error sums of all pieces at ``t`` (only pieces with points ``pm``
-            are evaluated, the others come back 0)."""
-            if pm is not None and len(pm) == len(pid):
-                pm = None  # (every point: no copies)
-            power_coeffs_into(cfm, p0t, p0t + t * q0, p3t + t * q3, p3t)
-            out = np.zeros(m)
-            _ssum_kernel(cfm, pid, _NO_POINTS if pm is None else pm, pm is None, pxy, ustate,
-                         tiny, chxy, sg, out)
-            return -out
-
-        tl = np.zeros(m)
-        th = np.ones(m)
-        sl = ssum(tl)
-        sh = ssum(th)
-        t = np.full(m, 0.5)
-        done = sl <= 0.0
-        t[done] = 0.0
-        hi_case = ~done & (sh >= 0.0)
-        t[hi_case] = 1.0
-        done |= hi_case
-        ustate[:] = u
-        side = np.zeros(m)
-        with np.errstate(divide="ignore", invalid="ignore"):
-            eps_s = self.eps_sum if eps_sum is None else eps_sum
-            for _ in range(max_iter):
-                if done.all():
-                    break
-                tn = (tl * sh - th * sl) / (sh - sl)
-                inner = (tl < tn) & (tn < th)
-                tn = np.where(inner, tn, 0.5 * (tl + th))
-                tn = np.where(done, t, tn)
-                s = ssum(tn, np.flatnonzero(~done[pid]) if done.any() else None)
-                t = tn
-                going = ~done
-                stop = going & ((np.abs(s) < eps_s) | (th - tl < 1e-9))
-                upd = going ^ stop  # (stop lies within going)
-                pos = upd & (s > 0.0)
-                neg = upd ^ pos
-                sh = np.where(pos & (side == 1), 0.5 * sh, sh)
-                tl = np.where(pos, t, tl)
-                sl = np.where(pos, s, sl)
-                sl = np.where(neg & (side == -1), 0.5 * sl, sl)
-                th = np.where(neg, t, th)
-                sh = np.where(neg, s, sh)
-                side[pos] = 1.0
-                side[neg] = -1.0
-                done |= stop
+        crosses zero (Illinois false position inside the bracket [0, 1]); each piece on its
+        own, compiled (:func:`_dichotomy_kernel`). Returns the pieces' cubics (m, 4, 2)."""
+        t = np.empty(len(p0))
+        _dichotomy_kernel(np.ascontiguousarray(p0, dtype=np.float64),
+                          np.ascontiguousarray(qq, dtype=np.float64),
+                          np.ascontiguousarray(p3, dtype=np.float64),
+                          np.ascontiguousarray(sig, dtype=np.float64),
+                          np.ascontiguousarray(i0, dtype=np.intp),
+                          np.ascontiguousarray(i1, dtype=np.intp), self.work, self.arc,
+                          sample, max_iter, self.eps_sum if eps_sum is None else eps_sum, t)
         return self._ctrl(p0, qq, p3, t)
 
     def _accept(self, ctrl: np.ndarray, i0: np.ndarray, i1: np.ndarray, e2: np.ndarray,
