@@ -490,42 +490,6 @@ def _bound_pair(ax, ay, bx, by, dx, dy, ex, ey, a0, a1, b0, b1, u0, u1,
     return math.sqrt(perp * perp + over * over)
 
 
-@njit(cache=True, nogil=True, error_model="numpy", inline="always")
-def _pair_within(ax, ay, bx, by, dx, dy, ex, ey, a0, a1, b0, b1, u0, u1,
-                 lim) -> bool:  # pragma: no cover (compiled)
-    """True when a cheap upper bound of :func:`_bound_pair` is within ``lim`` (False
-    proves nothing). Over u0..u1 the cubic keeps within S = (u1 - u0)² / 8 · max |B''| of
-    its chord (B'' is linear in u: its largest length is at an end), and along the chord
-    both the perpendicular distance to the segment's line and the overshoot beyond its ends
-    are largest at the chord's ends; so each of the two maxima that :func:`_bound_pair`
-    combines is at most its value at u0 or u1 plus S. (A margin covers the rounding.)"""
-    abx = b0 - a0
-    aby = b1 - a1
-    ln = math.hypot(abx, aby)
-    if not ln > 0.0:
-        return False
-    tx = abx / ln
-    ty = aby / ln
-    px0 = ((ax * u0 + bx) * u0 + dx) * u0 + ex - a0
-    py0 = ((ay * u0 + by) * u0 + dy) * u0 + ey - a1
-    px1 = ((ax * u1 + bx) * u1 + dx) * u1 + ex - a0
-    py1 = ((ay * u1 + by) * u1 + dy) * u1 + ey - a1
-    perp = max(abs(py0 * tx - px0 * ty), abs(py1 * tx - px1 * ty))
-    sa0 = px0 * tx + py0 * ty
-    sa1 = px1 * tx + py1 * ty
-    over = max(max(-sa0, sa0 - ln), max(-sa1, sa1 - ln), 0.0)
-    c0x = 6.0 * ax * u0 + 2.0 * bx
-    c0y = 6.0 * ay * u0 + 2.0 * by
-    c1x = 6.0 * ax * u1 + 2.0 * bx
-    c1y = 6.0 * ay * u1 + 2.0 * by
-    du = u1 - u0
-    sag = 0.125 * du * du * math.sqrt(max(c0x * c0x + c0y * c0y, c1x * c1x + c1y * c1y))
-    marg = 1e-9 * (1.0 + abs(a0) + abs(a1) + abs(ex) + abs(ey) + ln) + 1e-6 * sag
-    perp += sag + marg
-    over += sag + marg
-    return perp * perp + over * over <= lim * lim
-
-
 @njit(cache=True, nogil=True)
 def _accept_points(cm, i0, i1, starts, work, arc, e2, u, dist, emax0,
                    far) -> int:  # pragma: no cover (compiled)
@@ -611,9 +575,20 @@ def _accept_pairs(cm, i0, i1, starts, work, u, e2, qa, ok) -> None:  # pragma: n
     """:meth:`_BatchFitter._accept`'s curve-to-polyline side (compiled): for each piece r
     still ``ok``, the bound (:func:`_bound_pair`) of every pair of consecutive input
     points, plus on rounded input (``qa[r]`` > 0, else qa of length 0) the rounding slack
-    the curve may not use beside a long input segment; ``ok[r]`` False at the first pair
-    over ``e2[r]``."""
+    the curve may not use beside a long input segment; ``ok[r]`` False where one is over
+    ``e2[r]``.
+
+    A cheap upper bound first, for a chunk of pairs at a time (the loop vectorises); the
+    exact bound only where it does not pass. Over u0..u1 the cubic keeps within S =
+    (u1 - u0)² / 8 · max |B''| of its chord (B'' is linear in u: its largest length is at
+    an end), and along the chord both the perpendicular distance to the segment's line and
+    the overshoot beyond its ends are largest at the chord's ends: each of the two maxima
+    that :func:`_bound_pair` combines is at most its value at u0 or u1 plus S (plus a
+    margin for the rounding). Where that passes, the exact bound does too (the slack is 0
+    on segments shorter than ``_LONG_SEGMENT`` quanta; longer ones take the exact way)."""
     uu = np.empty(7)
+    ch = _ACCEPT_CHUNK
+    fb = np.empty(ch, dtype=np.bool_)
     quant = len(qa) > 0
     for r in range(len(i0)):
         if not ok[r]:
@@ -623,6 +598,8 @@ def _accept_pairs(cm, i0, i1, starts, work, u, e2, qa, ok) -> None:  # pragma: n
         lim = e2[r]
         q = qa[r] if quant else 0.0
         sl = q * _HALF_DIAGONAL
+        short2 = (_LONG_SEGMENT * q) ** 2 * (1.0 - 1e-9) if q > 0.0 else np.inf
+        lim2 = lim * lim
         ax = cm[r, 0, 0]
         ay = cm[r, 0, 1]
         bx = cm[r, 1, 0]
@@ -631,29 +608,62 @@ def _accept_pairs(cm, i0, i1, starts, work, u, e2, qa, ok) -> None:  # pragma: n
         dy = cm[r, 2, 1]
         ex = cm[r, 3, 0]
         ey = cm[r, 3, 1]
-        for j in range(i1[r] - base):
-            k = base + j
-            a0 = work[k, 0]
-            a1 = work[k, 1]
-            b0 = work[k + 1, 0]
-            b1 = work[k + 1, 1]
-            u0 = u[s + j]
-            u1 = u[s + j + 1]
-            slack = 0.0
-            if quant:
-                f = 1.0
-                if q > 0.0:
-                    f = min(max(_LONG_SEGMENT * q / math.hypot(b0 - a0, b1 - a1),
-                                _LONG_FLOOR), 1.0)
-                slack = sl * (1.0 - f)
-            if _pair_within(ax, ay, bx, by, dx, dy, ex, ey, a0, a1, b0, b1, u0, u1,
-                            lim - slack):
-                continue  # (a cheap upper bound passes: the exact one would)
-            bnd = _bound_pair(ax, ay, bx, by, dx, dy, ex, ey, a0, a1, b0, b1, u0, u1, uu)
-            if quant:
-                bnd = bnd + slack
-            if not (bnd <= lim):
-                ok[r] = False
+        npair = i1[r] - base
+        for c0 in range(0, npair, ch):
+            n = min(npair, c0 + ch) - c0
+            for j in range(n):
+                k = base + c0 + j
+                a0 = work[k, 0]
+                a1 = work[k, 1]
+                abx = work[k + 1, 0] - a0
+                aby = work[k + 1, 1] - a1
+                u0 = u[s + c0 + j]
+                u1 = u[s + c0 + j + 1]
+                l2 = abx * abx + aby * aby
+                ln = math.sqrt(l2)
+                tx = abx / ln
+                ty = aby / ln
+                px0 = ((ax * u0 + bx) * u0 + dx) * u0 + ex - a0
+                py0 = ((ay * u0 + by) * u0 + dy) * u0 + ey - a1
+                px1 = ((ax * u1 + bx) * u1 + dx) * u1 + ex - a0
+                py1 = ((ay * u1 + by) * u1 + dy) * u1 + ey - a1
+                perp = max(abs(py0 * tx - px0 * ty), abs(py1 * tx - px1 * ty))
+                sa0 = px0 * tx + py0 * ty
+                sa1 = px1 * tx + py1 * ty
+                over = max(max(-sa0, sa0 - ln), max(-sa1, sa1 - ln), 0.0)
+                c0x = 6.0 * ax * u0 + 2.0 * bx
+                c0y = 6.0 * ay * u0 + 2.0 * by
+                c1x = 6.0 * ax * u1 + 2.0 * bx
+                c1y = 6.0 * ay * u1 + 2.0 * by
+                du = u1 - u0
+                sag = 0.125 * du * du * math.sqrt(max(c0x * c0x + c0y * c0y,
+                                                      c1x * c1x + c1y * c1y))
+                marg = 1e-9 * (1.0 + abs(a0) + abs(a1) + abs(ex) + abs(ey) + ln) + 1e-6 * sag
+                perp += sag + marg
+                over += sag + marg
+                chk = px0 + py0 + px1 + py1 + tx + ty + sag  # (NaN, inf: no pass)
+                fb[j] = ((perp * perp + over * over <= lim2) & (l2 > 0.0) & (l2 < short2)
+                         & (chk - chk == 0.0))
+            for j in range(n):
+                if fb[j]:
+                    continue
+                k = base + c0 + j
+                a0 = work[k, 0]
+                a1 = work[k, 1]
+                b0 = work[k + 1, 0]
+                b1 = work[k + 1, 1]
+                bnd = _bound_pair(ax, ay, bx, by, dx, dy, ex, ey, a0, a1, b0, b1,
+                                  u[s + c0 + j], u[s + c0 + j + 1], uu)
+                if quant:
+                    f = 1.0
+                    if q > 0.0:
+                        f = min(max(_LONG_SEGMENT * q / math.hypot(b0 - a0, b1 - a1),
+                                    _LONG_FLOOR), 1.0)
+                    bnd = bnd + sl * (1.0 - f)
+                if not (bnd <= lim):
+                    ok[r] = False
+                    break
+            if not ok[r]:
                 break
 
 
