@@ -584,8 +584,9 @@ def _accept_pairs(cm, i0, i1, starts, work, u, e2, qa, ok) -> None:  # pragma: n
     an end), and along the chord both the perpendicular distance to the segment's line and
     the overshoot beyond its ends are largest at the chord's ends: each of the two maxima
     that :func:`_bound_pair` combines is at most its value at u0 or u1 plus S (plus a
-    margin for the rounding). Where that passes, the exact bound does too (the slack is 0
-    on segments shorter than ``_LONG_SEGMENT`` quanta; longer ones take the exact way)."""
+    margin for the rounding; at a repeated input point: the distance to it at u0 or u1 plus
+    S). Where that passes (with a little more slack than the exact one), the exact bound
+    does too."""
     uu = np.empty(7)
     ch = _ACCEPT_CHUNK
     fb = np.empty(ch, dtype=np.bool_)
@@ -598,8 +599,6 @@ def _accept_pairs(cm, i0, i1, starts, work, u, e2, qa, ok) -> None:  # pragma: n
         lim = e2[r]
         q = qa[r] if quant else 0.0
         sl = q * _HALF_DIAGONAL
-        short2 = (_LONG_SEGMENT * q) ** 2 * (1.0 - 1e-9) if q > 0.0 else np.inf
-        lim2 = lim * lim
         ax = cm[r, 0, 0]
         ay = cm[r, 0, 1]
         bx = cm[r, 1, 0]
@@ -621,8 +620,10 @@ def _accept_pairs(cm, i0, i1, starts, work, u, e2, qa, ok) -> None:  # pragma: n
                 u1 = u[s + c0 + j + 1]
                 l2 = abx * abx + aby * aby
                 ln = math.sqrt(l2)
-                tx = abx / ln
-                ty = aby / ln
+                zero = (abx == 0.0) & (aby == 0.0)  # (a repeated point: the distance to it)
+                lns = 1.0 if zero else ln
+                tx = abx / lns
+                ty = aby / lns
                 px0 = ((ax * u0 + bx) * u0 + dx) * u0 + ex - a0
                 py0 = ((ay * u0 + by) * u0 + dy) * u0 + ey - a1
                 px1 = ((ax * u1 + bx) * u1 + dx) * u1 + ex - a0
@@ -631,6 +632,9 @@ def _accept_pairs(cm, i0, i1, starts, work, u, e2, qa, ok) -> None:  # pragma: n
                 sa0 = px0 * tx + py0 * ty
                 sa1 = px1 * tx + py1 * ty
                 over = max(max(-sa0, sa0 - ln), max(-sa1, sa1 - ln), 0.0)
+                pz = max(math.sqrt(px0 * px0 + py0 * py0), math.sqrt(px1 * px1 + py1 * py1))
+                perp = pz if zero else perp
+                over = 0.0 if zero else over
                 c0x = 6.0 * ax * u0 + 2.0 * bx
                 c0y = 6.0 * ay * u0 + 2.0 * by
                 c1x = 6.0 * ax * u1 + 2.0 * bx
@@ -641,8 +645,11 @@ def _accept_pairs(cm, i0, i1, starts, work, u, e2, qa, ok) -> None:  # pragma: n
                 marg = 1e-9 * (1.0 + abs(a0) + abs(a1) + abs(ex) + abs(ey) + ln) + 1e-6 * sag
                 perp += sag + marg
                 over += sag + marg
-                chk = px0 + py0 + px1 + py1 + tx + ty + sag  # (NaN, inf: no pass)
-                fb[j] = ((perp * perp + over * over <= lim2) & (l2 > 0.0) & (l2 < short2)
+                # the slack (0 on short segments), a little over
+                f = min(max(_LONG_SEGMENT * q / lns, _LONG_FLOOR), 1.0)
+                room = lim - (sl * (1.0 - f) + 1e-9 * sl)
+                chk = px0 + py0 + px1 + py1 + tx + ty + sag + room  # (NaN, inf: no pass)
+                fb[j] = ((perp * perp + over * over <= room * room) & (room >= 0.0)
                          & (chk - chk == 0.0))
             for j in range(n):
                 if fb[j]:
