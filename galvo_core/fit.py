@@ -681,6 +681,61 @@ _NO_QUANTA = np.zeros(0)
 
 
 @njit(cache=True, nogil=True, error_model="numpy")
+def _sample_kernel(cm, i0, i1, work, arc, e2, sample, ok) -> None:  # pragma: no cover
+    """:meth:`_BatchFitter._sample_ok` one piece at a time (compiled): ``sample`` evenly
+    strided interior points, 4 Newton steps from arc length each (as :func:`_newton_kernel`),
+    ``ok[r]``: every squared distance within e2[r]² (none NaN)."""
+    ub = np.empty(sample)
+    qxb = np.empty(sample)
+    qyb = np.empty(sample)
+    for r in range(len(i0)):
+        a = i0[r]
+        L = i1[r] - a - 1
+        stride = max(1, -(-L // sample))
+        n = -(-L // stride)
+        span = arc[i1[r]] - arc[a]
+        den = span if span > 0 else 1.0
+        ax = cm[r, 0, 0]
+        ay = cm[r, 0, 1]
+        bx = cm[r, 1, 0]
+        by = cm[r, 1, 1]
+        dx = cm[r, 2, 0]
+        dy = cm[r, 2, 1]
+        ex = cm[r, 3, 0]
+        ey = cm[r, 3, 1]
+        for j in range(n):
+            k = a + 1 + stride * j
+            qxb[j] = work[k, 0] - ex
+            qyb[j] = work[k, 1] - ey
+            ub[j] = (arc[k] - arc[a]) / den
+        for _ in range(4):
+            for j in range(n):
+                uk = ub[j]
+                rx = ((ax * uk + bx) * uk + dx) * uk - qxb[j]
+                ry = ((ay * uk + by) * uk + dy) * uk - qyb[j]
+                d1x = (3.0 * ax * uk + 2.0 * bx) * uk + dx
+                d1y = (3.0 * ay * uk + 2.0 * by) * uk + dy
+                f = d1x * rx + d1y * ry
+                fp = (6.0 * ax * uk + 2.0 * bx) * rx + (6.0 * ay * uk + 2.0 * by) * ry
+                fp += d1x * d1x
+                fp += d1y * d1y
+                if not fp <= 0.0:  # (not convex here: no step)
+                    uk -= f / fp
+                ub[j] = min(max(uk, 0.0), 1.0)
+        lim = e2[r] * e2[r]
+        good = 0.0 <= lim
+        for j in range(n):
+            k = a + 1 + stride * j
+            uk = ub[j]
+            rx = ((ax * uk + bx) * uk + dx) * uk - (work[k, 0] - ex)
+            ry = ((ay * uk + by) * uk + dy) * uk - (work[k, 1] - ey)
+            if not rx * rx + ry * ry <= lim:
+                good = False
+                break
+        ok[r] = good
+
+
+@njit(cache=True, nogil=True, error_model="numpy")
 def _dichotomy_kernel(p0, qq, p3, sig, i0, i1, work, arc, sample, max_iter, eps_s,
                       t_out) -> None:  # pragma: no cover (compiled)
     """:meth:`_BatchFitter._dichotomy` one piece at a time (compiled): the Illinois false
@@ -868,21 +923,46 @@ def _handle_lengths(u, pid, pts, p0, p3, t0, t3, m):
     """Schneider's handle lengths per piece: the cubic p0, p0 + al t0, p3 - be t3, p3 nearest
     (least squares) to the points ``pts`` at the parameters ``u`` (piece ``pid`` each):
     (al, be, det, c11, c22) of the 2x2 normal equations (al, be inf/NaN where det is 0)."""
-    s = 1.0 - u
-    b0, b1, b2, b3 = s * s * s, 3 * s * s * u, 3 * s * u * u, u * u * u
-    a1 = b1[:, None] * t0[pid]
-    a2 = -b2[:, None] * t3[pid]
-    r = pts - (b0 + b1)[:, None] * p0[pid] - (b2 + b3)[:, None] * p3[pid]
-    c11 = np.bincount(pid, (a1 * a1).sum(1), m)
-    c12 = np.bincount(pid, (a1 * a2).sum(1), m)
-    c22 = np.bincount(pid, (a2 * a2).sum(1), m)
-    x1 = np.bincount(pid, (r * a1).sum(1), m)
-    x2 = np.bincount(pid, (r * a2).sum(1), m)
+    sums = np.zeros((5, m))
+    _handle_sums(np.ascontiguousarray(u, dtype=np.float64),
+                 np.ascontiguousarray(pid, dtype=np.intp),
+                 np.ascontiguousarray(pts, dtype=np.float64),
+                 np.ascontiguousarray(p0, dtype=np.float64),
+                 np.ascontiguousarray(p3, dtype=np.float64),
+                 np.ascontiguousarray(t0, dtype=np.float64),
+                 np.ascontiguousarray(t3, dtype=np.float64), sums)
+    c11, c12, c22, x1, x2 = sums
     with np.errstate(divide="ignore", invalid="ignore"):
         det = c11 * c22 - c12 * c12
         al = (x1 * c22 - x2 * c12) / det
         be = (c11 * x2 - c12 * x1) / det
     return al, be, det, c11, c22
+
+
+@njit(cache=True, nogil=True)
+def _handle_sums(u, pid, pts, p0, p3, t0, t3, sums) -> None:  # pragma: no cover (compiled)
+    """:func:`_handle_lengths`' sums per piece (compiled, in the order of the points, as
+    the former np.bincount): c11, c12, c22 of the normal matrix and the right side x1, x2
+    into ``sums`` (5, m)."""
+    for i in range(len(u)):
+        r = pid[i]
+        uk = u[i]
+        s = 1.0 - uk
+        b0 = s * s * s
+        b1 = 3 * s * s * uk
+        b2 = 3 * s * uk * uk
+        b3 = uk * uk * uk
+        a1x = b1 * t0[r, 0]
+        a1y = b1 * t0[r, 1]
+        a2x = -b2 * t3[r, 0]
+        a2y = -b2 * t3[r, 1]
+        rx = pts[i, 0] - (b0 + b1) * p0[r, 0] - (b2 + b3) * p3[r, 0]
+        ry = pts[i, 1] - (b0 + b1) * p0[r, 1] - (b2 + b3) * p3[r, 1]
+        sums[0, r] += a1x * a1x + a1y * a1y
+        sums[1, r] += a1x * a2x + a1y * a2y
+        sums[2, r] += a2x * a2x + a2y * a2y
+        sums[3, r] += rx * a1x + ry * a1y
+        sums[4, r] += rx * a2x + ry * a2y
 
 
 @njit(cache=True, nogil=True, error_model="numpy")
@@ -1587,7 +1667,7 @@ class _BatchFitter:
 
     def _failed_before(self, keys: np.ndarray) -> np.ndarray:
         """np.isin(keys, self._failed) by binary search (the failed keys are sorted and
-        unique: np.union1d keeps them so)."""
+        unique: :meth:`_remember_failed` keeps them so)."""
         f = self._failed
         if len(f) == 0:
             return np.zeros(len(keys), dtype=bool)
@@ -1596,25 +1676,20 @@ class _BatchFitter:
 
     def _remember_failed(self, keys: np.ndarray) -> None:
         if len(keys):
-            self._failed = np.union1d(self._failed, keys)
+            new = np.unique(keys)
+            new = new[~self._failed_before(new)]
+            if len(new):  # (two sorted runs: the stable sort merges them)
+                self._failed = np.sort(np.concatenate([self._failed, new]), kind="stable")
 
     def _sample_ok(self, ctrl, i0, i1, e2, sample: int = _BISECT_SAMPLE // 2) -> np.ndarray:
         """Per piece: every point of a sample (at most ``_BISECT_SAMPLE`` // 2, evenly
         strided) within ``e2`` of the cubic (Newton from arc length; a cheap necessary
         condition of :meth:`_accept`, up to Newton's local minima)."""
-        m = len(ctrl)
-        L = i1 - i0 - 1
-        stride = np.maximum(1, -(-L // sample))
-        cnt = -(-L // stride)
-        pid, off = _ragged(np.zeros(m, dtype=np.intp), cnt)
-        idx = i0[pid] + 1 + stride[pid] * off
-        span = self.arc[i1] - self.arc[i0]
-        u = (self.arc[idx] - self.arc[i0][pid]) / np.where(span > 0, span, 1.0)[pid]
-        cf = gather_coeffs(power_coeffs_many(ctrl), pid)
-        _, d2 = newton_nearest_many(cf, self.work[idx].T, u, 4)
-        worst = np.zeros(m)
-        np.maximum.at(worst, pid, d2)
-        return worst <= e2 * e2
+        ok = np.empty(len(ctrl), dtype=bool)
+        _sample_kernel(power_coeffs_many(ctrl), np.ascontiguousarray(i0, dtype=np.intp),
+                       np.ascontiguousarray(i1, dtype=np.intp), self.work, self.arc,
+                       np.ascontiguousarray(e2, dtype=np.float64), sample, ok)
+        return ok
 
     def _merge_round(self) -> bool:
         """Two accepted cubics meeting at a smooth vertex (shared tangent) are replaced by
