@@ -1085,19 +1085,90 @@ def _gn_rounds(ps, pts, u, p0, p3, t0, t3, al, be, chord, rounds) -> None:  # pr
         be[r] = b_
 
 
-def _normal_residuals(ctrl, pid, pts, u):
-    """Each point's nearest parameter on its cubic (Newton from ``u``), the unit normal
-    there and the point's signed distance along it: (u, nx, ny, res), for Gauss-Newton."""
-    cf = gather_coeffs(power_coeffs_many(ctrl), pid)
-    u, _ = newton_nearest_many(cf, pts.T, u, 2)
-    bx = ((cf[0, 0] * u + cf[1, 0]) * u + cf[2, 0]) * u + cf[3, 0] - pts[:, 0]
-    by = ((cf[0, 1] * u + cf[1, 1]) * u + cf[2, 1]) * u + cf[3, 1] - pts[:, 1]
-    dx = (3.0 * cf[0, 0] * u + 2.0 * cf[1, 0]) * u + cf[2, 0]
-    dy = (3.0 * cf[0, 1] * u + 2.0 * cf[1, 1]) * u + cf[2, 1]
-    dn = np.hypot(dx, dy)
-    dn = np.where(dn > 0.0, dn, 1.0)
-    nx, ny = -dy / dn, dx / dn
-    return u, nx, ny, nx * bx + ny * by
+@njit(cache=True, nogil=True, error_model="numpy")
+def _gn_free_sums(ps, pts, u, ctrl, N, g) -> None:  # pragma: no cover (compiled)
+    """:meth:`_BatchFitter._gauss_newton_free`'s normal equations of one round (compiled),
+    per piece r (sample points ps[r] .. ps[r + 1] - 1, cubic ``ctrl[r]``): 2 Newton steps per
+    point from ``u`` (updated; as :func:`_newton_kernel`), the unit normal at the nearest
+    point and the signed distance along it, the Jacobian of the distance in the two inner
+    control points; sums in the order of the points (as the former np.bincount) into ``N``
+    (m, 4, 4) and ``g`` (m, 4) (minus the gradient)."""
+    nmax = 0
+    for r in range(len(ps) - 1):
+        nmax = max(nmax, ps[r + 1] - ps[r])
+    ub = np.empty(nmax)
+    qxb = np.empty(nmax)
+    qyb = np.empty(nmax)
+    jb = np.empty((4, nmax))
+    resb = np.empty(nmax)
+    for r in range(len(ps) - 1):
+        p0x = ctrl[r, 0, 0]
+        p0y = ctrl[r, 0, 1]
+        p1x = ctrl[r, 1, 0]
+        p1y = ctrl[r, 1, 1]
+        p2x = ctrl[r, 2, 0]
+        p2y = ctrl[r, 2, 1]
+        ax = -p0x + 3.0 * (p1x - p2x)
+        ax += ctrl[r, 3, 0]
+        ay = -p0y + 3.0 * (p1y - p2y)
+        ay += ctrl[r, 3, 1]
+        bx = 3.0 * (p0x + p2x) - 6.0 * p1x
+        by = 3.0 * (p0y + p2y) - 6.0 * p1y
+        dx = 3.0 * (p1x - p0x)
+        dy = 3.0 * (p1y - p0y)
+        ex = p0x
+        ey = p0y
+        k0 = ps[r]
+        n = ps[r + 1] - k0
+        for j in range(n):
+            qxb[j] = pts[k0 + j, 0] - ex
+            qyb[j] = pts[k0 + j, 1] - ey
+            ub[j] = u[k0 + j]
+        for _i in range(2):
+            for j in range(n):
+                uk = ub[j]
+                rx = ((ax * uk + bx) * uk + dx) * uk - qxb[j]
+                ry = ((ay * uk + by) * uk + dy) * uk - qyb[j]
+                d1x = (3.0 * ax * uk + 2.0 * bx) * uk + dx
+                d1y = (3.0 * ay * uk + 2.0 * by) * uk + dy
+                f = d1x * rx + d1y * ry
+                fp = (6.0 * ax * uk + 2.0 * bx) * rx + (6.0 * ay * uk + 2.0 * by) * ry
+                fp += d1x * d1x
+                fp += d1y * d1y
+                if not fp <= 0.0:  # (not convex here: no step)
+                    uk -= f / fp
+                ub[j] = min(max(uk, 0.0), 1.0)
+        for j in range(n):
+            uk = ub[j]
+            u[k0 + j] = uk
+            rx = ((ax * uk + bx) * uk + dx) * uk + ex - pts[k0 + j, 0]
+            ry = ((ay * uk + by) * uk + dy) * uk + ey - pts[k0 + j, 1]
+            tx = (3.0 * ax * uk + 2.0 * bx) * uk + dx
+            ty = (3.0 * ay * uk + 2.0 * by) * uk + dy
+            dn = math.hypot(tx, ty)
+            if not dn > 0.0:
+                dn = 1.0
+            nx = -ty / dn
+            ny = tx / dn
+            resb[j] = nx * rx + ny * ry
+            sk = 1.0 - uk
+            b1 = 3 * sk * sk * uk
+            b2 = 3 * sk * uk * uk
+            jb[0, j] = b1 * nx
+            jb[1, j] = b1 * ny
+            jb[2, j] = b2 * nx
+            jb[3, j] = b2 * ny
+        for i in range(4):
+            for i2 in range(i, 4):
+                acc = 0.0
+                for j in range(n):
+                    acc += jb[i, j] * jb[i2, j]
+                N[r, i, i2] = acc
+                N[r, i2, i] = acc
+            acc = 0.0
+            for j in range(n):
+                acc += jb[i, j] * resb[j]
+            g[r, i] = -acc
 
 
 class _BatchFitter:
@@ -1855,16 +1926,13 @@ class _BatchFitter:
         pid, pts, u = self._piece_sample(i0, i1)
         ctrl = ctrl.copy()
         chord = np.hypot(*(ctrl[:, 3] - ctrl[:, 0]).T)
+        ps = np.r_[0, np.cumsum(np.bincount(pid, minlength=m))]
+        pts = np.ascontiguousarray(pts, dtype=np.float64)
+        u = np.array(u, dtype=np.float64)
         for _ in range(rounds):
-            u, nx, ny, res = _normal_residuals(ctrl, pid, pts, u)
-            s = 1.0 - u
-            b1, b2 = 3 * s * s * u, 3 * s * u * u
-            J = np.stack([b1 * nx, b1 * ny, b2 * nx, b2 * ny], axis=1)  # (K, 4)
             N = np.zeros((m, 4, 4))
-            for i in range(4):
-                for j in range(i, 4):
-                    N[:, i, j] = N[:, j, i] = np.bincount(pid, J[:, i] * J[:, j], m)
-            g = np.stack([-np.bincount(pid, J[:, i] * res, m) for i in range(4)], axis=1)
+            g = np.zeros((m, 4))
+            _gn_free_sums(ps, pts, u, ctrl, N, g)
             N = np.where(np.isfinite(N), N, 0.0)
             g = np.where(np.isfinite(g), g, 0.0)
             N += (1e-9 * np.trace(N, axis1=1, axis2=2) + 1e-12)[:, None, None] * np.eye(4)
