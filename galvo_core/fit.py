@@ -38,8 +38,8 @@ two thinned points is a line (always within ``eps_line``). So the guarantee hold
 the dichotomy does, and lines are the last resort.
 
 All curve pieces of all paths of a batch are fitted together, round by round
-(:class:`_BatchFitter`): one set of array operations per dichotomy step for every open
-piece, one vectorised acceptance test, the failures split for the next round. Each piece's
+(:class:`_BatchFitter`): one compiled call runs the dichotomy of every open piece, one the
+acceptance test, the failures split for the next round. Each piece's
 result does not depend on the other pieces in the batch. The bisection uses up to 128 of the piece's
 input points (every k-th); the acceptance test uses every input point, with nearest points
 from Newton steps seeded by arc length (a seeded search only for points over the bound).
@@ -1177,9 +1177,9 @@ class _BatchFitter:
     restarted at every path), round by round.
 
     Each round takes every piece still to do, runs the dichotomy for all of them at once
-    (one set of array operations per step, whatever the number of pieces), tests them all
-    at once, keeps the cubics that pass and splits the others for the next round. The
-    work per round is linear in the points of the pieces still open.
+    (one compiled call, each piece its own iterations), tests them all at once, keeps the
+    cubics that pass and splits the others for the next round. The work per round is
+    linear in the points of the pieces still open.
     """
 
     def __init__(
