@@ -1558,11 +1558,17 @@ def _fit_concatenated(
         bound = np.minimum(e_per, rounding[:, 0])
         changed = _joints_on_the_design(W, arc, points, is_cubic, tail, step, gf, gl,
                                         seg_owner, move_q, bound)
+        is_cubic, points, tail, step, gf, gl, seg_owner, changed = _smooth_stretches(
+            W, arc, points, is_cubic, tail, step, gf, gl, seg_owner, move_q, bound, changed)
         if changed.any():
             worst = _changed_errors(W, points, is_cubic, tail, gf, gl, seg_owner, changed,
                                     worst)
-        worst = _moved_ends_error(W, points, is_cubic, tail, step, first + o_w[seg_owner],
-                                  last + o_w[seg_owner], seg_owner, worst)
+        worst = _moved_ends_error(W, points, is_cubic, tail, step, gf, gl, seg_owner, worst)
+        first = gf - o_w[seg_owner]
+        last = gl - o_w[seg_owner]
+        seg_cut = np.searchsorted(seg_owner, np.arange(len(todo) + 1))
+        pt_cut = np.r_[0, np.cumsum(np.bincount(seg_owner, weights=step, minlength=len(todo))
+                                    .astype(np.int64) + 1)]
     for x in (is_cubic, points, first, last):
         x.setflags(write=False)
     return is_cubic, points, first, last, seg_cut.tolist(), pt_cut.tolist(), worst.tolist()
@@ -1751,6 +1757,351 @@ def _try_joint(W, points, is_cubic, tail, step, gfirst, glast, j, v, bound, q, c
             points[tail[b] - 1:tail[b] - 1 + len(cb)] = cb
             changed[a] = changed[b] = True
             return
+
+
+#: rounded input, after the joints: a segment is repaired where the design estimate (the
+#: joints' least-squares quadratic) of one of its input points lies this many quanta or more
+#: from it (inside a smooth stretch: the estimates are about 0.1-0.2 quanta from the design)
+_STRETCH_OFF = 0.45
+#: ... a repair kept only when it brings that distance down by this many quanta
+_STRETCH_GAIN = 0.05
+#: ... the least-squares cubic of a repair follows its input polyline sampled at most this
+#: far apart (units of q), with this many re-parametrisations
+_STRETCH_STEP = 1.0
+_STRETCH_ITERS = 4
+#: ... the estimates' windows end at a gap between input points longer than this (units of
+#: q: a design line between two rounded points)
+_STRETCH_GAP = 4.0
+#: ... a segment split in two (one more segment) only when no repair keeps the count, at
+#: most this share of the rounded paths' segments (and one)
+_STRETCH_SPLITS = 0.02
+#: ... at input points at least this many points from either end of the segment
+_STRETCH_PIECE = 4
+
+
+def _stretch_estimates(W, arc, ps, pe, quant):
+    """Per input point (global index) of the rounded paths ps..pe (quantum ``quant`` each):
+    the design estimate of :func:`_joint_estimates` and whether it holds (a smooth
+    stretch: enough points on both sides, the window's points within ``_JOINT_SMOOTH``
+    quanta of it). The windows stop at gaps longer than ``_STRETCH_GAP`` quanta."""
+    est = np.zeros_like(W)
+    valid = np.zeros(len(W), dtype=bool)
+    cnt = pe - ps + 1
+    if len(cnt) == 0:
+        return est, valid
+    start = np.cumsum(cnt) - cnt
+    g = np.repeat(ps, cnt) + np.arange(int(cnt.sum())) - np.repeat(start, cnt)
+    qg = np.repeat(quant, cnt)
+    gap = np.zeros(len(g), dtype=bool)  # a long gap before point g
+    step = np.hypot(*(W[g[1:]] - W[g[:-1]]).T)
+    gap[1:] = step > _STRETCH_GAP * qg[1:]
+    gap[start] = True
+    run = np.cumsum(gap) - 1
+    rs = g[np.flatnonzero(gap)]  # each run's first point
+    re = np.r_[rs[1:] - 1, 0]
+    ends = np.flatnonzero(gap)
+    last_of = np.r_[ends[1:] - 1, len(g) - 1]
+    re = g[last_of]
+    e, _, res, ok = _joint_estimates(W, arc, g, rs[run], re[run], _JOINT_SIDE)
+    est[g] = e
+    valid[g] = ok & (res <= _JOINT_SMOOTH * qg)
+    return est, valid
+
+
+def _stretch_targets(W, est, valid, f, e, q):
+    """The design polyline of the input points f..e: each smooth point's estimate (else the
+    point), the long gaps filled every ``_STRETCH_STEP`` quanta."""
+    d = np.where(valid[f:e + 1, None], est[f:e + 1], W[f:e + 1])
+    if len(d) < 2:
+        return d
+    gap = np.hypot(*np.diff(d, axis=0).T)
+    n = np.maximum(np.ceil(gap / (_STRETCH_STEP * q)).astype(np.intp), 1)
+    seg = np.repeat(np.arange(len(gap)), n)
+    frac = (np.arange(int(n.sum())) - np.repeat(np.cumsum(n) - n, n)) / np.repeat(n, n)
+    pts = d[seg] + frac[:, None] * (d[seg + 1] - d[seg])
+    return np.vstack([pts, d[-1:]])
+
+
+def _ls_cubic(p0, p3, tg):
+    """The cubic from p0 to p3 whose inner control points fit the targets ``tg`` best
+    (least squares, parameters re-fitted to the nearest points); None when degenerate."""
+    c = np.hypot(*np.diff(tg, axis=0).T)
+    tot = c.sum()
+    if len(tg) < 4 or tot <= 0.0:
+        return None
+    t = np.r_[0.0, np.cumsum(c)] / tot
+    ctrl = None
+    for _ in range(_STRETCH_ITERS):
+        s = 1.0 - t
+        b1 = 3.0 * s * s * t
+        b2 = 3.0 * s * t * t
+        r = tg - (s ** 3)[:, None] * p0 - (t ** 3)[:, None] * p3
+        a11, a12, a22 = b1 @ b1, b1 @ b2, b2 @ b2
+        det = a11 * a22 - a12 * a12
+        if not det > 1e-12 * max(a11 * a22, 1e-300):
+            return ctrl
+        r1, r2 = b1 @ r, b2 @ r
+        p1 = (a22 * r1 - a12 * r2) / det
+        p2 = (a11 * r2 - a12 * r1) / det
+        ctrl = np.stack([p0, p1, p2, p3])
+        t, _ = nearest_on_cubic(ctrl, tg, seeds=32, iters=4)
+    return ctrl
+
+
+def _design_off(W, est, valid, ctrl, f, e, h):
+    """How far the segment ``ctrl`` lies from the design estimates of its input points
+    f..e: (the largest distance of a smooth point's estimate to it, the largest distance
+    of its samples (at most h apart) to the polyline of estimates (else points))."""
+    v = np.flatnonzero(valid[f:e + 1]) + f
+    if len(ctrl) == 2:
+        d1 = point_segment_distance(est[v], ctrl[0], ctrl[1]) if len(v) else np.zeros(1)
+        length = float(np.hypot(*(ctrl[1] - ctrl[0])))
+        m = max(2, math.ceil(length / h) + 1)
+        samp = ctrl[0] + np.linspace(0.0, 1.0, m)[:, None] * (ctrl[1] - ctrl[0])
+    else:
+        d1 = nearest_on_cubic(ctrl, est[v], seeds=32, iters=4)[1] if len(v) else np.zeros(1)
+        length = float(np.hypot(*np.diff(ctrl, axis=0).T).sum())
+        m = max(16, math.ceil(length / h) + 1)
+        samp = cubic_eval(ctrl, np.linspace(0.0, 1.0, m))
+    poly = np.where(valid[f:e + 1, None], est[f:e + 1], W[f:e + 1])
+    return float(d1.max()), float(point_polyline_distance(samp, poly).max())
+
+
+class _Stretch:
+    """The state of :func:`_smooth_stretches` on one call: the input, the estimates, the
+    bound and step per path."""
+
+    def __init__(self, W, est, valid, bound, quant):
+        self.W, self.est, self.valid, self.bound, self.quant = W, est, valid, bound, quant
+
+    def piece(self, ctrl, f, e, o):
+        """(d1, d2) of :func:`_design_off` for the piece when it keeps within the bound of
+        path ``o``, else None."""
+        h = _JOINT_STEP * float(self.quant[o])
+        if not _seg_fits(self.W, ctrl, f, e, float(self.bound[o]), h):
+            return None
+        return _design_off(self.W, self.est, self.valid, ctrl, f, e, h)
+
+    def shapes(self, p0, p1, f, e, o, line_ok, old=None):
+        """The best piece from p0 to p1 over the input points f..e: the line (when
+        ``line_ok``), the least-squares cubic, the cubic ``old`` with its ends moved (its
+        inner control points along): ((d1, d2), ctrl) or None."""
+        q = float(self.quant[o])
+        alts = []
+        if line_ok:
+            alts.append(np.stack([p0, p1]))
+        if e - f >= 3:
+            c = _ls_cubic(p0, p1, _stretch_targets(self.W, self.est, self.valid, f, e, q))
+            if c is not None:
+                alts.append(c)
+        if old is not None and len(old) == 4:
+            c = old.copy()
+            c[:2] += p0 - old[0]
+            c[2:] += p1 - old[3]
+            alts.append(c)
+        best = None
+        for c in alts:
+            r = self.piece(c, f, e, o)
+            if r is not None and (best is None or max(r) < max(best[0])):
+                best = (r, c)
+        return best
+
+    def split(self, p0, p1, f, e, o):
+        """The best two pieces from p0 to p1 over f..e, split at an input point m (its
+        estimate when smooth): at the ends of long gaps, at the smooth stretch's ends, at
+        the estimate farthest from the chord: ((d1, d2), [(ctrl, f, m), (ctrl, m, e)])."""
+        W, est, valid = self.W, self.est, self.valid
+        lo, hi = f + _STRETCH_PIECE, e - _STRETCH_PIECE
+        if hi < lo:
+            return None
+        q = float(self.quant[o])
+        cand = set()
+        gap = np.hypot(*np.diff(W[f:e + 1], axis=0).T) > _STRETCH_GAP * q
+        for i in np.flatnonzero(gap).tolist():
+            cand.update((f + i, f + i + 1))
+        v = np.flatnonzero(valid[f:e + 1])
+        if len(v):
+            cand.update((f + int(v[0]), f + int(v[-1])))
+            dv = point_segment_distance(est[f + v], p0, p1)
+            cand.add(f + int(v[np.argmax(dv)]))
+        cand.add((f + e) // 2)
+        best = None
+        for m in sorted(c for c in cand if lo <= c <= hi):
+            pm = (np.clip(est[m], W[m] - 0.5 * q, W[m] + 0.5 * q) if valid[m]
+                  else W[m].astype(np.float64))
+            a = self.shapes(p0, pm, f, m, o, True)
+            if a is None:
+                continue
+            b = self.shapes(pm, p1, m, e, o, True)
+            if b is None:
+                continue
+            r = (max(a[0][0], b[0][0]), max(a[0][1], b[0][1]))
+            if best is None or max(r) < max(best[0]):
+                best = (r, [(a[1], f, m), (b[1], m, e)])
+        return best
+
+
+def _smooth_stretches(W, arc, points, is_cubic, tail, step, gfirst, glast, seg_owner, quant,
+                      bound, changed):
+    """Rounded input, after :func:`_joints_on_the_design`: the segments that lie
+    ``_STRETCH_OFF`` quanta or more from the design estimate of one of their input points
+    inside a smooth stretch (a line over a gently curved stretch, a joint left on its
+    rounded point) are repaired, worst first: the segment re-fitted between its ends (a
+    line made the least-squares cubic), or a joint of it moved onto its estimate (inside
+    its rounding square) with the two segments there re-fitted (a line kept a line or made
+    a least-squares cubic, a cubic's inner control points fitted by least squares with its
+    ends fixed or moved along); where none of those helps, the segment (or, with the
+    joint moved, one of the two) split in two at an input point (``_STRETCH_SPLITS``). A
+    repair is kept only when every new segment stays within ``bound`` (per path) of its
+    input points and polyline (:func:`_seg_fits`) and it brings the distance to the
+    estimates down by ``_STRETCH_GAIN`` quanta. Returns the segments (is_cubic, points,
+    tail, step, gfirst, glast, seg_owner, changed) rebuilt, or the inputs when none
+    changed."""
+    ns = len(is_cubic)
+    unchanged = (is_cubic, points, tail, step, gfirst, glast, seg_owner, changed)
+    rp = quant[seg_owner] > 0.0
+    if ns == 0 or not rp.any():
+        return unchanged
+    cut = np.searchsorted(seg_owner, np.arange(len(quant) + 1))
+    paths = np.flatnonzero((cut[1:] > cut[:-1]) & (quant > 0.0))
+    est, valid = _stretch_estimates(W, arc, gfirst[cut[paths]], glast[cut[paths + 1] - 1],
+                                    quant[paths])
+    # per segment: the largest distance of a smooth point's estimate to it
+    sr = np.flatnonzero(rp)
+    n = glast[sr] - gfirst[sr] + 1
+    pid = np.repeat(np.arange(len(sr)), n)
+    idx = np.repeat(gfirst[sr], n) + np.arange(int(n.sum())) - np.repeat(np.cumsum(n) - n, n)
+    keep = valid[idx]
+    pid, idx = pid[keep], idx[keep]
+    off = np.zeros(len(sr))
+    ln = ~is_cubic[sr[pid]]
+    if ln.any():
+        s = sr[pid[ln]]
+        d = point_segment_distance(est[idx[ln]], points[tail[s] - 1], points[tail[s]])
+        np.maximum.at(off, pid[ln], d)
+    if (~ln).any():
+        cs = np.flatnonzero(is_cubic[sr])
+        ctrl = np.stack([points[tail[sr[cs]] - 1 + k] for k in range(4)], axis=1)
+        loc = np.full(len(sr), -1)
+        loc[cs] = np.arange(len(cs))
+        _, d = nearest_on_cubic_each(ctrl, loc[pid[~ln]], est[idx[~ln]], seeds=32, iters=4)
+        np.maximum.at(off, pid[~ln], d)
+    bad = off >= _STRETCH_OFF * quant[seg_owner[sr]]
+    if not bad.any():
+        return unchanged
+    st = _Stretch(W, est, valid, bound, quant)
+    splits = max(1, int(_STRETCH_SPLITS * len(sr)))
+    rep: dict[int, list] = {}
+    done = np.zeros(ns, dtype=bool)
+    for k in np.argsort(-off[bad], kind="stable").tolist():
+        s = int(sr[bad][k])
+        if done[s]:
+            continue
+        o = int(seg_owner[s])
+        q = float(quant[o])
+        old = {}
+        oldoff = {}
+
+        def before(x, old=old, oldoff=oldoff, q=q):
+            if x not in old:
+                old[x] = _seg_ctrl(points, is_cubic, tail, x)
+                oldoff[x] = _design_off(W, est, valid, old[x], gfirst[x], glast[x],
+                                        _JOINT_STEP * q)
+            return oldoff[x]
+
+        best = None  # (split used, (d1, d2), {segment: [(ctrl, first, last)]})
+
+        def consider(new, used, q=q):
+            nonlocal best
+            segs = list(new)
+            o1 = max(before(x)[0] for x in segs)
+            o2 = max(before(x)[1] for x in segs)
+            n1 = max(r[0] for r, _ in new.values())
+            n2 = max(r[1] for r, _ in new.values())
+            if n1 > o1 - _STRETCH_GAIN * q or n2 > max(o2, n1):
+                return
+            if best is None or (used, max(n1, n2)) < (best[0], max(best[1])):
+                best = (used, (n1, n2), {x: p for x, (_, p) in new.items()})
+
+        c0 = _seg_ctrl(points, is_cubic, tail, s)
+        f, e = int(gfirst[s]), int(glast[s])
+        r = st.shapes(c0[0], c0[-1], f, e, o, False, None)
+        if r is not None:
+            consider({s: (r[0], [(r[1], f, e)])}, 0)
+        joints = []
+        for a, b in ((s - 1, s), (s, s + 1)):
+            if a < 0 or b >= ns or seg_owner[a] != o or seg_owner[b] != o or done[a] \
+                    or done[b] or glast[a] <= gfirst[a] or glast[b] <= gfirst[b]:
+                continue
+            j = int(gfirst[b])
+            if valid[j]:
+                joints.append((a, b, np.clip(est[j], W[j] - 0.5 * q, W[j] + 0.5 * q)))
+        for a, b, v in joints:
+            ca = _seg_ctrl(points, is_cubic, tail, a)
+            cb = _seg_ctrl(points, is_cubic, tail, b)
+            fa, ea, fb, eb = int(gfirst[a]), int(glast[a]), int(gfirst[b]), int(glast[b])
+            ra = st.shapes(ca[0], v, fa, ea, o, not is_cubic[a], ca)
+            rb = st.shapes(v, cb[-1], fb, eb, o, not is_cubic[b], cb)
+            if ra is not None and rb is not None:
+                consider({a: (ra[0], [(ra[1], fa, ea)]), b: (rb[0], [(rb[1], fb, eb)])}, 0)
+            if best is not None and best[0] == 0 or splits <= 0:
+                continue
+            if rb is not None:
+                sa = st.split(ca[0], v, fa, ea, o)
+                if sa is not None:
+                    consider({a: (sa[0], sa[1]), b: (rb[0], [(rb[1], fb, eb)])}, 1)
+            if ra is not None:
+                sb = st.split(v, cb[-1], fb, eb, o)
+                if sb is not None:
+                    consider({a: (ra[0], [(ra[1], fa, ea)]), b: (sb[0], sb[1])}, 1)
+        if (best is None or best[0] == 1) and splits > 0:
+            r = st.split(c0[0], c0[-1], f, e, o)
+            if r is not None:
+                consider({s: (r[0], r[1])}, 1)
+        if best is not None:
+            splits -= best[0]
+            for x, p in best[2].items():
+                rep[x] = p
+                done[x] = True
+    if not rep:
+        return unchanged
+    return _rebuilt(points, is_cubic, tail, step, gfirst, glast, seg_owner, changed, rep)
+
+
+def _rebuilt(points, is_cubic, tail, step, gfirst, glast, seg_owner, changed, rep):
+    """The segments with ``rep`` (segment -> its new pieces (ctrl, first, last)) in place."""
+    ns = len(is_cubic)
+    cnt = np.ones(ns, dtype=np.intp)
+    for x, p in rep.items():
+        cnt[x] = len(p)
+    at = np.cumsum(cnt) - cnt
+    n_cubic = np.repeat(is_cubic, cnt)
+    n_first = np.repeat(gfirst, cnt)
+    n_last = np.repeat(glast, cnt)
+    n_owner = np.repeat(seg_owner, cnt)
+    n_changed = np.repeat(changed, cnt)
+    for x, p in rep.items():
+        for i, (c, f, e) in enumerate(p):
+            n_cubic[at[x] + i] = len(c) == 4
+            n_first[at[x] + i] = f
+            n_last[at[x] + i] = e
+            n_changed[at[x] + i] = True
+    nstep = np.where(n_cubic, 3, 1)
+    ntail = np.cumsum(nstep) - nstep + n_owner + 1
+    npts = np.empty((int(nstep.sum()) + int(seg_owner[-1]) + 1, 2))
+    fs = np.flatnonzero(np.r_[True, seg_owner[1:] != seg_owner[:-1]])
+    npts[ntail[at[fs]] - 1] = points[tail[fs] - 1]
+    same = np.ones(ns, dtype=bool)
+    same[list(rep)] = False
+    same = np.flatnonzero(same)
+    c = step[same]
+    o = np.arange(int(c.sum())) - np.repeat(np.cumsum(c) - c, c)
+    npts[np.repeat(ntail[at[same]], c) + o] = points[np.repeat(tail[same], c) + o]
+    for x, p in rep.items():
+        for i, (cx, _, _) in enumerate(p):
+            r = ntail[at[x] + i] - 1
+            npts[r:r + len(cx)] = cx
+    return n_cubic, npts, ntail, nstep, n_first, n_last, n_owner, n_changed
 
 
 #: rounded input: a line over at least this many input points is checked for a bulge
