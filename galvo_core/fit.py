@@ -1622,17 +1622,17 @@ _JOINT_SHARES = (1.0, 2.0 / 3.0, 1.0 / 3.0)
 _JOINT_STEP = 0.05
 
 
-def _joint_estimates(W, arc, g, ps, pe, k):
+def _joint_estimates(W, arc, g, ps, pe, k, side=4):
     """Least-squares quadratics x(s), y(s) in arc length over the input points g - k ..
     g + k (clipped to ps..pe, global indices) of each joint ``g``: (position at g (V, 2),
     unit tangent (V, 2), the largest distance of a window point to its quadratic (V,),
-    ok (V,): at least 4 points on each side and a well-conditioned fit)."""
+    ok (V,): at least ``side`` points on each side and a well-conditioned fit)."""
     off = np.arange(-k, k + 1)
     idx = g[:, None] + off[None, :]
     m = (idx >= ps[:, None]) & (idx <= pe[:, None])
     idx = np.clip(idx, ps[:, None], pe[:, None])
     s = (arc[idx] - arc[g][:, None]) * m
-    ok = (m[:, :k].sum(axis=1) >= 4) & (m[:, k + 1:].sum(axis=1) >= 4)
+    ok = (m[:, :k].sum(axis=1) >= side) & (m[:, k + 1:].sum(axis=1) >= side)
     wm = m.astype(np.float64)
     V = np.stack([wm, s * wm, s * s * wm], axis=2)  # (V, 2k+1, 3)
     A = np.einsum("vni,vnj->vij", V, V)
@@ -1733,7 +1733,31 @@ def _seg_fits(W, ctrl, first, last, bound, h) -> bool:
         samp = cubic_eval(ctrl, np.linspace(0.0, 1.0, m))
     if d.max() > bound:
         return False
-    return bool(point_polyline_distance(samp, loc).max() <= bound - 0.5 * h)
+    return bool(_polyline_distance_over(samp, loc, bound - 0.5 * h).max() <= bound - 0.5 * h)
+
+
+#: samples in order along a polyline are measured first against this many of its segments
+#: on either side of their share of its length
+_NEAR_SEGMENTS = 8
+
+
+def _polyline_distance_over(samp, poly, lim):
+    """The distance of each of the samples ``samp`` (in order along ``poly``) to the
+    polyline where it is over ``lim``, else a distance within ``lim`` (each sample measured
+    against the segments near its share of the length, those over ``lim`` against all)."""
+    n = len(poly)
+    if n <= 2 * _NEAR_SEGMENTS + 2:
+        return point_polyline_distance(samp, poly)
+    cum = np.r_[0.0, np.cumsum(np.hypot(*np.diff(poly, axis=0).T))]
+    at = np.searchsorted(cum, np.linspace(0.0, cum[-1], len(samp))) - 1
+    idx = np.clip(at[:, None] + np.arange(-_NEAR_SEGMENTS, _NEAR_SEGMENTS + 1), 0, n - 2)
+    w = idx.shape[1]
+    d = point_segment_distance(np.repeat(samp, w, axis=0), poly[idx.ravel()],
+                               poly[idx.ravel() + 1]).reshape(-1, w).min(axis=1)
+    far = np.flatnonzero(d > lim)
+    if len(far):
+        d[far] = point_polyline_distance(samp[far], poly)
+    return d
 
 
 def _try_joint(W, points, is_cubic, tail, step, gfirst, glast, j, v, bound, q, changed):
@@ -1777,6 +1801,12 @@ _STRETCH_GAP = 4.0
 _STRETCH_SPLITS = 0.02
 #: ... at input points at least this many points from either end of the segment
 _STRETCH_PIECE = 4
+#: ... an estimate holds with this many input points on either side of it in its window
+_STRETCH_SIDE = 8
+#: ... a least-squares cubic is fitted over at least this many input points
+_STRETCH_CUBIC = 8
+#: ... the distance of a segment to the estimates' polyline sampled this far apart (q)
+_STRETCH_LOOK = 0.25
 
 
 def _stretch_estimates(W, arc, ps, pe, quant):
@@ -1802,7 +1832,8 @@ def _stretch_estimates(W, arc, ps, pe, quant):
     ends = np.flatnonzero(gap)
     last_of = np.r_[ends[1:] - 1, len(g) - 1]
     re = g[last_of]
-    e, _, res, ok = _joint_estimates(W, arc, g, rs[run], re[run], _JOINT_SIDE)
+    e, _, res, ok = _joint_estimates(W, arc, g, rs[run], re[run], _JOINT_SIDE,
+                                     _STRETCH_SIDE)
     est[g] = e
     valid[g] = ok & (res <= _JOINT_SMOOTH * qg)
     return est, valid
@@ -1824,15 +1855,30 @@ def _stretch_targets(W, est, valid, f, e, q):
 
 def _ls_cubic(p0, p3, tg):
     """The cubic from p0 to p3 whose inner control points fit the targets ``tg`` best
-    (least squares, parameters re-fitted to the nearest points); None when degenerate."""
+    (least squares, parameters re-fitted by Newton steps towards the nearest points); None
+    when degenerate."""
     c = np.hypot(*np.diff(tg, axis=0).T)
     tot = c.sum()
     if len(tg) < 4 or tot <= 0.0:
         return None
     t = np.r_[0.0, np.cumsum(c)] / tot
     ctrl = None
-    for _ in range(_STRETCH_ITERS):
+    for it in range(_STRETCH_ITERS + 1):
         s = 1.0 - t
+        if ctrl is not None:  # a Newton step of each target's parameter
+            d1 = 3.0 * ((s * s)[:, None] * (ctrl[1] - ctrl[0])
+                        + (2.0 * s * t)[:, None] * (ctrl[2] - ctrl[1])
+                        + (t * t)[:, None] * (ctrl[3] - ctrl[2]))
+            d2 = 6.0 * (s[:, None] * (ctrl[2] - 2.0 * ctrl[1] + ctrl[0])
+                        + t[:, None] * (ctrl[3] - 2.0 * ctrl[2] + ctrl[1]))
+            r = cubic_eval(ctrl, t) - tg
+            den = (d1 * d1).sum(axis=1) + (r * d2).sum(axis=1)
+            dt = np.where(den > 0.0, (r * d1).sum(axis=1) / np.where(den > 0.0, den, 1.0),
+                          0.0)
+            t = np.clip(t - dt, 0.0, 1.0)
+            s = 1.0 - t
+            if it == _STRETCH_ITERS:
+                return ctrl
         b1 = 3.0 * s * s * t
         b2 = 3.0 * s * t * t
         r = tg - (s ** 3)[:, None] * p0 - (t ** 3)[:, None] * p3
@@ -1841,30 +1887,33 @@ def _ls_cubic(p0, p3, tg):
         if not det > 1e-12 * max(a11 * a22, 1e-300):
             return ctrl
         r1, r2 = b1 @ r, b2 @ r
-        p1 = (a22 * r1 - a12 * r2) / det
-        p2 = (a11 * r2 - a12 * r1) / det
-        ctrl = np.stack([p0, p1, p2, p3])
-        t, _ = nearest_on_cubic(ctrl, tg, seeds=32, iters=4)
+        ctrl = np.stack([p0, (a22 * r1 - a12 * r2) / det, (a11 * r2 - a12 * r1) / det, p3])
     return ctrl
 
 
-def _design_off(W, est, valid, ctrl, f, e, h):
+def _design_off(W, est, valid, ctrl, f, e, h, limit=math.inf):
     """How far the segment ``ctrl`` lies from the design estimates of its input points
     f..e: (the largest distance of a smooth point's estimate to it, the largest distance
-    of its samples (at most h apart) to the polyline of estimates (else points))."""
+    of its samples (at most h apart) to the polyline of estimates (else points)); None
+    when the first is over ``limit``."""
     v = np.flatnonzero(valid[f:e + 1]) + f
     if len(ctrl) == 2:
-        d1 = point_segment_distance(est[v], ctrl[0], ctrl[1]) if len(v) else np.zeros(1)
+        d1 = float(point_segment_distance(est[v], ctrl[0], ctrl[1]).max()) if len(v) else 0.0
+    else:
+        d1 = float(nearest_on_cubic(ctrl, est[v], seeds=32, iters=4)[1].max()) if len(v) \
+            else 0.0
+    if d1 > limit:
+        return None
+    if len(ctrl) == 2:
         length = float(np.hypot(*(ctrl[1] - ctrl[0])))
         m = max(2, math.ceil(length / h) + 1)
         samp = ctrl[0] + np.linspace(0.0, 1.0, m)[:, None] * (ctrl[1] - ctrl[0])
     else:
-        d1 = nearest_on_cubic(ctrl, est[v], seeds=32, iters=4)[1] if len(v) else np.zeros(1)
         length = float(np.hypot(*np.diff(ctrl, axis=0).T).sum())
         m = max(16, math.ceil(length / h) + 1)
         samp = cubic_eval(ctrl, np.linspace(0.0, 1.0, m))
     poly = np.where(valid[f:e + 1, None], est[f:e + 1], W[f:e + 1])
-    return float(d1.max()), float(point_polyline_distance(samp, poly).max())
+    return d1, float(_polyline_distance_over(samp, poly, 2.0 * h).max())
 
 
 class _Stretch:
@@ -1874,15 +1923,7 @@ class _Stretch:
     def __init__(self, W, est, valid, bound, quant):
         self.W, self.est, self.valid, self.bound, self.quant = W, est, valid, bound, quant
 
-    def piece(self, ctrl, f, e, o):
-        """(d1, d2) of :func:`_design_off` for the piece when it keeps within the bound of
-        path ``o``, else None."""
-        h = _JOINT_STEP * float(self.quant[o])
-        if not _seg_fits(self.W, ctrl, f, e, float(self.bound[o]), h):
-            return None
-        return _design_off(self.W, self.est, self.valid, ctrl, f, e, h)
-
-    def shapes(self, p0, p1, f, e, o, line_ok, old=None):
+    def shapes(self, p0, p1, f, e, o, limit, line_ok, old=None):
         """The best piece from p0 to p1 over the input points f..e: the line (when
         ``line_ok``), the least-squares cubic, the cubic ``old`` with its ends moved (its
         inner control points along): ((d1, d2), ctrl) or None."""
@@ -1890,7 +1931,7 @@ class _Stretch:
         alts = []
         if line_ok:
             alts.append(np.stack([p0, p1]))
-        if e - f >= 3:
+        if e - f + 1 >= _STRETCH_CUBIC:
             c = _ls_cubic(p0, p1, _stretch_targets(self.W, self.est, self.valid, f, e, q))
             if c is not None:
                 alts.append(c)
@@ -1899,14 +1940,17 @@ class _Stretch:
             c[:2] += p0 - old[0]
             c[2:] += p1 - old[3]
             alts.append(c)
-        best = None
+        scored = []
         for c in alts:
-            r = self.piece(c, f, e, o)
-            if r is not None and (best is None or max(r) < max(best[0])):
-                best = (r, c)
-        return best
+            r = _design_off(self.W, self.est, self.valid, c, f, e, _STRETCH_LOOK * q, limit)
+            if r is not None:
+                scored.append((max(r), len(scored), r, c))
+        for _, _, r, c in sorted(scored, key=lambda x: x[:2]):
+            if _seg_fits(self.W, c, f, e, float(self.bound[o]), _JOINT_STEP * q):
+                return r, c
+        return None
 
-    def split(self, p0, p1, f, e, o):
+    def split(self, p0, p1, f, e, o, limit):
         """The best two pieces from p0 to p1 over f..e, split at an input point m (its
         estimate when smooth): at the ends of long gaps, at the smooth stretch's ends, at
         the estimate farthest from the chord: ((d1, d2), [(ctrl, f, m), (ctrl, m, e)])."""
@@ -1929,16 +1973,19 @@ class _Stretch:
         for m in sorted(c for c in cand if lo <= c <= hi):
             pm = (np.clip(est[m], W[m] - 0.5 * q, W[m] + 0.5 * q) if valid[m]
                   else W[m].astype(np.float64))
-            a = self.shapes(p0, pm, f, m, o, True)
+            a = self.shapes(p0, pm, f, m, o, limit, True)
             if a is None:
                 continue
-            b = self.shapes(pm, p1, m, e, o, True)
+            b = self.shapes(pm, p1, m, e, o, limit, True)
             if b is None:
                 continue
             r = (max(a[0][0], b[0][0]), max(a[0][1], b[0][1]))
             if best is None or max(r) < max(best[0]):
                 best = (r, [(a[1], f, m), (b[1], m, e)])
         return best
+
+
+_LOG = []
 
 
 def _smooth_stretches(W, arc, points, is_cubic, tail, step, gfirst, glast, seg_owner, quant,
@@ -2006,7 +2053,7 @@ def _smooth_stretches(W, arc, points, is_cubic, tail, step, gfirst, glast, seg_o
             if x not in old:
                 old[x] = _seg_ctrl(points, is_cubic, tail, x)
                 oldoff[x] = _design_off(W, est, valid, old[x], gfirst[x], glast[x],
-                                        _JOINT_STEP * q)
+                                        _STRETCH_LOOK * q)
             return oldoff[x]
 
         best = None  # (split used, (d1, d2), {segment: [(ctrl, first, last)]})
@@ -2025,7 +2072,8 @@ def _smooth_stretches(W, arc, points, is_cubic, tail, step, gfirst, glast, seg_o
 
         c0 = _seg_ctrl(points, is_cubic, tail, s)
         f, e = int(gfirst[s]), int(glast[s])
-        r = st.shapes(c0[0], c0[-1], f, e, o, False, None)
+        lim = before(s)[0] - _STRETCH_GAIN * q
+        r = st.shapes(c0[0], c0[-1], f, e, o, lim, False, None)
         if r is not None:
             consider({s: (r[0], [(r[1], f, e)])}, 0)
         joints = []
@@ -2040,24 +2088,26 @@ def _smooth_stretches(W, arc, points, is_cubic, tail, step, gfirst, glast, seg_o
             ca = _seg_ctrl(points, is_cubic, tail, a)
             cb = _seg_ctrl(points, is_cubic, tail, b)
             fa, ea, fb, eb = int(gfirst[a]), int(glast[a]), int(gfirst[b]), int(glast[b])
-            ra = st.shapes(ca[0], v, fa, ea, o, not is_cubic[a], ca)
-            rb = st.shapes(v, cb[-1], fb, eb, o, not is_cubic[b], cb)
+            lim = max(before(a)[0], before(b)[0]) - _STRETCH_GAIN * q
+            ra = st.shapes(ca[0], v, fa, ea, o, lim, not is_cubic[a], ca)
+            rb = st.shapes(v, cb[-1], fb, eb, o, lim, not is_cubic[b], cb)
             if ra is not None and rb is not None:
                 consider({a: (ra[0], [(ra[1], fa, ea)]), b: (rb[0], [(rb[1], fb, eb)])}, 0)
             if best is not None and best[0] == 0 or splits <= 0:
                 continue
             if rb is not None:
-                sa = st.split(ca[0], v, fa, ea, o)
+                sa = st.split(ca[0], v, fa, ea, o, lim)
                 if sa is not None:
                     consider({a: (sa[0], sa[1]), b: (rb[0], [(rb[1], fb, eb)])}, 1)
             if ra is not None:
-                sb = st.split(v, cb[-1], fb, eb, o)
+                sb = st.split(v, cb[-1], fb, eb, o, lim)
                 if sb is not None:
                     consider({a: (ra[0], [(ra[1], fa, ea)]), b: (sb[0], sb[1])}, 1)
         if (best is None or best[0] == 1) and splits > 0:
-            r = st.split(c0[0], c0[-1], f, e, o)
+            r = st.split(c0[0], c0[-1], f, e, o, before(s)[0] - _STRETCH_GAIN * q)
             if r is not None:
                 consider({s: (r[0], r[1])}, 1)
+        _LOG.append((s, int(gfirst[s]), W[gfirst[s]].tolist(), float(off[bad][k]), None if best is None else (best[0], best[1], sorted(best[2]), [len(c) for p in best[2].values() for c, _, _ in p])))
         if best is not None:
             splits -= best[0]
             for x, p in best[2].items():
