@@ -1795,7 +1795,7 @@ _STRETCH_STEP = 1.0
 _STRETCH_ITERS = 4
 #: ... the estimates' windows end at a gap between input points longer than this (units of
 #: q: a design line between two rounded points)
-_STRETCH_GAP = 4.0
+_STRETCH_GAP = 8.0
 #: ... a segment split in two (one more segment) only when no repair keeps the count, at
 #: most this share of the rounded paths' segments (and one)
 _STRETCH_SPLITS = 0.02
@@ -1893,15 +1893,16 @@ def _ls_cubic(p0, p3, tg):
 
 def _design_off(W, est, valid, ctrl, f, e, h, limit=math.inf):
     """How far the segment ``ctrl`` lies from the design estimates of its input points
-    f..e: (the largest distance of a smooth point's estimate to it, the largest distance
-    of its samples (at most h apart) to the polyline of estimates (else points)); None
+    f..e: (the largest distance of a smooth point's estimate (or of the middle between two
+    smooth neighbours' estimates) to it, the largest distance of its samples (at most h apart) to the polyline of estimates (else points)); None
     when the first is over ``limit``."""
     v = np.flatnonzero(valid[f:e + 1]) + f
+    v2 = v[:-1][np.diff(v) == 1]
+    tp = np.concatenate([est[v], 0.5 * (est[v2] + est[v2 + 1])])
     if len(ctrl) == 2:
-        d1 = float(point_segment_distance(est[v], ctrl[0], ctrl[1]).max()) if len(v) else 0.0
+        d1 = float(point_segment_distance(tp, ctrl[0], ctrl[1]).max()) if len(v) else 0.0
     else:
-        d1 = float(nearest_on_cubic(ctrl, est[v], seeds=32, iters=4)[1].max()) if len(v) \
-            else 0.0
+        d1 = float(nearest_on_cubic(ctrl, tp, seeds=32, iters=4)[1].max()) if len(v) else 0.0
     if d1 > limit:
         return None
     if len(ctrl) == 2:
@@ -2013,25 +2014,28 @@ def _smooth_stretches(W, arc, points, is_cubic, tail, step, gfirst, glast, seg_o
     paths = np.flatnonzero((cut[1:] > cut[:-1]) & (quant > 0.0))
     est, valid = _stretch_estimates(W, arc, gfirst[cut[paths]], glast[cut[paths + 1] - 1],
                                     quant[paths])
-    # per segment: the largest distance of a smooth point's estimate to it
+    # per segment: the largest distance of a smooth point's estimate (or of the middle
+    # between two smooth neighbours' estimates) to it
     sr = np.flatnonzero(rp)
     n = glast[sr] - gfirst[sr] + 1
     pid = np.repeat(np.arange(len(sr)), n)
     idx = np.repeat(gfirst[sr], n) + np.arange(int(n.sum())) - np.repeat(np.cumsum(n) - n, n)
+    pair = np.flatnonzero(valid[idx[:-1]] & valid[idx[:-1] + 1] & (pid[1:] == pid[:-1]))
     keep = valid[idx]
-    pid, idx = pid[keep], idx[keep]
+    tp = np.concatenate([est[idx[keep]], 0.5 * (est[idx[pair]] + est[idx[pair] + 1])])
+    pid = np.concatenate([pid[keep], pid[pair]])
     off = np.zeros(len(sr))
     ln = ~is_cubic[sr[pid]]
     if ln.any():
         s = sr[pid[ln]]
-        d = point_segment_distance(est[idx[ln]], points[tail[s] - 1], points[tail[s]])
+        d = point_segment_distance(tp[ln], points[tail[s] - 1], points[tail[s]])
         np.maximum.at(off, pid[ln], d)
     if (~ln).any():
         cs = np.flatnonzero(is_cubic[sr])
         ctrl = np.stack([points[tail[sr[cs]] - 1 + k] for k in range(4)], axis=1)
         loc = np.full(len(sr), -1)
         loc[cs] = np.arange(len(cs))
-        _, d = nearest_on_cubic_each(ctrl, loc[pid[~ln]], est[idx[~ln]], seeds=32, iters=4)
+        _, d = nearest_on_cubic_each(ctrl, loc[pid[~ln]], tp[~ln], seeds=32, iters=4)
         np.maximum.at(off, pid[~ln], d)
     bad = off >= _STRETCH_OFF * quant[seg_owner[sr]]
     if not bad.any():
