@@ -1802,7 +1802,7 @@ _STRETCH_SPLITS = 0.02
 #: ... at input points at least this many points from either end of the segment
 _STRETCH_PIECE = 4
 #: ... an estimate holds with this many input points on either side of it in its window
-_STRETCH_SIDE = 8
+_STRETCH_SIDE = 4
 #: ... a least-squares cubic is fitted over at least this many input points
 _STRETCH_CUBIC = 8
 #: ... the distance of a segment to the estimates' polyline sampled this far apart (q)
