@@ -1805,6 +1805,9 @@ _STRETCH_PIECE = 4
 _STRETCH_SIDE = 4
 #: ... a least-squares cubic is fitted over at least this many input points
 _STRETCH_CUBIC = 8
+#: ... a joint left on its input point this many quanta or more from its estimate is moved
+#: there with both of its segments re-fitted
+_STRETCH_JOINT = 0.3
 #: ... the distance of a segment to the estimates' polyline sampled this far apart (q)
 _STRETCH_LOOK = 0.25
 
@@ -1893,9 +1896,10 @@ def _ls_cubic(p0, p3, tg):
 
 def _design_off(W, est, valid, ctrl, f, e, h, limit=math.inf):
     """How far the segment ``ctrl`` lies from the design estimates of its input points
-    f..e: (the largest distance of a smooth point's estimate (or of the middle between two
-    smooth neighbours' estimates) to it, the largest distance of its samples (at most h apart) to the polyline of estimates (else points)); None
-    when the first is over ``limit``."""
+    f..e: (d1, d2), d1 the largest distance of a smooth point's estimate (or of the middle
+    between two smooth neighbours' estimates) to it, d2 the largest distance of its samples
+    (at most h apart) to the polyline of the estimates (else the points); None when d1 is
+    over ``limit``."""
     v = np.flatnonzero(valid[f:e + 1]) + f
     v2 = v[:-1][np.diff(v) == 1]
     tp = np.concatenate([est[v], 0.5 * (est[v2] + est[v2 + 1])])
@@ -2038,8 +2042,6 @@ def _smooth_stretches(W, arc, points, is_cubic, tail, step, gfirst, glast, seg_o
         _, d = nearest_on_cubic_each(ctrl, loc[pid[~ln]], tp[~ln], seeds=32, iters=4)
         np.maximum.at(off, pid[~ln], d)
     bad = off >= _STRETCH_OFF * quant[seg_owner[sr]]
-    if not bad.any():
-        return unchanged
     st = _Stretch(W, est, valid, bound, quant)
     splits = max(1, int(_STRETCH_SPLITS * len(sr)))
     rep: dict[int, list] = {}
@@ -2117,6 +2119,37 @@ def _smooth_stretches(W, arc, points, is_cubic, tail, step, gfirst, glast, seg_o
             for x, p in best[2].items():
                 rep[x] = p
                 done[x] = True
+    # the joints still on their input point, ``_STRETCH_JOINT`` quanta or more from their
+    # estimate: moved onto it with both segments re-fitted, where neither of them gets
+    # farther from the estimates
+    jb = np.flatnonzero((seg_owner[1:] == seg_owner[:-1]) & rp[1:]) + 1
+    jb = jb[(glast[jb] > gfirst[jb]) & (glast[jb - 1] > gfirst[jb - 1])]
+    g = gfirst[jb]
+    jb = jb[valid[g] & (points[tail[jb] - 1] == W[g]).all(axis=1)]
+    g = gfirst[jb]
+    qj = quant[seg_owner[jb]][:, None]
+    vj = np.clip(est[g], W[g] - 0.5 * qj, W[g] + 0.5 * qj)
+    far = np.hypot(*(vj - W[g]).T) >= _STRETCH_JOINT * qj[:, 0]
+    for b, v in zip(jb[far].tolist(), vj[far], strict=True):
+        a = b - 1
+        if done[a] or done[b]:
+            continue
+        o = int(seg_owner[b])
+        q = float(quant[o])
+        ca = _seg_ctrl(points, is_cubic, tail, a)
+        cb = _seg_ctrl(points, is_cubic, tail, b)
+        fa, ea, fb, eb = int(gfirst[a]), int(glast[a]), int(gfirst[b]), int(glast[b])
+        oa = _design_off(W, est, valid, ca, fa, ea, _STRETCH_LOOK * q)
+        ob = _design_off(W, est, valid, cb, fb, eb, _STRETCH_LOOK * q)
+        ra = st.shapes(ca[0], v, fa, ea, o, oa[0], not is_cubic[a], ca)
+        if ra is None or ra[0][1] > max(oa[1], ra[0][0]):
+            continue
+        rb = st.shapes(v, cb[-1], fb, eb, o, ob[0], not is_cubic[b], cb)
+        if rb is None or rb[0][1] > max(ob[1], rb[0][0]):
+            continue
+        rep[a] = [(ra[1], fa, ea)]
+        rep[b] = [(rb[1], fb, eb)]
+        done[a] = done[b] = True
     if not rep:
         return unchanged
     return _rebuilt(points, is_cubic, tail, step, gfirst, glast, seg_owner, changed, rep)
