@@ -1741,23 +1741,52 @@ def _seg_fits(W, ctrl, first, last, bound, h) -> bool:
 _NEAR_SEGMENTS = 8
 
 
-def _polyline_distance_over(samp, poly, lim):
+def _polyline_distance_over(samp, poly, lim, k=_NEAR_SEGMENTS):
     """The distance of each of the samples ``samp`` (in order along ``poly``) to the
     polyline where it is over ``lim``, else a distance within ``lim`` (each sample measured
     against the segments near its share of the length, those over ``lim`` against all)."""
     n = len(poly)
-    if n <= 2 * _NEAR_SEGMENTS + 2:
+    if n <= 2 * k + 2:
         return point_polyline_distance(samp, poly)
     cum = np.r_[0.0, np.cumsum(np.hypot(*np.diff(poly, axis=0).T))]
-    at = np.searchsorted(cum, np.linspace(0.0, cum[-1], len(samp))) - 1
-    idx = np.clip(at[:, None] + np.arange(-_NEAR_SEGMENTS, _NEAR_SEGMENTS + 1), 0, n - 2)
-    w = idx.shape[1]
-    d = point_segment_distance(np.repeat(samp, w, axis=0), poly[idx.ravel()],
-                               poly[idx.ravel() + 1]).reshape(-1, w).min(axis=1)
+    cs = np.r_[0.0, np.cumsum(np.hypot(*np.diff(samp, axis=0).T))]
+    at = np.searchsorted(cum, cs * (cum[-1] / cs[-1]) if cs[-1] > 0.0 else cs) - 1
+    d = np.empty(len(samp))
+    _window_distance(samp, poly, at, k, d)
     far = np.flatnonzero(d > lim)
     if len(far):
         d[far] = point_polyline_distance(samp[far], poly)
     return d
+
+
+@njit(cache=True, nogil=True)
+def _window_distance(samp, poly, at, k, out):  # pragma: no cover (compiled)
+    """out[i]: the distance of samp[i] to the segments at[i] - k .. at[i] + k of the
+    polyline ``poly`` (clipped to it)."""
+    ns = poly.shape[0] - 1
+    for i in range(samp.shape[0]):
+        px = samp[i, 0]
+        py = samp[i, 1]
+        lo = max(0, min(at[i] - k, ns - 1))
+        hi = min(ns - 1, max(at[i] + k, 0))
+        best = np.inf
+        for j in range(lo, hi + 1):
+            ax = poly[j, 0]
+            ay = poly[j, 1]
+            vx = poly[j + 1, 0] - ax
+            vy = poly[j + 1, 1] - ay
+            dx = px - ax
+            dy = py - ay
+            den = vx * vx + vy * vy
+            t = 0.0
+            if den > 0.0:
+                t = min(1.0, max(0.0, (dx * vx + dy * vy) / den))
+            ex = dx - t * vx
+            ey = dy - t * vy
+            d2 = ex * ex + ey * ey
+            if d2 < best:
+                best = d2
+        out[i] = math.sqrt(best)
 
 
 def _try_joint(W, points, is_cubic, tail, step, gfirst, glast, j, v, bound, q, changed):
@@ -1810,6 +1839,8 @@ _STRETCH_CUBIC = 8
 _STRETCH_JOINT = 0.3
 #: ... the distance of a segment to the estimates' polyline sampled this far apart (q)
 _STRETCH_LOOK = 0.25
+#: ... distances over this many samples' spacings measured exactly (below: an upper bound)
+_STRETCH_EXACT = 1.2
 
 
 def _stretch_estimates(W, arc, ps, pe, quant):
@@ -1899,16 +1930,8 @@ def _design_off(W, est, valid, ctrl, f, e, h, limit=math.inf):
     f..e: (d1, d2), d1 the largest distance of a smooth point's estimate (or of the middle
     between two smooth neighbours' estimates) to it, d2 the largest distance of its samples
     (at most h apart) to the polyline of the estimates (else the points); None when d1 is
-    over ``limit``."""
-    v = np.flatnonzero(valid[f:e + 1]) + f
-    v2 = v[:-1][np.diff(v) == 1]
-    tp = np.concatenate([est[v], 0.5 * (est[v2] + est[v2 + 1])])
-    if len(ctrl) == 2:
-        d1 = float(point_segment_distance(tp, ctrl[0], ctrl[1]).max()) if len(v) else 0.0
-    else:
-        d1 = float(nearest_on_cubic(ctrl, tp, seeds=32, iters=4)[1].max()) if len(v) else 0.0
-    if d1 > limit:
-        return None
+    over ``limit``. Both measured against polylines (the samples, the estimates), exactly
+    where over ``_STRETCH_EXACT`` h."""
     if len(ctrl) == 2:
         length = float(np.hypot(*(ctrl[1] - ctrl[0])))
         m = max(2, math.ceil(length / h) + 1)
@@ -1917,8 +1940,17 @@ def _design_off(W, est, valid, ctrl, f, e, h, limit=math.inf):
         length = float(np.hypot(*np.diff(ctrl, axis=0).T).sum())
         m = max(16, math.ceil(length / h) + 1)
         samp = cubic_eval(ctrl, np.linspace(0.0, 1.0, m))
+    v = np.flatnonzero(valid[f:e + 1]) + f
+    d1 = 0.0
+    if len(v):
+        v2 = v[:-1][np.diff(v) == 1]
+        key = np.concatenate([2 * v, 2 * v2 + 1])
+        tp = np.concatenate([est[v], 0.5 * (est[v2] + est[v2 + 1])])[np.argsort(key)]
+        d1 = float(_polyline_distance_over(tp, samp, _STRETCH_EXACT * h, 64).max())
+    if d1 > limit:
+        return None
     poly = np.where(valid[f:e + 1, None], est[f:e + 1], W[f:e + 1])
-    return d1, float(_polyline_distance_over(samp, poly, 2.0 * h).max())
+    return d1, float(_polyline_distance_over(samp, poly, _STRETCH_EXACT * h).max())
 
 
 class _Stretch:
