@@ -2022,9 +2022,6 @@ class _Stretch:
         return best
 
 
-_LOG = []
-
-
 def _smooth_stretches(W, arc, points, is_cubic, tail, step, gfirst, glast, seg_owner, quant,
                       bound, changed):
     """Rounded input, after :func:`_joints_on_the_design`: the segments that lie
@@ -2145,7 +2142,6 @@ def _smooth_stretches(W, arc, points, is_cubic, tail, step, gfirst, glast, seg_o
             r = st.split(c0[0], c0[-1], f, e, o, before(s)[0] - _STRETCH_GAIN * q)
             if r is not None:
                 consider({s: (r[0], r[1])}, 1)
-        _LOG.append((s, int(gfirst[s]), W[gfirst[s]].tolist(), float(off[bad][k]), None if best is None else (best[0], best[1], sorted(best[2]), [len(c) for p in best[2].values() for c, _, _ in p])))
         if best is not None:
             splits -= best[0]
             for x, p in best[2].items():
