@@ -1845,7 +1845,7 @@ _STRETCH_EXACT = 1.2
 
 def _stretch_estimates(W, arc, ps, pe, quant):
     """Per input point (global index) of the rounded paths ps..pe (quantum ``quant`` each):
-    the design estimate of :func:`_joint_estimates` and whether it holds (a smooth
+    the design estimate of :func:`_joint_estimates` (compiled) and whether it holds (a smooth
     stretch: enough points on both sides, the window's points within ``_JOINT_SMOOTH``
     quanta of it). The windows stop at gaps longer than ``_STRETCH_GAP`` quanta."""
     est = np.zeros_like(W)
@@ -1862,15 +1862,74 @@ def _stretch_estimates(W, arc, ps, pe, quant):
     gap[start] = True
     run = np.cumsum(gap) - 1
     rs = g[np.flatnonzero(gap)]  # each run's first point
-    re = np.r_[rs[1:] - 1, 0]
     ends = np.flatnonzero(gap)
     last_of = np.r_[ends[1:] - 1, len(g) - 1]
     re = g[last_of]
-    e, _, res, ok = _joint_estimates(W, arc, g, rs[run], re[run], _JOINT_SIDE,
-                                     _STRETCH_SIDE)
+    lo = np.maximum(g - _JOINT_SIDE, rs[run])
+    hi = np.minimum(g + _JOINT_SIDE, re[run])
+    e = np.empty((len(g), 2))
+    ok = np.zeros(len(g), dtype=np.bool_)
+    _quad_estimates(W, arc, g, lo, hi, _STRETCH_SIDE, _JOINT_SMOOTH * qg, e, ok)
     est[g] = e
-    valid[g] = ok & (res <= _JOINT_SMOOTH * qg)
+    valid[g] = ok
     return est, valid
+
+
+@njit(cache=True, nogil=True)
+def _quad_estimates(W, arc, g, lo, hi, side, tol, est, ok):  # pragma: no cover (compiled)
+    """:func:`_joint_estimates` compiled, per point g[i] over the window lo[i]..hi[i]:
+    est[i] the quadratic's position at g[i], ok[i] at least ``side`` points on either side,
+    a well-conditioned fit and every window point within tol[i] of the quadratic."""
+    for i in range(g.shape[0]):
+        c = g[i]
+        est[i, 0] = W[c, 0]
+        est[i, 1] = W[c, 1]
+        ok[i] = False
+        if c - lo[i] < side or hi[i] - c < side:
+            continue
+        m = np.zeros(5)
+        rx = np.zeros(3)
+        ry = np.zeros(3)
+        for j in range(lo[i], hi[i] + 1):
+            t = arc[j] - arc[c]
+            px = W[j, 0] - W[c, 0]
+            py = W[j, 1] - W[c, 1]
+            tk = 1.0
+            for k in range(5):
+                m[k] += tk
+                if k < 3:
+                    rx[k] += tk * px
+                    ry[k] += tk * py
+                tk *= t
+        a00, a01, a02, a11, a12, a22 = m[0], m[1], m[2], m[2], m[3], m[4]
+        c00 = a11 * a22 - a12 * a12
+        c01 = a02 * a12 - a01 * a22
+        c02 = a01 * a12 - a02 * a11
+        det = a00 * c00 + a01 * c01 + a02 * c02
+        big = max(abs(a00), abs(a01), abs(a02), abs(a11), abs(a12), abs(a22), 1.0)
+        if not abs(det) > 1e-12 * big * big * big:
+            continue
+        c11 = a00 * a22 - a02 * a02
+        c12 = a01 * a02 - a00 * a12
+        c22 = a00 * a11 - a01 * a01
+        cx0 = (c00 * rx[0] + c01 * rx[1] + c02 * rx[2]) / det
+        cx1 = (c01 * rx[0] + c11 * rx[1] + c12 * rx[2]) / det
+        cx2 = (c02 * rx[0] + c12 * rx[1] + c22 * rx[2]) / det
+        cy0 = (c00 * ry[0] + c01 * ry[1] + c02 * ry[2]) / det
+        cy1 = (c01 * ry[0] + c11 * ry[1] + c12 * ry[2]) / det
+        cy2 = (c02 * ry[0] + c12 * ry[1] + c22 * ry[2]) / det
+        if cx1 == 0.0 and cy1 == 0.0:
+            continue
+        worst = 0.0
+        for j in range(lo[i], hi[i] + 1):
+            t = arc[j] - arc[c]
+            ex = cx0 + t * (cx1 + t * cx2) - (W[j, 0] - W[c, 0])
+            ey = cy0 + t * (cy1 + t * cy2) - (W[j, 1] - W[c, 1])
+            worst = max(worst, math.sqrt(ex * ex + ey * ey))
+        if worst <= tol[i]:
+            est[i, 0] = W[c, 0] + cx0
+            est[i, 1] = W[c, 1] + cy0
+            ok[i] = True
 
 
 def _stretch_targets(W, est, valid, f, e, q):
@@ -2040,13 +2099,20 @@ def _smooth_stretches(W, arc, points, is_cubic, tail, step, gfirst, glast, seg_o
     changed."""
     ns = len(is_cubic)
     unchanged = (is_cubic, points, tail, step, gfirst, glast, seg_owner, changed)
-    rp = quant[seg_owner] > 0.0
-    if ns == 0 or not rp.any():
+    if ns == 0:
         return unchanged
+    # the rounded paths with enough input points for an estimate
     cut = np.searchsorted(seg_owner, np.arange(len(quant) + 1))
-    paths = np.flatnonzero((cut[1:] > cut[:-1]) & (quant > 0.0))
-    est, valid = _stretch_estimates(W, arc, gfirst[cut[paths]], glast[cut[paths + 1] - 1],
-                                    quant[paths])
+    has = cut[1:] > cut[:-1]
+    ps = gfirst[np.minimum(cut[:-1], ns - 1)]
+    pe = glast[np.maximum(cut[1:] - 1, 0)]
+    paths = np.flatnonzero(has & (quant > 0.0) & (pe - ps >= 2 * _STRETCH_SIDE))
+    if len(paths) == 0:
+        return unchanged
+    take = np.zeros(len(quant), dtype=bool)
+    take[paths] = True
+    rp = take[seg_owner]
+    est, valid = _stretch_estimates(W, arc, ps[paths], pe[paths], quant[paths])
     # per segment: the largest distance of a smooth point's estimate (or of the middle
     # between two smooth neighbours' estimates) to it
     sr = np.flatnonzero(rp)
@@ -2961,6 +3027,7 @@ def warm_up() -> None:
     t = np.linspace(0.0, 2.0 * np.pi, 97)
     e = np.c_[40.0 * np.cos(t), 25.0 * np.sin(t)]
     fit_paths([e, np.round(8.0 * e)], [True, True])
+    _polyline_distance_over(e, e, 0.0)  # (the smooth-stretch pass's windowed distance)
 
 
 def fit_report(
