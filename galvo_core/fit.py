@@ -1754,6 +1754,11 @@ def _polyline_distance_over(samp, poly, lim, k=_NEAR_SEGMENTS):
     d = np.empty(len(samp))
     _window_distance(samp, poly, at, k, d)
     far = np.flatnonzero(d > lim)
+    if len(far) and n > 16 * k + 2:  # a wider window first
+        wide = np.empty(len(far))
+        _window_distance(samp[far], poly, at[far], 16 * k, wide)
+        d[far] = wide
+        far = far[wide > lim]
     if len(far):
         d[far] = point_polyline_distance(samp[far], poly)
     return d
@@ -1822,6 +1827,7 @@ _STRETCH_GAIN = 0.05
 #: far apart (units of q), with this many re-parametrisations
 _STRETCH_STEP = 1.0
 _STRETCH_ITERS = 4
+_STRETCH_TARGETS = 128
 #: ... the estimates' windows end at a gap between input points longer than this (units of
 #: q: a design line between two rounded points)
 _STRETCH_GAP = 8.0
@@ -1837,6 +1843,10 @@ _STRETCH_CUBIC = 8
 #: ... a joint left on its input point this many quanta or more from its estimate is moved
 #: there with both of its segments re-fitted
 _STRETCH_JOINT = 0.3
+#: ... at most this many re-fits per call, plus one per this many input points (the worst
+#: segments first, then the joints: the pass's time stays a fraction of the fit's)
+_STRETCH_BUDGET = 256
+_STRETCH_PER = 20_000
 #: ... the distance of a segment to the estimates' polyline sampled this far apart (q)
 _STRETCH_LOOK = 0.25
 #: ... distances over this many samples' spacings measured exactly (below: an upper bound)
@@ -1934,7 +1944,8 @@ def _quad_estimates(W, arc, g, lo, hi, side, tol, est, ok):  # pragma: no cover 
 
 def _stretch_targets(W, est, valid, f, e, q):
     """The design polyline of the input points f..e: each smooth point's estimate (else the
-    point), the long gaps filled every ``_STRETCH_STEP`` quanta."""
+    point), the long gaps filled every ``_STRETCH_STEP`` quanta (at most
+    ``_STRETCH_TARGETS`` points, evenly taken)."""
     d = np.where(valid[f:e + 1, None], est[f:e + 1], W[f:e + 1])
     if len(d) < 2:
         return d
@@ -1942,8 +1953,10 @@ def _stretch_targets(W, est, valid, f, e, q):
     n = np.maximum(np.ceil(gap / (_STRETCH_STEP * q)).astype(np.intp), 1)
     seg = np.repeat(np.arange(len(gap)), n)
     frac = (np.arange(int(n.sum())) - np.repeat(np.cumsum(n) - n, n)) / np.repeat(n, n)
-    pts = d[seg] + frac[:, None] * (d[seg + 1] - d[seg])
-    return np.vstack([pts, d[-1:]])
+    pts = np.vstack([d[seg] + frac[:, None] * (d[seg + 1] - d[seg]), d[-1:]])
+    if len(pts) > _STRETCH_TARGETS:  # evenly thinned out
+        pts = pts[np.linspace(0, len(pts) - 1, _STRETCH_TARGETS).round().astype(np.intp)]
+    return pts
 
 
 def _ls_cubic(p0, p3, tg):
@@ -2016,13 +2029,18 @@ class _Stretch:
     """The state of :func:`_smooth_stretches` on one call: the input, the estimates, the
     bound and step per path."""
 
-    def __init__(self, W, est, valid, bound, quant):
+    def __init__(self, W, est, valid, bound, quant, budget):
         self.W, self.est, self.valid, self.bound, self.quant = W, est, valid, bound, quant
+        self.budget = budget  # re-fits left
 
     def shapes(self, p0, p1, f, e, o, limit, line_ok, old=None):
         """The best piece from p0 to p1 over the input points f..e: the line (when
         ``line_ok``), the least-squares cubic, the cubic ``old`` with its ends moved (its
-        inner control points along): ((d1, d2), ctrl) or None."""
+        inner control points along): ((d1, d2), ctrl) or None (also when the budget is
+        spent)."""
+        if self.budget <= 0:
+            return None
+        self.budget -= 1
         q = float(self.quant[o])
         alts = []
         if line_ok:
@@ -2094,7 +2112,8 @@ def _smooth_stretches(W, arc, points, is_cubic, tail, step, gfirst, glast, seg_o
     joint moved, one of the two) split in two at an input point (``_STRETCH_SPLITS``). A
     repair is kept only when every new segment stays within ``bound`` (per path) of its
     input points and polyline (:func:`_seg_fits`) and it brings the distance to the
-    estimates down by ``_STRETCH_GAIN`` quanta. Returns the segments (is_cubic, points,
+    estimates down by ``_STRETCH_GAIN`` quanta; at most ``_STRETCH_BUDGET`` re-fits (and
+    one per ``_STRETCH_PER`` input points). Returns the segments (is_cubic, points,
     tail, step, gfirst, glast, seg_owner, changed) rebuilt, or the inputs when none
     changed."""
     ns = len(is_cubic)
@@ -2134,15 +2153,18 @@ def _smooth_stretches(W, arc, points, is_cubic, tail, step, gfirst, glast, seg_o
         ctrl = np.stack([points[tail[sr[cs]] - 1 + k] for k in range(4)], axis=1)
         loc = np.full(len(sr), -1)
         loc[cs] = np.arange(len(cs))
-        _, d = nearest_on_cubic_each(ctrl, loc[pid[~ln]], tp[~ln], seeds=32, iters=4)
+        _, d = nearest_on_cubic_each(ctrl, loc[pid[~ln]], tp[~ln], seeds=12, iters=3)
         np.maximum.at(off, pid[~ln], d)
     bad = off >= _STRETCH_OFF * quant[seg_owner[sr]]
-    st = _Stretch(W, est, valid, bound, quant)
+    st = _Stretch(W, est, valid, bound, quant,
+                  _STRETCH_BUDGET + int((pe[paths] - ps[paths] + 1).sum()) // _STRETCH_PER)
     splits = max(1, int(_STRETCH_SPLITS * len(sr)))
     rep: dict[int, list] = {}
     done = np.zeros(ns, dtype=bool)
     for k in np.argsort(-off[bad], kind="stable").tolist():
         s = int(sr[bad][k])
+        if st.budget <= 0:
+            break
         if done[s]:
             continue
         o = int(seg_owner[s])
@@ -2226,6 +2248,8 @@ def _smooth_stretches(W, arc, points, is_cubic, tail, step, gfirst, glast, seg_o
     far = np.hypot(*(vj - W[g]).T) >= _STRETCH_JOINT * qj[:, 0]
     for b, v in zip(jb[far].tolist(), vj[far], strict=True):
         a = b - 1
+        if st.budget <= 0:
+            break
         if done[a] or done[b]:
             continue
         o = int(seg_owner[b])
