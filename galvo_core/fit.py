@@ -2168,6 +2168,10 @@ _STRETCH_SPLITS = 0.02
 _STRETCH_PIECE = 4
 #: ... an estimate holds with this many input points on either side of it in its window
 _STRETCH_SIDE = 4
+#: ... and with its window reaching this many quanta of arc length on either side (over
+#: fewer the rounding's staircase can move a quadratic half a quantum: input points much
+#: closer than the quantum, where the fit's least squares average the rounding anyway)
+_STRETCH_SPAN = 3.0
 #: ... a least-squares cubic is fitted over at least this many input points
 _STRETCH_CUBIC = 8
 #: ... a joint left on its input point this many quanta or more from its estimate is moved
@@ -2187,89 +2191,107 @@ def _stretch_estimates(W, arc, ps, pe, quant):
     """Per input point (global index) of the rounded paths ps..pe (quantum ``quant`` each):
     the design estimate of :func:`_joint_estimates` (compiled) and whether it holds (a smooth
     stretch: enough points on both sides, the window's points within ``_JOINT_SMOOTH``
-    quanta of it). The windows stop at gaps longer than ``_STRETCH_GAP`` quanta."""
+    quanta of it, the window reaching ``_STRETCH_SPAN`` quanta of arc length on either
+    side). The windows stop at gaps longer than ``_STRETCH_GAP`` quanta."""
     est = np.zeros_like(W)
-    valid = np.zeros(len(W), dtype=bool)
-    cnt = pe - ps + 1
-    if len(cnt) == 0:
-        return est, valid
-    start = np.cumsum(cnt) - cnt
-    g = np.repeat(ps, cnt) + np.arange(int(cnt.sum())) - np.repeat(start, cnt)
-    qg = np.repeat(quant, cnt)
-    gap = np.zeros(len(g), dtype=bool)  # a long gap before point g
-    step = np.hypot(*(W[g[1:]] - W[g[:-1]]).T)
-    gap[1:] = step > _STRETCH_GAP * qg[1:]
-    gap[start] = True
-    run = np.cumsum(gap) - 1
-    rs = g[np.flatnonzero(gap)]  # each run's first point
-    ends = np.flatnonzero(gap)
-    last_of = np.r_[ends[1:] - 1, len(g) - 1]
-    re = g[last_of]
-    lo = np.maximum(g - _JOINT_SIDE, rs[run])
-    hi = np.minimum(g + _JOINT_SIDE, re[run])
-    e = np.empty((len(g), 2))
-    ok = np.zeros(len(g), dtype=np.bool_)
-    _quad_estimates(W, arc, g, lo, hi, _STRETCH_SIDE, _JOINT_SMOOTH * qg, e, ok)
-    est[g] = e
-    valid[g] = ok
+    valid = np.zeros(len(W), dtype=np.bool_)
+    if len(ps):
+        _quad_estimates(W, arc, np.asarray(ps, dtype=np.int64), np.asarray(pe, dtype=np.int64),
+                        np.asarray(quant, dtype=np.float64), _JOINT_SIDE, _STRETCH_SIDE,
+                        _JOINT_SMOOTH, _STRETCH_GAP, _STRETCH_SPAN, est, valid)
     return est, valid
 
 
 @njit(cache=True, nogil=True)
-def _quad_estimates(W, arc, g, lo, hi, side, tol, est, ok):  # pragma: no cover (compiled)
-    """:func:`_joint_estimates` compiled, per point g[i] over the window lo[i]..hi[i]:
-    est[i] the quadratic's position at g[i], ok[i] at least ``side`` points on either side,
-    a well-conditioned fit and every window point within tol[i] of the quadratic."""
-    for i in range(g.shape[0]):
-        c = g[i]
-        est[i, 0] = W[c, 0]
-        est[i, 1] = W[c, 1]
-        ok[i] = False
-        if c - lo[i] < side or hi[i] - c < side:
-            continue
-        m = np.zeros(5)
-        rx = np.zeros(3)
-        ry = np.zeros(3)
-        for j in range(lo[i], hi[i] + 1):
-            t = arc[j] - arc[c]
-            px = W[j, 0] - W[c, 0]
-            py = W[j, 1] - W[c, 1]
-            tk = 1.0
-            for k in range(5):
-                m[k] += tk
-                if k < 3:
-                    rx[k] += tk * px
-                    ry[k] += tk * py
-                tk *= t
-        a00, a01, a02, a11, a12, a22 = m[0], m[1], m[2], m[2], m[3], m[4]
-        c00 = a11 * a22 - a12 * a12
-        c01 = a02 * a12 - a01 * a22
-        c02 = a01 * a12 - a02 * a11
-        det = a00 * c00 + a01 * c01 + a02 * c02
-        big = max(abs(a00), abs(a01), abs(a02), abs(a11), abs(a12), abs(a22), 1.0)
-        if not abs(det) > 1e-12 * big * big * big:
-            continue
-        c11 = a00 * a22 - a02 * a02
-        c12 = a01 * a02 - a00 * a12
-        c22 = a00 * a11 - a01 * a01
-        cx0 = (c00 * rx[0] + c01 * rx[1] + c02 * rx[2]) / det
-        cx1 = (c01 * rx[0] + c11 * rx[1] + c12 * rx[2]) / det
-        cx2 = (c02 * rx[0] + c12 * rx[1] + c22 * rx[2]) / det
-        cy0 = (c00 * ry[0] + c01 * ry[1] + c02 * ry[2]) / det
-        cy1 = (c01 * ry[0] + c11 * ry[1] + c12 * ry[2]) / det
-        cy2 = (c02 * ry[0] + c12 * ry[1] + c22 * ry[2]) / det
-        if cx1 == 0.0 and cy1 == 0.0:
-            continue
-        worst = 0.0
-        for j in range(lo[i], hi[i] + 1):
-            t = arc[j] - arc[c]
-            ex = cx0 + t * (cx1 + t * cx2) - (W[j, 0] - W[c, 0])
-            ey = cy0 + t * (cy1 + t * cy2) - (W[j, 1] - W[c, 1])
-            worst = max(worst, math.sqrt(ex * ex + ey * ey))
-        if worst <= tol[i]:
-            est[i, 0] = W[c, 0] + cx0
-            est[i, 1] = W[c, 1] + cy0
-            ok[i] = True
+def _quad_estimates(W, arc, ps, pe, quant, k, side, smooth, gap, span, est,
+                    ok):  # pragma: no cover (compiled)
+    """:func:`_joint_estimates` compiled, per input point c of each path ps..pe over the
+    window of up to ``k`` points on either side (ending at a step over ``gap`` quanta):
+    est[c] the quadratic's position at c, ok[c] at least ``side`` points and ``span``
+    quanta of arc length on either side, a well-conditioned fit and every window point
+    within ``smooth`` quanta of the quadratic."""
+    for p in range(ps.shape[0]):
+        q = quant[p]
+        lim = gap * q
+        reach = span * q
+        for c in range(ps[p], pe[p] + 1):
+            est[c, 0] = W[c, 0]
+            est[c, 1] = W[c, 1]
+            if c - ps[p] < side or pe[p] - c < side:
+                continue
+            lo = max(ps[p], c - k)
+            hi = min(pe[p], c + k)
+            if arc[c] - arc[lo] < reach or arc[hi] - arc[c] < reach:
+                continue  # (the gaps below only shorten the window)
+            j = c
+            while j > lo and math.hypot(W[j, 0] - W[j - 1, 0], W[j, 1] - W[j - 1, 1]) <= lim:
+                j -= 1
+            lo = j
+            j = c
+            while j < hi and math.hypot(W[j + 1, 0] - W[j, 0], W[j + 1, 1] - W[j, 1]) <= lim:
+                j += 1
+            hi = j
+            if c - lo < side or hi - c < side or arc[c] - arc[lo] < reach \
+                    or arc[hi] - arc[c] < reach:
+                continue
+            if _quad_one(W, arc, c, lo, hi, smooth * q, est):
+                ok[c] = True
+
+
+@njit(cache=True, nogil=True)
+def _quad_one(W, arc, c, lo, hi, tol, est):  # pragma: no cover (compiled)
+    """The least-squares quadratic x(s), y(s) over the window lo..hi, its position at c
+    into est[c] when it is well conditioned and every window point lies within ``tol`` of
+    it: whether it did."""
+    m0 = m1 = m2 = m3 = m4 = 0.0
+    rx0 = rx1 = rx2 = ry0 = ry1 = ry2 = 0.0
+    for j in range(lo, hi + 1):
+        t = arc[j] - arc[c]
+        px = W[j, 0] - W[c, 0]
+        py = W[j, 1] - W[c, 1]
+        t2 = t * t
+        t3 = t2 * t
+        m0 += 1.0
+        m1 += t
+        m2 += t2
+        m3 += t3
+        m4 += t3 * t
+        rx0 += px
+        rx1 += t * px
+        rx2 += t2 * px
+        ry0 += py
+        ry1 += t * py
+        ry2 += t2 * py
+    a00, a01, a02, a11, a12, a22 = m0, m1, m2, m2, m3, m4
+    c00 = a11 * a22 - a12 * a12
+    c01 = a02 * a12 - a01 * a22
+    c02 = a01 * a12 - a02 * a11
+    det = a00 * c00 + a01 * c01 + a02 * c02
+    big = max(abs(a00), abs(a01), abs(a02), abs(a11), abs(a12), abs(a22), 1.0)
+    if not abs(det) > 1e-12 * big * big * big:
+        return False
+    c11 = a00 * a22 - a02 * a02
+    c12 = a01 * a02 - a00 * a12
+    c22 = a00 * a11 - a01 * a01
+    cx0 = (c00 * rx0 + c01 * rx1 + c02 * rx2) / det
+    cx1 = (c01 * rx0 + c11 * rx1 + c12 * rx2) / det
+    cx2 = (c02 * rx0 + c12 * rx1 + c22 * rx2) / det
+    cy0 = (c00 * ry0 + c01 * ry1 + c02 * ry2) / det
+    cy1 = (c01 * ry0 + c11 * ry1 + c12 * ry2) / det
+    cy2 = (c02 * ry0 + c12 * ry1 + c22 * ry2) / det
+    if cx1 == 0.0 and cy1 == 0.0:
+        return False
+    worst = 0.0
+    for j in range(lo, hi + 1):
+        t = arc[j] - arc[c]
+        ex = cx0 + t * (cx1 + t * cx2) - (W[j, 0] - W[c, 0])
+        ey = cy0 + t * (cy1 + t * cy2) - (W[j, 1] - W[c, 1])
+        worst = max(worst, math.sqrt(ex * ex + ey * ey))
+    if worst > tol:
+        return False
+    est[c, 0] = W[c, 0] + cx0
+    est[c, 1] = W[c, 1] + cy0
+    return True
 
 
 def _stretch_targets(W, est, valid, f, e, q):

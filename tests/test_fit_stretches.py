@@ -56,3 +56,25 @@ def test_whole_unit_smooth_outlines_fit_within_0_6_of_the_design():
         to_fit = point_polyline_distance(design[::4], dense).max()
         assert max(to_design, to_fit) < 0.6, k
         assert fp.n_segments <= 60  # a handful of segments per turn, not a polyline
+
+
+def test_dense_rounded_input_costs_no_refit(monkeypatch):
+    """Input points much closer than the quantum (a finely sampled curve rounded to whole
+    units: runs of repeated points, steps of one unit): an estimate over 8 points on either
+    side spans about a quantum, the rounding's staircase; the pass re-fits nothing there
+    (its cost stays a small share of the fit's), and the fit keeps within the bound."""
+    calls = []
+    real = fitmod._Stretch.shapes
+
+    def counted(self, *a, **k):
+        calls.append(1)
+        return real(self, *a, **k)
+
+    monkeypatch.setattr(fitmod._Stretch, "shapes", counted)
+    rng = np.random.default_rng(3)
+    x = np.sort(rng.uniform(0.0, 600.0, 20_000))
+    y = 40.0 * np.sin(x / 30.0) + 12.0 * np.sin(x / 11.0 + 1.0)
+    w = np.round(np.c_[x, y])
+    fp = fit_paths([w], [False])[0]
+    assert not check_fit(w, fp, 0.02, 0.02, report=True)["violation"]
+    assert len(calls) == 0
