@@ -2377,6 +2377,104 @@ def _design_off(W, est, valid, ctrl, f, e, h, limit=math.inf):
     return d1, float(_polyline_distance_over(samp, poly, _STRETCH_EXACT * h).max())
 
 
+def _estimates_off(points, is_cubic, tail, gfirst, glast, sr, est, valid):
+    """Per segment of ``sr``: the largest distance of a smooth point's estimate (or of the
+    middle between two smooth neighbours' estimates) to it."""
+    n = glast[sr] - gfirst[sr] + 1
+    pid = np.repeat(np.arange(len(sr)), n)
+    idx = np.repeat(gfirst[sr], n) + np.arange(int(n.sum())) - np.repeat(np.cumsum(n) - n, n)
+    pair = np.flatnonzero(valid[idx[:-1]] & valid[idx[:-1] + 1] & (pid[1:] == pid[:-1]))
+    keep = valid[idx]
+    tp = np.concatenate([est[idx[keep]], 0.5 * (est[idx[pair]] + est[idx[pair] + 1])])
+    pid = np.concatenate([pid[keep], pid[pair]])
+    off = np.zeros(len(sr))
+    ln = ~is_cubic[sr[pid]]
+    if ln.any():
+        s = sr[pid[ln]]
+        d = point_segment_distance(tp[ln], points[tail[s] - 1], points[tail[s]])
+        np.maximum.at(off, pid[ln], d)
+    if (~ln).any():
+        cs = np.flatnonzero(is_cubic[sr])
+        ctrl = np.stack([points[tail[sr[cs]] - 1 + k] for k in range(4)], axis=1)
+        loc = np.full(len(sr), -1)
+        loc[cs] = np.arange(len(cs))
+        _, d = nearest_on_cubic_each(ctrl, loc[pid[~ln]], tp[~ln], seeds=12, iters=3)
+        np.maximum.at(off, pid[~ln], d)
+    return off
+
+
+@njit(cache=True, nogil=True)
+def _screen_segments(points, tail, is_cubic, gfirst, glast, sr, est, valid,
+                     out):  # pragma: no cover (compiled)
+    """out[i]: an upper bound of :func:`_estimates_off` for segment sr[i] (each target's
+    distance to the nearest of 17 samples of a cubic, then to the point Newton finds from
+    there; exact for a line)."""
+    sx = np.empty(17)
+    sy = np.empty(17)
+    for i in range(sr.shape[0]):
+        s = sr[i]
+        r = tail[s] - 1
+        cubic = is_cubic[s]
+        x0, y0 = points[r, 0], points[r, 1]
+        ax = ay = bx = by = cx = cy = vx = vy = den = 0.0
+        if cubic:
+            ax = -x0 + 3.0 * points[r + 1, 0] - 3.0 * points[r + 2, 0] + points[r + 3, 0]
+            ay = -y0 + 3.0 * points[r + 1, 1] - 3.0 * points[r + 2, 1] + points[r + 3, 1]
+            bx = 3.0 * x0 - 6.0 * points[r + 1, 0] + 3.0 * points[r + 2, 0]
+            by = 3.0 * y0 - 6.0 * points[r + 1, 1] + 3.0 * points[r + 2, 1]
+            cx = 3.0 * (points[r + 1, 0] - x0)
+            cy = 3.0 * (points[r + 1, 1] - y0)
+            for k in range(17):
+                u = k / 16.0
+                sx[k] = ((ax * u + bx) * u + cx) * u + x0
+                sy[k] = ((ay * u + by) * u + cy) * u + y0
+        else:
+            vx = points[r + 1, 0] - x0
+            vy = points[r + 1, 1] - y0
+            den = vx * vx + vy * vy
+        worst = 0.0
+        for g in range(gfirst[s], glast[s] + 1):
+            if not valid[g]:
+                continue
+            for half in range(2):
+                if half == 0:
+                    px, py = est[g, 0], est[g, 1]
+                elif g < glast[s] and valid[g + 1]:
+                    px = 0.5 * (est[g, 0] + est[g + 1, 0])
+                    py = 0.5 * (est[g, 1] + est[g + 1, 1])
+                else:
+                    continue
+                if not cubic:
+                    t = 0.0
+                    if den > 0.0:
+                        t = min(1.0, max(0.0, ((px - x0) * vx + (py - y0) * vy) / den))
+                    d2 = (x0 + t * vx - px) ** 2 + (y0 + t * vy - py) ** 2
+                else:
+                    kb = 0
+                    d2 = np.inf
+                    for k in range(17):
+                        e2 = (sx[k] - px) ** 2 + (sy[k] - py) ** 2
+                        if e2 < d2:
+                            d2 = e2
+                            kb = k
+                    u = kb / 16.0
+                    for _ in range(4):
+                        rx = ((ax * u + bx) * u + cx) * u + x0 - px
+                        ry = ((ay * u + by) * u + cy) * u + y0 - py
+                        d1x = (3.0 * ax * u + 2.0 * bx) * u + cx
+                        d1y = (3.0 * ay * u + 2.0 * by) * u + cy
+                        fp = (6.0 * ax * u + 2.0 * bx) * rx + (6.0 * ay * u + 2.0 * by) * ry \
+                            + d1x * d1x + d1y * d1y
+                        if not fp > 0.0:
+                            break
+                        u = min(1.0, max(0.0, u - (d1x * rx + d1y * ry) / fp))
+                    rx = ((ax * u + bx) * u + cx) * u + x0 - px
+                    ry = ((ay * u + by) * u + cy) * u + y0 - py
+                    d2 = min(d2, rx * rx + ry * ry)
+                worst = max(worst, d2)
+        out[i] = math.sqrt(worst)
+
+
 class _Stretch:
     """The state of :func:`_smooth_stretches` on one call: the input, the estimates, the
     bound and step per path."""
@@ -2487,26 +2585,15 @@ def _smooth_stretches(W, arc, points, is_cubic, tail, step, gfirst, glast, seg_o
     # per segment: the largest distance of a smooth point's estimate (or of the middle
     # between two smooth neighbours' estimates) to it
     sr = np.flatnonzero(rp)
-    n = glast[sr] - gfirst[sr] + 1
-    pid = np.repeat(np.arange(len(sr)), n)
-    idx = np.repeat(gfirst[sr], n) + np.arange(int(n.sum())) - np.repeat(np.cumsum(n) - n, n)
-    pair = np.flatnonzero(valid[idx[:-1]] & valid[idx[:-1] + 1] & (pid[1:] == pid[:-1]))
-    keep = valid[idx]
-    tp = np.concatenate([est[idx[keep]], 0.5 * (est[idx[pair]] + est[idx[pair] + 1])])
-    pid = np.concatenate([pid[keep], pid[pair]])
+    thr = _STRETCH_OFF * quant[seg_owner[sr]]
+    # screened first with a compiled upper bound (the nearest of 17 samples, then Newton),
+    # measured as below only where that reaches the threshold
+    ub = np.empty(len(sr))
+    _screen_segments(points, tail, is_cubic, gfirst, glast, sr, est, valid, ub)
     off = np.zeros(len(sr))
-    ln = ~is_cubic[sr[pid]]
-    if ln.any():
-        s = sr[pid[ln]]
-        d = point_segment_distance(tp[ln], points[tail[s] - 1], points[tail[s]])
-        np.maximum.at(off, pid[ln], d)
-    if (~ln).any():
-        cs = np.flatnonzero(is_cubic[sr])
-        ctrl = np.stack([points[tail[sr[cs]] - 1 + k] for k in range(4)], axis=1)
-        loc = np.full(len(sr), -1)
-        loc[cs] = np.arange(len(cs))
-        _, d = nearest_on_cubic_each(ctrl, loc[pid[~ln]], tp[~ln], seeds=12, iters=3)
-        np.maximum.at(off, pid[~ln], d)
+    cand = np.flatnonzero(ub >= thr)
+    if len(cand):
+        off[cand] = _estimates_off(points, is_cubic, tail, gfirst, glast, sr[cand], est, valid)
     bad = off >= _STRETCH_OFF * quant[seg_owner[sr]]
     st = _Stretch(W, est, valid, bound, quant,
                   _STRETCH_BUDGET + int((pe[paths] - ps[paths] + 1).sum()) // _STRETCH_PER)
