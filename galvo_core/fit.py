@@ -2090,8 +2090,41 @@ def _polyline_distance_over(samp, poly, lim, k=_NEAR_SEGMENTS):
         d[far] = wide
         far = far[wide > lim]
     if len(far):
-        d[far] = point_polyline_distance(samp[far], poly)
+        d[far] = _full_distance(samp[far], poly)
     return d
+
+
+def _full_distance(samp, poly):
+    """:func:`point_polyline_distance` of the samples to the polyline (n >= 2 points),
+    compiled (its arithmetic: the same numbers, without its (samples, segments) tables)."""
+    ab = poly[1:] - poly[:-1]
+    den = (ab * ab).sum(axis=1)
+    big = den > 1e-300
+    inv = np.where(big, 1.0 / np.where(big, den, 1.0), 0.0)
+    out = np.empty(len(samp))
+    _full_kernel(np.ascontiguousarray(samp, dtype=np.float64),
+                 np.ascontiguousarray(poly, dtype=np.float64), ab, inv, out)
+    return out
+
+
+@njit(cache=True, nogil=True)
+def _full_kernel(samp, poly, ab, inv, out):  # pragma: no cover (compiled)
+    for i in range(samp.shape[0]):
+        px = samp[i, 0]
+        py = samp[i, 1]
+        best = np.inf
+        for j in range(ab.shape[0]):
+            dx = px - poly[j, 0]
+            dy = py - poly[j, 1]
+            vx = ab[j, 0]
+            vy = ab[j, 1]
+            t = min(max((dx * vx + dy * vy) * inv[j], 0.0), 1.0)
+            ex = dx - t * vx
+            ey = dy - t * vy
+            d2 = ex * ex + ey * ey
+            if d2 < best:
+                best = d2
+        out[i] = math.sqrt(best)
 
 
 @njit(cache=True, nogil=True)
