@@ -2245,7 +2245,7 @@ def _quad_estimates(W, arc, ps, pe, quant, k, side, smooth, gap, span, est,
     within ``smooth`` quanta of the quadratic."""
     for p in range(ps.shape[0]):
         q = quant[p]
-        lim = gap * q
+        lim2 = (gap * q) ** 2
         reach = span * q
         for c in range(ps[p], pe[p] + 1):
             est[c, 0] = W[c, 0]
@@ -2257,11 +2257,11 @@ def _quad_estimates(W, arc, ps, pe, quant, k, side, smooth, gap, span, est,
             if arc[c] - arc[lo] < reach or arc[hi] - arc[c] < reach:
                 continue  # (the gaps below only shorten the window)
             j = c
-            while j > lo and math.hypot(W[j, 0] - W[j - 1, 0], W[j, 1] - W[j - 1, 1]) <= lim:
+            while j > lo and (W[j, 0] - W[j - 1, 0]) ** 2 + (W[j, 1] - W[j - 1, 1]) ** 2 <= lim2:
                 j -= 1
             lo = j
             j = c
-            while j < hi and math.hypot(W[j + 1, 0] - W[j, 0], W[j + 1, 1] - W[j, 1]) <= lim:
+            while j < hi and (W[j + 1, 0] - W[j, 0]) ** 2 + (W[j + 1, 1] - W[j, 1]) ** 2 <= lim2:
                 j += 1
             hi = j
             if c - lo < side or hi - c < side or arc[c] - arc[lo] < reach \
@@ -2314,14 +2314,13 @@ def _quad_one(W, arc, c, lo, hi, tol, est):  # pragma: no cover (compiled)
     cy2 = (c02 * ry0 + c12 * ry1 + c22 * ry2) / det
     if cx1 == 0.0 and cy1 == 0.0:
         return False
-    worst = 0.0
+    tol2 = tol * tol
     for j in range(lo, hi + 1):
         t = arc[j] - arc[c]
         ex = cx0 + t * (cx1 + t * cx2) - (W[j, 0] - W[c, 0])
         ey = cy0 + t * (cy1 + t * cy2) - (W[j, 1] - W[c, 1])
-        worst = max(worst, math.sqrt(ex * ex + ey * ey))
-    if worst > tol:
-        return False
+        if ex * ex + ey * ey > tol2:
+            return False
     est[c, 0] = W[c, 0] + cx0
     est[c, 1] = W[c, 1] + cy0
     return True
@@ -2437,11 +2436,12 @@ def _estimates_off(points, is_cubic, tail, gfirst, glast, sr, est, valid):
 
 
 @njit(cache=True, nogil=True)
-def _screen_segments(points, tail, is_cubic, gfirst, glast, sr, est, valid,
+def _screen_segments(points, tail, is_cubic, gfirst, glast, sr, est, valid, lim,
                      out):  # pragma: no cover (compiled)
-    """out[i]: an upper bound of :func:`_estimates_off` for segment sr[i] (each target's
-    distance to the nearest of 17 samples of a cubic, then to the point Newton finds from
-    there; exact for a line)."""
+    """out[i]: an upper bound of :func:`_estimates_off` for segment sr[i], exact for a
+    line; for a cubic, each target's distance to the point Newton finds from the previous
+    target's parameter when under lim[i], else to the nearest of 17 samples or the point
+    Newton finds from there (so out[i] >= lim[i] whenever the measure is)."""
     sx = np.empty(17)
     sy = np.empty(17)
     for i in range(sr.shape[0]):
@@ -2466,6 +2466,8 @@ def _screen_segments(points, tail, is_cubic, gfirst, glast, sr, est, valid,
             vy = points[r + 1, 1] - y0
             den = vx * vx + vy * vy
         worst = 0.0
+        lim2 = lim[i] * lim[i]
+        up = 0.0
         for g in range(gfirst[s], glast[s] + 1):
             if not valid[g]:
                 continue
@@ -2483,13 +2485,37 @@ def _screen_segments(points, tail, is_cubic, gfirst, glast, sr, est, valid,
                         t = min(1.0, max(0.0, ((px - x0) * vx + (py - y0) * vy) / den))
                     d2 = (x0 + t * vx - px) ** 2 + (y0 + t * vy - py) ** 2
                 else:
+                    # first Newton from the previous target's parameter: enough when it
+                    # finds a point nearer than ``lim`` (the bound is only compared to it)
+                    u = up
+                    for _ in range(3):
+                        rx = ((ax * u + bx) * u + cx) * u + x0 - px
+                        ry = ((ay * u + by) * u + cy) * u + y0 - py
+                        d1x = (3.0 * ax * u + 2.0 * bx) * u + cx
+                        d1y = (3.0 * ay * u + 2.0 * by) * u + cy
+                        fp = (6.0 * ax * u + 2.0 * bx) * rx + (6.0 * ay * u + 2.0 * by) * ry \
+                            + d1x * d1x + d1y * d1y
+                        if not fp > 0.0:
+                            break
+                        u = min(1.0, max(0.0, u - (d1x * rx + d1y * ry) / fp))
+                    rx = ((ax * u + bx) * u + cx) * u + x0 - px
+                    ry = ((ay * u + by) * u + cy) * u + y0 - py
+                    d2 = rx * rx + ry * ry
+                    if d2 < lim2:
+                        up = u
+                        worst = max(worst, d2)
+                        continue
+                    uw = u
                     kb = 0
-                    d2 = np.inf
+                    db = np.inf
                     for k in range(17):
                         e2 = (sx[k] - px) ** 2 + (sy[k] - py) ** 2
-                        if e2 < d2:
-                            d2 = e2
+                        if e2 < db:
+                            db = e2
                             kb = k
+                    if db < d2:
+                        d2 = db
+                        uw = kb / 16.0
                     u = kb / 16.0
                     for _ in range(4):
                         rx = ((ax * u + bx) * u + cx) * u + x0 - px
@@ -2503,7 +2529,10 @@ def _screen_segments(points, tail, is_cubic, gfirst, glast, sr, est, valid,
                         u = min(1.0, max(0.0, u - (d1x * rx + d1y * ry) / fp))
                     rx = ((ax * u + bx) * u + cx) * u + x0 - px
                     ry = ((ay * u + by) * u + cy) * u + y0 - py
-                    d2 = min(d2, rx * rx + ry * ry)
+                    up = uw
+                    if rx * rx + ry * ry < d2:
+                        d2 = rx * rx + ry * ry
+                        up = u
                 worst = max(worst, d2)
         out[i] = math.sqrt(worst)
 
@@ -2622,7 +2651,7 @@ def _smooth_stretches(W, arc, points, is_cubic, tail, step, gfirst, glast, seg_o
     # screened first with a compiled upper bound (the nearest of 17 samples, then Newton),
     # measured as below only where that reaches the threshold
     ub = np.empty(len(sr))
-    _screen_segments(points, tail, is_cubic, gfirst, glast, sr, est, valid, ub)
+    _screen_segments(points, tail, is_cubic, gfirst, glast, sr, est, valid, thr, ub)
     off = np.zeros(len(sr))
     cand = np.flatnonzero(ub >= thr)
     if len(cand):
