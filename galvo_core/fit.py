@@ -2210,6 +2210,8 @@ _STRETCH_CUBIC = 8
 #: ... a joint left on its input point this many quanta or more from its estimate is moved
 #: there with both of its segments re-fitted
 _STRETCH_JOINT = 0.3
+#: ... a corner's two one-sided estimates used only when they are this close (quanta)
+_STRETCH_CORNER_AGREE = 0.5
 #: ... at most this many re-fits per call, plus one per this many input points (the worst
 #: segments first, then the joints: the pass's time stays a fraction of the fit's)
 _STRETCH_BUDGET = 256
@@ -2267,15 +2269,17 @@ def _quad_estimates(W, arc, ps, pe, quant, k, side, smooth, gap, span, est,
             if c - lo < side or hi - c < side or arc[c] - arc[lo] < reach \
                     or arc[hi] - arc[c] < reach:
                 continue
-            if _quad_one(W, arc, c, lo, hi, smooth * q, est):
+            good, ex, ey = _quad_one(W, arc, c, lo, hi, smooth * q)
+            if good:
+                est[c, 0] = ex
+                est[c, 1] = ey
                 ok[c] = True
 
 
 @njit(cache=True, nogil=True)
-def _quad_one(W, arc, c, lo, hi, tol, est):  # pragma: no cover (compiled)
-    """The least-squares quadratic x(s), y(s) over the window lo..hi, its position at c
-    into est[c] when it is well conditioned and every window point lies within ``tol`` of
-    it: whether it did."""
+def _quad_one(W, arc, c, lo, hi, tol):  # pragma: no cover (compiled)
+    """The least-squares quadratic x(s), y(s) over the window lo..hi: (whether it is well
+    conditioned and every window point lies within ``tol`` of it, its position at c)."""
     m0 = m1 = m2 = m3 = m4 = 0.0
     rx0 = rx1 = rx2 = ry0 = ry1 = ry2 = 0.0
     for j in range(lo, hi + 1):
@@ -2302,7 +2306,7 @@ def _quad_one(W, arc, c, lo, hi, tol, est):  # pragma: no cover (compiled)
     det = a00 * c00 + a01 * c01 + a02 * c02
     big = max(abs(a00), abs(a01), abs(a02), abs(a11), abs(a12), abs(a22), 1.0)
     if not abs(det) > 1e-12 * big * big * big:
-        return False
+        return False, 0.0, 0.0
     c11 = a00 * a22 - a02 * a02
     c12 = a01 * a02 - a00 * a12
     c22 = a00 * a11 - a01 * a01
@@ -2313,17 +2317,53 @@ def _quad_one(W, arc, c, lo, hi, tol, est):  # pragma: no cover (compiled)
     cy1 = (c01 * ry0 + c11 * ry1 + c12 * ry2) / det
     cy2 = (c02 * ry0 + c12 * ry1 + c22 * ry2) / det
     if cx1 == 0.0 and cy1 == 0.0:
-        return False
+        return False, 0.0, 0.0
     tol2 = tol * tol
     for j in range(lo, hi + 1):
         t = arc[j] - arc[c]
         ex = cx0 + t * (cx1 + t * cx2) - (W[j, 0] - W[c, 0])
         ey = cy0 + t * (cy1 + t * cy2) - (W[j, 1] - W[c, 1])
         if ex * ex + ey * ey > tol2:
-            return False
-    est[c, 0] = W[c, 0] + cx0
-    est[c, 1] = W[c, 1] + cy0
-    return True
+            return False, 0.0, 0.0
+    return True, W[c, 0] + cx0, W[c, 1] + cy0
+
+
+@njit(cache=True, nogil=True)
+def _side_estimates(W, arc, g, ps, pe, quant, k, side, smooth, gap, span,
+                    out):  # pragma: no cover (compiled)
+    """Per joint g[i] (input point, path ps[i]..pe[i], quantum quant[i]): the least-squares
+    quadratics over up to ``k`` points before it (out[i, 0]) and after it (out[i, 1]), the
+    joint included, each evaluated at the joint: (x, y, 1.0) where the window has at least
+    ``side`` points besides the joint, reaches ``span`` quanta of arc, has no step over
+    ``gap`` quanta and every point within ``smooth`` quanta of its quadratic, else
+    (0, 0, 0)."""
+    for i in range(g.shape[0]):
+        c = g[i]
+        q = quant[i]
+        lim2 = (gap * q) ** 2
+        for sd in range(2):
+            out[i, sd, 0] = 0.0
+            out[i, sd, 1] = 0.0
+            out[i, sd, 2] = 0.0
+            if sd == 0:
+                j = c
+                while j > max(ps[i], c - k) and (W[j, 0] - W[j - 1, 0]) ** 2 \
+                        + (W[j, 1] - W[j - 1, 1]) ** 2 <= lim2:
+                    j -= 1
+                lo, hi = j, c
+            else:
+                j = c
+                while j < min(pe[i], c + k) and (W[j + 1, 0] - W[j, 0]) ** 2 \
+                        + (W[j + 1, 1] - W[j, 1]) ** 2 <= lim2:
+                    j += 1
+                lo, hi = c, j
+            if hi - lo < side or arc[hi] - arc[lo] < span * q:
+                continue
+            good, ex, ey = _quad_one(W, arc, c, lo, hi, smooth * q)
+            if good:
+                out[i, sd, 0] = ex
+                out[i, sd, 1] = ey
+                out[i, sd, 2] = 1.0
 
 
 def _stretch_targets(W, est, valid, f, e, q):
@@ -2769,6 +2809,55 @@ def _smooth_stretches(W, arc, points, is_cubic, tail, step, gfirst, glast, seg_o
         rep[a] = [(ra[1], fa, ea)]
         rep[b] = [(rb[1], fb, eb)]
         done[a] = done[b] = True
+    # the joints still on their input point where no estimate holds (a corner, the end of
+    # a smooth stretch): moved onto the one-sided estimates of the smooth stretches that
+    # end there (their mean where both sides have one and they agree within
+    # ``_STRETCH_CORNER_AGREE`` quanta), inside the rounding square, where both segments
+    # then fit and the one that has estimates gets no farther from them
+    jb = np.flatnonzero((seg_owner[1:] == seg_owner[:-1]) & rp[1:]) + 1
+    jb = jb[(glast[jb] > gfirst[jb]) & (glast[jb - 1] > gfirst[jb - 1])]
+    g = gfirst[jb]
+    jb = jb[~valid[g] & (points[tail[jb] - 1] == W[g]).all(axis=1) & ~done[jb] & ~done[jb - 1]]
+    if len(jb) and st.budget > 0:
+        g = gfirst[jb]
+        own = seg_owner[jb]
+        q1 = quant[own]
+        pfirst = gfirst[np.searchsorted(seg_owner, own)]
+        plast = glast[np.searchsorted(seg_owner, own, side="right") - 1]
+        side = np.zeros((len(jb), 2, 3))
+        _side_estimates(W, arc, g, pfirst, plast, q1, _JOINT_SIDE, _STRETCH_SIDE,
+                        _JOINT_SMOOTH, _STRETCH_GAP, _STRETCH_SPAN, side)
+        has = side[:, :, 2] > 0.0
+        both = has.all(axis=1)
+        agree = np.hypot(*(side[:, 0, :2] - side[:, 1, :2]).T) <= _STRETCH_CORNER_AGREE * q1
+        use = has.any(axis=1) & (~both | agree)
+        n = np.maximum(has.sum(axis=1), 1)
+        vc = (side[:, :, :2] * has[:, :, None]).sum(axis=1) / n[:, None]
+        qc = q1[:, None]
+        vc = np.clip(vc, W[g] - 0.5 * qc, W[g] + 0.5 * qc)
+        use &= np.hypot(*(vc - W[g]).T) >= _STRETCH_JOINT * q1
+        for b, v in zip(jb[use].tolist(), vc[use], strict=True):
+            a = b - 1
+            if st.budget <= 0:
+                break
+            if done[a] or done[b]:
+                continue
+            o = int(seg_owner[b])
+            q = float(quant[o])
+            ca = _seg_ctrl(points, is_cubic, tail, a)
+            cb = _seg_ctrl(points, is_cubic, tail, b)
+            fa, ea, fb, eb = int(gfirst[a]), int(glast[a]), int(gfirst[b]), int(glast[b])
+            oa = _design_off(W, est, valid, ca, fa, ea, _STRETCH_LOOK * q)
+            ob = _design_off(W, est, valid, cb, fb, eb, _STRETCH_LOOK * q)
+            ra = st.shapes(ca[0], v, fa, ea, o, oa[0], not is_cubic[a], ca)
+            if ra is None:
+                continue
+            rb = st.shapes(v, cb[-1], fb, eb, o, ob[0], not is_cubic[b], cb)
+            if rb is None:
+                continue
+            rep[a] = [(ra[1], fa, ea)]
+            rep[b] = [(rb[1], fb, eb)]
+            done[a] = done[b] = True
     if not rep:
         return unchanged
     return _rebuilt(points, is_cubic, tail, step, gfirst, glast, seg_owner, changed, rep)
