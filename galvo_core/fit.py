@@ -2331,11 +2331,17 @@ def _fit_concatenated(
         bound = np.minimum(e_per, rounding[:, 0])
         changed = _joints_on_the_design(W, arc, points, is_cubic, tail, step, gf, gl,
                                         seg_owner, move_q, bound)
+        is_cubic, points, tail, step, gf, gl, seg_owner, changed = _smooth_stretches(
+            W, arc, points, is_cubic, tail, step, gf, gl, seg_owner, move_q, bound, changed)
         if changed.any():
             worst = _changed_errors(W, points, is_cubic, tail, gf, gl, seg_owner, changed,
                                     worst)
-        worst = _moved_ends_error(W, points, is_cubic, tail, step, first + o_w[seg_owner],
-                                  last + o_w[seg_owner], seg_owner, worst)
+        worst = _moved_ends_error(W, points, is_cubic, tail, step, gf, gl, seg_owner, worst)
+        first = gf - o_w[seg_owner]
+        last = gl - o_w[seg_owner]
+        seg_cut = np.searchsorted(seg_owner, np.arange(len(todo) + 1))
+        pt_cut = np.r_[0, np.cumsum(np.bincount(seg_owner, weights=step, minlength=len(todo))
+                                    .astype(np.int64) + 1)]
     for x in (is_cubic, points, first, last):
         x.setflags(write=False)
     return is_cubic, points, first, last, seg_cut.tolist(), pt_cut.tolist(), worst.tolist()
@@ -2389,17 +2395,17 @@ _JOINT_SHARES = (1.0, 2.0 / 3.0, 1.0 / 3.0)
 _JOINT_STEP = 0.05
 
 
-def _joint_estimates(W, arc, g, ps, pe, k):
+def _joint_estimates(W, arc, g, ps, pe, k, side=4):
     """Least-squares quadratics x(s), y(s) in arc length over the input points g - k ..
     g + k (clipped to ps..pe, global indices) of each joint ``g``: (position at g (V, 2),
     unit tangent (V, 2), the largest distance of a window point to its quadratic (V,),
-    ok (V,): at least 4 points on each side and a well-conditioned fit)."""
+    ok (V,): at least ``side`` points on each side and a well-conditioned fit)."""
     off = np.arange(-k, k + 1)
     idx = g[:, None] + off[None, :]
     m = (idx >= ps[:, None]) & (idx <= pe[:, None])
     idx = np.clip(idx, ps[:, None], pe[:, None])
     s = (arc[idx] - arc[g][:, None]) * m
-    ok = (m[:, :k].sum(axis=1) >= 4) & (m[:, k + 1:].sum(axis=1) >= 4)
+    ok = (m[:, :k].sum(axis=1) >= side) & (m[:, k + 1:].sum(axis=1) >= side)
     wm = m.astype(np.float64)
     V = np.stack([wm, s * wm, s * s * wm], axis=2)  # (V, 2k+1, 3)
     A = np.einsum("vni,vnj->vij", V, V)
@@ -2500,7 +2506,98 @@ def _seg_fits(W, ctrl, first, last, bound, h) -> bool:
         samp = cubic_eval(ctrl, np.linspace(0.0, 1.0, m))
     if d.max() > bound:
         return False
-    return bool(point_polyline_distance(samp, loc).max() <= bound - 0.5 * h)
+    return bool(_polyline_distance_over(samp, loc, bound - 0.5 * h).max() <= bound - 0.5 * h)
+
+
+#: samples in order along a polyline are measured first against this many of its segments
+#: on either side of their share of its length
+_NEAR_SEGMENTS = 8
+
+
+def _polyline_distance_over(samp, poly, lim, k=_NEAR_SEGMENTS):
+    """The distance of each of the samples ``samp`` (in order along ``poly``) to the
+    polyline where it is over ``lim``, else a distance within ``lim`` (each sample measured
+    against the segments near its share of the length, those over ``lim`` against all)."""
+    n = len(poly)
+    if n <= 2 * k + 2:
+        return point_polyline_distance(samp, poly)
+    cum = np.r_[0.0, np.cumsum(np.hypot(*np.diff(poly, axis=0).T))]
+    cs = np.r_[0.0, np.cumsum(np.hypot(*np.diff(samp, axis=0).T))]
+    at = np.searchsorted(cum, cs * (cum[-1] / cs[-1]) if cs[-1] > 0.0 else cs) - 1
+    d = np.empty(len(samp))
+    _window_distance(samp, poly, at, k, d)
+    far = np.flatnonzero(d > lim)
+    if len(far) and n > 16 * k + 2:  # a wider window first
+        wide = np.empty(len(far))
+        _window_distance(samp[far], poly, at[far], 16 * k, wide)
+        d[far] = wide
+        far = far[wide > lim]
+    if len(far):
+        d[far] = _full_distance(samp[far], poly)
+    return d
+
+
+def _full_distance(samp, poly):
+    """:func:`point_polyline_distance` of the samples to the polyline (n >= 2 points),
+    compiled (its arithmetic: the same numbers, without its (samples, segments) tables)."""
+    ab = poly[1:] - poly[:-1]
+    den = (ab * ab).sum(axis=1)
+    big = den > 1e-300
+    inv = np.where(big, 1.0 / np.where(big, den, 1.0), 0.0)
+    out = np.empty(len(samp))
+    _full_kernel(np.ascontiguousarray(samp, dtype=np.float64),
+                 np.ascontiguousarray(poly, dtype=np.float64), ab, inv, out)
+    return out
+
+
+@njit(cache=True, nogil=True)
+def _full_kernel(samp, poly, ab, inv, out):  # pragma: no cover (compiled)
+    for i in range(samp.shape[0]):
+        px = samp[i, 0]
+        py = samp[i, 1]
+        best = np.inf
+        for j in range(ab.shape[0]):
+            dx = px - poly[j, 0]
+            dy = py - poly[j, 1]
+            vx = ab[j, 0]
+            vy = ab[j, 1]
+            t = min(max((dx * vx + dy * vy) * inv[j], 0.0), 1.0)
+            ex = dx - t * vx
+            ey = dy - t * vy
+            d2 = ex * ex + ey * ey
+            if d2 < best:
+                best = d2
+        out[i] = math.sqrt(best)
+
+
+@njit(cache=True, nogil=True)
+def _window_distance(samp, poly, at, k, out):  # pragma: no cover (compiled)
+    """out[i]: the distance of samp[i] to the segments at[i] - k .. at[i] + k of the
+    polyline ``poly`` (clipped to it)."""
+    ns = poly.shape[0] - 1
+    for i in range(samp.shape[0]):
+        px = samp[i, 0]
+        py = samp[i, 1]
+        lo = max(0, min(at[i] - k, ns - 1))
+        hi = min(ns - 1, max(at[i] + k, 0))
+        best = np.inf
+        for j in range(lo, hi + 1):
+            ax = poly[j, 0]
+            ay = poly[j, 1]
+            vx = poly[j + 1, 0] - ax
+            vy = poly[j + 1, 1] - ay
+            dx = px - ax
+            dy = py - ay
+            den = vx * vx + vy * vy
+            t = 0.0
+            if den > 0.0:
+                t = min(1.0, max(0.0, (dx * vx + dy * vy) / den))
+            ex = dx - t * vx
+            ey = dy - t * vy
+            d2 = ex * ex + ey * ey
+            if d2 < best:
+                best = d2
+        out[i] = math.sqrt(best)
 
 
 def _try_joint(W, points, is_cubic, tail, step, gfirst, glast, j, v, bound, q, changed):
@@ -2524,6 +2621,725 @@ def _try_joint(W, points, is_cubic, tail, step, gfirst, glast, j, v, bound, q, c
             points[tail[b] - 1:tail[b] - 1 + len(cb)] = cb
             changed[a] = changed[b] = True
             return
+
+
+#: rounded input, after the joints: a segment is repaired where the design estimate (the
+#: joints' least-squares quadratic) of one of its input points lies this many quanta or more
+#: from it (inside a smooth stretch: the estimates are about 0.1-0.2 quanta from the design)
+_STRETCH_OFF = 0.45
+#: ... a repair kept only when it brings that distance down by this many quanta
+_STRETCH_GAIN = 0.05
+#: ... the least-squares cubic of a repair follows its input polyline sampled at most this
+#: far apart (units of q), with this many re-parametrisations
+_STRETCH_STEP = 1.0
+_STRETCH_ITERS = 4
+_STRETCH_TARGETS = 128
+#: ... the estimates' windows end at a gap between input points longer than this (units of
+#: q: a design line between two rounded points)
+_STRETCH_GAP = 8.0
+#: ... a segment split in two (one more segment) only when no repair keeps the count, at
+#: most this share of the rounded paths' segments (and one)
+_STRETCH_SPLITS = 0.02
+#: ... at input points at least this many points from either end of the segment
+_STRETCH_PIECE = 4
+#: ... an estimate holds with this many input points on either side of it in its window
+_STRETCH_SIDE = 4
+#: ... and with its window reaching this many quanta of arc length on either side (over
+#: fewer the rounding's staircase can move a quadratic half a quantum: input points much
+#: closer than the quantum, where the fit's least squares average the rounding anyway)
+_STRETCH_SPAN = 3.0
+#: ... a least-squares cubic is fitted over at least this many input points
+_STRETCH_CUBIC = 8
+#: ... a joint left on its input point this many quanta or more from its estimate is moved
+#: there with both of its segments re-fitted
+_STRETCH_JOINT = 0.3
+#: ... a corner's two one-sided estimates used only when they are this close (quanta)
+_STRETCH_CORNER_AGREE = 0.5
+#: ... at most this many re-fits per call, plus one per this many input points (the worst
+#: segments first, then the joints: the pass's time stays a fraction of the fit's)
+_STRETCH_BUDGET = 256
+_STRETCH_PER = 20_000
+#: ... the distance of a segment to the estimates' polyline sampled this far apart (q)
+_STRETCH_LOOK = 0.25
+#: ... distances over this many samples' spacings measured exactly (below: an upper bound)
+_STRETCH_EXACT = 1.2
+
+
+def _stretch_estimates(W, arc, ps, pe, quant):
+    """Per input point (global index) of the rounded paths ps..pe (quantum ``quant`` each):
+    the design estimate of :func:`_joint_estimates` (compiled) and whether it holds (a smooth
+    stretch: enough points on both sides, the window's points within ``_JOINT_SMOOTH``
+    quanta of it, the window reaching ``_STRETCH_SPAN`` quanta of arc length on either
+    side). The windows stop at gaps longer than ``_STRETCH_GAP`` quanta."""
+    est = np.zeros_like(W)
+    valid = np.zeros(len(W), dtype=np.bool_)
+    if len(ps):
+        _quad_estimates(W, arc, np.asarray(ps, dtype=np.int64), np.asarray(pe, dtype=np.int64),
+                        np.asarray(quant, dtype=np.float64), _JOINT_SIDE, _STRETCH_SIDE,
+                        _JOINT_SMOOTH, _STRETCH_GAP, _STRETCH_SPAN, est, valid)
+    return est, valid
+
+
+@njit(cache=True, nogil=True)
+def _quad_estimates(W, arc, ps, pe, quant, k, side, smooth, gap, span, est,
+                    ok):  # pragma: no cover (compiled)
+    """:func:`_joint_estimates` compiled, per input point c of each path ps..pe over the
+    window of up to ``k`` points on either side (ending at a step over ``gap`` quanta):
+    est[c] the quadratic's position at c, ok[c] at least ``side`` points and ``span``
+    quanta of arc length on either side, a well-conditioned fit and every window point
+    within ``smooth`` quanta of the quadratic."""
+    for p in range(ps.shape[0]):
+        q = quant[p]
+        lim2 = (gap * q) ** 2
+        reach = span * q
+        for c in range(ps[p], pe[p] + 1):
+            est[c, 0] = W[c, 0]
+            est[c, 1] = W[c, 1]
+            if c - ps[p] < side or pe[p] - c < side:
+                continue
+            lo = max(ps[p], c - k)
+            hi = min(pe[p], c + k)
+            if arc[c] - arc[lo] < reach or arc[hi] - arc[c] < reach:
+                continue  # (the gaps below only shorten the window)
+            j = c
+            while j > lo and (W[j, 0] - W[j - 1, 0]) ** 2 + (W[j, 1] - W[j - 1, 1]) ** 2 <= lim2:
+                j -= 1
+            lo = j
+            j = c
+            while j < hi and (W[j + 1, 0] - W[j, 0]) ** 2 + (W[j + 1, 1] - W[j, 1]) ** 2 <= lim2:
+                j += 1
+            hi = j
+            if c - lo < side or hi - c < side or arc[c] - arc[lo] < reach \
+                    or arc[hi] - arc[c] < reach:
+                continue
+            good, ex, ey = _quad_one(W, arc, c, lo, hi, smooth * q)
+            if good:
+                est[c, 0] = ex
+                est[c, 1] = ey
+                ok[c] = True
+
+
+@njit(cache=True, nogil=True)
+def _quad_one(W, arc, c, lo, hi, tol):  # pragma: no cover (compiled)
+    """The least-squares quadratic x(s), y(s) over the window lo..hi: (whether it is well
+    conditioned and every window point lies within ``tol`` of it, its position at c)."""
+    m0 = m1 = m2 = m3 = m4 = 0.0
+    rx0 = rx1 = rx2 = ry0 = ry1 = ry2 = 0.0
+    for j in range(lo, hi + 1):
+        t = arc[j] - arc[c]
+        px = W[j, 0] - W[c, 0]
+        py = W[j, 1] - W[c, 1]
+        t2 = t * t
+        t3 = t2 * t
+        m0 += 1.0
+        m1 += t
+        m2 += t2
+        m3 += t3
+        m4 += t3 * t
+        rx0 += px
+        rx1 += t * px
+        rx2 += t2 * px
+        ry0 += py
+        ry1 += t * py
+        ry2 += t2 * py
+    a00, a01, a02, a11, a12, a22 = m0, m1, m2, m2, m3, m4
+    c00 = a11 * a22 - a12 * a12
+    c01 = a02 * a12 - a01 * a22
+    c02 = a01 * a12 - a02 * a11
+    det = a00 * c00 + a01 * c01 + a02 * c02
+    big = max(abs(a00), abs(a01), abs(a02), abs(a11), abs(a12), abs(a22), 1.0)
+    if not abs(det) > 1e-12 * big * big * big:
+        return False, 0.0, 0.0
+    c11 = a00 * a22 - a02 * a02
+    c12 = a01 * a02 - a00 * a12
+    c22 = a00 * a11 - a01 * a01
+    cx0 = (c00 * rx0 + c01 * rx1 + c02 * rx2) / det
+    cx1 = (c01 * rx0 + c11 * rx1 + c12 * rx2) / det
+    cx2 = (c02 * rx0 + c12 * rx1 + c22 * rx2) / det
+    cy0 = (c00 * ry0 + c01 * ry1 + c02 * ry2) / det
+    cy1 = (c01 * ry0 + c11 * ry1 + c12 * ry2) / det
+    cy2 = (c02 * ry0 + c12 * ry1 + c22 * ry2) / det
+    if cx1 == 0.0 and cy1 == 0.0:
+        return False, 0.0, 0.0
+    tol2 = tol * tol
+    for j in range(lo, hi + 1):
+        t = arc[j] - arc[c]
+        ex = cx0 + t * (cx1 + t * cx2) - (W[j, 0] - W[c, 0])
+        ey = cy0 + t * (cy1 + t * cy2) - (W[j, 1] - W[c, 1])
+        if ex * ex + ey * ey > tol2:
+            return False, 0.0, 0.0
+    return True, W[c, 0] + cx0, W[c, 1] + cy0
+
+
+@njit(cache=True, nogil=True)
+def _side_estimates(W, arc, g, ps, pe, quant, k, side, smooth, gap, span,
+                    out):  # pragma: no cover (compiled)
+    """Per joint g[i] (input point, path ps[i]..pe[i], quantum quant[i]): the least-squares
+    quadratics over up to ``k`` points before it (out[i, 0]) and after it (out[i, 1]), the
+    joint included, each evaluated at the joint: (x, y, 1.0) where the window has at least
+    ``side`` points besides the joint, reaches ``span`` quanta of arc, has no step over
+    ``gap`` quanta and every point within ``smooth`` quanta of its quadratic, else
+    (0, 0, 0)."""
+    for i in range(g.shape[0]):
+        c = g[i]
+        q = quant[i]
+        lim2 = (gap * q) ** 2
+        for sd in range(2):
+            out[i, sd, 0] = 0.0
+            out[i, sd, 1] = 0.0
+            out[i, sd, 2] = 0.0
+            if sd == 0:
+                j = c
+                while j > max(ps[i], c - k) and (W[j, 0] - W[j - 1, 0]) ** 2 \
+                        + (W[j, 1] - W[j - 1, 1]) ** 2 <= lim2:
+                    j -= 1
+                lo, hi = j, c
+            else:
+                j = c
+                while j < min(pe[i], c + k) and (W[j + 1, 0] - W[j, 0]) ** 2 \
+                        + (W[j + 1, 1] - W[j, 1]) ** 2 <= lim2:
+                    j += 1
+                lo, hi = c, j
+            if hi - lo < side or arc[hi] - arc[lo] < span * q:
+                continue
+            good, ex, ey = _quad_one(W, arc, c, lo, hi, smooth * q)
+            if good:
+                out[i, sd, 0] = ex
+                out[i, sd, 1] = ey
+                out[i, sd, 2] = 1.0
+
+
+def _stretch_targets(W, est, valid, f, e, q):
+    """The design polyline of the input points f..e: each smooth point's estimate (else the
+    point), the long gaps filled every ``_STRETCH_STEP`` quanta (at most
+    ``_STRETCH_TARGETS`` points, evenly taken)."""
+    d = np.where(valid[f:e + 1, None], est[f:e + 1], W[f:e + 1])
+    if len(d) < 2:
+        return d
+    gap = np.hypot(*np.diff(d, axis=0).T)
+    n = np.maximum(np.ceil(gap / (_STRETCH_STEP * q)).astype(np.intp), 1)
+    seg = np.repeat(np.arange(len(gap)), n)
+    frac = (np.arange(int(n.sum())) - np.repeat(np.cumsum(n) - n, n)) / np.repeat(n, n)
+    pts = np.vstack([d[seg] + frac[:, None] * (d[seg + 1] - d[seg]), d[-1:]])
+    if len(pts) > _STRETCH_TARGETS:  # evenly thinned out
+        pts = pts[np.linspace(0, len(pts) - 1, _STRETCH_TARGETS).round().astype(np.intp)]
+    return pts
+
+
+def _ls_cubic(p0, p3, tg):
+    """The cubic from p0 to p3 whose inner control points fit the targets ``tg`` best
+    (least squares, parameters re-fitted by Newton steps towards the nearest points); None
+    when degenerate."""
+    c = np.hypot(*np.diff(tg, axis=0).T)
+    tot = c.sum()
+    if len(tg) < 4 or tot <= 0.0:
+        return None
+    t = np.r_[0.0, np.cumsum(c)] / tot
+    ctrl = None
+    for it in range(_STRETCH_ITERS + 1):
+        s = 1.0 - t
+        if ctrl is not None:  # a Newton step of each target's parameter
+            d1 = 3.0 * ((s * s)[:, None] * (ctrl[1] - ctrl[0])
+                        + (2.0 * s * t)[:, None] * (ctrl[2] - ctrl[1])
+                        + (t * t)[:, None] * (ctrl[3] - ctrl[2]))
+            d2 = 6.0 * (s[:, None] * (ctrl[2] - 2.0 * ctrl[1] + ctrl[0])
+                        + t[:, None] * (ctrl[3] - 2.0 * ctrl[2] + ctrl[1]))
+            r = cubic_eval(ctrl, t) - tg
+            den = (d1 * d1).sum(axis=1) + (r * d2).sum(axis=1)
+            dt = np.where(den > 0.0, (r * d1).sum(axis=1) / np.where(den > 0.0, den, 1.0),
+                          0.0)
+            t = np.clip(t - dt, 0.0, 1.0)
+            s = 1.0 - t
+            if it == _STRETCH_ITERS:
+                return ctrl
+        b1 = 3.0 * s * s * t
+        b2 = 3.0 * s * t * t
+        r = tg - (s ** 3)[:, None] * p0 - (t ** 3)[:, None] * p3
+        a11, a12, a22 = b1 @ b1, b1 @ b2, b2 @ b2
+        det = a11 * a22 - a12 * a12
+        if not det > 1e-12 * max(a11 * a22, 1e-300):
+            return ctrl
+        r1, r2 = b1 @ r, b2 @ r
+        ctrl = np.stack([p0, (a22 * r1 - a12 * r2) / det, (a11 * r2 - a12 * r1) / det, p3])
+    return ctrl
+
+
+def _design_off(W, est, valid, ctrl, f, e, h, limit=math.inf):
+    """How far the segment ``ctrl`` lies from the design estimates of its input points
+    f..e: (d1, d2), d1 the largest distance of a smooth point's estimate (or of the middle
+    between two smooth neighbours' estimates) to it, d2 the largest distance of its samples
+    (at most h apart) to the polyline of the estimates (else the points); None when d1 is
+    over ``limit``. Both measured against polylines (the samples, the estimates), exactly
+    where over ``_STRETCH_EXACT`` h."""
+    if len(ctrl) == 2:
+        length = float(np.hypot(*(ctrl[1] - ctrl[0])))
+        m = max(2, math.ceil(length / h) + 1)
+        samp = ctrl[0] + np.linspace(0.0, 1.0, m)[:, None] * (ctrl[1] - ctrl[0])
+    else:
+        length = float(np.hypot(*np.diff(ctrl, axis=0).T).sum())
+        m = max(16, math.ceil(length / h) + 1)
+        samp = cubic_eval(ctrl, np.linspace(0.0, 1.0, m))
+    v = np.flatnonzero(valid[f:e + 1]) + f
+    d1 = 0.0
+    if len(v):
+        v2 = v[:-1][np.diff(v) == 1]
+        key = np.concatenate([2 * v, 2 * v2 + 1])
+        tp = np.concatenate([est[v], 0.5 * (est[v2] + est[v2 + 1])])[np.argsort(key)]
+        d1 = float(_polyline_distance_over(tp, samp, _STRETCH_EXACT * h, 64).max())
+    if d1 > limit:
+        return None
+    poly = np.where(valid[f:e + 1, None], est[f:e + 1], W[f:e + 1])
+    return d1, float(_polyline_distance_over(samp, poly, _STRETCH_EXACT * h).max())
+
+
+def _estimates_off(points, is_cubic, tail, gfirst, glast, sr, est, valid):
+    """Per segment of ``sr``: the largest distance of a smooth point's estimate (or of the
+    middle between two smooth neighbours' estimates) to it."""
+    n = glast[sr] - gfirst[sr] + 1
+    pid = np.repeat(np.arange(len(sr)), n)
+    idx = np.repeat(gfirst[sr], n) + np.arange(int(n.sum())) - np.repeat(np.cumsum(n) - n, n)
+    pair = np.flatnonzero(valid[idx[:-1]] & valid[idx[:-1] + 1] & (pid[1:] == pid[:-1]))
+    keep = valid[idx]
+    tp = np.concatenate([est[idx[keep]], 0.5 * (est[idx[pair]] + est[idx[pair] + 1])])
+    pid = np.concatenate([pid[keep], pid[pair]])
+    off = np.zeros(len(sr))
+    ln = ~is_cubic[sr[pid]]
+    if ln.any():
+        s = sr[pid[ln]]
+        d = point_segment_distance(tp[ln], points[tail[s] - 1], points[tail[s]])
+        np.maximum.at(off, pid[ln], d)
+    if (~ln).any():
+        cs = np.flatnonzero(is_cubic[sr])
+        ctrl = np.stack([points[tail[sr[cs]] - 1 + k] for k in range(4)], axis=1)
+        loc = np.full(len(sr), -1)
+        loc[cs] = np.arange(len(cs))
+        _, d = nearest_on_cubic_each(ctrl, loc[pid[~ln]], tp[~ln], seeds=12, iters=3)
+        np.maximum.at(off, pid[~ln], d)
+    return off
+
+
+@njit(cache=True, nogil=True)
+def _screen_segments(points, tail, is_cubic, gfirst, glast, sr, est, valid, lim,
+                     out):  # pragma: no cover (compiled)
+    """out[i]: an upper bound of :func:`_estimates_off` for segment sr[i], exact for a
+    line; for a cubic, each target's distance to the point Newton finds from the previous
+    target's parameter when under lim[i], else to the nearest of 17 samples or the point
+    Newton finds from there (so out[i] >= lim[i] whenever the measure is)."""
+    sx = np.empty(17)
+    sy = np.empty(17)
+    for i in range(sr.shape[0]):
+        s = sr[i]
+        r = tail[s] - 1
+        cubic = is_cubic[s]
+        x0, y0 = points[r, 0], points[r, 1]
+        ax = ay = bx = by = cx = cy = vx = vy = den = 0.0
+        if cubic:
+            ax = -x0 + 3.0 * points[r + 1, 0] - 3.0 * points[r + 2, 0] + points[r + 3, 0]
+            ay = -y0 + 3.0 * points[r + 1, 1] - 3.0 * points[r + 2, 1] + points[r + 3, 1]
+            bx = 3.0 * x0 - 6.0 * points[r + 1, 0] + 3.0 * points[r + 2, 0]
+            by = 3.0 * y0 - 6.0 * points[r + 1, 1] + 3.0 * points[r + 2, 1]
+            cx = 3.0 * (points[r + 1, 0] - x0)
+            cy = 3.0 * (points[r + 1, 1] - y0)
+            for k in range(17):
+                u = k / 16.0
+                sx[k] = ((ax * u + bx) * u + cx) * u + x0
+                sy[k] = ((ay * u + by) * u + cy) * u + y0
+        else:
+            vx = points[r + 1, 0] - x0
+            vy = points[r + 1, 1] - y0
+            den = vx * vx + vy * vy
+        worst = 0.0
+        lim2 = lim[i] * lim[i]
+        up = 0.0
+        for g in range(gfirst[s], glast[s] + 1):
+            if not valid[g]:
+                continue
+            for half in range(2):
+                if half == 0:
+                    px, py = est[g, 0], est[g, 1]
+                elif g < glast[s] and valid[g + 1]:
+                    px = 0.5 * (est[g, 0] + est[g + 1, 0])
+                    py = 0.5 * (est[g, 1] + est[g + 1, 1])
+                else:
+                    continue
+                if not cubic:
+                    t = 0.0
+                    if den > 0.0:
+                        t = min(1.0, max(0.0, ((px - x0) * vx + (py - y0) * vy) / den))
+                    d2 = (x0 + t * vx - px) ** 2 + (y0 + t * vy - py) ** 2
+                else:
+                    # first Newton from the previous target's parameter: enough when it
+                    # finds a point nearer than ``lim`` (the bound is only compared to it)
+                    u = up
+                    for _ in range(3):
+                        rx = ((ax * u + bx) * u + cx) * u + x0 - px
+                        ry = ((ay * u + by) * u + cy) * u + y0 - py
+                        d1x = (3.0 * ax * u + 2.0 * bx) * u + cx
+                        d1y = (3.0 * ay * u + 2.0 * by) * u + cy
+                        fp = (6.0 * ax * u + 2.0 * bx) * rx + (6.0 * ay * u + 2.0 * by) * ry \
+                            + d1x * d1x + d1y * d1y
+                        if not fp > 0.0:
+                            break
+                        u = min(1.0, max(0.0, u - (d1x * rx + d1y * ry) / fp))
+                    rx = ((ax * u + bx) * u + cx) * u + x0 - px
+                    ry = ((ay * u + by) * u + cy) * u + y0 - py
+                    d2 = rx * rx + ry * ry
+                    if d2 < lim2:
+                        up = u
+                        worst = max(worst, d2)
+                        continue
+                    uw = u
+                    kb = 0
+                    db = np.inf
+                    for k in range(17):
+                        e2 = (sx[k] - px) ** 2 + (sy[k] - py) ** 2
+                        if e2 < db:
+                            db = e2
+                            kb = k
+                    if db < d2:
+                        d2 = db
+                        uw = kb / 16.0
+                    u = kb / 16.0
+                    for _ in range(4):
+                        rx = ((ax * u + bx) * u + cx) * u + x0 - px
+                        ry = ((ay * u + by) * u + cy) * u + y0 - py
+                        d1x = (3.0 * ax * u + 2.0 * bx) * u + cx
+                        d1y = (3.0 * ay * u + 2.0 * by) * u + cy
+                        fp = (6.0 * ax * u + 2.0 * bx) * rx + (6.0 * ay * u + 2.0 * by) * ry \
+                            + d1x * d1x + d1y * d1y
+                        if not fp > 0.0:
+                            break
+                        u = min(1.0, max(0.0, u - (d1x * rx + d1y * ry) / fp))
+                    rx = ((ax * u + bx) * u + cx) * u + x0 - px
+                    ry = ((ay * u + by) * u + cy) * u + y0 - py
+                    up = uw
+                    if rx * rx + ry * ry < d2:
+                        d2 = rx * rx + ry * ry
+                        up = u
+                worst = max(worst, d2)
+        out[i] = math.sqrt(worst)
+
+
+class _Stretch:
+    """The state of :func:`_smooth_stretches` on one call: the input, the estimates, the
+    bound and step per path."""
+
+    def __init__(self, W, est, valid, bound, quant, budget):
+        self.W, self.est, self.valid, self.bound, self.quant = W, est, valid, bound, quant
+        self.budget = budget  # re-fits left
+
+    def shapes(self, p0, p1, f, e, o, limit, line_ok, old=None):
+        """The best piece from p0 to p1 over the input points f..e: the line (when
+        ``line_ok``), the least-squares cubic, the cubic ``old`` with its ends moved (its
+        inner control points along): ((d1, d2), ctrl) or None (also when the budget is
+        spent)."""
+        if self.budget <= 0:
+            return None
+        self.budget -= 1
+        q = float(self.quant[o])
+        alts = []
+        if line_ok:
+            alts.append(np.stack([p0, p1]))
+        if e - f + 1 >= _STRETCH_CUBIC:
+            c = _ls_cubic(p0, p1, _stretch_targets(self.W, self.est, self.valid, f, e, q))
+            if c is not None:
+                alts.append(c)
+        if old is not None and len(old) == 4:
+            c = old.copy()
+            c[:2] += p0 - old[0]
+            c[2:] += p1 - old[3]
+            alts.append(c)
+        scored = []
+        for c in alts:
+            r = _design_off(self.W, self.est, self.valid, c, f, e, _STRETCH_LOOK * q, limit)
+            if r is not None:
+                scored.append((max(r), len(scored), r, c))
+        for _, _, r, c in sorted(scored, key=lambda x: x[:2]):
+            if _seg_fits(self.W, c, f, e, float(self.bound[o]), _JOINT_STEP * q):
+                return r, c
+        return None
+
+    def split(self, p0, p1, f, e, o, limit):
+        """The best two pieces from p0 to p1 over f..e, split at an input point m (its
+        estimate when smooth): at the ends of long gaps, at the smooth stretch's ends, at
+        the estimate farthest from the chord: ((d1, d2), [(ctrl, f, m), (ctrl, m, e)])."""
+        W, est, valid = self.W, self.est, self.valid
+        lo, hi = f + _STRETCH_PIECE, e - _STRETCH_PIECE
+        if hi < lo:
+            return None
+        q = float(self.quant[o])
+        cand = set()
+        gap = np.hypot(*np.diff(W[f:e + 1], axis=0).T) > _STRETCH_GAP * q
+        for i in np.flatnonzero(gap).tolist():
+            cand.update((f + i, f + i + 1))
+        v = np.flatnonzero(valid[f:e + 1])
+        if len(v):
+            cand.update((f + int(v[0]), f + int(v[-1])))
+            dv = point_segment_distance(est[f + v], p0, p1)
+            cand.add(f + int(v[np.argmax(dv)]))
+        cand.add((f + e) // 2)
+        best = None
+        for m in sorted(c for c in cand if lo <= c <= hi):
+            pm = (np.clip(est[m], W[m] - 0.5 * q, W[m] + 0.5 * q) if valid[m]
+                  else W[m].astype(np.float64))
+            a = self.shapes(p0, pm, f, m, o, limit, True)
+            if a is None:
+                continue
+            b = self.shapes(pm, p1, m, e, o, limit, True)
+            if b is None:
+                continue
+            r = (max(a[0][0], b[0][0]), max(a[0][1], b[0][1]))
+            if best is None or max(r) < max(best[0]):
+                best = (r, [(a[1], f, m), (b[1], m, e)])
+        return best
+
+
+def _smooth_stretches(W, arc, points, is_cubic, tail, step, gfirst, glast, seg_owner, quant,
+                      bound, changed):
+    """Rounded input, after :func:`_joints_on_the_design`: the segments that lie
+    ``_STRETCH_OFF`` quanta or more from the design estimate of one of their input points
+    inside a smooth stretch (a line over a gently curved stretch, a joint left on its
+    rounded point) are repaired, worst first: the segment re-fitted between its ends (a
+    line made the least-squares cubic), or a joint of it moved onto its estimate (inside
+    its rounding square) with the two segments there re-fitted (a line kept a line or made
+    a least-squares cubic, a cubic's inner control points fitted by least squares with its
+    ends fixed or moved along); where none of those helps, the segment (or, with the
+    joint moved, one of the two) split in two at an input point (``_STRETCH_SPLITS``). A
+    repair is kept only when every new segment stays within ``bound`` (per path) of its
+    input points and polyline (:func:`_seg_fits`) and it brings the distance to the
+    estimates down by ``_STRETCH_GAIN`` quanta; at most ``_STRETCH_BUDGET`` re-fits (and
+    one per ``_STRETCH_PER`` input points). Returns the segments (is_cubic, points,
+    tail, step, gfirst, glast, seg_owner, changed) rebuilt, or the inputs when none
+    changed."""
+    ns = len(is_cubic)
+    unchanged = (is_cubic, points, tail, step, gfirst, glast, seg_owner, changed)
+    if ns == 0:
+        return unchanged
+    # the rounded paths with enough input points for an estimate
+    cut = np.searchsorted(seg_owner, np.arange(len(quant) + 1))
+    has = cut[1:] > cut[:-1]
+    ps = gfirst[np.minimum(cut[:-1], ns - 1)]
+    pe = glast[np.maximum(cut[1:] - 1, 0)]
+    paths = np.flatnonzero(has & (quant > 0.0) & (pe - ps >= 2 * _STRETCH_SIDE))
+    if len(paths) == 0:
+        return unchanged
+    take = np.zeros(len(quant), dtype=bool)
+    take[paths] = True
+    rp = take[seg_owner]
+    est, valid = _stretch_estimates(W, arc, ps[paths], pe[paths], quant[paths])
+    # per segment: the largest distance of a smooth point's estimate (or of the middle
+    # between two smooth neighbours' estimates) to it
+    sr = np.flatnonzero(rp)
+    thr = _STRETCH_OFF * quant[seg_owner[sr]]
+    # screened first with a compiled upper bound (the nearest of 17 samples, then Newton),
+    # measured as below only where that reaches the threshold
+    ub = np.empty(len(sr))
+    _screen_segments(points, tail, is_cubic, gfirst, glast, sr, est, valid, thr, ub)
+    off = np.zeros(len(sr))
+    cand = np.flatnonzero(ub >= thr)
+    if len(cand):
+        off[cand] = _estimates_off(points, is_cubic, tail, gfirst, glast, sr[cand], est, valid)
+    bad = off >= _STRETCH_OFF * quant[seg_owner[sr]]
+    st = _Stretch(W, est, valid, bound, quant,
+                  _STRETCH_BUDGET + int((pe[paths] - ps[paths] + 1).sum()) // _STRETCH_PER)
+    splits = max(1, int(_STRETCH_SPLITS * len(sr)))
+    rep: dict[int, list] = {}
+    done = np.zeros(ns, dtype=bool)
+    for k in np.argsort(-off[bad], kind="stable").tolist():
+        s = int(sr[bad][k])
+        if st.budget <= 0:
+            break
+        if done[s]:
+            continue
+        o = int(seg_owner[s])
+        q = float(quant[o])
+        old = {}
+        oldoff = {}
+
+        def before(x, old=old, oldoff=oldoff, q=q):
+            if x not in old:
+                old[x] = _seg_ctrl(points, is_cubic, tail, x)
+                oldoff[x] = _design_off(W, est, valid, old[x], gfirst[x], glast[x],
+                                        _STRETCH_LOOK * q)
+            return oldoff[x]
+
+        best = None  # (split used, (d1, d2), {segment: [(ctrl, first, last)]})
+
+        def consider(new, used, q=q):
+            nonlocal best
+            segs = list(new)
+            o1 = max(before(x)[0] for x in segs)
+            o2 = max(before(x)[1] for x in segs)
+            n1 = max(r[0] for r, _ in new.values())
+            n2 = max(r[1] for r, _ in new.values())
+            if n1 > o1 - _STRETCH_GAIN * q or n2 > max(o2, n1):
+                return
+            if best is None or (used, max(n1, n2)) < (best[0], max(best[1])):
+                best = (used, (n1, n2), {x: p for x, (_, p) in new.items()})
+
+        c0 = _seg_ctrl(points, is_cubic, tail, s)
+        f, e = int(gfirst[s]), int(glast[s])
+        lim = before(s)[0] - _STRETCH_GAIN * q
+        r = st.shapes(c0[0], c0[-1], f, e, o, lim, False, None)
+        if r is not None:
+            consider({s: (r[0], [(r[1], f, e)])}, 0)
+        joints = []
+        for a, b in ((s - 1, s), (s, s + 1)):
+            if a < 0 or b >= ns or seg_owner[a] != o or seg_owner[b] != o or done[a] \
+                    or done[b] or glast[a] <= gfirst[a] or glast[b] <= gfirst[b]:
+                continue
+            j = int(gfirst[b])
+            if valid[j]:
+                joints.append((a, b, np.clip(est[j], W[j] - 0.5 * q, W[j] + 0.5 * q)))
+        for a, b, v in joints:
+            ca = _seg_ctrl(points, is_cubic, tail, a)
+            cb = _seg_ctrl(points, is_cubic, tail, b)
+            fa, ea, fb, eb = int(gfirst[a]), int(glast[a]), int(gfirst[b]), int(glast[b])
+            lim = max(before(a)[0], before(b)[0]) - _STRETCH_GAIN * q
+            ra = st.shapes(ca[0], v, fa, ea, o, lim, not is_cubic[a], ca)
+            rb = st.shapes(v, cb[-1], fb, eb, o, lim, not is_cubic[b], cb)
+            if ra is not None and rb is not None:
+                consider({a: (ra[0], [(ra[1], fa, ea)]), b: (rb[0], [(rb[1], fb, eb)])}, 0)
+            if best is not None and best[0] == 0 or splits <= 0:
+                continue
+            if rb is not None:
+                sa = st.split(ca[0], v, fa, ea, o, lim)
+                if sa is not None:
+                    consider({a: (sa[0], sa[1]), b: (rb[0], [(rb[1], fb, eb)])}, 1)
+            if ra is not None:
+                sb = st.split(v, cb[-1], fb, eb, o, lim)
+                if sb is not None:
+                    consider({a: (ra[0], [(ra[1], fa, ea)]), b: (sb[0], sb[1])}, 1)
+        if (best is None or best[0] == 1) and splits > 0:
+            r = st.split(c0[0], c0[-1], f, e, o, before(s)[0] - _STRETCH_GAIN * q)
+            if r is not None:
+                consider({s: (r[0], r[1])}, 1)
+        if best is not None:
+            splits -= best[0]
+            for x, p in best[2].items():
+                rep[x] = p
+                done[x] = True
+    # the joints still on their input point, ``_STRETCH_JOINT`` quanta or more from their
+    # estimate: moved onto it with both segments re-fitted, where neither of them gets
+    # farther from the estimates
+    jb = np.flatnonzero((seg_owner[1:] == seg_owner[:-1]) & rp[1:]) + 1
+    jb = jb[(glast[jb] > gfirst[jb]) & (glast[jb - 1] > gfirst[jb - 1])]
+    g = gfirst[jb]
+    jb = jb[valid[g] & (points[tail[jb] - 1] == W[g]).all(axis=1)]
+    g = gfirst[jb]
+    qj = quant[seg_owner[jb]][:, None]
+    vj = np.clip(est[g], W[g] - 0.5 * qj, W[g] + 0.5 * qj)
+    far = np.hypot(*(vj - W[g]).T) >= _STRETCH_JOINT * qj[:, 0]
+    for b, v in zip(jb[far].tolist(), vj[far], strict=True):
+        a = b - 1
+        if st.budget <= 0:
+            break
+        if done[a] or done[b]:
+            continue
+        o = int(seg_owner[b])
+        q = float(quant[o])
+        ca = _seg_ctrl(points, is_cubic, tail, a)
+        cb = _seg_ctrl(points, is_cubic, tail, b)
+        fa, ea, fb, eb = int(gfirst[a]), int(glast[a]), int(gfirst[b]), int(glast[b])
+        oa = _design_off(W, est, valid, ca, fa, ea, _STRETCH_LOOK * q)
+        ob = _design_off(W, est, valid, cb, fb, eb, _STRETCH_LOOK * q)
+        ra = st.shapes(ca[0], v, fa, ea, o, oa[0], not is_cubic[a], ca)
+        if ra is None or ra[0][1] > max(oa[1], ra[0][0]):
+            continue
+        rb = st.shapes(v, cb[-1], fb, eb, o, ob[0], not is_cubic[b], cb)
+        if rb is None or rb[0][1] > max(ob[1], rb[0][0]):
+            continue
+        rep[a] = [(ra[1], fa, ea)]
+        rep[b] = [(rb[1], fb, eb)]
+        done[a] = done[b] = True
+    # the joints still on their input point where no estimate holds (a corner, the end of
+    # a smooth stretch): moved onto the one-sided estimates of the smooth stretches that
+    # end there (their mean where both sides have one and they agree within
+    # ``_STRETCH_CORNER_AGREE`` quanta), inside the rounding square, where both segments
+    # then fit and the one that has estimates gets no farther from them
+    jb = np.flatnonzero((seg_owner[1:] == seg_owner[:-1]) & rp[1:]) + 1
+    jb = jb[(glast[jb] > gfirst[jb]) & (glast[jb - 1] > gfirst[jb - 1])]
+    g = gfirst[jb]
+    jb = jb[~valid[g] & (points[tail[jb] - 1] == W[g]).all(axis=1) & ~done[jb] & ~done[jb - 1]]
+    if len(jb) and st.budget > 0:
+        g = gfirst[jb]
+        own = seg_owner[jb]
+        q1 = quant[own]
+        pfirst = gfirst[np.searchsorted(seg_owner, own)]
+        plast = glast[np.searchsorted(seg_owner, own, side="right") - 1]
+        side = np.zeros((len(jb), 2, 3))
+        _side_estimates(W, arc, g, pfirst, plast, q1, _JOINT_SIDE, _STRETCH_SIDE,
+                        _JOINT_SMOOTH, _STRETCH_GAP, _STRETCH_SPAN, side)
+        has = side[:, :, 2] > 0.0
+        both = has.all(axis=1)
+        agree = np.hypot(*(side[:, 0, :2] - side[:, 1, :2]).T) <= _STRETCH_CORNER_AGREE * q1
+        use = has.any(axis=1) & (~both | agree)
+        n = np.maximum(has.sum(axis=1), 1)
+        vc = (side[:, :, :2] * has[:, :, None]).sum(axis=1) / n[:, None]
+        qc = q1[:, None]
+        vc = np.clip(vc, W[g] - 0.5 * qc, W[g] + 0.5 * qc)
+        use &= np.hypot(*(vc - W[g]).T) >= _STRETCH_JOINT * q1
+        for b, v in zip(jb[use].tolist(), vc[use], strict=True):
+            a = b - 1
+            if st.budget <= 0:
+                break
+            if done[a] or done[b]:
+                continue
+            o = int(seg_owner[b])
+            q = float(quant[o])
+            ca = _seg_ctrl(points, is_cubic, tail, a)
+            cb = _seg_ctrl(points, is_cubic, tail, b)
+            fa, ea, fb, eb = int(gfirst[a]), int(glast[a]), int(gfirst[b]), int(glast[b])
+            oa = _design_off(W, est, valid, ca, fa, ea, _STRETCH_LOOK * q)
+            ob = _design_off(W, est, valid, cb, fb, eb, _STRETCH_LOOK * q)
+            ra = st.shapes(ca[0], v, fa, ea, o, oa[0], not is_cubic[a], ca)
+            if ra is None:
+                continue
+            rb = st.shapes(v, cb[-1], fb, eb, o, ob[0], not is_cubic[b], cb)
+            if rb is None:
+                continue
+            rep[a] = [(ra[1], fa, ea)]
+            rep[b] = [(rb[1], fb, eb)]
+            done[a] = done[b] = True
+    if not rep:
+        return unchanged
+    return _rebuilt(points, is_cubic, tail, step, gfirst, glast, seg_owner, changed, rep)
+
+
+def _rebuilt(points, is_cubic, tail, step, gfirst, glast, seg_owner, changed, rep):
+    """The segments with ``rep`` (segment -> its new pieces (ctrl, first, last)) in place."""
+    ns = len(is_cubic)
+    cnt = np.ones(ns, dtype=np.intp)
+    for x, p in rep.items():
+        cnt[x] = len(p)
+    at = np.cumsum(cnt) - cnt
+    n_cubic = np.repeat(is_cubic, cnt)
+    n_first = np.repeat(gfirst, cnt)
+    n_last = np.repeat(glast, cnt)
+    n_owner = np.repeat(seg_owner, cnt)
+    n_changed = np.repeat(changed, cnt)
+    for x, p in rep.items():
+        for i, (c, f, e) in enumerate(p):
+            n_cubic[at[x] + i] = len(c) == 4
+            n_first[at[x] + i] = f
+            n_last[at[x] + i] = e
+            n_changed[at[x] + i] = True
+    nstep = np.where(n_cubic, 3, 1)
+    ntail = np.cumsum(nstep) - nstep + n_owner + 1
+    npts = np.empty((int(nstep.sum()) + int(seg_owner[-1]) + 1, 2))
+    fs = np.flatnonzero(np.r_[True, seg_owner[1:] != seg_owner[:-1]])
+    npts[ntail[at[fs]] - 1] = points[tail[fs] - 1]
+    same = np.ones(ns, dtype=bool)
+    same[list(rep)] = False
+    same = np.flatnonzero(same)
+    c = step[same]
+    o = np.arange(int(c.sum())) - np.repeat(np.cumsum(c) - c, c)
+    npts[np.repeat(ntail[at[same]], c) + o] = points[np.repeat(tail[same], c) + o]
+    for x, p in rep.items():
+        for i, (cx, _, _) in enumerate(p):
+            r = ntail[at[x] + i] - 1
+            npts[r:r + len(cx)] = cx
+    return n_cubic, npts, ntail, nstep, n_first, n_last, n_owner, n_changed
 
 
 #: rounded input: a line over at least this many input points is checked for a bulge
@@ -3339,6 +4155,7 @@ def warm_up() -> None:
     t = np.linspace(0.0, 2.0 * np.pi, 97)
     e = np.c_[40.0 * np.cos(t), 25.0 * np.sin(t)]
     fit_paths([e, np.round(8.0 * e)], [True, True])
+    _polyline_distance_over(e, e, 0.0)  # (the smooth-stretch pass's windowed distance)
 
 
 def fit_report(
