@@ -12,8 +12,11 @@ refit of the corpus's fabric nesting file (40,705 paths) at e_per 0.05 and 0.02.
 actually imported and a hash of the fitted arrays (kinds, points, first/last, max_error,
 counts: equal hashes = the same fit bit for bit). ``--profile`` adds a cProfile of one run.
 
+``--sparse`` (issue 16, fifth round): the same on 1 M whole-unit points of font-like smooth
+closed outlines (516 ellipses with a k-lobed wobble, points 1-2 units apart, seeded).
+
 Usage: python bench/bench_precision_speed.py [--reps 3] [--code DIR] [--only exact|whole]
-       [--nesting] [--plt FILE [--profile]]
+       [--nesting] [--plt FILE | --sparse [--profile]]
 """
 
 from __future__ import annotations
@@ -37,7 +40,10 @@ def main() -> None:
     ap.add_argument("--only", choices=("exact", "whole"))
     ap.add_argument("--nesting", action="store_true", help="the nesting refit only")
     ap.add_argument("--plt", help="fit_drawing on this file only")
-    ap.add_argument("--profile", action="store_true", help="with --plt: cProfile one run")
+    ap.add_argument("--sparse", action="store_true",
+                    help="fit_drawing on 1 M whole-unit points of font-like outlines only")
+    ap.add_argument("--profile", action="store_true",
+                    help="with --plt/--sparse: cProfile one run")
     a = ap.parse_args()
     root = os.path.abspath(a.code) if a.code else os.path.join(HERE, "..")
     sys.path.insert(0, root)
@@ -52,13 +58,13 @@ def main() -> None:
 
     warm_up()
     tag = a.code or "this checkout"
-    if a.plt:
+    if a.plt or a.sparse:
         import hashlib
 
         import galvo_core
         from galvo_core import hpgl
 
-        d = hpgl.read_file(a.plt)
+        d = hpgl.read_file(a.plt) if a.plt else sparse_outlines(Drawing, Path)
         n = sum(len(p.points) for p in d.paths)
         times = []
         for _ in range(a.reps):
@@ -80,7 +86,8 @@ def main() -> None:
             h.update(np.float64(x.max_error).tobytes())
             h.update(np.int64([x.n_input, x.n_thinned]).tobytes())
         best = min(times)
-        print(f"{galvo_core.__file__}: {os.path.basename(a.plt)} {len(d.paths)} paths {n} "
+        name = os.path.basename(a.plt) if a.plt else "sparse"
+        print(f"{galvo_core.__file__}: {name} {len(d.paths)} paths {n} "
               f"points  best {best:.3f} s CPU (all: {' '.join(f'{t:.3f}' for t in times)})  "
               f"{n / best / 1e3:.0f} k points/s  {segments(f)} segments  "
               f"sha256 {h.hexdigest()[:16]}  load {os.getloadavg()[0]:.1f}", flush=True)
@@ -125,6 +132,31 @@ def main() -> None:
             print(f"{tag}: {label:12s} quantum {'detected' if qu is None else 'given 0':9s} "
                   f"{n} points  {best:.2f} s CPU  {n / best / 1e3:.0f} k points/s  "
                   f"{segments(f)} segments", flush=True)
+
+
+def sparse_outlines(Drawing, Path, n_points: int = 1_000_000):  # noqa: N803 (the classes)
+    """Closed smooth outlines rounded to whole units, font-like spacing (1-2 units between
+    points): ellipses (axes 60-400) with a k-lobed radial wobble, seeded."""
+    rng = np.random.default_rng(5)
+    paths = []
+    n = 0
+    while n < n_points:
+        ax, ay = rng.uniform(60, 400, 2)
+        cx, cy = rng.uniform(0, 3000, 2)
+        rot = rng.uniform(0, np.pi)
+        k = rng.integers(2, 6)
+        amp = rng.uniform(0.0, 0.2)
+        t = np.linspace(0, 2 * np.pi, 40000, endpoint=False)
+        r = 1.0 + amp * np.cos(k * t)
+        x, y = ax * r * np.cos(t), ay * r * np.sin(t)
+        c, s = np.cos(rot), np.sin(rot)
+        w = np.round(np.stack([cx + c * x - s * y, cy + s * x + c * y], axis=1))
+        w = w[np.r_[True, (w[1:] != w[:-1]).any(axis=1)]]
+        if (w[-1] == w[0]).all():
+            w = w[:-1]
+        paths.append(w)
+        n += len(w)
+    return Drawing(tuple(Path(p, 1, True) for p in paths), name="sparse")
 
 
 if __name__ == "__main__":

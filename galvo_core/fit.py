@@ -90,6 +90,7 @@ from numba import njit
 from galvo_core.drawing import Drawing, Path
 from galvo_core.errors import Cancelled, ParamError
 from galvo_core.geometry import (
+    _bernstein_each,
     cubic_eval,
     cubic_length,
     gather_coeffs,
@@ -2457,11 +2458,134 @@ def _joints_on_the_design(W, arc, points, is_cubic, tail, step, gfirst, glast, s
     mv = np.hypot(*(v - W[g]).T)
     keep = ok & (res <= _JOINT_SMOOTH * q) & (mv >= _JOINT_MOVE * q)
     j, g, v, q, own = j[keep], g[keep], v[keep], q[keep], own[keep]
+    if len(j) == 0:
+        return changed
+    wstep = np.hypot(*np.diff(W, axis=0).T)
+    bj = np.asarray(bound, dtype=np.float64)[own]
     for parity in (0, 1):
-        for i in np.flatnonzero(j % 2 == parity).tolist():
-            _try_joint(W, points, is_cubic, tail, step, gfirst, glast, int(j[i]), v[i],
-                       float(bound[own[i]]), float(q[i]), changed)
+        _try_joints(W, wstep, points, is_cubic, tail, gfirst, glast,
+                    np.flatnonzero(j % 2 == parity), j, v, bj, q, changed)
     return changed
+
+
+def _try_joints(W, wstep, points, is_cubic, tail, gfirst, glast, sel, j, v, bj, q, changed):
+    """:func:`_try_joint` for the joints ``j[sel]`` (no two sharing a segment) together:
+    per share of the move, the candidate segments of every joint still unmoved checked in
+    one batch (:func:`_seg_fits_many`, the same decisions)."""
+    rem = sel
+    ca0 = {int(i): _seg_ctrl(points, is_cubic, tail, int(j[i]) - 1) for i in rem.tolist()}
+    cb0 = {int(i): _seg_ctrl(points, is_cubic, tail, int(j[i])) for i in rem.tolist()}
+    for share in _JOINT_SHARES:
+        if len(rem) == 0:
+            return
+        ctrls = []
+        cand_b = []
+        for i in rem.tolist():
+            a, b = int(j[i]) - 1, int(j[i])
+            c0a, c0b = ca0[i], cb0[i]
+            dv = share * (v[i] - c0b[0])
+            ca = c0a.copy()
+            cb = c0b.copy()
+            ca[-1] += dv
+            cb[0] += dv
+            if is_cubic[a]:
+                ca[2] += dv
+            if is_cubic[b]:
+                cb[1] += dv
+            ctrls.append(ca)
+            cand_b.append(cb)
+        ctrls.extend(cand_b)
+        r = len(rem)
+        jr = j[rem]
+        segs = np.r_[jr - 1, jr]
+        h = np.tile(_JOINT_STEP * q[rem], 2)
+        fits = _seg_fits_many(W, wstep, ctrls, gfirst[segs], glast[segs],
+                              np.tile(bj[rem], 2), h)
+        both = fits[:r] & fits[r:]
+        for t in np.flatnonzero(both).tolist():
+            a, b = int(jr[t]) - 1, int(jr[t])
+            ca, cb = ctrls[t], ctrls[r + t]
+            points[tail[a] - 1:tail[a] - 1 + len(ca)] = ca
+            points[tail[b] - 1:tail[b] - 1 + len(cb)] = cb
+            changed[a] = changed[b] = True
+        rem = rem[~both]
+
+
+_LINSPACE: dict[int, np.ndarray] = {}
+
+
+def _unit_linspace(m: int) -> np.ndarray:
+    t = _LINSPACE.get(m)
+    if t is None:
+        t = _LINSPACE[m] = np.linspace(0.0, 1.0, m)
+    return t
+
+
+def _seg_fits_many(W, wstep, ctrls, first, last, bound, h):
+    """:func:`_seg_fits` for many segments (``ctrls`` a list of (2, 2) or (4, 2) control
+    points, ``first``, ``last``, ``bound``, ``h`` per segment; ``wstep`` the lengths of the
+    input's steps W[i]..W[i + 1]): the same arithmetic, so the same decisions, batched (the
+    nearest points of all cubics in one call, the polyline checks in one compiled loop)."""
+    n = len(ctrls)
+    ok = np.ones(n, dtype=bool)
+    if n == 0:
+        return ok
+    first = np.asarray(first, dtype=np.int64)
+    last = np.asarray(last, dtype=np.int64)
+    cub = np.array([len(c) == 4 for c in ctrls], dtype=bool)
+    cnt = last - first + 1
+    m = np.empty(n, dtype=np.int64)
+    li = np.flatnonzero(~cub)
+    ci = np.flatnonzero(cub)
+    if len(li):
+        L = np.stack([ctrls[i] for i in li.tolist()])
+        lc = cnt[li]
+        st = np.cumsum(lc) - lc
+        pid = np.repeat(np.arange(len(li)), lc)
+        idx = first[li][pid] + np.arange(int(lc.sum())) - st[pid]
+        d = point_segment_distance(W[idx], L[:, 0][pid], L[:, 1][pid])
+        ok[li] &= ~(np.maximum.reduceat(d, st) > bound[li])
+        length = np.hypot(*(L[:, 1] - L[:, 0]).T)
+        m[li] = np.maximum(2, np.ceil(length / h[li]).astype(np.int64) + 1)
+    if len(ci):
+        C = np.stack([ctrls[i] for i in ci.tolist()])
+        cc = cnt[ci]
+        st = np.cumsum(cc) - cc
+        pid = np.repeat(np.arange(len(ci)), cc)
+        idx = first[ci][pid] + np.arange(int(cc.sum())) - st[pid]
+        _, d = nearest_on_cubic_each(C, pid, W[idx], seeds=64, iters=8)
+        ok[ci] &= ~(np.maximum.reduceat(d, st) > bound[ci])
+        length = np.hypot(*np.diff(C, axis=1).transpose(2, 0, 1)).sum(axis=1)
+        m[ci] = np.maximum(16, np.ceil(length / h[ci]).astype(np.int64) + 1)
+    go = np.flatnonzero(ok)
+    if len(go) == 0:
+        return ok
+    mg = m[go]
+    soff = np.r_[0, np.cumsum(mg)].astype(np.int64)
+    T = np.concatenate([_unit_linspace(int(x)) for x in mg.tolist()])
+    sid = np.repeat(np.arange(len(go)), mg)
+    samp = np.empty((len(T), 2))
+    gl = cub[go]
+    sl = ~gl[sid]
+    if sl.any():
+        A = np.stack([ctrls[i][0] for i in go.tolist()])
+        B = np.stack([ctrls[i][-1] for i in go.tolist()])
+        s = sid[sl]
+        samp[sl] = A[s] + T[sl][:, None] * (B[s] - A[s])
+    sc = ~sl
+    if sc.any():
+        gc = np.flatnonzero(gl)
+        C = np.stack([ctrls[i] for i in go[gc].tolist()])
+        pos = np.full(len(go), -1, dtype=np.int64)
+        pos[gc] = np.arange(len(gc))
+        samp[sc] = _bernstein_each(C[pos[sid[sc]]], T[sc])
+    sstep = np.hypot(*np.diff(samp, axis=0).T) if len(samp) > 1 else np.zeros(0)
+    lim = bound[go] - 0.5 * h[go]
+    res = np.empty(len(go), dtype=np.bool_)
+    _polyline_checks(samp, sstep, soff, W, wstep, first[go], last[go], lim,
+                     _NEAR_SEGMENTS, res)
+    ok[go] = res
+    return ok
 
 
 def _changed_errors(W, points, is_cubic, tail, gfirst, glast, seg_owner, changed, worst):
@@ -2535,6 +2659,114 @@ def _polyline_distance_over(samp, poly, lim, k=_NEAR_SEGMENTS):
     if len(far):
         d[far] = _full_distance(samp[far], poly)
     return d
+
+
+@njit(cache=True, nogil=True)
+def _polyline_checks(samp, sstep, soff, W, wstep, first, last, lim, k,
+                     out):  # pragma: no cover (compiled)
+    """out[i]: whether :func:`_polyline_distance_over` (window ``k``) of the samples
+    samp[soff[i]:soff[i + 1]] to the polyline W[first[i]..last[i]] stays within lim[i] (its
+    arithmetic: the windowed, wider and full distances in turn, the brute force for short
+    polylines; ``sstep``/``wstep`` the step lengths of samp/W)."""
+    for i in range(first.shape[0]):
+        f = first[i]
+        n = last[i] - f + 1
+        s0 = soff[i]
+        ms = soff[i + 1] - s0
+        lm = lim[i]
+        good = True
+        if n == 1:
+            for t in range(ms):
+                if math.hypot(samp[s0 + t, 0] - W[f, 0], samp[s0 + t, 1] - W[f, 1]) > lm:
+                    good = False
+                    break
+        elif n <= 2 * k + 2:
+            for t in range(ms):
+                if _brute_d(samp[s0 + t, 0], samp[s0 + t, 1], W, f, n) > lm:
+                    good = False
+                    break
+        else:
+            cum = np.empty(n)
+            cum[0] = 0.0
+            for t in range(n - 1):
+                cum[t + 1] = cum[t] + wstep[f + t]
+            cs = np.empty(ms)
+            cs[0] = 0.0
+            for t in range(ms - 1):
+                cs[t + 1] = cs[t] + sstep[s0 + t]
+            scale = cs[ms - 1] > 0.0
+            r = cum[n - 1] / cs[ms - 1] if scale else 1.0
+            nseg = n - 1
+            for t in range(ms):
+                val = cs[t] * r if scale else cs[t]
+                lo = 0
+                hi = n
+                while lo < hi:  # (np.searchsorted, side left)
+                    mid = (lo + hi) >> 1
+                    if cum[mid] < val:
+                        lo = mid + 1
+                    else:
+                        hi = mid
+                at = lo - 1
+                px = samp[s0 + t, 0]
+                py = samp[s0 + t, 1]
+                d = _win_d(px, py, W, f, nseg, at, k)
+                if d > lm and n > 16 * k + 2:
+                    d = _win_d(px, py, W, f, nseg, at, 16 * k)
+                if d > lm:
+                    d = _brute_d(px, py, W, f, n)
+                if d > lm:
+                    good = False
+                    break
+        out[i] = good
+
+
+@njit(cache=True, nogil=True, inline="always")
+def _win_d(px, py, W, f, ns, at, k):  # pragma: no cover (compiled)
+    """One sample's :func:`_window_distance` to the polyline W[f..f + ns]."""
+    lo = max(0, min(at - k, ns - 1))
+    hi = min(ns - 1, max(at + k, 0))
+    best = np.inf
+    for j in range(lo, hi + 1):
+        ax = W[f + j, 0]
+        ay = W[f + j, 1]
+        vx = W[f + j + 1, 0] - ax
+        vy = W[f + j + 1, 1] - ay
+        dx = px - ax
+        dy = py - ay
+        den = vx * vx + vy * vy
+        u = 0.0
+        if den > 0.0:
+            u = min(1.0, max(0.0, (dx * vx + dy * vy) / den))
+        ex = dx - u * vx
+        ey = dy - u * vy
+        d2 = ex * ex + ey * ey
+        if d2 < best:
+            best = d2
+    return math.sqrt(best)
+
+
+@njit(cache=True, nogil=True, inline="always")
+def _brute_d(px, py, W, f, n):  # pragma: no cover (compiled)
+    """One sample's :func:`point_polyline_distance` (and :func:`_full_kernel`) to the
+    polyline W[f..f + n - 1], n >= 2: their arithmetic (1 / the squared length)."""
+    best = np.inf
+    for j in range(n - 1):
+        ax = W[f + j, 0]
+        ay = W[f + j, 1]
+        vx = W[f + j + 1, 0] - ax
+        vy = W[f + j + 1, 1] - ay
+        den = vx * vx + vy * vy
+        inv = 1.0 / den if den > 1e-300 else 0.0
+        dx = px - ax
+        dy = py - ay
+        u = min(max((dx * vx + dy * vy) * inv, 0.0), 1.0)
+        ex = dx - u * vx
+        ey = dy - u * vy
+        d2 = ex * ex + ey * ey
+        if d2 < best:
+            best = d2
+    return math.sqrt(best)
 
 
 def _full_distance(samp, poly):
