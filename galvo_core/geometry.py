@@ -263,6 +263,105 @@ def _sampled_candidates(
     )  # (G, ns + 1, 2), the arithmetic of cubic_eval
     spx = np.ascontiguousarray(sp[:, :, 0])
     spy = np.ascontiguousarray(sp[:, :, 1])
+    ncand = min(_NEAREST_CANDIDATES, ns + 1)
+    k = len(p)
+    bj = np.empty(k, dtype=np.int64)
+    bd = np.empty(k)
+    cj = np.zeros((ncand, k), dtype=np.int64)
+    cok = np.zeros((ncand, k), dtype=np.bool_)
+    tie = np.zeros(k, dtype=np.bool_)
+    pc = np.ascontiguousarray(p, dtype=np.float64)
+    _candidates_kernel(spx, spy, ci.astype(np.int64), pc, bj, bd, cj, cok, tie)
+    best_u[out] = su[bj]
+    best_d2[out] = bd
+    for m in range(ncand):
+        j = cj[m]
+        ok[m, out] = cok[m]
+        u0[m, out] = su[j]
+        lo[m, out] = su[np.maximum(j - 1, 0)]
+        hi[m, out] = su[np.minimum(j + 1, ns)]
+    if tie.any():  # equal sampled minima: numpy's order of the candidates, as before
+        r = np.flatnonzero(tie)
+        _sampled_candidates_np(spx, spy, ci[r], p[r], su, ns, out[r], best_u, best_d2, cands)
+
+
+@njit(cache=True, nogil=True)
+def _candidates_kernel(spx, spy, ci, p, bj, bd, cj, cok, tie):  # type: ignore[no-untyped-def]
+    """Per point i (against the samples spx/spy[ci[i]]): the first nearest sample bj[i]
+    and its squared distance bd[i], and the (up to) cj.shape[0] local minima of the sampled
+    squared distance, smallest first (cok: one was found); tie[i]: two of the smallest
+    local minima are equal (the caller then uses numpy's selection). The arithmetic of
+    the numpy version (the same squared distances)."""
+    nc = cj.shape[0]
+    n = spx.shape[1]
+    d2 = np.empty(n)
+    tv = np.empty(nc + 1)
+    tj = np.empty(nc + 1, dtype=np.int64)
+    for i in range(p.shape[0]):
+        g = ci[i]
+        px = p[i, 0]
+        py = p[i, 1]
+        best = np.inf
+        bi = 0
+        for j in range(n):
+            dx = px - spx[g, j]
+            dy = py - spy[g, j]
+            v = dx * dx + dy * dy
+            d2[j] = v
+            if v < best:
+                best = v
+                bi = j
+        bj[i] = bi
+        bd[i] = best
+        nt = 0
+        eq = False
+        for j in range(n):
+            v = d2[j]
+            if j > 0 and not v <= d2[j - 1]:
+                continue
+            if j < n - 1 and not v <= d2[j + 1]:
+                continue
+            # insert (v, j) into the nc + 1 smallest so far
+            if nt == nc + 1 and not v < tv[nt - 1]:
+                if v == tv[nt - 1]:
+                    eq = True
+                continue
+            pos = nt if nt < nc + 1 else nc
+            while pos > 0 and v < tv[pos - 1]:
+                if pos < nc + 1:
+                    tv[pos] = tv[pos - 1]
+                    tj[pos] = tj[pos - 1]
+                pos -= 1
+            if pos > 0 and v == tv[pos - 1]:
+                eq = True
+            tv[pos] = v
+            tj[pos] = j
+            if nt < nc + 1:
+                nt += 1
+        for m in range(nc):
+            if m < nt:
+                cj[m, i] = tj[m]
+                cok[m, i] = True
+            else:
+                cj[m, i] = 0
+                cok[m, i] = False
+        tie[i] = eq
+
+
+def _sampled_candidates_np(
+    spx: np.ndarray,
+    spy: np.ndarray,
+    ci: np.ndarray,
+    p: np.ndarray,
+    su: np.ndarray,
+    ns: int,
+    out: np.ndarray,
+    best_u: np.ndarray,
+    best_d2: np.ndarray,
+    cands: tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray],
+) -> None:
+    """The numpy selection of :func:`_sampled_candidates` (rows with equal minima)."""
+    u0, lo, hi, ok = cands
     rows = max(1, (_CHUNK_CELLS // 2) // (ns + 1))
     ncand = min(_NEAREST_CANDIDATES, ns + 1)
     for s0 in range(0, len(p), rows):
