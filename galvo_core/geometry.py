@@ -694,12 +694,28 @@ def nearest_on_cubics(
     su = np.linspace(0.0, 1.0, seeds + 1)
     s = 1.0 - su
     basis = np.stack([s**3, 3.0 * s * s * su, 3.0 * s * su * su, su**3], axis=1)  # (S, 4)
-    samp = np.einsum("sk,mkd->msd", basis, c)  # (M, S, 2)
+    samp = np.empty((len(c), len(su), 2))  # (M, S, 2): np.einsum("sk,mkd->msd", basis, c)
+    _samples_kernel(basis, np.ascontiguousarray(c), samp)
     t_out = np.empty(k)
     d_out = np.empty(k)
     _seeded_kernel(power_coeffs_many(c), np.ascontiguousarray(pid, dtype=np.intp),
                    np.ascontiguousarray(p), samp, su, iters, t_out, d_out)
     return t_out, d_out
+
+
+@njit(cache=True, nogil=True)
+def _samples_kernel(basis, c, out):  # type: ignore[no-untyped-def]
+    """out[m, s] = sum over k of basis[s, k] * c[m, k], summed in order (the numbers of
+    the former ``np.einsum("sk,mkd->msd", basis, c)``)."""
+    for m in range(c.shape[0]):
+        for i in range(basis.shape[0]):
+            b0 = basis[i, 0]
+            b1 = basis[i, 1]
+            b2 = basis[i, 2]
+            b3 = basis[i, 3]
+            for d in range(2):
+                out[m, i, d] = ((b0 * c[m, 0, d] + b1 * c[m, 1, d]) + b2 * c[m, 2, d]) \
+                    + b3 * c[m, 3, d]
 
 
 @njit(cache=True, nogil=True)
