@@ -903,6 +903,24 @@ def _ragged(starts: np.ndarray, counts: np.ndarray) -> tuple[np.ndarray, np.ndar
     return owner, off
 
 
+@njit(cache=True, nogil=True)
+def _piece_sample_kernel(i0, i1, stride, cnt, arc, work, pid, pts, u):  # pragma: no cover
+    """:meth:`_BatchFitter._piece_sample` compiled: point j of piece r is input point
+    i0[r] + 1 + stride[r] * j, its parameter its arc length from i0[r] over the piece's."""
+    o = 0
+    for r in range(i0.shape[0]):
+        a = i0[r]
+        span = arc[i1[r]] - arc[a]
+        den = span if span > 0 else 1.0
+        for j in range(cnt[r]):
+            ix = a + 1 + stride[r] * j
+            pid[o] = r
+            pts[o, 0] = work[ix, 0]
+            pts[o, 1] = work[ix, 1]
+            u[o] = (arc[ix] - arc[a]) / den
+            o += 1
+
+
 def _halves(a: np.ndarray, b: np.ndarray, k: np.ndarray) -> np.ndarray:
     """Pieces (a, k) and (k, b) for every split piece, in order: (2n, 2)."""
     return np.stack([np.stack([a, k], axis=1), np.stack([k, b], axis=1)], axis=1).reshape(-1, 2)
@@ -1805,11 +1823,14 @@ class _BatchFitter:
         L = i1 - i0 - 1
         stride = np.maximum(1, -(-L // _BISECT_SAMPLE))
         cnt = -(-L // stride)
-        pid, off = _ragged(np.zeros(len(i0), dtype=np.intp), cnt)
-        idx = i0[pid] + 1 + stride[pid] * off
-        span = self.arc[i1] - self.arc[i0]
-        u = (self.arc[idx] - self.arc[i0][pid]) / np.where(span > 0, span, 1.0)[pid]
-        return pid, self.work[idx], u
+        total = int(cnt.sum())
+        pid = np.empty(total, dtype=np.intp)
+        pts = np.empty((total, 2))
+        u = np.empty(total)
+        _piece_sample_kernel(np.asarray(i0, dtype=np.intp), np.asarray(i1, dtype=np.intp),
+                             stride.astype(np.intp), cnt.astype(np.intp), self.arc,
+                             self.work, pid, pts, u)
+        return pid, pts, u
 
     def _least_squares(self, A: np.ndarray, B: np.ndarray, i0: np.ndarray, i1: np.ndarray):
         """Per piece: the cubic with the piece's end points and end tangents whose two
