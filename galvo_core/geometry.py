@@ -718,56 +718,82 @@ def _samples_kernel(basis, c, out):  # type: ignore[no-untyped-def]
                     + b3 * c[m, 3, d]
 
 
+#: points per chunk of :func:`_seeded_kernel` (its Newton steps run over a chunk at a time)
+_SEEDED_CHUNK = 256
+
+
 @njit(cache=True, nogil=True)
 def _seeded_kernel(cm, pid, p, samp, su, iters, t_out, d_out):  # type: ignore[no-untyped-def]
     """:func:`nearest_on_cubics` per point (compiled): the nearest of the cubic's samples
     ``samp[pid[k]]`` (at parameters ``su``; the first on ties, or the first NaN), Newton
-    from there (as :func:`_newton_kernel`, bit for bit), the better of both."""
-    for k in range(len(pid)):
-        m = pid[k]
-        px = p[k, 0]
-        py = p[k, 1]
-        j = 0
-        best = np.inf
-        for i in range(samp.shape[1]):
-            ex = px - samp[m, i, 0]
-            ey = py - samp[m, i, 1]
-            v = ex * ex + ey * ey
-            if v != v:
-                j = i
-                best = v
-                break
-            if i == 0 or v < best:
-                j = i
-                best = v
-        ax = cm[m, 0, 0]
-        ay = cm[m, 0, 1]
-        bx = cm[m, 1, 0]
-        by = cm[m, 1, 1]
-        dx = cm[m, 2, 0]
-        dy = cm[m, 2, 1]
-        qx = px - cm[m, 3, 0]
-        qy = py - cm[m, 3, 1]
-        u0 = su[j]
-        uk = u0
+    from there (as :func:`_newton_kernel`, bit for bit), the better of both. The Newton
+    steps run step by step over chunks of points (the same numbers per point)."""
+    nc = _SEEDED_CHUNK
+    cb = np.empty((8, nc))
+    ub = np.empty(nc)
+    u0b = np.empty(nc)
+    bestb = np.empty(nc)
+    for k0 in range(0, len(pid), nc):
+        n = min(nc, len(pid) - k0)
+        for jj in range(n):
+            k = k0 + jj
+            m = pid[k]
+            px = p[k, 0]
+            py = p[k, 1]
+            j = 0
+            best = np.inf
+            for i in range(samp.shape[1]):
+                ex = px - samp[m, i, 0]
+                ey = py - samp[m, i, 1]
+                v = ex * ex + ey * ey
+                if v != v:
+                    j = i
+                    best = v
+                    break
+                if i == 0 or v < best:
+                    j = i
+                    best = v
+            bestb[jj] = best
+            u0b[jj] = su[j]
+            ub[jj] = su[j]
+            cb[0, jj] = cm[m, 0, 0]
+            cb[1, jj] = cm[m, 0, 1]
+            cb[2, jj] = cm[m, 1, 0]
+            cb[3, jj] = cm[m, 1, 1]
+            cb[4, jj] = cm[m, 2, 0]
+            cb[5, jj] = cm[m, 2, 1]
+            cb[6, jj] = px - cm[m, 3, 0]
+            cb[7, jj] = py - cm[m, 3, 1]
         for _ in range(iters):
-            rx = ((ax * uk + bx) * uk + dx) * uk - qx
-            ry = ((ay * uk + by) * uk + dy) * uk - qy
-            d1x = (3.0 * ax * uk + 2.0 * bx) * uk + dx
-            d1y = (3.0 * ay * uk + 2.0 * by) * uk + dy
-            f = d1x * rx + d1y * ry
-            fp = (6.0 * ax * uk + 2.0 * bx) * rx + (6.0 * ay * uk + 2.0 * by) * ry
-            fp += d1x * d1x
-            fp += d1y * d1y
-            if not fp <= 0.0:
-                uk -= f / fp
-            uk = min(max(uk, 0.0), 1.0)
-        rx = ((ax * uk + bx) * uk + dx) * uk - (px - cm[m, 3, 0])
-        ry = ((ay * uk + by) * uk + dy) * uk - (py - cm[m, 3, 1])
-        dn = rx * rx + ry * ry
-        if dn < best:
-            t_out[k] = uk
-            d_out[k] = math.sqrt(dn)
-        else:
-            t_out[k] = u0
-            d_out[k] = math.sqrt(best)
+            for jj in range(n):
+                ax = cb[0, jj]
+                ay = cb[1, jj]
+                bx = cb[2, jj]
+                by = cb[3, jj]
+                dx = cb[4, jj]
+                dy = cb[5, jj]
+                uk = ub[jj]
+                rx = ((ax * uk + bx) * uk + dx) * uk - cb[6, jj]
+                ry = ((ay * uk + by) * uk + dy) * uk - cb[7, jj]
+                d1x = (3.0 * ax * uk + 2.0 * bx) * uk + dx
+                d1y = (3.0 * ay * uk + 2.0 * by) * uk + dy
+                f = d1x * rx + d1y * ry
+                fp = (6.0 * ax * uk + 2.0 * bx) * rx + (6.0 * ay * uk + 2.0 * by) * ry
+                fp += d1x * d1x
+                fp += d1y * d1y
+                if not fp <= 0.0:
+                    uk -= f / fp
+                ub[jj] = min(max(uk, 0.0), 1.0)
+        for jj in range(n):
+            k = k0 + jj
+            uk = ub[jj]
+            rx = ((cb[0, jj] * uk + cb[2, jj]) * uk + cb[4, jj]) * uk - cb[6, jj]
+            ry = ((cb[1, jj] * uk + cb[3, jj]) * uk + cb[5, jj]) * uk - cb[7, jj]
+            dn = rx * rx + ry * ry
+            best = bestb[jj]
+            if dn < best:
+                t_out[k] = uk
+                d_out[k] = math.sqrt(dn)
+            else:
+                t_out[k] = u0b[jj]
+                d_out[k] = math.sqrt(best)
