@@ -2533,12 +2533,17 @@ def _try_joints(W, wstep, points, is_cubic, tail, gfirst, glast, sel, j, v, bj, 
 
 
 _LINSPACE: dict[int, np.ndarray] = {}
+#: sample counts up to this many keep their parameters (np.linspace(0, 1, m)) for reuse
+_LINSPACE_KEEP = 2048
 
 
 def _unit_linspace(m: int) -> np.ndarray:
+    """np.linspace(0, 1, m) (the same numbers), kept for reuse when m is small."""
     t = _LINSPACE.get(m)
     if t is None:
-        t = _LINSPACE[m] = np.linspace(0.0, 1.0, m)
+        t = np.linspace(0.0, 1.0, m)
+        if m <= _LINSPACE_KEEP:
+            _LINSPACE[m] = t
     return t
 
 
