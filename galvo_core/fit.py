@@ -2490,9 +2490,11 @@ def _joints_on_the_design(W, arc, points, is_cubic, tail, step, gfirst, glast, s
 
 
 def _try_joints(W, wstep, points, is_cubic, tail, gfirst, glast, sel, j, v, bj, q, changed):
-    """:func:`_try_joint` for the joints ``j[sel]`` (no two sharing a segment) together:
-    per share of the move, the candidate segments of every joint still unmoved checked in
-    one batch (:func:`_seg_fits_many`, the same decisions)."""
+    """The joints ``j[sel]`` (no two sharing a segment) moved by the first share of the
+    way to ``v`` (``_JOINT_SHARES``) that keeps both of their segments (the inner control
+    points moved along) within the bound (:func:`_seg_fits`, steps of ``_JOINT_STEP`` q);
+    per share the segments of every joint still unmoved checked in one batch
+    (:func:`_seg_fits_many`)."""
     rem = sel
     ca0 = {int(i): _seg_ctrl(points, is_cubic, tail, int(j[i]) - 1) for i in rem.tolist()}
     cb0 = {int(i): _seg_ctrl(points, is_cubic, tail, int(j[i])) for i in rem.tolist()}
@@ -2667,24 +2669,58 @@ _NEAR_SEGMENTS = 8
 def _polyline_distance_over(samp, poly, lim, k=_NEAR_SEGMENTS):
     """The distance of each of the samples ``samp`` (in order along ``poly``) to the
     polyline where it is over ``lim``, else a distance within ``lim`` (each sample measured
-    against the segments near its share of the length, those over ``lim`` against all)."""
+    against the segments near its share of the length, those over ``lim`` against all;
+    compiled, :func:`_over_kernel`)."""
     n = len(poly)
     if n <= 2 * k + 2:
         return point_polyline_distance(samp, poly)
-    cum = np.r_[0.0, np.cumsum(np.hypot(*np.diff(poly, axis=0).T))]
-    cs = np.r_[0.0, np.cumsum(np.hypot(*np.diff(samp, axis=0).T))]
-    at = np.searchsorted(cum, cs * (cum[-1] / cs[-1]) if cs[-1] > 0.0 else cs) - 1
+    samp = np.ascontiguousarray(samp, dtype=np.float64)
+    poly = np.ascontiguousarray(poly, dtype=np.float64)
     d = np.empty(len(samp))
-    _window_distance(samp, poly, at, k, d)
-    far = np.flatnonzero(d > lim)
-    if len(far) and n > 16 * k + 2:  # a wider window first
-        wide = np.empty(len(far))
-        _window_distance(samp[far], poly, at[far], 16 * k, wide)
-        d[far] = wide
-        far = far[wide > lim]
-    if len(far):
-        d[far] = _full_distance(samp[far], poly)
+    if len(samp):
+        _over_kernel(samp, np.hypot(*np.diff(samp, axis=0).T), poly,
+                     np.hypot(*np.diff(poly, axis=0).T), float(lim), k, d)
     return d
+
+
+@njit(cache=True, nogil=True)
+def _over_kernel(samp, sstep, poly, pstep, lim, k, out):  # pragma: no cover (compiled)
+    """:func:`_polyline_distance_over` of the samples to the polyline (more than 2k + 2
+    points; ``sstep``/``pstep`` their step lengths): each sample's place along the polyline
+    by its share of the length (np.searchsorted of the scaled cumulated lengths), the
+    distance to the 2k + 1 segments there, where over ``lim`` to 32k + 1 (on polylines of
+    over 16k + 2 points), where still over to all of them."""
+    n = poly.shape[0]
+    ms = samp.shape[0]
+    cum = np.empty(n)
+    cum[0] = 0.0
+    for t in range(n - 1):
+        cum[t + 1] = cum[t] + pstep[t]
+    cs = np.empty(ms)
+    cs[0] = 0.0
+    for t in range(ms - 1):
+        cs[t + 1] = cs[t] + sstep[t]
+    scale = cs[ms - 1] > 0.0
+    r = cum[n - 1] / cs[ms - 1] if scale else 1.0
+    for t in range(ms):
+        val = cs[t] * r if scale else cs[t]
+        lo = 0
+        hi = n
+        while lo < hi:  # (np.searchsorted, side left)
+            mid = (lo + hi) >> 1
+            if cum[mid] < val:
+                lo = mid + 1
+            else:
+                hi = mid
+        at = lo - 1
+        px = samp[t, 0]
+        py = samp[t, 1]
+        d = _win_d(px, py, poly, 0, n - 1, at, k)
+        if d > lim and n > 16 * k + 2:
+            d = _win_d(px, py, poly, 0, n - 1, at, 16 * k)
+        if d > lim:
+            d = _brute_d(px, py, poly, 0, n)
+        out[t] = d
 
 
 @njit(cache=True, nogil=True)
@@ -2749,7 +2785,8 @@ def _polyline_checks(samp, sstep, soff, W, wstep, first, last, lim, k,
 
 @njit(cache=True, nogil=True, inline="always")
 def _win_d(px, py, W, f, ns, at, k):  # pragma: no cover (compiled)
-    """One sample's :func:`_window_distance` to the polyline W[f..f + ns]."""
+    """One sample's distance to the segments at - k .. at + k (clipped) of the polyline
+    W[f..f + ns] (1 / the squared length not taken: the windowed arithmetic)."""
     lo = max(0, min(at - k, ns - 1))
     hi = min(ns - 1, max(at + k, 0))
     best = np.inf
@@ -2774,8 +2811,8 @@ def _win_d(px, py, W, f, ns, at, k):  # pragma: no cover (compiled)
 
 @njit(cache=True, nogil=True, inline="always")
 def _brute_d(px, py, W, f, n):  # pragma: no cover (compiled)
-    """One sample's :func:`point_polyline_distance` (and :func:`_full_kernel`) to the
-    polyline W[f..f + n - 1], n >= 2: their arithmetic (1 / the squared length)."""
+    """One sample's :func:`point_polyline_distance` to the polyline W[f..f + n - 1],
+    n >= 2: its arithmetic (1 / the squared length)."""
     best = np.inf
     for j in range(n - 1):
         ax = W[f + j, 0]
@@ -2793,92 +2830,6 @@ def _brute_d(px, py, W, f, n):  # pragma: no cover (compiled)
         if d2 < best:
             best = d2
     return math.sqrt(best)
-
-
-def _full_distance(samp, poly):
-    """:func:`point_polyline_distance` of the samples to the polyline (n >= 2 points),
-    compiled (its arithmetic: the same numbers, without its (samples, segments) tables)."""
-    ab = poly[1:] - poly[:-1]
-    den = (ab * ab).sum(axis=1)
-    big = den > 1e-300
-    inv = np.where(big, 1.0 / np.where(big, den, 1.0), 0.0)
-    out = np.empty(len(samp))
-    _full_kernel(np.ascontiguousarray(samp, dtype=np.float64),
-                 np.ascontiguousarray(poly, dtype=np.float64), ab, inv, out)
-    return out
-
-
-@njit(cache=True, nogil=True)
-def _full_kernel(samp, poly, ab, inv, out):  # pragma: no cover (compiled)
-    for i in range(samp.shape[0]):
-        px = samp[i, 0]
-        py = samp[i, 1]
-        best = np.inf
-        for j in range(ab.shape[0]):
-            dx = px - poly[j, 0]
-            dy = py - poly[j, 1]
-            vx = ab[j, 0]
-            vy = ab[j, 1]
-            t = min(max((dx * vx + dy * vy) * inv[j], 0.0), 1.0)
-            ex = dx - t * vx
-            ey = dy - t * vy
-            d2 = ex * ex + ey * ey
-            if d2 < best:
-                best = d2
-        out[i] = math.sqrt(best)
-
-
-@njit(cache=True, nogil=True)
-def _window_distance(samp, poly, at, k, out):  # pragma: no cover (compiled)
-    """out[i]: the distance of samp[i] to the segments at[i] - k .. at[i] + k of the
-    polyline ``poly`` (clipped to it)."""
-    ns = poly.shape[0] - 1
-    for i in range(samp.shape[0]):
-        px = samp[i, 0]
-        py = samp[i, 1]
-        lo = max(0, min(at[i] - k, ns - 1))
-        hi = min(ns - 1, max(at[i] + k, 0))
-        best = np.inf
-        for j in range(lo, hi + 1):
-            ax = poly[j, 0]
-            ay = poly[j, 1]
-            vx = poly[j + 1, 0] - ax
-            vy = poly[j + 1, 1] - ay
-            dx = px - ax
-            dy = py - ay
-            den = vx * vx + vy * vy
-            t = 0.0
-            if den > 0.0:
-                t = min(1.0, max(0.0, (dx * vx + dy * vy) / den))
-            ex = dx - t * vx
-            ey = dy - t * vy
-            d2 = ex * ex + ey * ey
-            if d2 < best:
-                best = d2
-        out[i] = math.sqrt(best)
-
-
-def _try_joint(W, points, is_cubic, tail, step, gfirst, glast, j, v, bound, q, changed):
-    a, b = j - 1, j
-    c0a = _seg_ctrl(points, is_cubic, tail, a)
-    c0b = _seg_ctrl(points, is_cubic, tail, b)
-    h = _JOINT_STEP * q
-    for share in _JOINT_SHARES:
-        dv = share * (v - c0b[0])
-        ca = c0a.copy()
-        cb = c0b.copy()
-        ca[-1] += dv
-        cb[0] += dv
-        if is_cubic[a]:
-            ca[2] += dv
-        if is_cubic[b]:
-            cb[1] += dv
-        if (_seg_fits(W, ca, gfirst[a], glast[a], bound, h)
-                and _seg_fits(W, cb, gfirst[b], glast[b], bound, h)):
-            points[tail[a] - 1:tail[a] - 1 + len(ca)] = ca
-            points[tail[b] - 1:tail[b] - 1 + len(cb)] = cb
-            changed[a] = changed[b] = True
-            return
 
 
 #: rounded input, after the joints: a segment is repaired where the design estimate (the

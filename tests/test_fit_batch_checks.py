@@ -98,3 +98,30 @@ def test_seeded_samples_are_the_einsum_ones():
     out = np.empty((len(c), len(su), 2))
     geo._samples_kernel(basis, c, out)
     assert np.array_equal(out, np.einsum("sk,mkd->msd", basis, c))
+
+
+def test_windowed_polyline_distance_keeps_its_contract():
+    """Over ``lim`` the exact distance (point_polyline_distance's), within ``lim`` a distance
+    between the exact one (up to rounding) and ``lim``: checks built on it are never too
+    lenient."""
+    rng = np.random.default_rng(11)
+    over = within = 0
+    for trial in range(40):
+        t = np.sort(rng.uniform(0.0, 6.0, int(rng.integers(20, 2000))))
+        poly = np.c_[100.0 * np.cos(t), 80.0 * np.sin(t)]
+        if trial % 2:
+            poly = np.round(poly)
+        ts = np.sort(rng.uniform(0.0, 6.0, int(rng.integers(1, 500))))
+        samp = np.c_[100.0 * np.cos(ts), 80.0 * np.sin(ts)]
+        samp += rng.normal(size=samp.shape) * (0.1, 1.0, 4.0)[trial % 3]
+        for k, lim in ((8, 0.5), (64, 0.3), (8, 2.0)):
+            d = fitmod._polyline_distance_over(samp, poly, lim, k)
+            exact = geo.point_polyline_distance(samp, poly)
+            big = d > lim
+            assert np.array_equal(d[big], exact[big])
+            # (the windowed arithmetic divides by the squared length: ulps apart)
+            assert (exact[~big] <= d[~big] * (1.0 + 1e-12) + 1e-12).all()
+            assert (d[~big] <= lim).all()
+            over += int(big.sum())
+            within += int((~big).sum())
+    assert over and within
