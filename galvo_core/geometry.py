@@ -251,54 +251,48 @@ def _sampled_candidates(
     (``cands`` = u0, lo, hi, ok, each (candidates, K))."""
     u0, lo, hi, ok = cands
     cubs, ci = np.unique(pid, return_inverse=True)
-    cc = c[cubs]
+    cc = np.ascontiguousarray(c[cubs])
     su = np.linspace(0.0, 1.0, ns + 1)
-    t = su.reshape(1, -1, 1)
-    s = 1.0 - t
-    sp = (
-        (s * s * s) * cc[:, None, 0]
-        + (3.0 * s * s * t) * cc[:, None, 1]
-        + (3.0 * s * t * t) * cc[:, None, 2]
-        + (t * t * t) * cc[:, None, 3]
-    )  # (G, ns + 1, 2), the arithmetic of cubic_eval
-    spx = np.ascontiguousarray(sp[:, :, 0])
-    spy = np.ascontiguousarray(sp[:, :, 1])
-    ncand = min(_NEAREST_CANDIDATES, ns + 1)
-    k = len(p)
-    bj = np.empty(k, dtype=np.int64)
-    bd = np.empty(k)
-    cj = np.zeros((ncand, k), dtype=np.int64)
-    cok = np.zeros((ncand, k), dtype=np.bool_)
-    tie = np.zeros(k, dtype=np.bool_)
-    pc = np.ascontiguousarray(p, dtype=np.float64)
-    _candidates_kernel(spx, spy, ci.astype(np.int64), pc, bj, bd, cj, cok, tie)
-    best_u[out] = su[bj]
-    best_d2[out] = bd
-    for m in range(ncand):
-        j = cj[m]
-        ok[m, out] = cok[m]
-        u0[m, out] = su[j]
-        lo[m, out] = su[np.maximum(j - 1, 0)]
-        hi[m, out] = su[np.minimum(j + 1, ns)]
+    spx = np.empty((len(cc), ns + 1))  # the samples, the arithmetic of cubic_eval
+    spy = np.empty((len(cc), ns + 1))
+    tie = np.zeros(len(p), dtype=np.bool_)
+    _candidates_kernel(cc, su, ci.astype(np.int64), np.ascontiguousarray(p, dtype=np.float64),
+                       np.asarray(out, dtype=np.int64), spx, spy, best_u, best_d2, u0, lo, hi,
+                       ok, min(_NEAREST_CANDIDATES, ns + 1), tie)
     if tie.any():  # equal sampled minima: numpy's order of the candidates, as before
         r = np.flatnonzero(tie)
         _sampled_candidates_np(spx, spy, ci[r], p[r], su, ns, out[r], best_u, best_d2, cands)
 
 
 @njit(cache=True, nogil=True)
-def _candidates_kernel(spx, spy, ci, p, bj, bd, cj, cok, tie):  # type: ignore[no-untyped-def]
-    """Per point i (against the samples spx/spy[ci[i]]): the first nearest sample bj[i]
-    and its squared distance bd[i], and the (up to) cj.shape[0] local minima of the sampled
-    squared distance, smallest first (cok: one was found); tie[i]: two of the smallest
-    local minima are equal (the caller then uses numpy's selection). The arithmetic of
-    the numpy version (the same squared distances)."""
-    nc = cj.shape[0]
-    n = spx.shape[1]
+def _candidates_kernel(cc, su, ci, p, out, spx, spy, best_u, best_d2, u0, lo, hi, ok, nc,
+                       tie):  # type: ignore[no-untyped-def]
+    """The samples spx/spy of the cubics ``cc`` at ``su`` (cubic_eval's arithmetic), then
+    per point i (against the samples of cubic ci[i], written at out[i]): the first nearest
+    sample and its squared distance (best_u, best_d2), and the (up to) ``nc`` local minima
+    of the sampled squared distance, smallest first, as candidates (u0 the sample, lo/hi
+    its neighbours, ok: one was found); tie[i]: two of the smallest local minima are equal
+    (the caller then uses numpy's selection). The numbers of the numpy version."""
+    n = su.shape[0]
+    ns = n - 1
+    for g in range(cc.shape[0]):
+        for j in range(n):
+            t = su[j]
+            s = 1.0 - t
+            b0 = s * s * s
+            b1 = 3.0 * s * s * t
+            b2 = 3.0 * s * t * t
+            b3 = t * t * t
+            spx[g, j] = ((b0 * cc[g, 0, 0] + b1 * cc[g, 1, 0]) + b2 * cc[g, 2, 0]) \
+                + b3 * cc[g, 3, 0]
+            spy[g, j] = ((b0 * cc[g, 0, 1] + b1 * cc[g, 1, 1]) + b2 * cc[g, 2, 1]) \
+                + b3 * cc[g, 3, 1]
     d2 = np.empty(n)
     tv = np.empty(nc + 1)
     tj = np.empty(nc + 1, dtype=np.int64)
     for i in range(p.shape[0]):
         g = ci[i]
+        o = out[i]
         px = p[i, 0]
         py = p[i, 1]
         best = np.inf
@@ -311,8 +305,8 @@ def _candidates_kernel(spx, spy, ci, p, bj, bd, cj, cok, tie):  # type: ignore[n
             if v < best:
                 best = v
                 bi = j
-        bj[i] = bi
-        bd[i] = best
+        best_u[o] = su[bi]
+        best_d2[o] = best
         nt = 0
         eq = False
         for j in range(n):
@@ -328,9 +322,8 @@ def _candidates_kernel(spx, spy, ci, p, bj, bd, cj, cok, tie):  # type: ignore[n
                 continue
             pos = nt if nt < nc + 1 else nc
             while pos > 0 and v < tv[pos - 1]:
-                if pos < nc + 1:
-                    tv[pos] = tv[pos - 1]
-                    tj[pos] = tj[pos - 1]
+                tv[pos] = tv[pos - 1]
+                tj[pos] = tj[pos - 1]
                 pos -= 1
             if pos > 0 and v == tv[pos - 1]:
                 eq = True
@@ -339,12 +332,11 @@ def _candidates_kernel(spx, spy, ci, p, bj, bd, cj, cok, tie):  # type: ignore[n
             if nt < nc + 1:
                 nt += 1
         for m in range(nc):
-            if m < nt:
-                cj[m, i] = tj[m]
-                cok[m, i] = True
-            else:
-                cj[m, i] = 0
-                cok[m, i] = False
+            j = tj[m] if m < nt else 0
+            ok[m, o] = m < nt
+            u0[m, o] = su[j]
+            lo[m, o] = su[max(j - 1, 0)]
+            hi[m, o] = su[min(j + 1, ns)]
         tie[i] = eq
 
 
