@@ -90,7 +90,6 @@ from numba import njit
 from galvo_core.drawing import Drawing, Path
 from galvo_core.errors import Cancelled, ParamError
 from galvo_core.geometry import (
-    _bernstein_each,
     cubic_eval,
     cubic_length,
     gather_coeffs,
@@ -101,6 +100,7 @@ from galvo_core.geometry import (
     point_polyline_distance,
     point_segment_distance,
     power_coeffs_many,
+    sampled_upper_d2,
 )
 from galvo_core.job import gc_paused
 from galvo_core.precision import path_quanta
@@ -2534,21 +2534,6 @@ def _try_joints(W, wstep, points, is_cubic, tail, gfirst, glast, sel, j, v, bj, 
         rem = rem[~both]
 
 
-_LINSPACE: dict[int, np.ndarray] = {}
-#: sample counts up to this many keep their parameters (np.linspace(0, 1, m)) for reuse
-_LINSPACE_KEEP = 2048
-
-
-def _unit_linspace(m: int) -> np.ndarray:
-    """np.linspace(0, 1, m) (the same numbers), kept for reuse when m is small."""
-    t = _LINSPACE.get(m)
-    if t is None:
-        t = np.linspace(0.0, 1.0, m)
-        if m <= _LINSPACE_KEEP:
-            _LINSPACE[m] = t
-    return t
-
-
 def _seg_fits_many(W, wstep, ctrls, first, last, bound, h):
     """:func:`_seg_fits` for many segments (``ctrls`` a list of (2, 2) or (4, 2) control
     points, ``first``, ``last``, ``bound``, ``h`` per segment; ``wstep`` the lengths of the
@@ -2581,37 +2566,28 @@ def _seg_fits_many(W, wstep, ctrls, first, last, bound, h):
         st = np.cumsum(cc) - cc
         pid = np.repeat(np.arange(len(ci)), cc)
         idx = first[ci][pid] + np.arange(int(cc.sum())) - st[pid]
-        _, d = nearest_on_cubic_each(C, pid, W[idx], seeds=64, iters=8)
-        ok[ci] &= ~(np.maximum.reduceat(d, st) > bound[ci])
+        P = W[idx]
+        bp = bound[ci][pid]
+        # (a point within the bound at its nearest sample is within it: no Newton there)
+        need = np.flatnonzero(~(np.sqrt(sampled_upper_d2(C, pid, P, seeds=64)) <= bp))
+        if len(need):
+            _, d = nearest_on_cubic_each(C, pid[need], P[need], seeds=64, iters=8)
+            over = np.zeros(len(ci), dtype=bool)
+            over[pid[need][d > bp[need]]] = True
+            ok[ci] &= ~over
         length = np.hypot(*np.diff(C, axis=1).transpose(2, 0, 1)).sum(axis=1)
         m[ci] = np.maximum(16, np.ceil(length / h[ci]).astype(np.int64) + 1)
     go = np.flatnonzero(ok)
     if len(go) == 0:
         return ok
-    mg = m[go]
-    soff = np.r_[0, np.cumsum(mg)].astype(np.int64)
-    T = np.concatenate([_unit_linspace(int(x)) for x in mg.tolist()])
-    sid = np.repeat(np.arange(len(go)), mg)
-    samp = np.empty((len(T), 2))
-    gl = cub[go]
-    sl = ~gl[sid]
-    if sl.any():
-        A = np.stack([ctrls[i][0] for i in go.tolist()])
-        B = np.stack([ctrls[i][-1] for i in go.tolist()])
-        s = sid[sl]
-        samp[sl] = A[s] + T[sl][:, None] * (B[s] - A[s])
-    sc = ~sl
-    if sc.any():
-        gc = np.flatnonzero(gl)
-        C = np.stack([ctrls[i] for i in go[gc].tolist()])
-        pos = np.full(len(go), -1, dtype=np.int64)
-        pos[gc] = np.arange(len(gc))
-        samp[sc] = _bernstein_each(C[pos[sid[sc]]], T[sc])
-    sstep = np.hypot(*np.diff(samp, axis=0).T) if len(samp) > 1 else np.zeros(0)
+    C4 = np.zeros((len(go), 4, 2))
+    for r, i in enumerate(go.tolist()):
+        c = ctrls[i]
+        C4[r, :len(c)] = c
     lim = bound[go] - 0.5 * h[go]
     res = np.empty(len(go), dtype=np.bool_)
-    _polyline_checks(samp, sstep, soff, W, wstep, first[go], last[go], lim,
-                     _NEAR_SEGMENTS, res)
+    _polyline_checks(C4, cub[go], m[go], W, wstep, first[go], last[go], lim, _NEAR_SEGMENTS,
+                     res)
     ok[go] = res
     return ok
 
@@ -2724,27 +2700,50 @@ def _over_kernel(samp, sstep, poly, pstep, lim, k, out):  # pragma: no cover (co
 
 
 @njit(cache=True, nogil=True)
-def _polyline_checks(samp, sstep, soff, W, wstep, first, last, lim, k,
+def _polyline_checks(C4, cub, msz, W, wstep, first, last, lim, k,
                      out):  # pragma: no cover (compiled)
-    """out[i]: whether :func:`_polyline_distance_over` (window ``k``) of the samples
-    samp[soff[i]:soff[i + 1]] to the polyline W[first[i]..last[i]] stays within lim[i] (its
-    arithmetic: the windowed, wider and full distances in turn, the brute force for short
-    polylines; ``sstep``/``wstep`` the step lengths of samp/W)."""
+    """out[i]: whether the samples of segment i (``msz[i]`` at np.linspace(0, 1, m) on the
+    cubic C4[i], or the line C4[i, 0]..C4[i, 1] where not cub[i]; the arithmetic of
+    cubic_eval and of ctrl[0] + t (ctrl[1] - ctrl[0])) stay within lim[i] of the polyline
+    W[first[i]..last[i]] by :func:`_polyline_distance_over` (window ``k``; its arithmetic:
+    the windowed, wider and full distances in turn, the brute force for short polylines;
+    ``wstep`` the step lengths of W)."""
+    mmax = 2
+    for i in range(msz.shape[0]):
+        mmax = max(mmax, msz[i])
+    sx = np.empty(mmax)
+    sy = np.empty(mmax)
+    cs = np.empty(mmax)
     for i in range(first.shape[0]):
+        ms = msz[i]
+        step = 1.0 / (ms - 1)
+        for t in range(ms):
+            u = t * step if t < ms - 1 else 1.0
+            if cub[i]:
+                v = 1.0 - u
+                b0 = v * v * v
+                b1 = 3.0 * v * v * u
+                b2 = 3.0 * v * u * u
+                b3 = u * u * u
+                sx[t] = ((b0 * C4[i, 0, 0] + b1 * C4[i, 1, 0]) + b2 * C4[i, 2, 0]) \
+                    + b3 * C4[i, 3, 0]
+                sy[t] = ((b0 * C4[i, 0, 1] + b1 * C4[i, 1, 1]) + b2 * C4[i, 2, 1]) \
+                    + b3 * C4[i, 3, 1]
+            else:
+                sx[t] = C4[i, 0, 0] + u * (C4[i, 1, 0] - C4[i, 0, 0])
+                sy[t] = C4[i, 0, 1] + u * (C4[i, 1, 1] - C4[i, 0, 1])
         f = first[i]
         n = last[i] - f + 1
-        s0 = soff[i]
-        ms = soff[i + 1] - s0
         lm = lim[i]
         good = True
         if n == 1:
             for t in range(ms):
-                if math.hypot(samp[s0 + t, 0] - W[f, 0], samp[s0 + t, 1] - W[f, 1]) > lm:
+                if math.hypot(sx[t] - W[f, 0], sy[t] - W[f, 1]) > lm:
                     good = False
                     break
         elif n <= 2 * k + 2:
             for t in range(ms):
-                if _brute_d(samp[s0 + t, 0], samp[s0 + t, 1], W, f, n) > lm:
+                if _brute_d(sx[t], sy[t], W, f, n) > lm:
                     good = False
                     break
         else:
@@ -2752,10 +2751,9 @@ def _polyline_checks(samp, sstep, soff, W, wstep, first, last, lim, k,
             cum[0] = 0.0
             for t in range(n - 1):
                 cum[t + 1] = cum[t] + wstep[f + t]
-            cs = np.empty(ms)
             cs[0] = 0.0
             for t in range(ms - 1):
-                cs[t + 1] = cs[t] + sstep[s0 + t]
+                cs[t + 1] = cs[t] + math.hypot(sx[t + 1] - sx[t], sy[t + 1] - sy[t])
             scale = cs[ms - 1] > 0.0
             r = cum[n - 1] / cs[ms - 1] if scale else 1.0
             nseg = n - 1
@@ -2770,8 +2768,8 @@ def _polyline_checks(samp, sstep, soff, W, wstep, first, last, lim, k,
                     else:
                         hi = mid
                 at = lo - 1
-                px = samp[s0 + t, 0]
-                py = samp[s0 + t, 1]
+                px = sx[t]
+                py = sy[t]
                 d = _win_d(px, py, W, f, nseg, at, k)
                 if d > lm and n > 16 * k + 2:
                     d = _win_d(px, py, W, f, nseg, at, 16 * k)

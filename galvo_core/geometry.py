@@ -233,6 +233,61 @@ def nearest_on_cubic_each(
     return best_u, np.sqrt(best_d2)
 
 
+def sampled_upper_d2(ctrl: object, pid: object, pts: object, *, seeds: int = 48) -> np.ndarray:
+    """Per point the smallest squared distance to the samples of its cubic ``ctrl[pid[k]]``
+    that :func:`nearest_on_cubic_each` (same ``seeds``) starts from, with their arithmetic:
+    its distance is never larger than the square root of this (a cheap upper bound, exact
+    in floating point). ``pid`` sorted (the points of a cubic together) is fastest."""
+    c = np.asarray(ctrl, dtype=np.float64).reshape(-1, 4, 2)
+    pid = np.asarray(pid, dtype=np.int64).reshape(-1)
+    p = np.ascontiguousarray(pts, dtype=np.float64).reshape(-1, 2)
+    out = np.empty(len(p))
+    if len(p) == 0:
+        return out
+    nsp = _seed_counts(c, seeds)
+    per = nsp[pid]
+    cc = np.ascontiguousarray(c)
+    for ns in np.unique(per).tolist():
+        sel = np.flatnonzero(per == ns)
+        o = np.empty(len(sel))
+        _upper_kernel(cc, pid[sel], p[sel], np.linspace(0.0, 1.0, ns + 1), o)
+        out[sel] = o
+    return out
+
+
+@njit(cache=True, nogil=True)
+def _upper_kernel(c, pid, p, su, out):  # type: ignore[no-untyped-def]
+    """out[i]: the smallest squared distance of p[i] to cubic c[pid[i]] sampled at ``su``
+    (cubic_eval's arithmetic; the samples recomputed when pid changes)."""
+    n = su.shape[0]
+    sx = np.empty(n)
+    sy = np.empty(n)
+    last = -1
+    for i in range(pid.shape[0]):
+        g = pid[i]
+        if g != last:
+            for j in range(n):
+                t = su[j]
+                s = 1.0 - t
+                b0 = s * s * s
+                b1 = 3.0 * s * s * t
+                b2 = 3.0 * s * t * t
+                b3 = t * t * t
+                sx[j] = ((b0 * c[g, 0, 0] + b1 * c[g, 1, 0]) + b2 * c[g, 2, 0]) + b3 * c[g, 3, 0]
+                sy[j] = ((b0 * c[g, 0, 1] + b1 * c[g, 1, 1]) + b2 * c[g, 2, 1]) + b3 * c[g, 3, 1]
+            last = g
+        px = p[i, 0]
+        py = p[i, 1]
+        best = np.inf
+        for j in range(n):
+            dx = px - sx[j]
+            dy = py - sy[j]
+            v = dx * dx + dy * dy
+            if v < best:
+                best = v
+        out[i] = best
+
+
 def _sampled_candidates(
     c: np.ndarray,
     pid: np.ndarray,

@@ -125,3 +125,17 @@ def test_windowed_polyline_distance_keeps_its_contract():
             over += int(big.sum())
             within += int((~big).sum())
     assert over and within
+
+
+def test_sampled_upper_bound_is_never_below_the_nearest_distance():
+    """The batch check skips Newton where a point is within the bound at its cubic's
+    nearest sample: that must never be less than the distance the full search gives."""
+    rng = np.random.default_rng(5)
+    c = rng.normal(size=(60, 4, 2)) * 40.0
+    c[::5, 2] = c[::5, 0] + (c[::5, 3] - c[::5, 1])  # (loops and cusps: more samples)
+    pid = np.sort(rng.integers(0, len(c), 6000))
+    p = rng.normal(size=(6000, 2)) * 40.0
+    _, d = geo.nearest_on_cubic_each(c, pid, p, seeds=64, iters=8)
+    up = np.sqrt(geo.sampled_upper_d2(c, pid, p, seeds=64))
+    assert (d <= up).all()
+    assert (d < up).mean() > 0.5  # (Newton does improve on the samples)
