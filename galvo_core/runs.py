@@ -203,11 +203,10 @@ def _rounded_rules(smooth, sign, rounding, inner, dot, cr, la, lb, length_ratio,
     curve too, the segment is rather a wiggle of the rounding inside one curve (the
     thinning cut a curve's stretch into long, short, long): both of its ends are smooth
     where the two long segments around it meet as a smooth vertex may. Such vertices have
-    no sign (their turn is the rounding's). ``cos_join``: the plain rule's threshold;
-    ``seg``: the segment vectors of the points."""
-    eps = rounding[1:-1, 0]
-    qq = rounding[1:-1, 1]
-    rnd = inner & (qq > 0.0)
+    no sign (their turn is the rounding's). Then the stretches of several short segments
+    (:func:`_short_clusters`). ``cos_join``: the plain rule's threshold; ``seg``: the
+    segment vectors of the points."""
+    rnd = inner & (rounding[1:-1, 1] > 0.0)
     if not rnd.any():
         return
     _wiggle_rules(smooth, sign, rounding, rnd, dot, cr, la, lb, length_ratio, cos_join, seg)
@@ -218,6 +217,8 @@ def _rounded_rules(smooth, sign, rounding, inner, dot, cr, la, lb, length_ratio,
 
 def _wiggle_rules(smooth, sign, rounding, rnd, dot, cr, la, lb, length_ratio, cos_join,
                   seg) -> None:
+    """:func:`_rounded_rules` up to the stretches of several short segments (``rnd``: the
+    interior vertices of rounded paths; the other arguments as there)."""
     eps = rounding[1:-1, 0]
     qq = rounding[1:-1, 1]
     ang = np.abs(np.arctan2(cr, dot))
@@ -272,7 +273,7 @@ def _wiggle_rules(smooth, sign, rounding, rnd, dot, cr, la, lb, length_ratio, co
 
 #: rounded input: clusters of short thinned segments are looked at as a whole (see
 #: :func:`_short_clusters`)
-_CLUSTERS = True
+_CLUSTERS = True  # (False: off, for measurements)
 
 
 def _short_clusters(smooth, sign, rounding, rnd, dot, cr, la, lb, length_ratio, cos_join,
@@ -288,8 +289,10 @@ def _short_clusters(smooth, sign, rounding, rnd, dot, cr, la, lb, length_ratio, 
     add up to is within what the rounding of the short segments on that side can make
     (q sqrt2 over their length) or a smooth vertex may turn. A cluster's end vertex is
     made smooth only where the vertex beyond it is smooth already (a long line running
-    into the cluster stays a line). Such vertices have no sign (their turns are the
-    rounding's). In place; the arrays as in :func:`_rounded_rules`."""
+    into the cluster stays a line). The vertices of a zigzag, and those made smooth beside
+    a corner, have no sign (their turns are the rounding's; a vertex beside a corner that
+    was smooth already keeps its sign). In place; the arrays as in
+    :func:`_rounded_rules`."""
     n = len(smooth)
     ln = np.hypot(seg[:, 0], seg[:, 1])  # segment s: point s -> s + 1
     qp = rounding[:, 1]
@@ -327,6 +330,9 @@ def _short_clusters(smooth, sign, rounding, rnd, dot, cr, la, lb, length_ratio, 
         wig &= (wc <= length_ratio * wa) & (wa <= length_ratio * wc)
     make = np.zeros(n, dtype=bool)
     make[v[wig[own]]] = True
+    # a zigzag's vertices have no sign where they turn as the rounding can make them
+    zig = make.copy()
+    zig[1:-1] &= np.abs(turn[1:-1]) <= _SQRT2 * qp[1:-1] * (1.0 / la + 1.0 / lb)
     # a corner in the cluster: the vertex turning most; the turns on each side of it
     ca = np.flatnonzero(~wig)
     if len(ca):
@@ -364,10 +370,10 @@ def _short_clusters(smooth, sign, rounding, rnd, dot, cr, la, lb, length_ratio, 
     end_j[j + 1] = True
     beyond_prev = np.r_[False, smooth[:-1]]
     beyond_next = np.r_[smooth[1:], False]
-    make &= ~end_i | beyond_prev
-    make &= ~end_j | beyond_next
+    make &= (~end_i | beyond_prev) & (~end_j | beyond_next)
+    unsigned = make & (zig | ~smooth)
     smooth |= make
-    sign[make] = 0.0
+    sign[unsigned] = 0.0
 
 
 def _runs(smooth: np.ndarray, sign: np.ndarray, lay: _Layout) -> tuple[np.ndarray, np.ndarray]:
