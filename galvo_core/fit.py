@@ -2677,8 +2677,7 @@ def _corners_on_the_design(W, K, Q, arc, smooth, rnd, first, last, quant, eps) -
     other end a corner too), else a least-squares quadratic (over at least
     ``_CORNER_POINTS`` input points of the path). The corner is the
     intersection of the two tangent lines where they cross at an angle, else the mean of
-    the two positions (a least-squares line beside a curve: the line's position, the
-    better estimate of the two). A side that is a line over two input points only (no least-squares
+    the two positions. A side that is a line over two input points only (no least-squares
     line) beside a curve side is the line through its two rounded ends
     (:func:`_lone_sides`), intersected with the curve's tangent where they cross at
     ``_LONE_SINE`` or more; at a middling angle (``_CORNER_SINE`` to ``_LONE_SINE``: an
