@@ -2711,14 +2711,14 @@ def _corners_on_the_design(W, K, Q, arc, smooth, rnd, first, last, quant, eps) -
     p_in, t_in, ok_in = _local_fits(W, arc, lo_i, K[vi], K[vi])
     p_out, t_out, ok_out = _local_fits(W, arc, k, hi_o, k)
     # a side that is a line (its other end a corner too): its least-squares line
-    lin_i = ~smooth[vi - 1]
-    if lin_i.any():
-        p, t, ok = _local_lines(W, K[vi - 1][lin_i], K[vi][lin_i], K[vi][lin_i])
-        p_in[lin_i], t_in[lin_i], ok_in[lin_i] = p, t, ok
-    lin_o = ~smooth[vo + 1]
-    if lin_o.any():
-        p, t, ok = _local_lines(W, k[lin_o], K[vo + 1][lin_o], k[lin_o])
-        p_out[lin_o], t_out[lin_o], ok_out[lin_o] = p, t, ok
+    lin = ~smooth[vi - 1]
+    if lin.any():
+        p, t, ok = _local_lines(W, K[vi - 1][lin], K[vi][lin], K[vi][lin])
+        p_in[lin], t_in[lin], ok_in[lin] = p, t, ok
+    lin = ~smooth[vo + 1]
+    if lin.any():
+        p, t, ok = _local_lines(W, k[lin], K[vo + 1][lin], k[lin])
+        p_out[lin], t_out[lin], ok_out[lin] = p, t, ok
     # a side that is a line written as its two ends only (no least-squares line) beside a
     # curve side: the line through those two rounded ends, long enough to give a direction
     # (the curve side of such a corner is not checked as a line below: the fitter checks
@@ -2728,12 +2728,6 @@ def _corners_on_the_design(W, K, Q, arc, smooth, rnd, first, last, quant, eps) -
                            after=True)
     both = ok_in & ok_out
     est = 0.5 * (p_in + p_out)
-    # a line running into a curve at a small angle: the line's estimate (a least-squares
-    # line over its points) rather than the mean with the estimate at the curve's end
-    li = lin_i & ok_in & ~lin_o
-    lo_ = lin_o & ok_out & ~lin_i
-    est[li] = p_in[li]
-    est[lo_] = p_out[lo_]
     cr = t_in[:, 0] * t_out[:, 1] - t_in[:, 1] * t_out[:, 0]
     lone = lone_in | lone_out
     # a side of two points meeting a curve at a middling angle: neither estimate is good
