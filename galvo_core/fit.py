@@ -2567,10 +2567,8 @@ def _local_lines(
 #: rounded input: a smooth vertex's design estimate is fitted over at least this many input
 #: points on each side of it
 _SMOOTH_HALF = 6
-#: ... on a side whose thinned segment is at most this many quanta long (runs._SHORT_END:
-#: a zigzag of the rounding; a window of half such segments gives a tangent off by the
-#: rounding over a few units)
-_SMOOTH_SHORT = 16.0
+#: ... on a side whose thinned segment is at most this many quanta long
+_SMOOTH_SHORT = 4.0
 
 
 def _on_the_design(W, K, Q, arc, t_in, t_out, smooth, quant, tlen, eps) -> None:

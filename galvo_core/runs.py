@@ -188,25 +188,24 @@ _WIGGLE = True  # (the rounding-wiggle rule below; False: off, for measurements)
 
 def _rounded_rules(smooth, sign, rounding, inner, dot, cr, la, lb, length_ratio,
                    cos_join, seg) -> None:
-    """The vertex rules on rounded input (quantum q > 0, thinned with tolerance eps), in place.
-    Thinning a smooth curve of radius R with eps leaves chords of sagitta about eps, so each
-    turns about l / R <= 8 eps / l: on a tight curve the chords turn more than cos_join allows
-    although nothing is a corner. A vertex whose turn is at most ``_ROUNDED_TURN_MARGIN`` times
-    (la + lb) 4 eps / max(la, lb)^2 (and at most ``_ROUNDED_TURN_CAP``) is smooth too, if its
-    segments pass the length rule (waived where the vertex turns no more than the rounding of
-    its points can make it, q sqrt2 (1 / la + 1 / lb), and neither segment is short: a gentle
-    curve's staircase thinned into long and short chords); a real corner turns more than that. A
-    turn smaller than the rounding can make it (q / the longer segment) has no sign: rounding
-    wiggles are not inflections. A segment of up to ``_SHORT_END`` quanta between a curve run
-    (the vertex on its other side smooth) and a corner is what the thinning leaves of the
-    curve's end before the corner: the vertex between it and the run is smooth when it turns as
-    a smooth vertex may (the length rule aside), so that the run ends at the corner; where the
-    corner's other side is a curve too, the segment is rather a wiggle of the rounding inside
-    one curve (the thinning cut a curve's stretch into long, short, long): both of its ends are
-    smooth where the two long segments around it meet as a smooth vertex may. Such vertices have
+    """The vertex rules on rounded input (quantum q > 0, thinned with tolerance eps), in
+    place. Thinning a smooth curve of radius R with eps leaves chords of sagitta about eps,
+    so each turns about l / R <= 8 eps / l: on a tight curve the chords turn more than
+    cos_join allows although nothing is a corner. A vertex whose turn is at most
+    ``_ROUNDED_TURN_MARGIN`` times (la + lb) 4 eps / max(la, lb)^2 (and at most
+    ``_ROUNDED_TURN_CAP``) is smooth too, if its segments pass the length rule; a real
+    corner turns more than that. A turn smaller than the rounding can make it (q / the
+    longer segment) has no sign: rounding wiggles are not inflections. A segment of up to
+    ``_SHORT_END`` quanta between a curve run (the vertex on its other side smooth) and a
+    corner is what the thinning leaves of the curve's end before the corner: the vertex
+    between it and the run is smooth when it turns as a smooth vertex may (the length
+    rule aside), so that the run ends at the corner; where the corner's other side is a
+    curve too, the segment is rather a wiggle of the rounding inside one curve (the
+    thinning cut a curve's stretch into long, short, long): both of its ends are smooth
+    where the two long segments around it meet as a smooth vertex may. Such vertices have
     no sign (their turn is the rounding's). Then the stretches of several short segments
-    (:func:`_short_clusters`). ``cos_join``: the plain rule's threshold; ``seg``: the segment
-    vectors of the points."""
+    (:func:`_short_clusters`). ``cos_join``: the plain rule's threshold; ``seg``: the
+    segment vectors of the points."""
     rnd = inner & (rounding[1:-1, 1] > 0.0)
     if not rnd.any():
         return
@@ -228,11 +227,6 @@ def _wiggle_rules(smooth, sign, rounding, rnd, dot, cr, la, lb, length_ratio, co
         lim = np.minimum(_ROUNDED_TURN_MARGIN * (la + lb) * 4.0 * eps / (lmax * lmax),
                          _ROUNDED_TURN_CAP)
         ratio_ok = (lb <= length_ratio * la) & (la <= length_ratio * lb)
-        # the length rule waived where the vertex turns no more than the rounding of its
-        # points can make it and neither segment is short (a gentle curve's staircase
-        # thinned into long and short chords)
-        ratio_ok |= ((ang <= _SQRT2 * qq * (1.0 / la + 1.0 / lb))
-                     & (np.minimum(la, lb) > _SHORT_END * qq))
         add = rnd & ratio_ok & (ang <= lim)
         flat = rnd & (ang < qq / lmax)
     smooth[1:-1] |= add
