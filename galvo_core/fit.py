@@ -2157,8 +2157,10 @@ def _valid_lines(W, K, Q, la, lb, lpts, lfirst, llast, lerr, eps):
     miss its input points by more than the thinning's tolerance ``eps`` (per thinned
     point); such a line is replaced by the thinned line between the input points (valid by
     construction of the thinning) and short connectors from the moved vertices to them
-    (inside the rounding square, no input point between). Returns the lines (start thinned
-    index, points, first, last, error, sort key 3 a + 0/1/2) with the replacements."""
+    (inside the rounding square, no input point between). A moved vertex between two lines
+    (no cubic ends there) that one of them misses by it goes back to its input point instead,
+    where the other line keeps its bound so (no connector there). Returns the lines (start
+    thinned index, points, first, last, error, sort key 3 a + 0/1/2) with the replacements."""
     tol = eps[la] * (1.0 + 1e-9)
     bad = lerr > tol
     if not bad.any():
