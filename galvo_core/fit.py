@@ -3623,22 +3623,56 @@ def _valid_lines(W, K, Q, la, lb, lpts, lfirst, llast, lerr, eps):
     miss its input points by more than the thinning's tolerance ``eps`` (per thinned
     point); such a line is replaced by the thinned line between the input points (valid by
     construction of the thinning) and short connectors from the moved vertices to them
-    (inside the rounding square, no input point between). Returns the lines (start thinned
-    index, points, first, last, error, sort key 3 a + 0/1/2) with the replacements."""
-    bad = lerr > eps[la] * (1.0 + 1e-9)
+    (inside the rounding square, no input point between). A moved vertex between two lines
+    (no cubic ends there) that one of them misses by it goes back to its input point instead,
+    where the other line keeps its bound so (no connector there). Returns the lines (start
+    thinned index, points, first, last, error, sort key 3 a + 0/1/2) with the replacements."""
+    tol = eps[la] * (1.0 + 1e-9)
+    bad = lerr > tol
     if not bad.any():
         return la, lpts, lfirst, llast, lerr, 3 * la
     orig = W[K]
+    # a moved end of a missing line between two lines (no cubic's end) goes back to its
+    # input point where the other line keeps its bound so (no connector there)
+    v = np.intersect1d(np.concatenate([la[bad], lb[bad]]), np.intersect1d(la, lb))
+    v = v[(Q[v] != orig[v]).any(axis=1)]
+    if len(v):
+        # the line starting at v and the one ending there (each line is one thinned segment)
+        srt = np.argsort(la, kind="stable")
+        las = la[srt]
+        i1 = np.minimum(np.searchsorted(las, v), len(la) - 1)
+        i0 = np.minimum(np.searchsorted(las, v - 1), len(la) - 1)
+        ok = (las[i1] == v) & (las[i0] == v - 1)
+        v, li, lo = v[ok], srt[i1[ok]], srt[i0[ok]]
+    if len(v):
+        pin = np.stack([lpts[lo, 0], orig[v]], axis=1)
+        pout = np.stack([orig[v], lpts[li, 1]], axis=1)
+        ein = _line_errors(W, pin, lfirst[lo], llast[lo])
+        eout = _line_errors(W, pout, lfirst[li], llast[li])
+        go = ((ein <= tol[lo]) | bad[lo]) & ((eout <= tol[li]) | bad[li])
+        # (two neighbouring vertices both going back: their shared line is recomputed)
+        v, li, lo = v[go], li[go], lo[go]
+    if len(v):
+        lpts = lpts.copy()
+        lpts[lo, 1] = orig[v]
+        lpts[li, 0] = orig[v]
+        ch = np.unique(np.concatenate([lo, li]))
+        lerr = lerr.copy()
+        lerr[ch] = _line_errors(W, lpts[ch], lfirst[ch], llast[ch])
+        bad = lerr > tol
+        if not bad.any():
+            return la, lpts, lfirst, llast, lerr, 3 * la
     b = np.flatnonzero(bad)
     a0, b0 = la[b], lb[b]
     parts = [(la[~bad], lpts[~bad], lfirst[~bad], llast[~bad], 3 * la[~bad] + 1)]
     mid = np.stack([orig[a0], orig[b0]], axis=1)
     parts.append((a0, mid, lfirst[b], llast[b], 3 * a0 + 1))
-    ma = (Q[a0] != orig[a0]).any(axis=1)
-    parts.append((a0[ma], np.stack([Q[a0[ma]], orig[a0[ma]]], axis=1), lfirst[b][ma],
+    pa, pb = lpts[b, 0], lpts[b, 1]
+    ma = (pa != orig[a0]).any(axis=1)
+    parts.append((a0[ma], np.stack([pa[ma], orig[a0[ma]]], axis=1), lfirst[b][ma],
                   lfirst[b][ma], 3 * a0[ma]))
-    mb = (Q[b0] != orig[b0]).any(axis=1)
-    parts.append((a0[mb], np.stack([orig[b0[mb]], Q[b0[mb]]], axis=1), llast[b][mb],
+    mb = (pb != orig[b0]).any(axis=1)
+    parts.append((a0[mb], np.stack([orig[b0[mb]], pb[mb]], axis=1), llast[b][mb],
                   llast[b][mb], 3 * a0[mb] + 2))
     la2 = np.concatenate([p[0] for p in parts])
     pts2 = np.concatenate([p[1] for p in parts])

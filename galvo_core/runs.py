@@ -58,6 +58,7 @@ __all__ = [
 
 #: np.unwrap's default period (numpy's pi is math.pi)
 _PERIOD = 2.0 * math.pi
+_SQRT2 = math.sqrt(2.0)
 #: segments up to this length go into one padded table in :func:`segmented_cumsum`
 _SHORT_SEGMENT = 64
 
@@ -202,13 +203,24 @@ def _rounded_rules(smooth, sign, rounding, inner, dot, cr, la, lb, length_ratio,
     curve too, the segment is rather a wiggle of the rounding inside one curve (the
     thinning cut a curve's stretch into long, short, long): both of its ends are smooth
     where the two long segments around it meet as a smooth vertex may. Such vertices have
-    no sign (their turn is the rounding's). ``cos_join``: the plain rule's threshold;
-    ``seg``: the segment vectors of the points."""
-    eps = rounding[1:-1, 0]
-    qq = rounding[1:-1, 1]
-    rnd = inner & (qq > 0.0)
+    no sign (their turn is the rounding's). Then the stretches of several short segments
+    (:func:`_short_clusters`). ``cos_join``: the plain rule's threshold; ``seg``: the
+    segment vectors of the points."""
+    rnd = inner & (rounding[1:-1, 1] > 0.0)
     if not rnd.any():
         return
+    _wiggle_rules(smooth, sign, rounding, rnd, dot, cr, la, lb, length_ratio, cos_join, seg)
+    if _CLUSTERS:
+        _short_clusters(smooth, sign, rounding, rnd, dot, cr, la, lb, length_ratio, cos_join,
+                        seg)
+
+
+def _wiggle_rules(smooth, sign, rounding, rnd, dot, cr, la, lb, length_ratio, cos_join,
+                  seg) -> None:
+    """:func:`_rounded_rules` up to the stretches of several short segments (``rnd``: the
+    interior vertices of rounded paths; the other arguments as there)."""
+    eps = rounding[1:-1, 0]
+    qq = rounding[1:-1, 1]
     ang = np.abs(np.arctan2(cr, dot))
     lmax = np.maximum(la, lb)
     with np.errstate(invalid="ignore", divide="ignore"):
@@ -257,6 +269,111 @@ def _rounded_rules(smooth, sign, rounding, inner, dot, cr, la, lb, length_ratio,
         ext = np.concatenate([ext, k, k + 1])
     smooth[1:-1][ext] = True
     sign[1:-1][ext] = 0.0
+
+
+#: rounded input: clusters of short thinned segments are looked at as a whole (see
+#: :func:`_short_clusters`)
+_CLUSTERS = True  # (False: off, for measurements)
+
+
+def _short_clusters(smooth, sign, rounding, rnd, dot, cr, la, lb, length_ratio, cos_join,
+                    seg) -> None:
+    """Rounded input: a cluster of consecutive short thinned segments (each up to
+    ``_SHORT_END`` quanta, all its vertices inside a rounded path) between two longer
+    ones is what the thinning leaves of a stretch where the rounding zigzags (the design
+    passing a grid line, a tangent point on a half unit) or of a curve's end at a corner.
+    Where the two longer segments meet as a smooth vertex would (the turn over the
+    cluster's length of a thinned circle, :func:`_rounded_rules`; their lengths within
+    ``length_ratio``), every vertex of the cluster is smooth; else the vertex that turns
+    most is a corner and the vertices on either side of it are smooth where the turn they
+    add up to is within what the rounding of the short segments on that side can make
+    (q sqrt2 over their length) or a smooth vertex may turn. A cluster's end vertex is
+    made smooth only where the vertex beyond it is smooth already (a long line running
+    into the cluster stays a line). The vertices of a zigzag, and those made smooth beside
+    a corner, have no sign (their turns are the rounding's; a vertex beside a corner that
+    was smooth already keeps its sign). In place; the arrays as in
+    :func:`_rounded_rules`."""
+    n = len(smooth)
+    ln = np.hypot(seg[:, 0], seg[:, 1])  # segment s: point s -> s + 1
+    qp = rounding[:, 1]
+    ep = rounding[:, 0]
+    iv = np.zeros(n, dtype=bool)  # interior vertices of rounded paths
+    iv[1:-1] = rnd
+    short = (ln <= _SHORT_END * qp[:-1]) & iv[:-1] & iv[1:]
+    if not short.any():
+        return
+    # maximal stretches of short segments i..j; the segments i - 1 and j + 1 exist (the
+    # ends i and j + 1 are interior vertices) and must be longer
+    edge = np.diff(np.r_[0, short.astype(np.int8), 0])
+    i = np.flatnonzero(edge == 1)
+    j = np.flatnonzero(edge == -1) - 1
+    ok = (ln[i - 1] > _SHORT_END * qp[i - 1]) & (ln[j + 1] > _SHORT_END * qp[j + 1])
+    i, j = i[ok], j[ok]
+    if len(i) == 0:
+        return
+    # per vertex v (point index) its signed turn; per cluster its vertices i .. j + 1
+    turn = np.zeros(n)
+    turn[1:-1] = np.arctan2(cr, dot)
+    cnt = j - i + 2
+    own = np.repeat(np.arange(len(i)), cnt)
+    v = np.repeat(i, cnt) + (np.arange(int(cnt.sum())) - np.repeat(np.cumsum(cnt) - cnt, cnt))
+    a_, c_ = seg[i - 1], seg[j + 1]
+    wa, wc = ln[i - 1], ln[j + 1]
+    gap = np.add.reduceat(ln[v], np.cumsum(cnt) - cnt) - ln[j + 1]  # the short segments
+    dot2 = (a_ * c_).sum(axis=1)
+    net = np.arctan2(a_[:, 0] * c_[:, 1] - a_[:, 1] * c_[:, 0], dot2)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        lmax = np.maximum(wa, wc)
+        lim = np.minimum(_ROUNDED_TURN_MARGIN * (wa + wc + 2.0 * gap) * 4.0 * ep[i]
+                         / (lmax * lmax), _ROUNDED_TURN_CAP)
+        wig = ((dot2 > cos_join * wa * wc) | (np.abs(net) <= lim))
+        wig &= (wc <= length_ratio * wa) & (wa <= length_ratio * wc)
+    make = np.zeros(n, dtype=bool)
+    make[v[wig[own]]] = True
+    # a zigzag's vertices have no sign where they turn as the rounding can make them
+    zig = make.copy()
+    zig[1:-1] &= np.abs(turn[1:-1]) <= _SQRT2 * qp[1:-1] * (1.0 / la + 1.0 / lb)
+    # a corner in the cluster: the vertex turning most; the turns on each side of it
+    ca = np.flatnonzero(~wig)
+    if len(ca):
+        sel = ~wig[own]
+        vv, oo = v[sel], own[sel]
+        at = np.abs(turn[vv])
+        top = np.zeros(len(i))
+        np.maximum.at(top, oo, at)
+        # the first vertex turning most
+        is_top = at == top[oo]
+        first_top = np.full(len(i), n, dtype=np.intp)
+        np.minimum.at(first_top, oo[is_top], vv[is_top])
+        corner = first_top[oo]
+        before = vv < corner
+        after = vv > corner
+        tb = np.zeros(len(i))
+        ta = np.zeros(len(i))
+        lb_ = np.zeros(len(i))
+        la_ = np.zeros(len(i))
+        np.add.at(tb, oo[before], turn[vv[before]])
+        np.add.at(ta, oo[after], turn[vv[after]])
+        # the short segments on each side: those starting before the corner / after it
+        np.add.at(lb_, oo[before], ln[vv[before]])
+        np.add.at(la_, oo[after], ln[vv[after] - 1])
+        with np.errstate(invalid="ignore", divide="ignore"):
+            tol_b = np.maximum(_SQRT2 * qp[i] / lb_, lim)
+            tol_a = np.maximum(_SQRT2 * qp[i] / la_, lim)
+        side_ok = np.where(before, (np.abs(tb) <= tol_b)[oo], False)
+        side_ok |= np.where(after, (np.abs(ta) <= tol_a)[oo], False)
+        make[vv[side_ok]] = True
+    # the cluster's ends only where the vertex beyond them is smooth
+    end_i = np.zeros(n, dtype=bool)
+    end_i[i] = True
+    end_j = np.zeros(n, dtype=bool)
+    end_j[j + 1] = True
+    beyond_prev = np.r_[False, smooth[:-1]]
+    beyond_next = np.r_[smooth[1:], False]
+    make &= (~end_i | beyond_prev) & (~end_j | beyond_next)
+    unsigned = make & (zig | ~smooth)
+    smooth |= make
+    sign[unsigned] = 0.0
 
 
 def _runs(smooth: np.ndarray, sign: np.ndarray, lay: _Layout) -> tuple[np.ndarray, np.ndarray]:
