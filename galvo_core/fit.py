@@ -3557,6 +3557,41 @@ _BULGE_SHARE = 0.5
 _BULGE_ROUNDS = 2
 
 
+#: ... the farthest input point's estimate is fitted over the input points within this many
+#: quanta of arc of it (a short side of a hidden corner, not the line's far end)
+_BULGE_WINDOW = 8.0
+
+
+def _farthest_estimates(W, arc, p0, p1, first, last, q):
+    """Per line (ends ``p0``, ``p1`` over the input points first..last): the input point
+    between its ends farthest from it, and the least-squares quadratic estimate of the design
+    there over the line's input points within ``_BULGE_WINDOW`` q of arc of it: (position,
+    that input point's index, ok) as :func:`_local_fits`."""
+    cnt = last - first - 1
+    v = len(first)
+    own, off = _ragged(np.arange(v), np.maximum(cnt, 0))
+    idx = first[own] + 1 + off
+    dd = point_segment_distance(W[idx], p0[own], p1[own])
+    starts = np.cumsum(cnt) - cnt
+    has = cnt > 0
+    mx = np.full(v, -1.0)
+    mx[has] = np.maximum.reduceat(dd, starts[has])
+    top = np.flatnonzero(dd >= mx[own])
+    _, one = np.unique(own[top], return_index=True)
+    far = first.copy()
+    far[own[top[one]]] = idx[top[one]]
+    # the window: the line's input points (ends included) within the arc radius
+    allc = last - first + 1
+    own2, off2 = _ragged(np.arange(v), allc)
+    idx2 = first[own2] + off2
+    near = np.abs(arc[idx2] - arc[far[own2]]) <= _BULGE_WINDOW * q[own2]
+    big = np.iinfo(np.intp).max
+    lo = np.minimum.reduceat(np.where(near, idx2, big), np.cumsum(allc) - allc)
+    hi = np.maximum.reduceat(np.where(near, idx2, -1), np.cumsum(allc) - allc)
+    pos, _, ok = _local_fits(W, arc, lo, hi, far)
+    return pos, far, ok & has
+
+
 def _split_bulging_lines(W, arc, la, lpts, lfirst, llast, lerr, lkey, quant, eps):
     """Rounded input: a line over a gently curved stretch of the design may keep within
     its bound of the rounded points while the design bulges up to that bound away from it
@@ -3566,7 +3601,9 @@ def _split_bulging_lines(W, arc, la, lpts, lfirst, llast, lerr, lkey, quant, eps
     than ``_BULGE_SHARE`` quanta from the line, the line is split there into two lines
     meeting at the estimate (kept inside the middle point's rounding square), or at the
     middle input point where the two lines from the estimate would miss their points by
-    more than ``eps`` (the line's bound); not split where both miss. Returns the lines as
+    more than ``eps`` (the line's bound); not split where both miss. Where the middle's
+    estimate is on the line, the line's input point farthest from it is tried the same way
+    (:func:`_farthest_estimates`: a corner hidden beside the line's end). Returns the lines as
     :func:`_valid_lines` does (a split line's two halves in order under its sort key) and
     whether any line was split."""
     q = quant[la]
@@ -3578,10 +3615,18 @@ def _split_bulging_lines(W, arc, la, lpts, lfirst, llast, lerr, lkey, quant, eps
     p0, p1 = lpts[cand, 0], lpts[cand, 1]
     d = point_segment_distance(pos, p0, p1)
     hit = ok & (d > _BULGE_SHARE * q[cand])
+    at = m[cand]
+    # ... else at the input point farthest from the line, over the input points within
+    # _BULGE_WINDOW quanta of arc of it (a corner the thinning hid beside a line's end: its
+    # short side's points all within the bound of a line from the far end)
+    wpos, wat, wok = _farthest_estimates(W, arc, p0, p1, lfirst[cand], llast[cand], q[cand])
+    dw = point_segment_distance(wpos, p0, p1)
+    better = wok & (dw > _BULGE_SHARE * q[cand]) & ~hit
+    pos[better], at[better], hit[better] = wpos[better], wat[better], True
     if not hit.any():
         return la, lpts, lfirst, llast, lerr, lkey, False
     c = cand[hit]
-    mc = m[c]
+    mc = at[hit]
     h = 0.5 * q[c][:, None]
     v = np.clip(pos[hit], W[mc] - h, W[mc] + h)
     e = eps[la[c]] * (1.0 + 1e-9)

@@ -84,8 +84,9 @@ def test_corner_joints_move_onto_their_one_sided_estimates(monkeypatch):
     """A joint where no centred estimate holds (a corner, the end of a smooth stretch) and
     the smooth stretch ending there has a one-sided estimate 0.3 q or more from the rounded
     point moves onto it: two contours of the bench's whole-unit serif-bolditalic text
-    come within 0.55 of the design (0.561 with those joints left on their rounded points),
-    no violation, no more segments."""
+    come within 0.55 of the design, no violation, no more segments and no farther than with
+    those joints left on their rounded points (0.561 before the rounding zigzags were judged
+    as a whole, s5-c; since then 0.497 both ways on these two contours)."""
     import os
     import sys
 
@@ -110,5 +111,39 @@ def test_corner_joints_move_onto_their_one_sided_estimates(monkeypatch):
     d, n = worst()
     monkeypatch.setattr(fitmod, "_side_estimates", lambda *a: None)  # the joints stay
     d0, n0 = worst()
-    assert d < 0.55 <= d0
+    assert d < 0.55
+    assert d <= d0
     assert n <= n0
+
+
+# Cantarell '@' at 1500 units per em, written in whole units (offsets from (7585, 188)): a
+# curve ends going straight up at x = -41.5 (its last 11 points rounded to x = -41), and a
+# long line leaves that corner to (-11, 520). All of the short straight end lies within the
+# bound (0.727) of one line from (-41, 59) to (-11, 520), so thinning hides the corner.
+_HIDDEN_CORNER = [
+    (0, 0), (-1, 0), (-2, 1), (-3, 1), (-4, 2), (-5, 2), (-5, 3), (-6, 3), (-7, 3), (-8, 4),
+    (-9, 5), (-10, 5), (-11, 6), (-12, 7), (-13, 7), (-14, 8), (-15, 9), (-16, 10), (-17, 10),
+    (-17, 11), (-18, 11), (-19, 12), (-19, 13), (-20, 13), (-21, 14), (-22, 15), (-22, 16),
+    (-23, 16), (-24, 17), (-24, 18), (-25, 18), (-25, 19), (-26, 20), (-27, 21), (-28, 22),
+    (-28, 23), (-29, 24), (-30, 25), (-30, 26), (-31, 27), (-31, 28), (-32, 28), (-32, 29),
+    (-33, 30), (-33, 31), (-33, 32), (-34, 33), (-35, 34), (-35, 35), (-35, 36), (-36, 37),
+    (-36, 38), (-36, 39), (-37, 40), (-37, 41), (-37, 42), (-38, 43), (-38, 44), (-38, 45),
+    (-39, 46), (-39, 47), (-39, 48), (-39, 49), (-40, 50), (-40, 51), (-40, 52), (-40, 53),
+    (-40, 54), (-40, 55), (-41, 56), (-41, 57), (-41, 58), (-41, 59), (-41, 61), (-41, 62),
+    (-41, 63), (-41, 64), (-41, 65), (-41, 66), (-41, 68), (-41, 69), (-41, 70), (-11, 520),
+    (-112, 520), (-127, 462),
+]
+
+
+def test_corner_hidden_inside_a_thinned_line_is_kept():
+    """A line from the far end to the curve may keep within its bound of every rounded point
+    of a short straight stretch before the corner and still cut the corner by 1.2 units (the
+    points lie 0.72 on the far side of the truth): the line's input point farthest from it,
+    estimated over its neighbours, is where it is split, so the fit keeps the corner."""
+    w = np.array(_HIDDEN_CORNER, dtype=float)
+    fp = fit_paths([w], [False])[0]
+    assert not check_fit(w, fp, 0.02, 0.02, report=True)["violation"]
+    dense = np.vstack([flatten_cubic(s.points, 0.002) if s.kind == "cubic"
+                       else np.asarray(s.points) for s in fp.segments])
+    design_corner = np.array([[-41.5, 70.0]])
+    assert point_polyline_distance(design_corner, dense)[0] < 0.6
