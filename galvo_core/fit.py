@@ -4219,6 +4219,14 @@ def _corners_on_the_design(W, K, Q, arc, smooth, rnd, first, last, quant, eps) -
     pid_o = np.searchsorted(last, vo)
     lo_i = np.minimum(K[vi - 1], np.maximum(K[vi] - _CORNER_POINTS + 1, K[first[pid_i]]))
     hi_o = np.maximum(K[vo + 1], np.minimum(k + _CORNER_POINTS - 1, K[last[pid_o]]))
+    # ... but not past the corner at the run's other end (a short run of lines that barely
+    # turn: a window across other corners estimates nothing)
+    idx = np.arange(n)
+    stop = ~smooth | is_first | is_last
+    prev_c = np.maximum.accumulate(np.where(stop, idx, 0))
+    next_c = np.minimum.accumulate(np.where(stop, idx, n - 1)[::-1])[::-1]
+    lo_i = np.maximum(lo_i, K[prev_c[vi - 1]])
+    hi_o = np.minimum(hi_o, K[next_c[vo + 1]])
     p_in, t_in, ok_in = _local_fits(W, arc, lo_i, K[vi], K[vi])
     p_out, t_out, ok_out = _local_fits(W, arc, k, hi_o, k)
     # a side that is a line (its other end a corner too): its least-squares line

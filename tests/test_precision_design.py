@@ -78,3 +78,18 @@ def test_vertices_move_onto_the_design_only_where_the_rounding_counts():
         assert _ends_on_input(fp, pts) is on_points
         rep = check_fit(pts, fp, 0.02, 0.02, report=True, quantum_units=q)
         assert not rep["violation"]
+
+
+def test_corners_of_a_short_run_of_lines_keep_their_place():
+    """A ten-point contour of lines only (Cantarell "y" at 3000 units per em: every vertex a
+    multiple of 3, so its grid is detected as 3): one vertex turns by 1 degree, so its two lines
+    form a run, but the corners at the run's ends have no curve to estimate: a window of 20
+    points reaching across the other corners gave estimates 1.5 units off and moved them
+    there. The corners stay on their input points."""
+    p = np.array([[20919.0, -651.0], [21174.0, -651.0], [21414.0, 0.0], [21978.0, 1446.0],
+                  [21738.0, 1446.0], [21303.0, 234.0], [20877.0, 1446.0], [20610.0, 1446.0],
+                  [21180.0, 0.0], [20919.0, -651.0]])
+    fp = fitmod.fit_paths([p], [True])[0]
+    ends = np.array([np.asarray(s.points)[-1] for s in fp.segments])
+    for corner in p[[1, 3, 5, 6, 8]]:
+        assert np.hypot(*(ends - corner).T).min() < 1e-9, corner
