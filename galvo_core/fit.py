@@ -97,6 +97,7 @@ from galvo_core.geometry import (
     nearest_on_cubic_each,
     nearest_on_cubics,
     newton_nearest_many,
+    newton_param,
     point_polyline_distance,
     point_segment_distance,
     power_coeffs_many,
@@ -536,17 +537,7 @@ def _accept_points(cm, i0, i1, starts, work, arc, e2, u, dist, emax0,
             for _ in range(6):  # (step by step over the chunk: the loop vectorises)
                 for j in range(n):
                     uk = ub[j]
-                    rx = ((ax * uk + bx) * uk + dx) * uk - qxb[j]
-                    ry = ((ay * uk + by) * uk + dy) * uk - qyb[j]
-                    d1x = (3.0 * ax * uk + 2.0 * bx) * uk + dx
-                    d1y = (3.0 * ay * uk + 2.0 * by) * uk + dy
-                    f = d1x * rx + d1y * ry
-                    fp = (6.0 * ax * uk + 2.0 * bx) * rx + (6.0 * ay * uk + 2.0 * by) * ry
-                    fp += d1x * d1x
-                    fp += d1y * d1y
-                    if not fp <= 0.0:  # (not convex here: no step)
-                        uk -= f / fp
-                    ub[j] = min(max(uk, 0.0), 1.0)
+                    ub[j] = newton_param(ax, ay, bx, by, dx, dy, qxb[j], qyb[j], uk)
             for j in range(n):
                 k = base + c0 + j
                 uk = ub[j]
@@ -712,17 +703,7 @@ def _sample_kernel(cm, i0, i1, work, arc, e2, sample, ok) -> None:  # pragma: no
         for _ in range(4):
             for j in range(n):
                 uk = ub[j]
-                rx = ((ax * uk + bx) * uk + dx) * uk - qxb[j]
-                ry = ((ay * uk + by) * uk + dy) * uk - qyb[j]
-                d1x = (3.0 * ax * uk + 2.0 * bx) * uk + dx
-                d1y = (3.0 * ay * uk + 2.0 * by) * uk + dy
-                f = d1x * rx + d1y * ry
-                fp = (6.0 * ax * uk + 2.0 * bx) * rx + (6.0 * ay * uk + 2.0 * by) * ry
-                fp += d1x * d1x
-                fp += d1y * d1y
-                if not fp <= 0.0:  # (not convex here: no step)
-                    uk -= f / fp
-                ub[j] = min(max(uk, 0.0), 1.0)
+                ub[j] = newton_param(ax, ay, bx, by, dx, dy, qxb[j], qyb[j], uk)
         lim = e2[r] * e2[r]
         good = 0.0 <= lim
         for j in range(n):
@@ -814,17 +795,7 @@ def _dichotomy_kernel(p0, qq, p3, sig, i0, i1, work, arc, sample, max_iter, eps_
             for _ in range(3):
                 for j in range(n):
                     uk = ub[j]
-                    rx = ((ax * uk + bx) * uk + dx) * uk - qxb[j]
-                    ry = ((ay * uk + by) * uk + dy) * uk - qyb[j]
-                    d1x = (3.0 * ax * uk + 2.0 * bx) * uk + dx
-                    d1y = (3.0 * ay * uk + 2.0 * by) * uk + dy
-                    f = d1x * rx + d1y * ry
-                    fp = (6.0 * ax * uk + 2.0 * bx) * rx + (6.0 * ay * uk + 2.0 * by) * ry
-                    fp += d1x * d1x
-                    fp += d1y * d1y
-                    if not fp <= 0.0:  # (not convex here: no step)
-                        uk -= f / fp
-                    ub[j] = min(max(uk, 0.0), 1.0)
+                    ub[j] = newton_param(ax, ay, bx, by, dx, dy, qxb[j], qyb[j], uk)
             for j in range(n):
                 uk = ub[j]
                 px = pxb[j]
@@ -1047,17 +1018,7 @@ def _gn_rounds(ps, pts, u, p0, p3, t0, t3, al, be, chord, rounds) -> None:  # pr
             for _i in range(2):
                 for j in range(n):
                     uk = ub[j]
-                    rx = ((ax * uk + bx) * uk + dx) * uk - qxb[j]
-                    ry = ((ay * uk + by) * uk + dy) * uk - qyb[j]
-                    d1x = (3.0 * ax * uk + 2.0 * bx) * uk + dx
-                    d1y = (3.0 * ay * uk + 2.0 * by) * uk + dy
-                    f = d1x * rx + d1y * ry
-                    fp = (6.0 * ax * uk + 2.0 * bx) * rx + (6.0 * ay * uk + 2.0 * by) * ry
-                    fp += d1x * d1x
-                    fp += d1y * d1y
-                    if not fp <= 0.0:  # (not convex here: no step)
-                        uk -= f / fp
-                    ub[j] = min(max(uk, 0.0), 1.0)
+                    ub[j] = newton_param(ax, ay, bx, by, dx, dy, qxb[j], qyb[j], uk)
             for j in range(n):
                 uk = ub[j]
                 u[k0 + j] = uk
@@ -1146,17 +1107,7 @@ def _gn_free_sums(ps, pts, u, ctrl, N, g) -> None:  # pragma: no cover (compiled
         for _i in range(2):
             for j in range(n):
                 uk = ub[j]
-                rx = ((ax * uk + bx) * uk + dx) * uk - qxb[j]
-                ry = ((ay * uk + by) * uk + dy) * uk - qyb[j]
-                d1x = (3.0 * ax * uk + 2.0 * bx) * uk + dx
-                d1y = (3.0 * ay * uk + 2.0 * by) * uk + dy
-                f = d1x * rx + d1y * ry
-                fp = (6.0 * ax * uk + 2.0 * bx) * rx + (6.0 * ay * uk + 2.0 * by) * ry
-                fp += d1x * d1x
-                fp += d1y * d1y
-                if not fp <= 0.0:  # (not convex here: no step)
-                    uk -= f / fp
-                ub[j] = min(max(uk, 0.0), 1.0)
+                ub[j] = newton_param(ax, ay, bx, by, dx, dy, qxb[j], qyb[j], uk)
         for j in range(n):
             uk = ub[j]
             u[k0 + j] = uk

@@ -675,6 +675,25 @@ def _newton_step(cf, p, u, c0, c1, lo, hi, one_lo, one_hi, downhill):  # type: i
         u[k] = min(max(uk, lo_k), hi_k)
 
 
+@njit(cache=True, nogil=True, inline="always")
+def newton_param(ax, ay, bx, by, dx, dy, qx, qy, uk):  # type: ignore[no-untyped-def]
+    """One Newton step of the parameter ``uk`` of the cubic a u^3 + b u^2 + d u (power form,
+    its start at the origin) towards the point of it nearest (qx, qy) (relative to the start
+    too), clamped to [0, 1]; no step where the squared distance is not convex (the compiled
+    fitting kernels' reparametrisation; inlined, so their arithmetic is unchanged)."""
+    rx = ((ax * uk + bx) * uk + dx) * uk - qx  # B(u) - p
+    ry = ((ay * uk + by) * uk + dy) * uk - qy
+    d1x = (3.0 * ax * uk + 2.0 * bx) * uk + dx  # B'(u)
+    d1y = (3.0 * ay * uk + 2.0 * by) * uk + dy
+    f = d1x * rx + d1y * ry  # f = B'·(B - p)
+    fp = (6.0 * ax * uk + 2.0 * bx) * rx + (6.0 * ay * uk + 2.0 * by) * ry
+    fp += d1x * d1x  # f' = B''·(B - p) + |B'|^2
+    fp += d1y * d1y
+    if not fp <= 0.0:
+        uk -= f / fp
+    return min(max(uk, 0.0), 1.0)
+
+
 @njit(cache=True, nogil=True)
 def _newton_one_cubic(cf, p, u, d2, iters, lo, hi, downhill):  # type: ignore[no-untyped-def]
     """The scalar :func:`_newton_kernel` (one point after the other), for ``cf`` (4, 2, 1)
@@ -820,17 +839,7 @@ def _seeded_kernel(cm, pid, p, samp, su, iters, t_out, d_out):  # type: ignore[n
                 dx = cb[4, jj]
                 dy = cb[5, jj]
                 uk = ub[jj]
-                rx = ((ax * uk + bx) * uk + dx) * uk - cb[6, jj]
-                ry = ((ay * uk + by) * uk + dy) * uk - cb[7, jj]
-                d1x = (3.0 * ax * uk + 2.0 * bx) * uk + dx
-                d1y = (3.0 * ay * uk + 2.0 * by) * uk + dy
-                f = d1x * rx + d1y * ry
-                fp = (6.0 * ax * uk + 2.0 * bx) * rx + (6.0 * ay * uk + 2.0 * by) * ry
-                fp += d1x * d1x
-                fp += d1y * d1y
-                if not fp <= 0.0:
-                    uk -= f / fp
-                ub[jj] = min(max(uk, 0.0), 1.0)
+                ub[jj] = newton_param(ax, ay, bx, by, dx, dy, cb[6, jj], cb[7, jj], uk)
         for jj in range(n):
             k = k0 + jj
             uk = ub[jj]
