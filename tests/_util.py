@@ -49,3 +49,30 @@ def circle_plt(r: float = 400.0, n: int = 720, *, decimals: int = 3, cx: float =
     pts.append(pts[0])
     body = ",".join(f"{x},{y}" for x, y in pts[1:])
     return f"IN;SP1;PU{pts[0][0]},{pts[0][1]};PD{body};PU;SP0;".encode()
+
+
+def waved_ellipse(seed: int, k: int, n: int = 20000):
+    """The k-th smooth closed outline of a seed (an ellipse with a three-fold wave, 60-400
+    units across, at most 1000 units from the origin): ``n`` exact (float) points."""
+    import numpy as np
+
+    rng = np.random.default_rng(seed)
+    for _ in range(k + 1):
+        a, b = rng.uniform(60, 400, 2)
+        cx, cy = rng.uniform(0, 1000, 2)
+        rot = rng.uniform(0, np.pi)
+    t = np.linspace(0, 2 * np.pi, n, endpoint=False)
+    r = 1.0 + 0.15 * np.cos(3 * t)
+    x, y = a * r * np.cos(t), b * r * np.sin(t)
+    c, s = np.cos(rot), np.sin(rot)
+    return np.stack([cx + c * x - s * y, cy + s * x + c * y], axis=1)
+
+
+def whole_units(points, *, closed: bool = True):
+    """``points`` as a PLT file writes them: rounded to whole units, repeated points dropped
+    (and, ``closed``, a last point equal to the first)."""
+    import numpy as np
+
+    w = np.round(np.asarray(points, dtype=np.float64))
+    w = w[np.r_[True, (w[1:] != w[:-1]).any(axis=1)]]
+    return w[:-1] if closed and len(w) > 1 and (w[-1] == w[0]).all() else w

@@ -9,24 +9,9 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from _util import waved_ellipse, whole_units
 
 from galvo_core.fit import check_fit, fit_paths
-
-
-def _waved_ellipse(seed: int, k: int) -> np.ndarray:
-    """The k-th closed outline of a seed: an ellipse with a three-fold wave, whole units."""
-    rng = np.random.default_rng(seed)
-    for _ in range(k + 1):
-        a, b = rng.uniform(60, 400, 2)
-        cx, cy = rng.uniform(0, 1000, 2)
-        rot = rng.uniform(0, np.pi)
-    t = np.linspace(0, 2 * np.pi, 20000, endpoint=False)
-    r = 1.0 + 0.15 * np.cos(3 * t)
-    x, y = a * r * np.cos(t), b * r * np.sin(t)
-    c, s = np.cos(rot), np.sin(rot)
-    w = np.round(np.stack([cx + c * x - s * y, cy + s * x + c * y], axis=1))
-    w = w[np.r_[True, (w[1:] != w[:-1]).any(axis=1)]]
-    return w[:-1] if (w[-1] == w[0]).all() else w
 
 
 def _random_paths(seed: int, count: int):
@@ -68,7 +53,7 @@ def _assert_bound(paths, closed):
 
 
 def test_outline_that_lost_a_range_is_covered_within_the_bound():
-    _assert_bound([_waved_ellipse(1, 2)], [True])
+    _assert_bound([whole_units(waved_ellipse(1, 2))], [True])
 
 
 @pytest.mark.parametrize("seed", [7])

@@ -5,6 +5,7 @@ re-fitted onto the design estimate, within the stated bound and the segment budg
 from __future__ import annotations
 
 import numpy as np
+from _util import waved_ellipse, whole_units
 
 from galvo_core import fit as fitmod
 from galvo_core.fit import check_fit, fit_paths
@@ -26,27 +27,10 @@ def test_straight_rounded_line_is_left_alone():
     assert out[1] is points and not out[-1].any()
 
 
-def _outline(seed: int, k: int) -> np.ndarray:
-    """A smooth closed outline (an ellipse with a three-fold wave), the k-th of a seed."""
-    rng = np.random.default_rng(seed)
-    for _ in range(k + 1):
-        a, b = rng.uniform(60, 400, 2)
-        cx, cy = rng.uniform(0, 1000, 2)
-        rot = rng.uniform(0, np.pi)
-    t = np.linspace(0, 2 * np.pi, 20000, endpoint=False)
-    r = 1.0 + 0.15 * np.cos(3 * t)
-    x, y = a * r * np.cos(t), b * r * np.sin(t)
-    c, s = np.cos(rot), np.sin(rot)
-    return np.stack([cx + c * x - s * y, cy + s * x + c * y], axis=1)
-
-
 def test_whole_unit_smooth_outlines_fit_within_0_6_of_the_design():
     for k in (3, 10):
-        design = _outline(1, k)
-        w = np.round(design)
-        w = w[np.r_[True, (w[1:] != w[:-1]).any(axis=1)]]
-        if (w[-1] == w[0]).all():
-            w = w[:-1]
+        design = waved_ellipse(1, k)
+        w = whole_units(design)
         fp = fit_paths([w], [True])[0]
         assert not check_fit(w, fp, 0.02, 0.02, report=True)["violation"]
         dense = np.vstack([flatten_cubic(s.points, 0.002) if s.kind == "cubic"
