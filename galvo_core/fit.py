@@ -95,13 +95,15 @@ from galvo_core.geometry import (
     gather_coeffs,
     nearest_on_cubic,
     nearest_on_cubic_each,
-    nearest_on_cubics,
+    bernstein_samples,
     newton_nearest_many,
     newton_param,
     point_polyline_distance,
     point_segment_distance,
     power_coeffs_many,
     sampled_upper_d2,
+    seed_basis,
+    seeded_nearest,
 )
 from galvo_core.job import gc_paused
 from galvo_core.precision import path_quanta
@@ -668,8 +670,71 @@ def _accept_pairs(cm, i0, i1, starts, work, u, e2, qa, ok) -> None:  # pragma: n
 
 #: points per chunk of :func:`_accept_points` (its Newton steps run over a chunk at a time)
 _ACCEPT_CHUNK = 512
+#: the samples of :func:`_accept_far`'s seeded search (nearest_on_cubics' defaults)
+_SEED_U, _SEED_BASIS = seed_basis(48)
+_SEED_ITERS = 6
 #: no quanta (:func:`_accept_pairs` on exact input)
 _NO_QUANTA = np.zeros(0)
+
+
+@njit(cache=True, nogil=True)
+def _accept_far(ctrl, cm, i0, i1, starts, work, e2, far, su, basis, full, u, dist, emax,
+                ok) -> None:  # pragma: no cover (compiled)
+    """:meth:`_BatchFitter._accept`'s seeded search (compiled) for the points ``far`` (flat
+    indices, ascending: :func:`_accept_points` left them over the bound e2[r] of their piece
+    r): each point's :func:`galvo_core.geometry.nearest_on_cubics` (its numbers: the samples
+    of the piece's cubic at ``su``, the nearest, Newton from there), kept where nearer than
+    Newton's; then the piece's largest error into ``emax[r]`` and ``ok[r]`` whether it is
+    within e2[r]. Unless ``full``, a piece stops at its first point still over the bound
+    (its worst point first): it fails, and its other errors and ``emax[r]`` stay as they
+    were."""
+    samp = np.empty((basis.shape[0], 2))
+    nf = far.shape[0]
+    m = starts.shape[0]
+    r = 0
+    k = 0
+    while k < nf:
+        while r + 1 < m and starts[r + 1] <= far[k]:
+            r += 1
+        s0 = starts[r]
+        s1 = s0 + i1[r] - i0[r] + 1
+        k1 = k
+        while k1 < nf and far[k1] < s1:
+            k1 += 1
+        bernstein_samples(basis, ctrl, r, samp)
+        lim = e2[r]
+        base = i0[r] - s0
+        good = True
+        if not full:  # the worst point first: a failing piece mostly fails there
+            w = k
+            for j in range(k + 1, k1):
+                if dist[far[j]] > dist[far[w]]:
+                    w = j
+            f = far[w]
+            t, d = seeded_nearest(cm, r, samp, su, _SEED_ITERS, work[base + f, 0],
+                                  work[base + f, 1])
+            good = d <= lim
+        if good:
+            for j in range(k, k1):
+                f = far[j]
+                t, d = seeded_nearest(cm, r, samp, su, _SEED_ITERS, work[base + f, 0],
+                                      work[base + f, 1])
+                if not full and not d <= lim:  # (over: dist[f] > lim stays)
+                    good = False
+                    break
+                if d < dist[f]:
+                    u[f] = t
+                    dist[f] = d
+        if good:
+            worst = 0.0
+            for j in range(s0, s1):
+                if dist[j] > worst:
+                    worst = dist[j]
+            emax[r] = worst
+            ok[r] = worst <= lim
+        else:
+            ok[r] = False
+        k = k1
 
 
 @njit(cache=True, nogil=True, error_model="numpy")
@@ -1230,7 +1295,7 @@ class _BatchFitter:
         return self._ctrl(p0, qq, p3, t)
 
     def _accept(self, ctrl: np.ndarray, i0: np.ndarray, i1: np.ndarray, e2: np.ndarray,
-                A: np.ndarray | None = None):
+                A: np.ndarray | None = None, full: bool = False):
         """Per piece: bound of the max input-point error, pass/fail of both sides of the
         guarantee, and the flat per-point errors (with the offsets of each piece).
 
@@ -1242,7 +1307,12 @@ class _BatchFitter:
         input segment is the design up to the rounding of its ends, so the curve keeps
         closer to it than the rounding allows. Both sides compiled, one piece at a time
         (:func:`_accept_points`, :func:`_accept_pairs`); a piece stops at its first pair
-        over the bound."""
+        over the bound.
+
+        Only the passing pieces' bounds and errors are final unless ``full``: a failing
+        piece may stop at its first point that the seeded search leaves over the bound
+        (:func:`_accept_far`); with ``full`` every point's error is (for the split
+        points)."""
         m = len(ctrl)
         i0 = np.ascontiguousarray(i0, dtype=np.intp)
         i1 = np.ascontiguousarray(i1, dtype=np.intp)
@@ -1257,18 +1327,12 @@ class _BatchFitter:
         far = np.empty(total, dtype=np.intp)
         nfar = _accept_points(cm, i0, i1, starts, self.work, self.arc, e2, u, dist, emax0,
                               far)
-        emax = emax0
+        ok = emax0 <= e2
         if nfar:
-            far = far[:nfar]
-            pid = np.searchsorted(starts, far, side="right") - 1
-            pts = self.work[i0[pid] + far - starts[pid]]
-            used, inv = np.unique(pid, return_inverse=True)  # (only their cubics)
-            tu, td = nearest_on_cubics(ctrl[used], inv, pts)
-            better = td < dist[far]
-            u[far[better]] = tu[better]
-            dist[far[better]] = td[better]
-            emax = np.maximum.reduceat(dist, starts)
-        ok = emax <= e2
+            _accept_far(np.ascontiguousarray(ctrl, dtype=np.float64), cm, i0, i1, starts,
+                        self.work, e2, far[:nfar], _SEED_U, _SEED_BASIS, full, u, dist,
+                        emax0, ok)
+        emax = emax0
         qa = _NO_QUANTA
         if self.quant is not None and A is not None:
             qa = np.ascontiguousarray(self.quant[A], dtype=np.float64)
@@ -1314,7 +1378,8 @@ class _BatchFitter:
             if len(A):
                 i0, i1 = self.kept[A], self.kept[B]
                 ctrl = self._dichotomy(p0[ok], qq[ok], p3[ok], sig[ok], i0, i1)
-                good, emax, dist, starts = self._accept(ctrl, i0, i1, self.e_per[A], A)
+                good, emax, dist, starts = self._accept(ctrl, i0, i1, self.e_per[A], A,
+                                                        full=True)
                 if self.quant is not None:
                     rq = np.flatnonzero(self.quant[A] > 0.0)
                     if len(rq):

@@ -757,9 +757,7 @@ def nearest_on_cubics(
     k = len(p)
     if k == 0:
         return np.zeros(0), np.zeros(0)
-    su = np.linspace(0.0, 1.0, seeds + 1)
-    s = 1.0 - su
-    basis = np.stack([s**3, 3.0 * s * s * su, 3.0 * s * su * su, su**3], axis=1)  # (S, 4)
+    su, basis = seed_basis(seeds)
     samp = np.empty((len(c), len(su), 2))  # (M, S, 2): np.einsum("sk,mkd->msd", basis, c)
     _samples_kernel(basis, np.ascontiguousarray(c), samp)
     t_out = np.empty(k)
@@ -769,19 +767,71 @@ def nearest_on_cubics(
     return t_out, d_out
 
 
+def seed_basis(seeds: int = 48) -> tuple[np.ndarray, np.ndarray]:
+    """The sample parameters of :func:`nearest_on_cubics` (``seeds + 1`` of them, evenly
+    spread over [0, 1]) and their Bernstein basis (S, 4)."""
+    su = np.linspace(0.0, 1.0, seeds + 1)
+    s = 1.0 - su
+    return su, np.stack([s**3, 3.0 * s * s * su, 3.0 * s * su * su, su**3], axis=1)
+
+
 @njit(cache=True, nogil=True)
 def _samples_kernel(basis, c, out):  # type: ignore[no-untyped-def]
     """out[m, s] = sum over k of basis[s, k] * c[m, k], summed in order (the numbers of
     the former ``np.einsum("sk,mkd->msd", basis, c)``)."""
     for m in range(c.shape[0]):
-        for i in range(basis.shape[0]):
-            b0 = basis[i, 0]
-            b1 = basis[i, 1]
-            b2 = basis[i, 2]
-            b3 = basis[i, 3]
-            for d in range(2):
-                out[m, i, d] = ((b0 * c[m, 0, d] + b1 * c[m, 1, d]) + b2 * c[m, 2, d]) \
-                    + b3 * c[m, 3, d]
+        bernstein_samples(basis, c, m, out[m])
+
+
+@njit(cache=True, nogil=True, inline="always")
+def bernstein_samples(basis, c, m, out):  # type: ignore[no-untyped-def]
+    """out[i] = the cubic c[m] at the sample i of ``basis`` (S, 4), summed in order
+    ((b0 c0 + b1 c1) + b2 c2) + b3 c3 (np.einsum's numbers, and cubic_eval's)."""
+    for i in range(basis.shape[0]):
+        b0 = basis[i, 0]
+        b1 = basis[i, 1]
+        b2 = basis[i, 2]
+        b3 = basis[i, 3]
+        for d in range(2):
+            out[i, d] = ((b0 * c[m, 0, d] + b1 * c[m, 1, d]) + b2 * c[m, 2, d]) \
+                + b3 * c[m, 3, d]
+
+
+@njit(cache=True, nogil=True, inline="always")
+def seeded_nearest(cm, m, samp, su, iters, px, py):  # type: ignore[no-untyped-def]
+    """One point's :func:`_seeded_kernel` (its numbers): the nearest of the samples
+    ``samp`` (S, 2) of cubic m (power coefficients ``cm``), Newton from there, the better of
+    both: (t, distance)."""
+    j = 0
+    best = np.inf
+    for i in range(samp.shape[0]):
+        ex = px - samp[i, 0]
+        ey = py - samp[i, 1]
+        v = ex * ex + ey * ey
+        if v != v:
+            j = i
+            best = v
+            break
+        if i == 0 or v < best:
+            j = i
+            best = v
+    ax = cm[m, 0, 0]
+    ay = cm[m, 0, 1]
+    bx = cm[m, 1, 0]
+    by = cm[m, 1, 1]
+    dx = cm[m, 2, 0]
+    dy = cm[m, 2, 1]
+    qx = px - cm[m, 3, 0]
+    qy = py - cm[m, 3, 1]
+    uk = su[j]
+    for _ in range(iters):
+        uk = newton_param(ax, ay, bx, by, dx, dy, qx, qy, uk)
+    rx = ((ax * uk + bx) * uk + dx) * uk - qx
+    ry = ((ay * uk + by) * uk + dy) * uk - qy
+    dn = rx * rx + ry * ry
+    if dn < best:
+        return uk, math.sqrt(dn)
+    return su[j], math.sqrt(best)
 
 
 #: points per chunk of :func:`_seeded_kernel` (its Newton steps run over a chunk at a time)
