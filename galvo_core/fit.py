@@ -939,24 +939,6 @@ def _ragged(starts: np.ndarray, counts: np.ndarray) -> tuple[np.ndarray, np.ndar
     return owner, off
 
 
-@njit(cache=True, nogil=True)
-def _piece_sample_kernel(i0, i1, stride, cnt, arc, work, pid, pts, u):  # pragma: no cover
-    """:meth:`_BatchFitter._piece_sample` compiled: point j of piece r is input point
-    i0[r] + 1 + stride[r] * j, its parameter its arc length from i0[r] over the piece's."""
-    o = 0
-    for r in range(i0.shape[0]):
-        a = i0[r]
-        span = arc[i1[r]] - arc[a]
-        den = span if span > 0 else 1.0
-        for j in range(cnt[r]):
-            ix = a + 1 + stride[r] * j
-            pid[o] = r
-            pts[o, 0] = work[ix, 0]
-            pts[o, 1] = work[ix, 1]
-            u[o] = (arc[ix] - arc[a]) / den
-            o += 1
-
-
 def _halves(a: np.ndarray, b: np.ndarray, k: np.ndarray) -> np.ndarray:
     """Pieces (a, k) and (k, b) for every split piece, in order: (2n, 2)."""
     return np.stack([np.stack([a, k], axis=1), np.stack([k, b], axis=1)], axis=1).reshape(-1, 2)
@@ -974,75 +956,101 @@ def _chain_phase(idx: np.ndarray, k: int) -> np.ndarray:
     return (idx - idx[chain_start]) % k
 
 
-def _handle_lengths(u, pid, pts, p0, p3, t0, t3, m):
-    """Schneider's handle lengths per piece: the cubic p0, p0 + al t0, p3 - be t3, p3 nearest
-    (least squares) to the points ``pts`` at the parameters ``u`` (piece ``pid`` each):
-    (al, be, det, c11, c22) of the 2x2 normal equations (al, be inf/NaN where det is 0)."""
-    sums = np.zeros((5, m))
-    _handle_sums(np.ascontiguousarray(u, dtype=np.float64),
-                 np.ascontiguousarray(pid, dtype=np.intp),
-                 np.ascontiguousarray(pts, dtype=np.float64),
-                 np.ascontiguousarray(p0, dtype=np.float64),
-                 np.ascontiguousarray(p3, dtype=np.float64),
-                 np.ascontiguousarray(t0, dtype=np.float64),
-                 np.ascontiguousarray(t3, dtype=np.float64), sums)
-    c11, c12, c22, x1, x2 = sums
-    with np.errstate(divide="ignore", invalid="ignore"):
-        det = c11 * c22 - c12 * c12
-        al = (x1 * c22 - x2 * c12) / det
-        be = (c11 * x2 - c12 * x1) / det
-    return al, be, det, c11, c22
+@njit(cache=True, nogil=True, inline="always")
+def _piece_points(a, b, work, arc, sample, pxb, pyb, ub):  # pragma: no cover (compiled)
+    """The input points strictly inside the piece a..b (input indices; at most ``sample``,
+    evenly strided: the least-squares fits' sample) into ``pxb``, ``pyb`` and their
+    chord-length parameters (arc length over the piece's) into ``ub``; returns their
+    number."""
+    L = b - a - 1
+    stride = max(1, -(-L // sample))
+    n = -(-L // stride)
+    span = arc[b] - arc[a]
+    den = span if span > 0 else 1.0
+    for j in range(n):
+        ix = a + 1 + stride * j
+        pxb[j] = work[ix, 0]
+        pyb[j] = work[ix, 1]
+        ub[j] = (arc[ix] - arc[a]) / den
+    return n
 
 
-@njit(cache=True, nogil=True)
-def _handle_sums(u, pid, pts, p0, p3, t0, t3, sums) -> None:  # pragma: no cover (compiled)
-    """:func:`_handle_lengths`' sums per piece (compiled, in the order of the points, as
-    the former np.bincount): c11, c12, c22 of the normal matrix and the right side x1, x2
-    into ``sums`` (5, m)."""
-    for i in range(len(u)):
-        r = pid[i]
-        uk = u[i]
+@njit(cache=True, nogil=True, error_model="numpy", inline="always")
+def _handle_solve(n, pxb, pyb, ub, p0x, p0y, p3x, p3y, t0x, t0y, t3x,
+                  t3y):  # pragma: no cover (compiled)
+    """Schneider's handle lengths of one piece: the cubic p0, p0 + al t0, p3 - be t3, p3
+    nearest (least squares) to the points at the parameters ``ub`` (sums in the order of
+    the points): (al, be, det, c11, c22) of the 2x2 normal equations (al, be inf/NaN where
+    det is 0)."""
+    c11 = 0.0
+    c12 = 0.0
+    c22 = 0.0
+    x1 = 0.0
+    x2 = 0.0
+    for j in range(n):
+        uk = ub[j]
         s = 1.0 - uk
         b0 = s * s * s
         b1 = 3 * s * s * uk
         b2 = 3 * s * uk * uk
         b3 = uk * uk * uk
-        a1x = b1 * t0[r, 0]
-        a1y = b1 * t0[r, 1]
-        a2x = -b2 * t3[r, 0]
-        a2y = -b2 * t3[r, 1]
-        rx = pts[i, 0] - (b0 + b1) * p0[r, 0] - (b2 + b3) * p3[r, 0]
-        ry = pts[i, 1] - (b0 + b1) * p0[r, 1] - (b2 + b3) * p3[r, 1]
-        sums[0, r] += a1x * a1x + a1y * a1y
-        sums[1, r] += a1x * a2x + a1y * a2y
-        sums[2, r] += a2x * a2x + a2y * a2y
-        sums[3, r] += rx * a1x + ry * a1y
-        sums[4, r] += rx * a2x + ry * a2y
+        a1x = b1 * t0x
+        a1y = b1 * t0y
+        a2x = -b2 * t3x
+        a2y = -b2 * t3y
+        rx = pxb[j] - (b0 + b1) * p0x - (b2 + b3) * p3x
+        ry = pyb[j] - (b0 + b1) * p0y - (b2 + b3) * p3y
+        c11 += a1x * a1x + a1y * a1y
+        c12 += a1x * a2x + a1y * a2y
+        c22 += a2x * a2x + a2y * a2y
+        x1 += rx * a1x + ry * a1y
+        x2 += rx * a2x + ry * a2y
+    det = c11 * c22 - c12 * c12
+    al = (x1 * c22 - x2 * c12) / det
+    be = (c11 * x2 - c12 * x1) / det
+    return al, be, det, c11, c22
+
+
+@njit(cache=True, nogil=True, error_model="numpy", inline="always")
+def _nearest_params(p0x, p0y, p1x, p1y, p2x, p2y, p3x, p3y, n, pxb, pyb, ub, qxb, qyb,
+                    steps):  # pragma: no cover (compiled)
+    """The power coefficients (a, b, d, e: x, y each) of the cubic p0..p3 (power_coeffs'
+    arithmetic), and ``steps`` Newton steps of each point's parameter ``ub`` (in place,
+    step by step over the points: the loop vectorises) towards its nearest point (as
+    :func:`_newton_kernel`); ``qxb``, ``qyb`` get the points relative to the start."""
+    ax = -p0x + 3.0 * (p1x - p2x)
+    ax += p3x
+    ay = -p0y + 3.0 * (p1y - p2y)
+    ay += p3y
+    bx = 3.0 * (p0x + p2x) - 6.0 * p1x
+    by = 3.0 * (p0y + p2y) - 6.0 * p1y
+    dx = 3.0 * (p1x - p0x)
+    dy = 3.0 * (p1y - p0y)
+    for j in range(n):
+        qxb[j] = pxb[j] - p0x
+        qyb[j] = pyb[j] - p0y
+    for _ in range(steps):
+        for j in range(n):
+            uk = ub[j]
+            ub[j] = newton_param(ax, ay, bx, by, dx, dy, qxb[j], qyb[j], uk)
+    return ax, ay, bx, by, dx, dy
 
 
 @njit(cache=True, nogil=True, error_model="numpy")
-def _gn_rounds(ps, pts, u, p0, p3, t0, t3, al, be, chord, rounds) -> None:  # pragma: no cover
-    """:meth:`_BatchFitter._gauss_newton`'s rounds (compiled), in place on the handle
-    lengths ``al``, ``be`` and the sample points' parameters ``u``: piece r's sample points
-    are ps[r] .. ps[r + 1] - 1 of ``pts``. Per round and piece: the cubic's power
-    coefficients, 2 Newton steps per point (as :func:`_newton_kernel`), the unit normal at
-    the nearest point and the signed distance along it, the 2x2 normal equations of the
-    handle lengths, a damped step (the numbers of the former numpy version, bit for bit)."""
-    nmax = 0
-    for r in range(len(al)):
-        nmax = max(nmax, ps[r + 1] - ps[r])
-    ub = np.empty(nmax)
-    qxb = np.empty(nmax)
-    qyb = np.empty(nmax)
-    rxb = np.empty(nmax)
-    ryb = np.empty(nmax)
-    txb = np.empty(nmax)
-    tyb = np.empty(nmax)
-    nb = np.empty(nmax)
-    resb = np.empty(nmax)
-    j1b = np.empty(nmax)
-    j2b = np.empty(nmax)
-    for r in range(len(al)):
+def _ls_kernel(i0, i1, work, arc, sample, p0, p3, t0, t3, chord, ctrl,
+               ok) -> None:  # pragma: no cover (compiled)
+    """:meth:`_BatchFitter._least_squares` one piece at a time (compiled): Schneider's
+    handle lengths at chord-length parameters, twice 2 Newton steps of the parameters and
+    the handles again; a handle not positive or over twice the chord (or a singular
+    system) is a third of the chord, ``ok[r]`` False. The numbers of the former numpy
+    version (:func:`_handle_sums`, :func:`_newton_kernel`), bit for bit."""
+    pxb = np.empty(sample)
+    pyb = np.empty(sample)
+    ub = np.empty(sample)
+    qxb = np.empty(sample)
+    qyb = np.empty(sample)
+    for r in range(i0.shape[0]):
+        n = _piece_points(i0[r], i1[r], work, arc, sample, pxb, pyb, ub)
         p0x = p0[r, 0]
         p0y = p0[r, 1]
         p3x = p3[r, 0]
@@ -1051,44 +1059,88 @@ def _gn_rounds(ps, pts, u, p0, p3, t0, t3, al, be, chord, rounds) -> None:  # pr
         t0y = t0[r, 1]
         t3x = t3[r, 0]
         t3y = t3[r, 1]
-        lim = 0.25 * chord[r]
-        a_ = al[r]
-        b_ = be[r]
+        c = chord[r]
+        good = False
+        for it in range(3):
+            al, be, det, c11, c22 = _handle_solve(n, pxb, pyb, ub, p0x, p0y, p3x, p3y, t0x,
+                                                  t0y, t3x, t3y)
+            good = ((abs(det) > 1e-12 * (c11 * c22 + 1e-300)) and al > 0 and be > 0
+                    and al < 2.0 * c and be < 2.0 * c)
+            if not good:
+                al = c / 3.0
+                be = c / 3.0
+            p1x = p0x + al * t0x
+            p1y = p0y + al * t0y
+            p2x = p3x - be * t3x
+            p2y = p3y - be * t3y
+            ctrl[r, 0, 0] = p0x
+            ctrl[r, 0, 1] = p0y
+            ctrl[r, 1, 0] = p1x
+            ctrl[r, 1, 1] = p1y
+            ctrl[r, 2, 0] = p2x
+            ctrl[r, 2, 1] = p2y
+            ctrl[r, 3, 0] = p3x
+            ctrl[r, 3, 1] = p3y
+            if it == 2:
+                break
+            _nearest_params(p0x, p0y, p1x, p1y, p2x, p2y, p3x, p3y, n, pxb, pyb, ub, qxb,
+                            qyb, 2)
+        ok[r] = good
+
+
+@njit(cache=True, nogil=True, error_model="numpy")
+def _gn_kernel(i0, i1, work, arc, sample, p0, p3, t0, t3, chord, rounds, ctrl,
+               ok) -> None:  # pragma: no cover (compiled)
+    """:meth:`_BatchFitter._gauss_newton` one piece at a time (compiled): Schneider's
+    handle lengths at chord-length parameters to start (a third of the chord where not
+    positive or over twice the chord), then per round the cubic's power coefficients, 2
+    Newton steps per point, the unit normal at the nearest point and the signed distance
+    along it, the 2x2 normal equations of the handle lengths, a damped step; ``ok[r]``:
+    both handles positive and under twice the chord (else a third of it). The numbers of
+    the former numpy version, bit for bit."""
+    pxb = np.empty(sample)
+    pyb = np.empty(sample)
+    ub = np.empty(sample)
+    qxb = np.empty(sample)
+    qyb = np.empty(sample)
+    rxb = np.empty(sample)
+    ryb = np.empty(sample)
+    txb = np.empty(sample)
+    tyb = np.empty(sample)
+    nb = np.empty(sample)
+    resb = np.empty(sample)
+    j1b = np.empty(sample)
+    j2b = np.empty(sample)
+    for r in range(i0.shape[0]):
+        n = _piece_points(i0[r], i1[r], work, arc, sample, pxb, pyb, ub)
+        p0x = p0[r, 0]
+        p0y = p0[r, 1]
+        p3x = p3[r, 0]
+        p3y = p3[r, 1]
+        t0x = t0[r, 0]
+        t0y = t0[r, 1]
+        t3x = t3[r, 0]
+        t3y = t3[r, 1]
+        c = chord[r]
+        a_, b_, _d, _c11, _c22 = _handle_solve(n, pxb, pyb, ub, p0x, p0y, p3x, p3y, t0x,
+                                               t0y, t3x, t3y)
+        if not (a_ > 0 and b_ > 0 and a_ < 2.0 * c and b_ < 2.0 * c):
+            a_ = c / 3.0
+            b_ = c / 3.0
+        lim = 0.25 * c
         for _ in range(rounds):
             p1x = p0x + a_ * t0x
             p1y = p0y + a_ * t0y
             p2x = p3x - b_ * t3x
             p2y = p3y - b_ * t3y
-            ax = -p0x + 3.0 * (p1x - p2x)
-            ax += p3x
-            ay = -p0y + 3.0 * (p1y - p2y)
-            ay += p3y
-            bx = 3.0 * (p0x + p2x) - 6.0 * p1x
-            by = 3.0 * (p0y + p2y) - 6.0 * p1y
-            dx = 3.0 * (p1x - p0x)
-            dy = 3.0 * (p1y - p0y)
+            ax, ay, bx, by, dx, dy = _nearest_params(p0x, p0y, p1x, p1y, p2x, p2y, p3x, p3y,
+                                                     n, pxb, pyb, ub, qxb, qyb, 2)
             ex = p0x
             ey = p0y
-            c11 = 0.0
-            c12 = 0.0
-            c22 = 0.0
-            x1 = 0.0
-            x2 = 0.0
-            k0 = ps[r]
-            n = ps[r + 1] - k0
-            for j in range(n):  # (step by step over the piece's points: vectorises)
-                qxb[j] = pts[k0 + j, 0] - ex
-                qyb[j] = pts[k0 + j, 1] - ey
-                ub[j] = u[k0 + j]
-            for _i in range(2):
-                for j in range(n):
-                    uk = ub[j]
-                    ub[j] = newton_param(ax, ay, bx, by, dx, dy, qxb[j], qyb[j], uk)
             for j in range(n):
                 uk = ub[j]
-                u[k0 + j] = uk
-                rxb[j] = ((ax * uk + bx) * uk + dx) * uk + ex - pts[k0 + j, 0]
-                ryb[j] = ((ay * uk + by) * uk + dy) * uk + ey - pts[k0 + j, 1]
+                rxb[j] = ((ax * uk + bx) * uk + dx) * uk + ex - pxb[j]
+                ryb[j] = ((ay * uk + by) * uk + dy) * uk + ey - pyb[j]
                 txb[j] = (3.0 * ax * uk + 2.0 * bx) * uk + dx
                 tyb[j] = (3.0 * ay * uk + 2.0 * by) * uk + dy
             for j in range(n):
@@ -1103,6 +1155,11 @@ def _gn_rounds(ps, pts, u, p0, p3, t0, t3, al, be, chord, rounds) -> None:  # pr
                 sk = 1.0 - uk
                 j1b[j] = 3 * sk * sk * uk * (nx * t0x + ny * t0y)
                 j2b[j] = -3 * sk * uk * uk * (nx * t3x + ny * t3y)
+            c11 = 0.0
+            c12 = 0.0
+            c22 = 0.0
+            x1 = 0.0
+            x2 = 0.0
             for j in range(n):
                 j1 = j1b[j]
                 j2 = j2b[j]
@@ -1126,58 +1183,57 @@ def _gn_rounds(ps, pts, u, p0, p3, t0, t3, al, be, chord, rounds) -> None:  # pr
                 v = b_ + min(max(db, -lim), lim)
                 h = 0.5 * b_
                 b_ = v if (v >= h or v != v) else h
-        al[r] = a_
-        be[r] = b_
+        good = (np.isfinite(a_) and np.isfinite(b_) and a_ > 0 and b_ > 0 and a_ < 2.0 * c
+                and b_ < 2.0 * c)
+        if not good:
+            a_ = c / 3.0
+            b_ = c / 3.0
+        ok[r] = good
+        ctrl[r, 0, 0] = p0x
+        ctrl[r, 0, 1] = p0y
+        ctrl[r, 1, 0] = p0x + a_ * t0x
+        ctrl[r, 1, 1] = p0y + a_ * t0y
+        ctrl[r, 2, 0] = p3x - b_ * t3x
+        ctrl[r, 2, 1] = p3y - b_ * t3y
+        ctrl[r, 3, 0] = p3x
+        ctrl[r, 3, 1] = p3y
 
 
 @njit(cache=True, nogil=True, error_model="numpy")
-def _gn_free_sums(ps, pts, u, ctrl, N, g) -> None:  # pragma: no cover (compiled)
+def _gn_free_sums(i0, i1, work, arc, sample, ps, u, ctrl, first, N,
+                  g) -> None:  # pragma: no cover (compiled)
     """:meth:`_BatchFitter._gauss_newton_free`'s normal equations of one round (compiled),
-    per piece r (sample points ps[r] .. ps[r + 1] - 1, cubic ``ctrl[r]``): 2 Newton steps per
-    point from ``u`` (updated; as :func:`_newton_kernel`), the unit normal at the nearest
-    point and the signed distance along it, the Jacobian of the distance in the two inner
-    control points; sums in the order of the points (as the former np.bincount) into ``N``
-    (m, 4, 4) and ``g`` (m, 4) (minus the gradient)."""
-    nmax = 0
-    for r in range(len(ps) - 1):
-        nmax = max(nmax, ps[r + 1] - ps[r])
-    ub = np.empty(nmax)
-    qxb = np.empty(nmax)
-    qyb = np.empty(nmax)
-    jb = np.empty((4, nmax))
-    resb = np.empty(nmax)
-    for r in range(len(ps) - 1):
+    per piece r (its sample points: :func:`_piece_points`; their parameters u[ps[r]] ..
+    u[ps[r + 1] - 1], chord length ones when ``first``; cubic ``ctrl[r]``): 2 Newton steps
+    per point from ``u`` (updated; as :func:`_newton_kernel`), the unit normal at the
+    nearest point and the signed distance along it, the Jacobian of the distance in the two
+    inner control points; sums in the order of the points (as the former np.bincount) into
+    ``N`` (m, 4, 4) and ``g`` (m, 4) (minus the gradient)."""
+    pxb = np.empty(sample)
+    pyb = np.empty(sample)
+    ub = np.empty(sample)
+    qxb = np.empty(sample)
+    qyb = np.empty(sample)
+    jb = np.empty((4, sample))
+    resb = np.empty(sample)
+    for r in range(i0.shape[0]):
+        n = _piece_points(i0[r], i1[r], work, arc, sample, pxb, pyb, ub)
+        k0 = ps[r]
+        if not first:
+            for j in range(n):
+                ub[j] = u[k0 + j]
         p0x = ctrl[r, 0, 0]
         p0y = ctrl[r, 0, 1]
-        p1x = ctrl[r, 1, 0]
-        p1y = ctrl[r, 1, 1]
-        p2x = ctrl[r, 2, 0]
-        p2y = ctrl[r, 2, 1]
-        ax = -p0x + 3.0 * (p1x - p2x)
-        ax += ctrl[r, 3, 0]
-        ay = -p0y + 3.0 * (p1y - p2y)
-        ay += ctrl[r, 3, 1]
-        bx = 3.0 * (p0x + p2x) - 6.0 * p1x
-        by = 3.0 * (p0y + p2y) - 6.0 * p1y
-        dx = 3.0 * (p1x - p0x)
-        dy = 3.0 * (p1y - p0y)
+        ax, ay, bx, by, dx, dy = _nearest_params(
+            p0x, p0y, ctrl[r, 1, 0], ctrl[r, 1, 1], ctrl[r, 2, 0], ctrl[r, 2, 1],
+            ctrl[r, 3, 0], ctrl[r, 3, 1], n, pxb, pyb, ub, qxb, qyb, 2)
         ex = p0x
         ey = p0y
-        k0 = ps[r]
-        n = ps[r + 1] - k0
-        for j in range(n):
-            qxb[j] = pts[k0 + j, 0] - ex
-            qyb[j] = pts[k0 + j, 1] - ey
-            ub[j] = u[k0 + j]
-        for _i in range(2):
-            for j in range(n):
-                uk = ub[j]
-                ub[j] = newton_param(ax, ay, bx, by, dx, dy, qxb[j], qyb[j], uk)
         for j in range(n):
             uk = ub[j]
             u[k0 + j] = uk
-            rx = ((ax * uk + bx) * uk + dx) * uk + ex - pts[k0 + j, 0]
-            ry = ((ay * uk + by) * uk + dy) * uk + ey - pts[k0 + j, 1]
+            rx = ((ax * uk + bx) * uk + dx) * uk + ex - pxb[j]
+            ry = ((ay * uk + by) * uk + dy) * uk + ey - pyb[j]
             tx = (3.0 * ax * uk + 2.0 * bx) * uk + dx
             ty = (3.0 * ay * uk + 2.0 * by) * uk + dy
             dn = math.hypot(tx, ty)
@@ -1832,45 +1888,23 @@ class _BatchFitter:
         self._cubics = [(A[keep], B[keep], C[keep], E[keep])]
         return True
 
-    def _piece_sample(self, i0: np.ndarray, i1: np.ndarray):
-        """The input points strictly inside each piece i0..i1 (at most ``_BISECT_SAMPLE``,
-        evenly strided) for the least-squares fits: (piece of each (K,), points (K, 2),
-        chord-length parameters (K,))."""
-        L = i1 - i0 - 1
-        stride = np.maximum(1, -(-L // _BISECT_SAMPLE))
-        cnt = -(-L // stride)
-        total = int(cnt.sum())
-        pid = np.empty(total, dtype=np.intp)
-        pts = np.empty((total, 2))
-        u = np.empty(total)
-        _piece_sample_kernel(np.asarray(i0, dtype=np.intp), np.asarray(i1, dtype=np.intp),
-                             stride.astype(np.intp), cnt.astype(np.intp), self.arc,
-                             self.work, pid, pts, u)
-        return pid, pts, u
-
     def _least_squares(self, A: np.ndarray, B: np.ndarray, i0: np.ndarray, i1: np.ndarray):
         """Per piece: the cubic with the piece's end points and end tangents whose two
         handle lengths minimise the squared distances of (a sample of) its input points at
         their parameters (chord length, then twice the nearest point's), Schneider's
-        fit; (ctrl (m, 4, 2), ok (m,): positive handles no longer than twice the chord)."""
+        fit; (ctrl (m, 4, 2), ok (m,): positive handles no longer than twice the chord).
+        Compiled, one piece at a time (:func:`_ls_kernel`)."""
         m = len(A)
         p0, p3 = self.q[A], self.q[B]
-        t0, t3 = self.t_out[A], self.t_in[B]
-        pid, pts, u = self._piece_sample(i0, i1)
         chord = np.hypot(*(p3 - p0).T)
-        ctrl = np.zeros((m, 4, 2))
-        ok = np.zeros(m, dtype=bool)
-        for it in range(3):
-            al, be, det, c11, c22 = _handle_lengths(u, pid, pts, p0, p3, t0, t3, m)
-            ok = (np.abs(det) > 1e-12 * (c11 * c22 + 1e-300)) & (al > 0) & (be > 0)
-            ok &= (al < 2.0 * chord) & (be < 2.0 * chord)
-            al = np.where(ok, al, chord / 3.0)
-            be = np.where(ok, be, chord / 3.0)
-            ctrl = np.stack([p0, p0 + al[:, None] * t0, p3 - be[:, None] * t3, p3], axis=1)
-            if it == 2:
-                break
-            cf = gather_coeffs(power_coeffs_many(ctrl), pid)
-            u, _ = newton_nearest_many(cf, pts.T, u, 2)
+        ctrl = np.empty((m, 4, 2))
+        ok = np.empty(m, dtype=bool)
+        _ls_kernel(np.ascontiguousarray(i0, dtype=np.intp),
+                   np.ascontiguousarray(i1, dtype=np.intp), self.work, self.arc,
+                   _BISECT_SAMPLE, np.ascontiguousarray(p0, dtype=np.float64),
+                   np.ascontiguousarray(p3, dtype=np.float64),
+                   np.ascontiguousarray(self.t_out[A], dtype=np.float64),
+                   np.ascontiguousarray(self.t_in[B], dtype=np.float64), chord, ctrl, ok)
         return ctrl, ok
 
     def _gauss_newton(self, A: np.ndarray, B: np.ndarray, i0: np.ndarray, i1: np.ndarray,
@@ -1882,30 +1916,20 @@ class _BatchFitter:
         (:meth:`_least_squares`: handles for fixed parameters, then new parameters) creeps
         towards that minimum (a design cubic sampled exactly, handles 102 / 81: still 91 /
         92 after 50 rounds); this reaches it in 3. Returns (ctrl (m, 4, 2), ok (m,):
-        positive handles no longer than twice the chord)."""
+        positive handles no longer than twice the chord). Compiled, one piece at a time
+        (:func:`_gn_kernel`)."""
         m = len(A)
         p0, p3 = self.q[A], self.q[B]
-        t0, t3 = self.t_out[A], self.t_in[B]
-        pid, pts, u = self._piece_sample(i0, i1)
         chord = np.hypot(*(p3 - p0).T)
-        # start: Schneider's handles at chord-length parameters
-        al, be, _, _, _ = _handle_lengths(u, pid, pts, p0, p3, t0, t3, m)
-        bad = ~((al > 0) & (be > 0) & (al < 2.0 * chord) & (be < 2.0 * chord))
-        al = np.where(bad, chord / 3.0, al)
-        be = np.where(bad, chord / 3.0, be)
-        ps = np.r_[0, np.cumsum(np.bincount(pid, minlength=m))]
-        al = np.ascontiguousarray(al, dtype=np.float64)
-        be = np.ascontiguousarray(be, dtype=np.float64)
-        _gn_rounds(ps, np.ascontiguousarray(pts, dtype=np.float64),
-                   np.ascontiguousarray(u, dtype=np.float64), np.ascontiguousarray(p0),
-                   np.ascontiguousarray(p3), np.ascontiguousarray(t0, dtype=np.float64),
-                   np.ascontiguousarray(t3, dtype=np.float64), al, be,
-                   np.ascontiguousarray(chord), rounds)
-        ok = np.isfinite(al) & np.isfinite(be) & (al > 0) & (be > 0)
-        ok &= (al < 2.0 * chord) & (be < 2.0 * chord)
-        al = np.where(ok, al, chord / 3.0)
-        be = np.where(ok, be, chord / 3.0)
-        ctrl = np.stack([p0, p0 + al[:, None] * t0, p3 - be[:, None] * t3, p3], axis=1)
+        ctrl = np.empty((m, 4, 2))
+        ok = np.empty(m, dtype=bool)
+        _gn_kernel(np.ascontiguousarray(i0, dtype=np.intp),
+                   np.ascontiguousarray(i1, dtype=np.intp), self.work, self.arc,
+                   _BISECT_SAMPLE, np.ascontiguousarray(p0, dtype=np.float64),
+                   np.ascontiguousarray(p3, dtype=np.float64),
+                   np.ascontiguousarray(self.t_out[A], dtype=np.float64),
+                   np.ascontiguousarray(self.t_in[B], dtype=np.float64), chord, rounds, ctrl,
+                   ok)
         return ctrl, ok
 
     def _bulging_segments(self, ab: np.ndarray, line: np.ndarray) -> np.ndarray:
@@ -1961,16 +1985,19 @@ class _BatchFitter:
         free (the end tangents too: they are estimates from rounded points), Gauss-Newton on
         the normal distances; ok where each end tangent turned at most ``_GN_TURN``."""
         m = len(A)
-        pid, pts, u = self._piece_sample(i0, i1)
-        ctrl = ctrl.copy()
+        i0 = np.ascontiguousarray(i0, dtype=np.intp)
+        i1 = np.ascontiguousarray(i1, dtype=np.intp)
+        L = i1 - i0 - 1
+        cnt = -(-L // np.maximum(1, -(-L // _BISECT_SAMPLE)))
+        ps = np.r_[0, np.cumsum(cnt)]
+        ctrl = np.array(ctrl, dtype=np.float64)
         chord = np.hypot(*(ctrl[:, 3] - ctrl[:, 0]).T)
-        ps = np.r_[0, np.cumsum(np.bincount(pid, minlength=m))]
-        pts = np.ascontiguousarray(pts, dtype=np.float64)
-        u = np.array(u, dtype=np.float64)
-        for _ in range(rounds):
+        u = np.empty(int(ps[-1]))
+        for it in range(rounds):
             N = np.zeros((m, 4, 4))
             g = np.zeros((m, 4))
-            _gn_free_sums(ps, pts, u, ctrl, N, g)
+            _gn_free_sums(i0, i1, self.work, self.arc, _BISECT_SAMPLE, ps, u, ctrl, it == 0,
+                          N, g)
             N = np.where(np.isfinite(N), N, 0.0)
             g = np.where(np.isfinite(g), g, 0.0)
             N += (1e-9 * np.trace(N, axis1=1, axis2=2) + 1e-12)[:, None, None] * np.eye(4)
