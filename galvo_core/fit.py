@@ -90,13 +90,11 @@ from numba import njit
 from galvo_core.drawing import Drawing, Path
 from galvo_core.errors import Cancelled, ParamError
 from galvo_core.geometry import (
+    bernstein_samples,
     cubic_eval,
     cubic_length,
-    gather_coeffs,
     nearest_on_cubic,
     nearest_on_cubic_each,
-    bernstein_samples,
-    newton_nearest_many,
     newton_param,
     point_polyline_distance,
     point_segment_distance,
