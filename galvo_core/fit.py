@@ -1198,11 +1198,12 @@ def _gn_kernel(i0, i1, work, arc, sample, p0, p3, t0, t3, chord, rounds, ctrl,
 
 
 @njit(cache=True, nogil=True, error_model="numpy")
-def _gn_free_sums(i0, i1, work, arc, sample, ps, u, ctrl, first, N,
+def _gn_free_sums(i0, i1, work, arc, sample, ps, pts, u, ctrl, first, N,
                   g) -> None:  # pragma: no cover (compiled)
     """:meth:`_BatchFitter._gauss_newton_free`'s normal equations of one round (compiled),
-    per piece r (its sample points: :func:`_piece_points`; their parameters u[ps[r]] ..
-    u[ps[r + 1] - 1], chord length ones when ``first``; cubic ``ctrl[r]``): 2 Newton steps
+    per piece r (its sample points: :func:`_piece_points`, kept in pts[ps[r]] ..
+    pts[ps[r + 1] - 1] on the ``first`` round, their parameters in ``u``, chord length ones
+    on the first round; cubic ``ctrl[r]``): 2 Newton steps
     per point from ``u`` (updated; as :func:`_newton_kernel`), the unit normal at the
     nearest point and the signed distance along it, the Jacobian of the distance in the two
     inner control points; sums in the order of the points (as the former np.bincount) into
@@ -1215,10 +1216,17 @@ def _gn_free_sums(i0, i1, work, arc, sample, ps, u, ctrl, first, N,
     jb = np.empty((4, sample))
     resb = np.empty(sample)
     for r in range(i0.shape[0]):
-        n = _piece_points(i0[r], i1[r], work, arc, sample, pxb, pyb, ub)
         k0 = ps[r]
-        if not first:
+        n = ps[r + 1] - k0
+        if first:
+            _piece_points(i0[r], i1[r], work, arc, sample, pxb, pyb, ub)
             for j in range(n):
+                pts[k0 + j, 0] = pxb[j]
+                pts[k0 + j, 1] = pyb[j]
+        else:
+            for j in range(n):
+                pxb[j] = pts[k0 + j, 0]
+                pyb[j] = pts[k0 + j, 1]
                 ub[j] = u[k0 + j]
         p0x = ctrl[r, 0, 0]
         p0y = ctrl[r, 0, 1]
@@ -1991,11 +1999,12 @@ class _BatchFitter:
         ctrl = np.array(ctrl, dtype=np.float64)
         chord = np.hypot(*(ctrl[:, 3] - ctrl[:, 0]).T)
         u = np.empty(int(ps[-1]))
+        pts = np.empty((len(u), 2))
         for it in range(rounds):
             N = np.zeros((m, 4, 4))
             g = np.zeros((m, 4))
-            _gn_free_sums(i0, i1, self.work, self.arc, _BISECT_SAMPLE, ps, u, ctrl, it == 0,
-                          N, g)
+            _gn_free_sums(i0, i1, self.work, self.arc, _BISECT_SAMPLE, ps, pts, u, ctrl,
+                          it == 0, N, g)
             N = np.where(np.isfinite(N), N, 0.0)
             g = np.where(np.isfinite(g), g, 0.0)
             N += (1e-9 * np.trace(N, axis1=1, axis2=2) + 1e-12)[:, None, None] * np.eye(4)
