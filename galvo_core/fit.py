@@ -1255,17 +1255,62 @@ def _gn_free_sums(i0, i1, work, arc, sample, ps, pts, u, ctrl, first, N,
             jb[1, j] = b1 * ny
             jb[2, j] = b2 * nx
             jb[3, j] = b2 * ny
-        for i in range(4):
-            for i2 in range(i, 4):
-                acc = 0.0
-                for j in range(n):
-                    acc += jb[i, j] * jb[i2, j]
-                N[r, i, i2] = acc
-                N[r, i2, i] = acc
-            acc = 0.0
-            for j in range(n):
-                acc += jb[i, j] * resb[j]
-            g[r, i] = -acc
+        # the 14 sums in one pass (each in the order of the points, as before; their
+        # chains of additions independent of each other, so they overlap)
+        n00 = 0.0
+        n01 = 0.0
+        n02 = 0.0
+        n03 = 0.0
+        n11 = 0.0
+        n12 = 0.0
+        n13 = 0.0
+        n22 = 0.0
+        n23 = 0.0
+        n33 = 0.0
+        g0 = 0.0
+        g1 = 0.0
+        g2 = 0.0
+        g3 = 0.0
+        for j in range(n):
+            j0 = jb[0, j]
+            j1 = jb[1, j]
+            j2 = jb[2, j]
+            j3 = jb[3, j]
+            rs = resb[j]
+            n00 += j0 * j0
+            n01 += j0 * j1
+            n02 += j0 * j2
+            n03 += j0 * j3
+            n11 += j1 * j1
+            n12 += j1 * j2
+            n13 += j1 * j3
+            n22 += j2 * j2
+            n23 += j2 * j3
+            n33 += j3 * j3
+            g0 += j0 * rs
+            g1 += j1 * rs
+            g2 += j2 * rs
+            g3 += j3 * rs
+        N[r, 0, 0] = n00
+        N[r, 0, 1] = n01
+        N[r, 1, 0] = n01
+        N[r, 0, 2] = n02
+        N[r, 2, 0] = n02
+        N[r, 0, 3] = n03
+        N[r, 3, 0] = n03
+        N[r, 1, 1] = n11
+        N[r, 1, 2] = n12
+        N[r, 2, 1] = n12
+        N[r, 1, 3] = n13
+        N[r, 3, 1] = n13
+        N[r, 2, 2] = n22
+        N[r, 2, 3] = n23
+        N[r, 3, 2] = n23
+        N[r, 3, 3] = n33
+        g[r, 0] = -g0
+        g[r, 1] = -g1
+        g[r, 2] = -g2
+        g[r, 3] = -g3
 
 
 class _BatchFitter:
@@ -1785,9 +1830,14 @@ class _BatchFitter:
                 return passed, ctrl_all, em_all
         ctrl = self._dichotomy(p0[w], qq[w], p3[w], sig[w], i0, i1, _MERGE_SAMPLE)
         # screen on a sample of the points first: the full test only where it can pass
-        lk = self._sample_ok(ctrl, i0, i1, self.e_per[a])
-        if self.quant is not None:
-            lk |= self.quant[a] > 0.0  # (the least-squares cubic may pass where this fails)
+        # (not on rounded input: the least-squares cubic may pass where this fails)
+        if self.quant is None:
+            lk = self._sample_ok(ctrl, i0, i1, self.e_per[a])
+        else:
+            lk = self.quant[a] > 0.0
+            ex = np.flatnonzero(~lk)
+            if len(ex):
+                lk[ex] = self._sample_ok(ctrl[ex], i0[ex], i1[ex], self.e_per[a[ex]])
         if not lk.any():
             self._second_try(A, B, fresh, fresh, passed, ctrl_all, em_all)
             self._remember_failed(key[fresh & ~passed])
