@@ -2791,9 +2791,9 @@ def _over_kernel(samp, sstep, poly, pstep, lim, k, out):  # pragma: no cover (co
         at = lo - 1
         px = samp[t, 0]
         py = samp[t, 1]
-        d = _win_d(px, py, poly, 0, n - 1, at, k)
+        d = _win_d(px, py, poly, 0, n - 1, at, k, cum)
         if d > lim and n > 16 * k + 2:
-            d = _win_d(px, py, poly, 0, n - 1, at, 16 * k)
+            d = _win_d(px, py, poly, 0, n - 1, at, 16 * k, cum)
         if d > lim:
             d = _brute_d(px, py, poly, 0, n)
         out[t] = d
@@ -2870,9 +2870,9 @@ def _polyline_checks(C4, cub, msz, W, wstep, first, last, lim, k,
                 at = lo - 1
                 px = sx[t]
                 py = sy[t]
-                d = _win_d(px, py, W, f, nseg, at, k)
+                d = _win_d(px, py, W, f, nseg, at, k, cum)
                 if d > lm and n > 16 * k + 2:
-                    d = _win_d(px, py, W, f, nseg, at, 16 * k)
+                    d = _win_d(px, py, W, f, nseg, at, 16 * k, cum)
                 if d > lm:
                     d = _brute_d(px, py, W, f, n)
                 if d > lm:
@@ -2882,13 +2882,64 @@ def _polyline_checks(C4, cub, msz, W, wstep, first, last, lim, k,
 
 
 @njit(cache=True, nogil=True, inline="always")
-def _win_d(px, py, W, f, ns, at, k):  # pragma: no cover (compiled)
+def _win_d(px, py, W, f, ns, at, k, cum):  # pragma: no cover (compiled)
     """One sample's distance to the segments at - k .. at + k (clipped) of the polyline
-    W[f..f + ns] (1 / the squared length not taken: the windowed arithmetic)."""
+    W[f..f + ns] (1 / the squared length not taken: the windowed arithmetic); ``cum`` its
+    cumulated step lengths from W[f].
+
+    From the window's segment at ``at`` outwards, and segments that cannot be nearer than
+    the nearest so far are skipped: a point X of segment i lies within the polyline's
+    length between W[f + j] and X of W[f + j], so its distance is at least |p - W[f + j]|
+    minus that length (with a margin for the rounding). The smallest squared distance is
+    the same number as over the whole window."""
     lo = max(0, min(at - k, ns - 1))
     hi = min(ns - 1, max(at + k, 0))
+    c = min(max(at, lo), hi)
     best = np.inf
-    for j in range(lo, hi + 1):
+    sb = np.inf
+    span = cum[hi + 1] - cum[lo]
+    j = c
+    while j <= hi:
+        ax = W[f + j, 0]
+        ay = W[f + j, 1]
+        dx = px - ax
+        dy = py - ay
+        if sb < np.inf:
+            e = math.sqrt(dx * dx + dy * dy)
+            room = e - sb - 1e-9 * (1.0 + e + span)
+            if room > 0.0:  # segments j .. i - 1 are all farther than the nearest
+                i = j
+                while i <= hi and cum[i + 1] - cum[j] < room:
+                    i += 1
+                if i > j:
+                    j = i
+                    continue
+        vx = W[f + j + 1, 0] - ax
+        vy = W[f + j + 1, 1] - ay
+        den = vx * vx + vy * vy
+        u = 0.0
+        if den > 0.0:
+            u = min(1.0, max(0.0, (dx * vx + dy * vy) / den))
+        ex = dx - u * vx
+        ey = dy - u * vy
+        d2 = ex * ex + ey * ey
+        if d2 < best:
+            best = d2
+            sb = math.sqrt(best)
+        j += 1
+    j = c - 1
+    while j >= lo:
+        dx = px - W[f + j + 1, 0]
+        dy = py - W[f + j + 1, 1]
+        e = math.sqrt(dx * dx + dy * dy)
+        room = e - sb - 1e-9 * (1.0 + e + span)
+        if room > 0.0:  # segments i + 1 .. j are all farther than the nearest
+            i = j
+            while i >= lo and cum[j + 1] - cum[i] < room:
+                i -= 1
+            if i < j:
+                j = i
+                continue
         ax = W[f + j, 0]
         ay = W[f + j, 1]
         vx = W[f + j + 1, 0] - ax
@@ -2904,6 +2955,8 @@ def _win_d(px, py, W, f, ns, at, k):  # pragma: no cover (compiled)
         d2 = ex * ex + ey * ey
         if d2 < best:
             best = d2
+            sb = math.sqrt(best)
+        j -= 1
     return math.sqrt(best)
 
 
