@@ -675,17 +675,113 @@ _SEED_ITERS = 6
 _NO_QUANTA = np.zeros(0)
 
 
+#: points per chunk of :func:`_accept_quick` (each chunk strided over the whole piece)
+_QUICK_CHUNK = 64
+
+
 @njit(cache=True, nogil=True)
-def _accept_far(ctrl, cm, i0, i1, starts, work, e2, far, su, basis, full, u, dist, emax,
+def _accept_quick(ctrl, cm, i0, i1, starts, work, arc, e2, su, basis, u, dist, emax,
+                  ok) -> None:  # pragma: no cover (compiled)
+    """:func:`_accept_points` and :func:`_accept_far` for a verdict only (compiled): per
+    piece r, its interior points in strided chunks of at most ``_QUICK_CHUNK`` (every
+    chunk spread over the whole piece), each point's parameter and distance as
+    :func:`_accept_points` has them (the same numbers: the 6 Newton steps of a point do
+    not depend on its chunk); a point over e2[r] gets the seeded search of
+    :func:`_accept_far` at once, and the piece fails (``ok[r]`` False) at its first point
+    that stays over, or that Newton leaves over 4 e2[r] (or NaN): :func:`_accept_points`
+    and :func:`_accept_far` fail it then too. A passing piece ends with the numbers of
+    both (its points' ``u``, ``dist``, and ``emax[r]`` their largest); a failing piece's
+    others are left unset."""
+    nc = _QUICK_CHUNK
+    ub = np.empty(nc)
+    qxb = np.empty(nc)
+    qyb = np.empty(nc)
+    db = np.empty(nc)
+    ib = np.empty(nc, dtype=np.intp)
+    samp = np.empty((basis.shape[0], 2))
+    for r in range(len(i0)):
+        ax = cm[r, 0, 0]
+        ay = cm[r, 0, 1]
+        bx = cm[r, 1, 0]
+        by = cm[r, 1, 1]
+        dx = cm[r, 2, 0]
+        dy = cm[r, 2, 1]
+        ex = cm[r, 3, 0]
+        ey = cm[r, 3, 1]
+        base = i0[r]
+        s = starts[r]
+        cnt = i1[r] - base + 1
+        span = arc[i1[r]] - arc[base]
+        den = span if span > 0 else 1.0
+        u[s] = 0.0
+        dist[s] = 0.0
+        u[s + cnt - 1] = 1.0
+        dist[s + cnt - 1] = 0.0
+        lim = e2[r]
+        nck = max(1, -(-(cnt - 2) // nc))
+        worst = 0.0
+        good = True
+        sampled = False
+        for c in range(nck):
+            n = 0
+            for jj in range(1 + c, cnt - 1, nck):
+                k = base + jj
+                ib[n] = jj
+                qxb[n] = work[k, 0] - ex
+                qyb[n] = work[k, 1] - ey
+                ub[n] = (arc[k] - arc[base]) / den
+                n += 1
+            for _ in range(6):  # (step by step over the chunk: the loop vectorises)
+                for j in range(n):
+                    uk = ub[j]
+                    ub[j] = newton_param(ax, ay, bx, by, dx, dy, qxb[j], qyb[j], uk)
+            for j in range(n):
+                k = base + ib[j]
+                uk = ub[j]
+                rx = ((ax * uk + bx) * uk + dx) * uk - (work[k, 0] - ex)
+                ry = ((ay * uk + by) * uk + dy) * uk - (work[k, 1] - ey)
+                db[j] = math.sqrt(rx * rx + ry * ry)
+            for j in range(n):
+                d = db[j]
+                f = s + ib[j]
+                uk = ub[j]
+                if not d <= lim:
+                    if not d <= 4.0 * lim:
+                        good = False
+                        emax[r] = d
+                        break
+                    if not sampled:
+                        bernstein_samples(basis, ctrl, r, samp)
+                        sampled = True
+                    k = base + ib[j]
+                    t, ds = seeded_nearest(cm, r, samp, su, _SEED_ITERS, work[k, 0],
+                                           work[k, 1])
+                    if not ds <= lim:
+                        good = False
+                        emax[r] = d
+                        break
+                    uk = t  # (nearer than Newton's: ds <= lim < d)
+                    d = ds
+                u[f] = uk
+                dist[f] = d
+                if d > worst:
+                    worst = d
+            if not good:
+                break
+        if good:
+            emax[r] = worst
+        ok[r] = good
+
+
+@njit(cache=True, nogil=True)
+def _accept_far(ctrl, cm, i0, i1, starts, work, e2, far, su, basis, u, dist, emax,
                 ok) -> None:  # pragma: no cover (compiled)
     """:meth:`_BatchFitter._accept`'s seeded search (compiled) for the points ``far`` (flat
     indices, ascending: :func:`_accept_points` left them over the bound e2[r] of their piece
     r): each point's :func:`galvo_core.geometry.nearest_on_cubics` (its numbers: the samples
     of the piece's cubic at ``su``, the nearest, Newton from there), kept where nearer than
     Newton's; then the piece's largest error into ``emax[r]`` and ``ok[r]`` whether it is
-    within e2[r]. Unless ``full``, a piece stops at its first point still over the bound
-    (its worst point first): it fails, and its other errors and ``emax[r]`` stay as they
-    were."""
+    within e2[r]."""
     samp = np.empty((basis.shape[0], 2))
     nf = far.shape[0]
     m = starts.shape[0]
@@ -700,38 +796,20 @@ def _accept_far(ctrl, cm, i0, i1, starts, work, e2, far, su, basis, full, u, dis
         while k1 < nf and far[k1] < s1:
             k1 += 1
         bernstein_samples(basis, ctrl, r, samp)
-        lim = e2[r]
         base = i0[r] - s0
-        good = True
-        if not full:  # the worst point first: a failing piece mostly fails there
-            w = k
-            for j in range(k + 1, k1):
-                if dist[far[j]] > dist[far[w]]:
-                    w = j
-            f = far[w]
+        for j in range(k, k1):
+            f = far[j]
             t, d = seeded_nearest(cm, r, samp, su, _SEED_ITERS, work[base + f, 0],
                                   work[base + f, 1])
-            good = d <= lim
-        if good:
-            for j in range(k, k1):
-                f = far[j]
-                t, d = seeded_nearest(cm, r, samp, su, _SEED_ITERS, work[base + f, 0],
-                                      work[base + f, 1])
-                if not full and not d <= lim:  # (over: dist[f] > lim stays)
-                    good = False
-                    break
-                if d < dist[f]:
-                    u[f] = t
-                    dist[f] = d
-        if good:
-            worst = 0.0
-            for j in range(s0, s1):
-                if dist[j] > worst:
-                    worst = dist[j]
-            emax[r] = worst
-            ok[r] = worst <= lim
-        else:
-            ok[r] = False
+            if d < dist[f]:
+                u[f] = t
+                dist[f] = d
+        worst = 0.0
+        for j in range(s0, s1):
+            if dist[j] > worst:
+                worst = dist[j]
+        emax[r] = worst
+        ok[r] = worst <= e2[r]
         k = k1
 
 
@@ -1417,9 +1495,9 @@ class _BatchFitter:
         over the bound.
 
         Only the passing pieces' bounds and errors are final unless ``full``: a failing
-        piece may stop at its first point that the seeded search leaves over the bound
-        (:func:`_accept_far`); with ``full`` every point's error is (for the split
-        points)."""
+        piece stops at its first point that the seeded search leaves over the bound
+        (:func:`_accept_quick`: the same verdicts); with ``full`` every point's error is
+        (for the split points)."""
         m = len(ctrl)
         i0 = np.ascontiguousarray(i0, dtype=np.intp)
         i1 = np.ascontiguousarray(i1, dtype=np.intp)
@@ -1430,16 +1508,20 @@ class _BatchFitter:
         cm = power_coeffs_many(ctrl)
         u = np.empty(total)
         dist = np.empty(total)
-        emax0 = np.empty(m)
-        far = np.empty(total, dtype=np.intp)
-        nfar = _accept_points(cm, i0, i1, starts, self.work, self.arc, e2, u, dist, emax0,
-                              far)
-        ok = emax0 <= e2
-        if nfar:
-            _accept_far(np.ascontiguousarray(ctrl, dtype=np.float64), cm, i0, i1, starts,
-                        self.work, e2, far[:nfar], _SEED_U, _SEED_BASIS, full, u, dist,
-                        emax0, ok)
-        emax = emax0
+        emax = np.empty(m)
+        ctrl = np.ascontiguousarray(ctrl, dtype=np.float64)
+        if full:
+            far = np.empty(total, dtype=np.intp)
+            nfar = _accept_points(cm, i0, i1, starts, self.work, self.arc, e2, u, dist, emax,
+                                  far)
+            ok = emax <= e2
+            if nfar:
+                _accept_far(ctrl, cm, i0, i1, starts, self.work, e2, far[:nfar], _SEED_U,
+                            _SEED_BASIS, u, dist, emax, ok)
+        else:
+            ok = np.empty(m, dtype=bool)
+            _accept_quick(ctrl, cm, i0, i1, starts, self.work, self.arc, e2, _SEED_U,
+                          _SEED_BASIS, u, dist, emax, ok)
         qa = _NO_QUANTA
         if self.quant is not None and A is not None:
             qa = np.ascontiguousarray(self.quant[A], dtype=np.float64)
