@@ -2877,7 +2877,7 @@ def _over_kernel(samp, sstep, poly, pstep, lim, k, out):  # pragma: no cover (co
         if d > lim and n > 16 * k + 2:
             d = _win_d(px, py, poly, 0, n - 1, at, 16 * k, cum)
         if d > lim:
-            d = _brute_d(px, py, poly, 0, n)
+            d = _full_d(px, py, poly, 0, n, at, cum)
         out[t] = d
 
 
@@ -2956,7 +2956,7 @@ def _polyline_checks(C4, cub, msz, W, wstep, first, last, lim, k,
                 if d > lm and n > 16 * k + 2:
                     d = _win_d(px, py, W, f, nseg, at, 16 * k, cum)
                 if d > lm:
-                    d = _brute_d(px, py, W, f, n)
+                    d = _full_d(px, py, W, f, n, at, cum)
                 if d > lm:
                     good = False
                     break
@@ -2964,31 +2964,49 @@ def _polyline_checks(C4, cub, msz, W, wstep, first, last, lim, k,
 
 
 @njit(cache=True, nogil=True, inline="always")
-def _win_d(px, py, W, f, ns, at, k, cum):  # pragma: no cover (compiled)
-    """One sample's distance to the segments at - k .. at + k (clipped) of the polyline
-    W[f..f + ns] (1 / the squared length not taken: the windowed arithmetic); ``cum`` its
-    cumulated step lengths from W[f].
+def _seg_d2(px, py, W, j, brute):  # pragma: no cover (compiled)
+    """The squared distance of (px, py) to the segment W[j]..W[j + 1]: the windowed
+    arithmetic (a division by the squared length), or with ``brute`` that of
+    :func:`point_polyline_distance` (1 / the squared length)."""
+    ax = W[j, 0]
+    ay = W[j, 1]
+    vx = W[j + 1, 0] - ax
+    vy = W[j + 1, 1] - ay
+    dx = px - ax
+    dy = py - ay
+    den = vx * vx + vy * vy
+    if brute:
+        inv = 1.0 / den if den > 1e-300 else 0.0
+        u = min(max((dx * vx + dy * vy) * inv, 0.0), 1.0)
+    else:
+        u = 0.0
+        if den > 0.0:
+            u = min(1.0, max(0.0, (dx * vx + dy * vy) / den))
+    ex = dx - u * vx
+    ey = dy - u * vy
+    return ex * ex + ey * ey
 
-    From the window's segment at ``at`` outwards, and segments that cannot be nearer than
+
+@njit(cache=True, nogil=True, inline="always")
+def _scan_d(px, py, W, f, lo, hi, at, cum, brute):  # pragma: no cover (compiled)
+    """The distance of (px, py) to the nearest of the segments lo .. hi of the polyline
+    W[f..] (``cum`` its cumulated step lengths from W[f]; :func:`_seg_d2`'s arithmetic):
+    from the segment at ``at`` (clipped) outwards, and segments that cannot be nearer than
     the nearest so far are skipped: a point X of segment i lies within the polyline's
     length between W[f + j] and X of W[f + j], so its distance is at least |p - W[f + j]|
     minus that length (with a margin for the rounding). The smallest squared distance is
-    the same number as over the whole window."""
-    lo = max(0, min(at - k, ns - 1))
-    hi = min(ns - 1, max(at + k, 0))
+    the same number as over all of them."""
     c = min(max(at, lo), hi)
     best = np.inf
     sb = np.inf
-    span = cum[hi + 1] - cum[lo]
+    tol = 1e-9 * (1.0 + cum[hi + 1] - cum[lo])
     j = c
     while j <= hi:
-        ax = W[f + j, 0]
-        ay = W[f + j, 1]
-        dx = px - ax
-        dy = py - ay
         if sb < np.inf:
+            dx = px - W[f + j, 0]
+            dy = py - W[f + j, 1]
             e = math.sqrt(dx * dx + dy * dy)
-            room = e - sb - 1e-9 * (1.0 + e + span)
+            room = e - sb - tol - 1e-9 * e
             if room > 0.0:  # segments j .. i - 1 are all farther than the nearest
                 i = j
                 while i <= hi and cum[i + 1] - cum[j] < room:
@@ -2996,15 +3014,7 @@ def _win_d(px, py, W, f, ns, at, k, cum):  # pragma: no cover (compiled)
                 if i > j:
                     j = i
                     continue
-        vx = W[f + j + 1, 0] - ax
-        vy = W[f + j + 1, 1] - ay
-        den = vx * vx + vy * vy
-        u = 0.0
-        if den > 0.0:
-            u = min(1.0, max(0.0, (dx * vx + dy * vy) / den))
-        ex = dx - u * vx
-        ey = dy - u * vy
-        d2 = ex * ex + ey * ey
+        d2 = _seg_d2(px, py, W, f + j, brute)
         if d2 < best:
             best = d2
             sb = math.sqrt(best)
@@ -3014,7 +3024,7 @@ def _win_d(px, py, W, f, ns, at, k, cum):  # pragma: no cover (compiled)
         dx = px - W[f + j + 1, 0]
         dy = py - W[f + j + 1, 1]
         e = math.sqrt(dx * dx + dy * dy)
-        room = e - sb - 1e-9 * (1.0 + e + span)
+        room = e - sb - tol - 1e-9 * e
         if room > 0.0:  # segments i + 1 .. j are all farther than the nearest
             i = j
             while i >= lo and cum[j + 1] - cum[i] < room:
@@ -3022,19 +3032,7 @@ def _win_d(px, py, W, f, ns, at, k, cum):  # pragma: no cover (compiled)
             if i < j:
                 j = i
                 continue
-        ax = W[f + j, 0]
-        ay = W[f + j, 1]
-        vx = W[f + j + 1, 0] - ax
-        vy = W[f + j + 1, 1] - ay
-        dx = px - ax
-        dy = py - ay
-        den = vx * vx + vy * vy
-        u = 0.0
-        if den > 0.0:
-            u = min(1.0, max(0.0, (dx * vx + dy * vy) / den))
-        ex = dx - u * vx
-        ey = dy - u * vy
-        d2 = ex * ex + ey * ey
+        d2 = _seg_d2(px, py, W, f + j, brute)
         if d2 < best:
             best = d2
             sb = math.sqrt(best)
@@ -3043,26 +3041,32 @@ def _win_d(px, py, W, f, ns, at, k, cum):  # pragma: no cover (compiled)
 
 
 @njit(cache=True, nogil=True, inline="always")
+def _win_d(px, py, W, f, ns, at, k, cum):  # pragma: no cover (compiled)
+    """One sample's distance to the segments at - k .. at + k (clipped) of the polyline
+    W[f..f + ns] (1 / the squared length not taken: the windowed arithmetic); ``cum`` its
+    cumulated step lengths from W[f] (:func:`_scan_d`)."""
+    lo = max(0, min(at - k, ns - 1))
+    hi = min(ns - 1, max(at + k, 0))
+    return _scan_d(px, py, W, f, lo, hi, at, cum, False)
+
+
+@njit(cache=True, nogil=True, inline="always")
 def _brute_d(px, py, W, f, n):  # pragma: no cover (compiled)
     """One sample's :func:`point_polyline_distance` to the polyline W[f..f + n - 1],
     n >= 2: its arithmetic (1 / the squared length)."""
     best = np.inf
     for j in range(n - 1):
-        ax = W[f + j, 0]
-        ay = W[f + j, 1]
-        vx = W[f + j + 1, 0] - ax
-        vy = W[f + j + 1, 1] - ay
-        den = vx * vx + vy * vy
-        inv = 1.0 / den if den > 1e-300 else 0.0
-        dx = px - ax
-        dy = py - ay
-        u = min(max((dx * vx + dy * vy) * inv, 0.0), 1.0)
-        ex = dx - u * vx
-        ey = dy - u * vy
-        d2 = ex * ex + ey * ey
+        d2 = _seg_d2(px, py, W, f + j, True)
         if d2 < best:
             best = d2
     return math.sqrt(best)
+
+
+@njit(cache=True, nogil=True, inline="always")
+def _full_d(px, py, W, f, n, at, cum):  # pragma: no cover (compiled)
+    """:func:`_brute_d` (the same number) from the segment at ``at`` outwards
+    (:func:`_scan_d`; ``cum`` the cumulated step lengths from W[f])."""
+    return _scan_d(px, py, W, f, 0, n - 2, at, cum, True)
 
 
 #: rounded input, after the joints: a segment is repaired where the design estimate (the
