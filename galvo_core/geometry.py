@@ -208,29 +208,93 @@ def nearest_on_cubic_each(
     for ns in np.unique(nsp).tolist():
         sel = np.flatnonzero(nsp == ns)
         _sampled_candidates(c, pid[sel], p[sel], ns, sel, best_u, best_d2, (u0, lo, hi, ok))
-    # Newton from every candidate (the arithmetic of _power_coeffs and cubic_eval)
-    p0, p1, p2, p3 = c[:, 0], c[:, 1], c[:, 2], c[:, 3]
-    coef = (
-        -p0 + 3.0 * p1 - 3.0 * p2 + p3,
-        3.0 * p0 - 6.0 * p1 + 3.0 * p2,
-        -3.0 * p0 + 3.0 * p1,
-        p0,
-    )
-    if len(c) == 1:  # one cubic (nearest_on_cubic): no per-point copies
-        cf = np.array(coef)[:, 0, :, None]
-        cq = np.broadcast_to(c, (k, 4, 2))
-    else:
-        cf = gather_coeffs(np.stack(coef, axis=1), pid)
-        cq = c[pid]
-    pt = p.T
-    for m in range(_NEAREST_CANDIDATES):
-        u = newton_nearest_many(cf, pt, u0[m], iters, lo=lo[m], hi=hi[m], downhill=True)[0]
-        r = _bernstein_each(cq, u) - p
-        dn = r[:, 0] * r[:, 0] + r[:, 1] * r[:, 1]
-        better = ok[m] & (dn < best_d2)
-        best_u = np.where(better, u, best_u)
-        best_d2 = np.where(better, dn, best_d2)
+    # Newton from every candidate (the arithmetic of _power_coeffs and cubic_eval), compiled
+    _refine_kernel(np.ascontiguousarray(c), pid, p, u0, lo, hi, ok, iters, best_u, best_d2)
     return best_u, np.sqrt(best_d2)
+
+
+#: points per chunk of :func:`_refine_kernel` (its Newton steps run over a chunk at a time)
+_REFINE_CHUNK = 256
+
+
+@njit(cache=True, nogil=True)
+def _refine_kernel(c, pid, p, u0, lo, hi, ok, iters, best_u,
+                   best_d2):  # type: ignore[no-untyped-def]
+    """:func:`nearest_on_cubic_each`'s refinement (compiled): per candidate m and point k
+    (its cubic c[pid[k]]), ``iters`` Newton steps from u0[m, k] inside lo[m, k] .. hi[m, k]
+    (:func:`_newton_kernel`'s downhill steps, the power coefficients of the former numpy
+    version: a = ((-p0 + 3 p1) - 3 p2) + p3, b = (3 p0 - 6 p1) + 3 p2, d = -3 p0 + 3 p1),
+    the point of the cubic there (:func:`_bernstein_each`'s arithmetic) and, where ok[m, k]
+    and nearer than best_d2[k], it replaces best_u[k], best_d2[k] (in place). Candidate by
+    candidate, as before; the same numbers."""
+    k_n = pid.shape[0]
+    nc = _REFINE_CHUNK
+    cb = np.empty((8, nc))
+    ub = np.empty(nc)
+    for m in range(u0.shape[0]):
+        for c0 in range(0, k_n, nc):
+            n = min(nc, k_n - c0)
+            for j in range(n):
+                k = c0 + j
+                g = pid[k]
+                p0x = c[g, 0, 0]
+                p0y = c[g, 0, 1]
+                p1x = c[g, 1, 0]
+                p1y = c[g, 1, 1]
+                p2x = c[g, 2, 0]
+                p2y = c[g, 2, 1]
+                p3x = c[g, 3, 0]
+                p3y = c[g, 3, 1]
+                cb[0, j] = ((-p0x + 3.0 * p1x) - 3.0 * p2x) + p3x
+                cb[1, j] = ((-p0y + 3.0 * p1y) - 3.0 * p2y) + p3y
+                cb[2, j] = (3.0 * p0x - 6.0 * p1x) + 3.0 * p2x
+                cb[3, j] = (3.0 * p0y - 6.0 * p1y) + 3.0 * p2y
+                cb[4, j] = -3.0 * p0x + 3.0 * p1x
+                cb[5, j] = -3.0 * p0y + 3.0 * p1y
+                cb[6, j] = p[k, 0] - p0x
+                cb[7, j] = p[k, 1] - p0y
+                ub[j] = u0[m, k]
+            for _ in range(iters):
+                for j in range(n):
+                    k = c0 + j
+                    ax = cb[0, j]
+                    ay = cb[1, j]
+                    bx = cb[2, j]
+                    by = cb[3, j]
+                    dx = cb[4, j]
+                    dy = cb[5, j]
+                    lo_k = lo[m, k]
+                    hi_k = hi[m, k]
+                    uk = ub[j]
+                    rx = ((ax * uk + bx) * uk + dx) * uk - cb[6, j]  # B(u) - p
+                    ry = ((ay * uk + by) * uk + dy) * uk - cb[7, j]
+                    d1x = (3.0 * ax * uk + 2.0 * bx) * uk + dx  # B'(u)
+                    d1y = (3.0 * ay * uk + 2.0 * by) * uk + dy
+                    f = d1x * rx + d1y * ry  # f = B'·(B - p)
+                    fp = (6.0 * ax * uk + 2.0 * bx) * rx + (6.0 * ay * uk + 2.0 * by) * ry
+                    fp += d1x * d1x  # f' = B''·(B - p) + |B'|^2
+                    fp += d1y * d1y
+                    if fp <= 0.0:  # not convex here: halve the way downhill
+                        end = hi_k if f < 0.0 else lo_k
+                        uk = 0.5 * (uk + end)
+                    else:
+                        uk -= f / fp
+                    ub[j] = min(max(uk, lo_k), hi_k)
+            for j in range(n):
+                k = c0 + j
+                if not ok[m, k]:
+                    continue
+                g = pid[k]
+                t = ub[j]
+                s = 1.0 - t
+                rx = ((((s * s * s) * c[g, 0, 0] + (3.0 * s * s * t) * c[g, 1, 0])
+                       + (3.0 * s * t * t) * c[g, 2, 0]) + (t * t * t) * c[g, 3, 0]) - p[k, 0]
+                ry = ((((s * s * s) * c[g, 0, 1] + (3.0 * s * s * t) * c[g, 1, 1])
+                       + (3.0 * s * t * t) * c[g, 2, 1]) + (t * t * t) * c[g, 3, 1]) - p[k, 1]
+                dn = rx * rx + ry * ry
+                if dn < best_d2[k]:
+                    best_u[k] = t
+                    best_d2[k] = dn
 
 
 def sampled_upper_d2(ctrl: object, pid: object, pts: object, *, seeds: int = 48) -> np.ndarray:
