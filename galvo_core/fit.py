@@ -1285,7 +1285,7 @@ def _gn_free_sums(i0, i1, work, arc, sample, ps, pts, u, ctrl, first, N,
     per point from ``u`` (updated; as :func:`_newton_kernel`), the unit normal at the
     nearest point and the signed distance along it, the Jacobian of the distance in the two
     inner control points; sums in the order of the points (as the former np.bincount) into
-    ``N`` (m, 4, 4) and ``g`` (m, 4) (minus the gradient)."""
+    ``N`` (m, 4, 4) and ``g`` (m, 4, 1) (minus the gradient), made ready for the solve."""
     pxb = np.empty(sample)
     pyb = np.empty(sample)
     ub = np.empty(sample)
@@ -1385,10 +1385,39 @@ def _gn_free_sums(i0, i1, work, arc, sample, ps, pts, u, ctrl, first, N,
         N[r, 2, 3] = n23
         N[r, 3, 2] = n23
         N[r, 3, 3] = n33
-        g[r, 0] = -g0
-        g[r, 1] = -g1
-        g[r, 2] = -g2
-        g[r, 3] = -g3
+        g[r, 0, 0] = -g0
+        g[r, 1, 0] = -g1
+        g[r, 2, 0] = -g2
+        g[r, 3, 0] = -g3
+        # non-finite sums are 0; the diagonal gets 1e-9 of the trace (summed in order, as
+        # np.trace) + 1e-12 (as N + reg * eye(4): the others + reg * 0)
+        for i in range(4):
+            if not np.isfinite(g[r, i, 0]):
+                g[r, i, 0] = 0.0
+            for i2 in range(4):
+                if not np.isfinite(N[r, i, i2]):
+                    N[r, i, i2] = 0.0
+        reg = 1e-9 * (((N[r, 0, 0] + N[r, 1, 1]) + N[r, 2, 2]) + N[r, 3, 3]) + 1e-12
+        for i in range(4):
+            for i2 in range(4):
+                N[r, i, i2] = N[r, i, i2] + reg * (1.0 if i == i2 else 0.0)
+
+
+@njit(cache=True, nogil=True)
+def _gn_free_step(ctrl, d, chord) -> None:  # pragma: no cover (compiled)
+    """:meth:`_BatchFitter._gauss_newton_free`'s step of one round (compiled): the solution
+    ``d`` (m, 4, 1) where finite (else 0), clipped to a quarter of the chord either way (as
+    np.clip), added to the two inner control points."""
+    for r in range(ctrl.shape[0]):
+        lim = 0.25 * chord[r]
+        nlim = -lim
+        for i in range(4):
+            v = d[r, i, 0]
+            if not np.isfinite(v):
+                v = 0.0
+            v = v if v > nlim else nlim  # (np.clip: max, then min)
+            v = v if v < lim else lim
+            ctrl[r, 1 + i // 2, i % 2] += v
 
 
 class _BatchFitter:
@@ -2133,20 +2162,13 @@ class _BatchFitter:
         u = np.empty(int(ps[-1]))
         pts = np.empty((len(u), 2))
         for it in range(rounds):
-            N = np.zeros((m, 4, 4))
-            g = np.zeros((m, 4))
+            N = np.empty((m, 4, 4))
+            g = np.empty((m, 4, 1))
             _gn_free_sums(i0, i1, self.work, self.arc, _BISECT_SAMPLE, ps, pts, u, ctrl,
                           it == 0, N, g)
-            N = np.where(np.isfinite(N), N, 0.0)
-            g = np.where(np.isfinite(g), g, 0.0)
-            N += (1e-9 * np.trace(N, axis1=1, axis2=2) + 1e-12)[:, None, None] * np.eye(4)
             with np.errstate(divide="ignore", invalid="ignore"):
-                d = np.linalg.solve(N, g[:, :, None])[:, :, 0]
-            d = np.where(np.isfinite(d), d, 0.0)
-            lim = 0.25 * chord[:, None]
-            d = np.clip(d, -lim, lim)
-            ctrl[:, 1] += d[:, :2]
-            ctrl[:, 2] += d[:, 2:]
+                d = np.linalg.solve(N, g)
+            _gn_free_step(ctrl, d, chord)
         h0 = ctrl[:, 1] - ctrl[:, 0]
         h3 = ctrl[:, 3] - ctrl[:, 2]
         t0, t3 = self.t_out[A], self.t_in[B]
