@@ -93,6 +93,7 @@ from galvo_core.geometry import (
     bernstein_samples,
     cubic_eval,
     cubic_length,
+    hypot_into,
     nearest_on_cubic,
     nearest_on_cubic_each,
     newton_param,
@@ -1187,6 +1188,7 @@ def _gn_kernel(i0, i1, work, arc, sample, p0, p3, t0, t3, chord, rounds, ctrl,
     resb = np.empty(sample)
     j1b = np.empty(sample)
     j2b = np.empty(sample)
+    fb = np.empty(sample, dtype=np.bool_)
     for r in range(i0.shape[0]):
         n = _piece_points(i0[r], i1[r], work, arc, sample, pxb, pyb, ub)
         p0x = p0[r, 0]
@@ -1219,8 +1221,9 @@ def _gn_kernel(i0, i1, work, arc, sample, p0, p3, t0, t3, chord, rounds, ctrl,
                 ryb[j] = ((ay * uk + by) * uk + dy) * uk + ey - pyb[j]
                 txb[j] = (3.0 * ax * uk + 2.0 * bx) * uk + dx
                 tyb[j] = (3.0 * ay * uk + 2.0 * by) * uk + dy
+            hypot_into(txb, tyb, n, nb, fb)
             for j in range(n):
-                dn = math.hypot(txb[j], tyb[j])
+                dn = nb[j]
                 nb[j] = dn if dn > 0.0 else 1.0
             for j in range(n):
                 uk = ub[j]
@@ -1293,6 +1296,10 @@ def _gn_free_sums(i0, i1, work, arc, sample, ps, pts, u, ctrl, first, N,
     qyb = np.empty(sample)
     jb = np.empty((4, sample))
     resb = np.empty(sample)
+    txb = np.empty(sample)
+    tyb = np.empty(sample)
+    nb = np.empty(sample)
+    fb = np.empty(sample, dtype=np.bool_)
     for r in range(i0.shape[0]):
         k0 = ps[r]
         n = ps[r + 1] - k0
@@ -1316,11 +1323,16 @@ def _gn_free_sums(i0, i1, work, arc, sample, ps, pts, u, ctrl, first, N,
         for j in range(n):
             uk = ub[j]
             u[k0 + j] = uk
+            txb[j] = (3.0 * ax * uk + 2.0 * bx) * uk + dx
+            tyb[j] = (3.0 * ay * uk + 2.0 * by) * uk + dy
+        hypot_into(txb, tyb, n, nb, fb)
+        for j in range(n):
+            uk = ub[j]
             rx = ((ax * uk + bx) * uk + dx) * uk + ex - pxb[j]
             ry = ((ay * uk + by) * uk + dy) * uk + ey - pyb[j]
-            tx = (3.0 * ax * uk + 2.0 * bx) * uk + dx
-            ty = (3.0 * ay * uk + 2.0 * by) * uk + dy
-            dn = math.hypot(tx, ty)
+            tx = txb[j]
+            ty = tyb[j]
+            dn = nb[j]
             if not dn > 0.0:
                 dn = 1.0
             nx = -ty / dn

@@ -739,6 +739,52 @@ def _newton_step(cf, p, u, c0, c1, lo, hi, one_lo, one_hi, downhill):  # type: i
         u[k] = min(max(uk, lo_k), hi_k)
 
 
+#: :func:`hypot_into`'s common range (both in it: libm's hypot is this arithmetic)
+_HYPOT_LARGE = 2.0 ** 511
+_HYPOT_TINY = 2.0 ** -459
+_HYPOT_RATIO = 2.0 ** -26
+
+
+@njit(cache=True, nogil=True, inline="always")
+def _hypot_common(x, y):  # type: ignore[no-untyped-def]
+    """(h, ok): ok where |x| and |y| are in the common range (the larger at most 2^511, the
+    smaller at least 2^-459 and over 2^-26 of the larger: finite, no scaling, not widely
+    varying), h then libm's hypot(x, y) (glibc's correction of sqrt(x² + y²) after Borges,
+    without FMA: the same operations, so the same number); branch-free, so a loop of it
+    vectorises."""
+    x = abs(x)
+    y = abs(y)
+    ax = y if x < y else x
+    ay = x if x < y else y
+    ok = (ax <= _HYPOT_LARGE) & (ay >= _HYPOT_TINY) & (ay > ax * _HYPOT_RATIO)
+    h = math.sqrt(ax * ax + ay * ay)
+    d1 = h - ay
+    t1a = ax * (2.0 * d1 - ax)
+    t2a = (d1 - 2.0 * (ax - ay)) * d1
+    d2 = h - ax
+    t1b = 2.0 * d2 * (ax - 2.0 * ay)
+    t2b = (4.0 * d2 - ay) * ay + d2 * d2
+    near = h <= 2.0 * ay
+    t1 = t1a if near else t1b
+    t2 = t2a if near else t2b
+    hh = h if ok else 1.0  # (no division by 0 outside the range: libm's value there)
+    return h - (t1 + t2) / (2.0 * hh), ok
+
+
+@njit(cache=True, nogil=True, inline="always")
+def hypot_into(xs, ys, n, out, flag):  # type: ignore[no-untyped-def]
+    """out[j] = math.hypot(xs[j], ys[j]) for j < n, the same numbers, faster: the common
+    range (:func:`_hypot_common`) in a loop that vectorises, the rest (zeros, huge, tiny,
+    widely varying, NaN) by libm's hypot in a second pass (``flag`` a bool work array)."""
+    for j in range(n):
+        h, ok = _hypot_common(xs[j], ys[j])
+        out[j] = h
+        flag[j] = ok
+    for j in range(n):
+        if not flag[j]:
+            out[j] = math.hypot(xs[j], ys[j])
+
+
 @njit(cache=True, nogil=True, inline="always")
 def newton_param(ax, ay, bx, by, dx, dy, qx, qy, uk):  # type: ignore[no-untyped-def]
     """One Newton step of the parameter ``uk`` of the cubic a u^3 + b u^2 + d u (power form,
