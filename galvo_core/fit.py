@@ -678,6 +678,8 @@ _NO_QUANTA = np.zeros(0)
 
 #: points per chunk of :func:`_accept_quick` (each chunk strided over the whole piece)
 _QUICK_CHUNK = 64
+#: ... of :func:`_sample_kernel`
+_SAMPLE_CHUNK = 16
 
 
 @njit(cache=True, nogil=True)
@@ -822,6 +824,7 @@ def _sample_kernel(cm, i0, i1, work, arc, e2, sample, ok) -> None:  # pragma: no
     ub = np.empty(sample)
     qxb = np.empty(sample)
     qyb = np.empty(sample)
+    ib = np.empty(sample, dtype=np.intp)
     for r in range(len(i0)):
         a = i0[r]
         L = i1[r] - a - 1
@@ -837,25 +840,34 @@ def _sample_kernel(cm, i0, i1, work, arc, e2, sample, ok) -> None:  # pragma: no
         dy = cm[r, 2, 1]
         ex = cm[r, 3, 0]
         ey = cm[r, 3, 1]
-        for j in range(n):
-            k = a + 1 + stride * j
-            qxb[j] = work[k, 0] - ex
-            qyb[j] = work[k, 1] - ey
-            ub[j] = (arc[k] - arc[a]) / den
-        for _ in range(4):
-            for j in range(n):
-                uk = ub[j]
-                ub[j] = newton_param(ax, ay, bx, by, dx, dy, qxb[j], qyb[j], uk)
         lim = e2[r] * e2[r]
         good = 0.0 <= lim
-        for j in range(n):
-            k = a + 1 + stride * j
-            uk = ub[j]
-            rx = ((ax * uk + bx) * uk + dx) * uk - (work[k, 0] - ex)
-            ry = ((ay * uk + by) * uk + dy) * uk - (work[k, 1] - ey)
-            if not rx * rx + ry * ry <= lim:
-                good = False
+        # in strided chunks (each spread over the piece): a failing piece mostly stops
+        # after the first (each point's Newton steps are its own: the same verdict)
+        nck = max(1, -(-n // _SAMPLE_CHUNK))
+        for c in range(nck):
+            if not good:
                 break
+            m = 0
+            for j in range(c, n, nck):
+                k = a + 1 + stride * j
+                ib[m] = k
+                qxb[m] = work[k, 0] - ex
+                qyb[m] = work[k, 1] - ey
+                ub[m] = (arc[k] - arc[a]) / den
+                m += 1
+            for _ in range(4):
+                for j in range(m):
+                    uk = ub[j]
+                    ub[j] = newton_param(ax, ay, bx, by, dx, dy, qxb[j], qyb[j], uk)
+            for j in range(m):
+                k = ib[j]
+                uk = ub[j]
+                rx = ((ax * uk + bx) * uk + dx) * uk - (work[k, 0] - ex)
+                ry = ((ay * uk + by) * uk + dy) * uk - (work[k, 1] - ey)
+                if not rx * rx + ry * ry <= lim:
+                    good = False
+                    break
         ok[r] = good
 
 
@@ -2930,6 +2942,10 @@ def _polyline_checks(C4, cub, msz, W, wstep, first, last, lim, k,
     sx = np.empty(mmax)
     sy = np.empty(mmax)
     cs = np.empty(mmax)
+    dxb = np.empty(mmax)
+    dyb = np.empty(mmax)
+    hb = np.empty(mmax)
+    fb = np.empty(mmax, dtype=np.bool_)
     for i in range(first.shape[0]):
         ms = msz[i]
         step = 1.0 / (ms - 1)
@@ -2967,9 +2983,13 @@ def _polyline_checks(C4, cub, msz, W, wstep, first, last, lim, k,
             cum[0] = 0.0
             for t in range(n - 1):
                 cum[t + 1] = cum[t] + wstep[f + t]
+            for t in range(ms - 1):
+                dxb[t] = sx[t + 1] - sx[t]
+                dyb[t] = sy[t + 1] - sy[t]
+            hypot_into(dxb, dyb, ms - 1, hb, fb)
             cs[0] = 0.0
             for t in range(ms - 1):
-                cs[t + 1] = cs[t] + math.hypot(sx[t + 1] - sx[t], sy[t + 1] - sy[t])
+                cs[t + 1] = cs[t] + hb[t]
             scale = cs[ms - 1] > 0.0
             r = cum[n - 1] / cs[ms - 1] if scale else 1.0
             nseg = n - 1
