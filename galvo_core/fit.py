@@ -90,7 +90,9 @@ from numba import njit
 from galvo_core.drawing import Drawing, Path
 from galvo_core.errors import Cancelled, ParamError
 from galvo_core.geometry import (
+    bernstein_point,
     bernstein_samples,
+    bernstein_weights,
     cubic_eval,
     cubic_length,
     hypot_into,
@@ -2952,15 +2954,9 @@ def _polyline_checks(C4, cub, msz, W, wstep, first, last, lim, k,
         for t in range(ms):
             u = t * step if t < ms - 1 else 1.0
             if cub[i]:
-                v = 1.0 - u
-                b0 = v * v * v
-                b1 = 3.0 * v * v * u
-                b2 = 3.0 * v * u * u
-                b3 = u * u * u
-                sx[t] = ((b0 * C4[i, 0, 0] + b1 * C4[i, 1, 0]) + b2 * C4[i, 2, 0]) \
-                    + b3 * C4[i, 3, 0]
-                sy[t] = ((b0 * C4[i, 0, 1] + b1 * C4[i, 1, 1]) + b2 * C4[i, 2, 1]) \
-                    + b3 * C4[i, 3, 1]
+                b0, b1, b2, b3 = bernstein_weights(u)
+                sx[t] = bernstein_point(b0, b1, b2, b3, C4, i, 0)
+                sy[t] = bernstein_point(b0, b1, b2, b3, C4, i, 1)
             else:
                 sx[t] = C4[i, 0, 0] + u * (C4[i, 1, 0] - C4[i, 0, 0])
                 sy[t] = C4[i, 0, 1] + u * (C4[i, 1, 1] - C4[i, 0, 1])

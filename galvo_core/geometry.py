@@ -331,14 +331,9 @@ def _upper_kernel(c, pid, p, su, out):  # type: ignore[no-untyped-def]
         g = pid[i]
         if g != last:
             for j in range(n):
-                t = su[j]
-                s = 1.0 - t
-                b0 = s * s * s
-                b1 = 3.0 * s * s * t
-                b2 = 3.0 * s * t * t
-                b3 = t * t * t
-                sx[j] = ((b0 * c[g, 0, 0] + b1 * c[g, 1, 0]) + b2 * c[g, 2, 0]) + b3 * c[g, 3, 0]
-                sy[j] = ((b0 * c[g, 0, 1] + b1 * c[g, 1, 1]) + b2 * c[g, 2, 1]) + b3 * c[g, 3, 1]
+                b0, b1, b2, b3 = bernstein_weights(su[j])
+                sx[j] = bernstein_point(b0, b1, b2, b3, c, g, 0)
+                sy[j] = bernstein_point(b0, b1, b2, b3, c, g, 1)
             last = g
         px = p[i, 0]
         py = p[i, 1]
@@ -396,16 +391,9 @@ def _candidates_kernel(cc, su, ci, p, out, spx, spy, best_u, best_d2, u0, lo, hi
     ns = n - 1
     for g in range(cc.shape[0]):
         for j in range(n):
-            t = su[j]
-            s = 1.0 - t
-            b0 = s * s * s
-            b1 = 3.0 * s * s * t
-            b2 = 3.0 * s * t * t
-            b3 = t * t * t
-            spx[g, j] = ((b0 * cc[g, 0, 0] + b1 * cc[g, 1, 0]) + b2 * cc[g, 2, 0]) \
-                + b3 * cc[g, 3, 0]
-            spy[g, j] = ((b0 * cc[g, 0, 1] + b1 * cc[g, 1, 1]) + b2 * cc[g, 2, 1]) \
-                + b3 * cc[g, 3, 1]
+            b0, b1, b2, b3 = bernstein_weights(su[j])
+            spx[g, j] = bernstein_point(b0, b1, b2, b3, cc, g, 0)
+            spy[g, j] = bernstein_point(b0, b1, b2, b3, cc, g, 1)
     d2 = np.empty(n)
     tv = np.empty(nc + 1)
     tj = np.empty(nc + 1, dtype=np.int64)
@@ -894,17 +882,31 @@ def _samples_kernel(basis, c, out):  # type: ignore[no-untyped-def]
 
 
 @njit(cache=True, nogil=True, inline="always")
+def bernstein_weights(t):  # type: ignore[no-untyped-def]
+    """The cubic Bernstein weights at t, cubic_eval's arithmetic: (1 - t)³, 3 (1 - t)² t,
+    3 (1 - t) t², t³ (each multiplied left to right)."""
+    s = 1.0 - t
+    return s * s * s, 3.0 * s * s * t, 3.0 * s * t * t, t * t * t
+
+
+@njit(cache=True, nogil=True, inline="always")
+def bernstein_point(b0, b1, b2, b3, c, m, d):  # type: ignore[no-untyped-def]
+    """Coordinate d of the cubic c[m] (control points, (M, 4, 2)) at the weights b0..b3,
+    summed in order ((b0 c0 + b1 c1) + b2 c2) + b3 c3 (cubic_eval's and np.einsum's
+    numbers): the one sampling loop of the compiled kernels."""
+    return ((b0 * c[m, 0, d] + b1 * c[m, 1, d]) + b2 * c[m, 2, d]) + b3 * c[m, 3, d]
+
+
+@njit(cache=True, nogil=True, inline="always")
 def bernstein_samples(basis, c, m, out):  # type: ignore[no-untyped-def]
-    """out[i] = the cubic c[m] at the sample i of ``basis`` (S, 4), summed in order
-    ((b0 c0 + b1 c1) + b2 c2) + b3 c3 (np.einsum's numbers, and cubic_eval's)."""
+    """out[i] = the cubic c[m] at the sample i of ``basis`` (S, 4) (:func:`bernstein_point`)."""
     for i in range(basis.shape[0]):
         b0 = basis[i, 0]
         b1 = basis[i, 1]
         b2 = basis[i, 2]
         b3 = basis[i, 3]
         for d in range(2):
-            out[i, d] = ((b0 * c[m, 0, d] + b1 * c[m, 1, d]) + b2 * c[m, 2, d]) \
-                + b3 * c[m, 3, d]
+            out[i, d] = bernstein_point(b0, b1, b2, b3, c, m, d)
 
 
 @njit(cache=True, nogil=True, inline="always")
