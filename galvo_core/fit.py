@@ -2921,11 +2921,11 @@ def _over_kernel(samp, sstep, poly, pstep, lim, k, out):  # pragma: no cover (co
         at = lo - 1
         px = samp[t, 0]
         py = samp[t, 1]
-        d = _win_d(px, py, poly, 0, n - 1, at, k, cum)
-        if d > lim and n > 16 * k + 2:
-            d = _win_d(px, py, poly, 0, n - 1, at, 16 * k, cum)
+        d = _win_d(px, py, poly, 0, n - 1, at, k, cum, np.inf)
+        if d > lim and n > 16 * k + 2:  # (the narrower window's distance bounds these)
+            d = _win_d(px, py, poly, 0, n - 1, at, 16 * k, cum, d)
         if d > lim:
-            d = _full_d(px, py, poly, 0, n, at, cum)
+            d = _full_d(px, py, poly, 0, n, at, cum, d)
         out[t] = d
 
 
@@ -3002,11 +3002,11 @@ def _polyline_checks(C4, cub, msz, W, wstep, first, last, lim, k,
                 at = lo - 1
                 px = sx[t]
                 py = sy[t]
-                d = _win_d(px, py, W, f, nseg, at, k, cum)
+                d = _win_d(px, py, W, f, nseg, at, k, cum, np.inf)
                 if d > lm and n > 16 * k + 2:
-                    d = _win_d(px, py, W, f, nseg, at, 16 * k, cum)
+                    d = _win_d(px, py, W, f, nseg, at, 16 * k, cum, d)
                 if d > lm:
-                    d = _full_d(px, py, W, f, n, at, cum)
+                    d = _full_d(px, py, W, f, n, at, cum, d)
                 if d > lm:
                     good = False
                     break
@@ -3038,31 +3038,38 @@ def _seg_d2(px, py, W, j, brute):  # pragma: no cover (compiled)
 
 
 @njit(cache=True, nogil=True, inline="always")
-def _scan_d(px, py, W, f, lo, hi, at, cum, brute):  # pragma: no cover (compiled)
+def _scan_d(px, py, W, f, lo, hi, at, cum, brute, ub):  # pragma: no cover (compiled)
     """The distance of (px, py) to the nearest of the segments lo .. hi of the polyline
     W[f..] (``cum`` its cumulated step lengths from W[f]; :func:`_seg_d2`'s arithmetic):
     from the segment at ``at`` (clipped) outwards, and segments that cannot be nearer than
-    the nearest so far are skipped: a point X of segment i lies within the polyline's
-    length between W[f + j] and X of W[f + j], so its distance is at least |p - W[f + j]|
-    minus that length (with a margin for the rounding). The smallest squared distance is
-    the same number as over all of them."""
+    the nearest so far (or than ``ub``, a known upper bound of the answer up to the
+    rounding) are skipped: a point X of segment i lies within the polyline's length
+    between W[f + j] and X of W[f + j], so its distance is at least |p - W[f + j]| minus
+    that length (with a margin for the rounding; the skipped run found by bisection of
+    ``cum``). The smallest squared distance is the same number as over all of them."""
     c = min(max(at, lo), hi)
     best = np.inf
     sb = np.inf
     tol = 1e-9 * (1.0 + cum[hi + 1] - cum[lo])
     j = c
     while j <= hi:
-        if sb < np.inf:
+        bound = min(sb, ub)
+        if bound < np.inf:
             dx = px - W[f + j, 0]
             dy = py - W[f + j, 1]
             e = math.sqrt(dx * dx + dy * dy)
-            room = e - sb - tol - 1e-9 * e
+            room = e - bound - tol - 1e-9 * e
             if room > 0.0:  # segments j .. i - 1 are all farther than the nearest
-                i = j
-                while i <= hi and cum[i + 1] - cum[j] < room:
-                    i += 1
-                if i > j:
-                    j = i
+                a = j
+                b = hi + 1
+                while a < b:  # the first i with cum[i + 1] - cum[j] >= room
+                    mid = (a + b) >> 1
+                    if cum[mid + 1] - cum[j] < room:
+                        a = mid + 1
+                    else:
+                        b = mid
+                if a > j:
+                    j = a
                     continue
         d2 = _seg_d2(px, py, W, f + j, brute)
         if d2 < best:
@@ -3071,16 +3078,22 @@ def _scan_d(px, py, W, f, lo, hi, at, cum, brute):  # pragma: no cover (compiled
         j += 1
     j = c - 1
     while j >= lo:
+        bound = min(sb, ub)
         dx = px - W[f + j + 1, 0]
         dy = py - W[f + j + 1, 1]
         e = math.sqrt(dx * dx + dy * dy)
-        room = e - sb - tol - 1e-9 * e
+        room = e - bound - tol - 1e-9 * e
         if room > 0.0:  # segments i + 1 .. j are all farther than the nearest
-            i = j
-            while i >= lo and cum[j + 1] - cum[i] < room:
-                i -= 1
-            if i < j:
-                j = i
+            a = lo
+            b = j + 1
+            while a < b:  # the first i with cum[j + 1] - cum[i] < room
+                mid = (a + b) >> 1
+                if cum[j + 1] - cum[mid] < room:
+                    b = mid
+                else:
+                    a = mid + 1
+            if a <= j:
+                j = a - 1
                 continue
         d2 = _seg_d2(px, py, W, f + j, brute)
         if d2 < best:
@@ -3091,13 +3104,14 @@ def _scan_d(px, py, W, f, lo, hi, at, cum, brute):  # pragma: no cover (compiled
 
 
 @njit(cache=True, nogil=True, inline="always")
-def _win_d(px, py, W, f, ns, at, k, cum):  # pragma: no cover (compiled)
+def _win_d(px, py, W, f, ns, at, k, cum, ub):  # pragma: no cover (compiled)
     """One sample's distance to the segments at - k .. at + k (clipped) of the polyline
     W[f..f + ns] (1 / the squared length not taken: the windowed arithmetic); ``cum`` its
-    cumulated step lengths from W[f] (:func:`_scan_d`)."""
+    cumulated step lengths from W[f], ``ub`` an upper bound of the answer (or inf)
+    (:func:`_scan_d`)."""
     lo = max(0, min(at - k, ns - 1))
     hi = min(ns - 1, max(at + k, 0))
-    return _scan_d(px, py, W, f, lo, hi, at, cum, False)
+    return _scan_d(px, py, W, f, lo, hi, at, cum, False, ub)
 
 
 @njit(cache=True, nogil=True, inline="always")
@@ -3113,10 +3127,11 @@ def _brute_d(px, py, W, f, n):  # pragma: no cover (compiled)
 
 
 @njit(cache=True, nogil=True, inline="always")
-def _full_d(px, py, W, f, n, at, cum):  # pragma: no cover (compiled)
+def _full_d(px, py, W, f, n, at, cum, ub):  # pragma: no cover (compiled)
     """:func:`_brute_d` (the same number) from the segment at ``at`` outwards
-    (:func:`_scan_d`; ``cum`` the cumulated step lengths from W[f])."""
-    return _scan_d(px, py, W, f, 0, n - 2, at, cum, True)
+    (:func:`_scan_d`; ``cum`` the cumulated step lengths from W[f], ``ub`` an upper bound
+    of the answer up to the rounding, or inf)."""
+    return _scan_d(px, py, W, f, 0, n - 2, at, cum, True, ub)
 
 
 #: rounded input, after the joints: a segment is repaired where the design estimate (the

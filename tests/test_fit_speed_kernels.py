@@ -113,13 +113,13 @@ def _window_min(px, py, poly, at, k):
 
 
 @njit(cache=False)
-def _win(px, py, poly, at, k, cum):
-    return fitmod._win_d(px, py, poly, 0, len(poly) - 1, at, k, cum)
+def _win(px, py, poly, at, k, cum, ub):
+    return fitmod._win_d(px, py, poly, 0, len(poly) - 1, at, k, cum, ub)
 
 
 @njit(cache=False)
-def _full(px, py, poly, at, cum):
-    return fitmod._full_d(px, py, poly, 0, len(poly), at, cum)
+def _full(px, py, poly, at, cum, ub):
+    return fitmod._full_d(px, py, poly, 0, len(poly), at, cum, ub)
 
 
 @njit(cache=False)
@@ -144,10 +144,16 @@ def test_pruned_polyline_distances_are_the_plain_ones() -> None:
             j = int(rng.integers(0, n))
             p = poly[j] + rng.normal(0.0, rng.choice([0.3, 3.0, 30.0]), 2)
             at = int(np.clip(j + rng.integers(-20, 20), -1, n - 1))
+            near = _win(p[0], p[1], poly, at, 2, cum, np.inf)
             for k in (2, 8, 64):
-                assert _win(p[0], p[1], poly, at, k, cum) == _window_min(p[0], p[1], poly,
-                                                                         at, k)
-            assert _full(p[0], p[1], poly, at, cum) == _brute(p[0], p[1], poly)
+                want = _window_min(p[0], p[1], poly, at, k)
+                assert _win(p[0], p[1], poly, at, k, cum, np.inf) == want
+                # (a wider window, bounded by a narrower one's distance)
+                assert _win(p[0], p[1], poly, at, k, cum, near) == want
+            want = _brute(p[0], p[1], poly)
+            assert _full(p[0], p[1], poly, at, cum, np.inf) == want
+            # (bounded by a windowed distance: the other arithmetic)
+            assert _full(p[0], p[1], poly, at, cum, near) == want
 
 
 def test_compiled_refinement_gives_the_numpy_nearest_points() -> None:
