@@ -2879,7 +2879,12 @@ def _polyline_distance_over(samp, poly, lim, k=_NEAR_SEGMENTS):
     compiled, :func:`_over_kernel`)."""
     n = len(poly)
     if n <= 2 * k + 2:
-        return point_polyline_distance(samp, poly)
+        if n < 2:
+            return point_polyline_distance(samp, poly)
+        d = np.empty(len(samp))
+        _brute_kernel(np.ascontiguousarray(samp, dtype=np.float64),
+                      np.ascontiguousarray(poly, dtype=np.float64), d)
+        return d
     samp = np.ascontiguousarray(samp, dtype=np.float64)
     poly = np.ascontiguousarray(poly, dtype=np.float64)
     d = np.empty(len(samp))
@@ -2887,6 +2892,14 @@ def _polyline_distance_over(samp, poly, lim, k=_NEAR_SEGMENTS):
         _over_kernel(samp, np.hypot(*np.diff(samp, axis=0).T), poly,
                      np.hypot(*np.diff(poly, axis=0).T), float(lim), k, d)
     return d
+
+
+@njit(cache=True, nogil=True)
+def _brute_kernel(samp, poly, out):  # pragma: no cover (compiled)
+    """:func:`point_polyline_distance` of the samples to a short polyline (2 points or
+    more) compiled: :func:`_brute_d`, its arithmetic."""
+    for t in range(samp.shape[0]):
+        out[t] = _brute_d(samp[t, 0], samp[t, 1], poly, 0, poly.shape[0])
 
 
 @njit(cache=True, nogil=True)

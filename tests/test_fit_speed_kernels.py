@@ -151,9 +151,21 @@ def test_pruned_polyline_distances_are_the_plain_ones() -> None:
                 # (a wider window, bounded by a narrower one's distance)
                 assert _win(p[0], p[1], poly, at, k, cum, near) == want
             want = _brute(p[0], p[1], poly)
+            assert want == geo.point_polyline_distance(p[None], poly)[0]
             assert _full(p[0], p[1], poly, at, cum, np.inf) == want
             # (bounded by a windowed distance: the other arithmetic)
             assert _full(p[0], p[1], poly, at, cum, near) == want
+
+
+def test_short_polylines_measured_as_point_polyline_distance() -> None:
+    rng = np.random.default_rng(12)
+    for n in (2, 3, 17, 130):
+        poly = np.round(np.cumsum(rng.normal(0.0, 2.0, (n, 2)), axis=0))
+        poly[n // 2] = poly[n // 2 - 1]  # (a repeated point)
+        samp = poly[0] + rng.normal(0.0, 5.0, (200, 2)) + rng.uniform(0, 1, (200, 1)) * (
+            poly[-1] - poly[0])
+        got = fitmod._polyline_distance_over(samp, poly, 0.5, 64)
+        assert np.array_equal(got, geo.point_polyline_distance(samp, poly))
 
 
 def test_compiled_refinement_gives_the_numpy_nearest_points() -> None:
