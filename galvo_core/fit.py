@@ -90,18 +90,21 @@ from numba import njit
 from galvo_core.drawing import Drawing, Path
 from galvo_core.errors import Cancelled, ParamError
 from galvo_core.geometry import (
+    bernstein_point,
+    bernstein_samples,
+    bernstein_weights,
     cubic_eval,
     cubic_length,
-    gather_coeffs,
+    hypot_into,
     nearest_on_cubic,
     nearest_on_cubic_each,
-    nearest_on_cubics,
-    newton_nearest_many,
     newton_param,
     point_polyline_distance,
     point_segment_distance,
     power_coeffs_many,
     sampled_upper_d2,
+    seed_basis,
+    seeded_nearest,
 )
 from galvo_core.job import gc_paused
 from galvo_core.precision import path_quanta
@@ -668,8 +671,151 @@ def _accept_pairs(cm, i0, i1, starts, work, u, e2, qa, ok) -> None:  # pragma: n
 
 #: points per chunk of :func:`_accept_points` (its Newton steps run over a chunk at a time)
 _ACCEPT_CHUNK = 512
+#: the samples of :func:`_accept_far`'s seeded search (nearest_on_cubics' defaults)
+_SEED_U, _SEED_BASIS = seed_basis(48)
+_SEED_ITERS = 6
 #: no quanta (:func:`_accept_pairs` on exact input)
 _NO_QUANTA = np.zeros(0)
+
+
+#: points per chunk of :func:`_accept_quick` (each chunk strided over the whole piece)
+_QUICK_CHUNK = 64
+#: ... of :func:`_sample_kernel`
+_SAMPLE_CHUNK = 16
+
+
+@njit(cache=True, nogil=True)
+def _accept_quick(ctrl, cm, i0, i1, starts, work, arc, e2, su, basis, u, dist, emax,
+                  ok) -> None:  # pragma: no cover (compiled)
+    """:func:`_accept_points` and :func:`_accept_far` for a verdict only (compiled): per
+    piece r, its interior points in strided chunks of at most ``_QUICK_CHUNK`` (every
+    chunk spread over the whole piece), each point's parameter and distance as
+    :func:`_accept_points` has them (the same numbers: the 6 Newton steps of a point do
+    not depend on its chunk); a point over e2[r] gets the seeded search of
+    :func:`_accept_far` at once, and the piece fails (``ok[r]`` False) at its first point
+    that stays over, or that Newton leaves over 4 e2[r] (or NaN): :func:`_accept_points`
+    and :func:`_accept_far` fail it then too. A passing piece ends with the numbers of
+    both (its points' ``u``, ``dist``, and ``emax[r]`` their largest); a failing piece's
+    others are left unset."""
+    nc = _QUICK_CHUNK
+    ub = np.empty(nc)
+    qxb = np.empty(nc)
+    qyb = np.empty(nc)
+    db = np.empty(nc)
+    ib = np.empty(nc, dtype=np.intp)
+    samp = np.empty((basis.shape[0], 2))
+    for r in range(len(i0)):
+        ax = cm[r, 0, 0]
+        ay = cm[r, 0, 1]
+        bx = cm[r, 1, 0]
+        by = cm[r, 1, 1]
+        dx = cm[r, 2, 0]
+        dy = cm[r, 2, 1]
+        ex = cm[r, 3, 0]
+        ey = cm[r, 3, 1]
+        base = i0[r]
+        s = starts[r]
+        cnt = i1[r] - base + 1
+        span = arc[i1[r]] - arc[base]
+        den = span if span > 0 else 1.0
+        u[s] = 0.0
+        dist[s] = 0.0
+        u[s + cnt - 1] = 1.0
+        dist[s + cnt - 1] = 0.0
+        lim = e2[r]
+        nck = max(1, -(-(cnt - 2) // nc))
+        worst = 0.0
+        good = True
+        sampled = False
+        for c in range(nck):
+            n = 0
+            for jj in range(1 + c, cnt - 1, nck):
+                k = base + jj
+                ib[n] = jj
+                qxb[n] = work[k, 0] - ex
+                qyb[n] = work[k, 1] - ey
+                ub[n] = (arc[k] - arc[base]) / den
+                n += 1
+            for _ in range(6):  # (step by step over the chunk: the loop vectorises)
+                for j in range(n):
+                    uk = ub[j]
+                    ub[j] = newton_param(ax, ay, bx, by, dx, dy, qxb[j], qyb[j], uk)
+            for j in range(n):
+                k = base + ib[j]
+                uk = ub[j]
+                rx = ((ax * uk + bx) * uk + dx) * uk - (work[k, 0] - ex)
+                ry = ((ay * uk + by) * uk + dy) * uk - (work[k, 1] - ey)
+                db[j] = math.sqrt(rx * rx + ry * ry)
+            for j in range(n):
+                d = db[j]
+                f = s + ib[j]
+                uk = ub[j]
+                if not d <= lim:
+                    if not d <= 4.0 * lim:
+                        good = False
+                        emax[r] = d
+                        break
+                    if not sampled:
+                        bernstein_samples(basis, ctrl, r, samp)
+                        sampled = True
+                    k = base + ib[j]
+                    t, ds = seeded_nearest(cm, r, samp, su, _SEED_ITERS, work[k, 0],
+                                           work[k, 1])
+                    if not ds <= lim:
+                        good = False
+                        emax[r] = d
+                        break
+                    uk = t  # (nearer than Newton's: ds <= lim < d)
+                    d = ds
+                u[f] = uk
+                dist[f] = d
+                if d > worst:
+                    worst = d
+            if not good:
+                break
+        if good:
+            emax[r] = worst
+        ok[r] = good
+
+
+@njit(cache=True, nogil=True)
+def _accept_far(ctrl, cm, i0, i1, starts, work, e2, far, su, basis, u, dist, emax,
+                ok) -> None:  # pragma: no cover (compiled)
+    """:meth:`_BatchFitter._accept`'s seeded search (compiled) for the points ``far`` (flat
+    indices, ascending: :func:`_accept_points` left them over the bound e2[r] of their piece
+    r): each point's :func:`galvo_core.geometry.nearest_on_cubics` (its numbers: the samples
+    of the piece's cubic at ``su``, the nearest, Newton from there), kept where nearer than
+    Newton's; then the piece's largest error into ``emax[r]`` and ``ok[r]`` whether it is
+    within e2[r]."""
+    samp = np.empty((basis.shape[0], 2))
+    nf = far.shape[0]
+    m = starts.shape[0]
+    r = 0
+    k = 0
+    while k < nf:
+        while r + 1 < m and starts[r + 1] <= far[k]:
+            r += 1
+        s0 = starts[r]
+        s1 = s0 + i1[r] - i0[r] + 1
+        k1 = k
+        while k1 < nf and far[k1] < s1:
+            k1 += 1
+        bernstein_samples(basis, ctrl, r, samp)
+        base = i0[r] - s0
+        for j in range(k, k1):
+            f = far[j]
+            t, d = seeded_nearest(cm, r, samp, su, _SEED_ITERS, work[base + f, 0],
+                                  work[base + f, 1])
+            if d < dist[f]:
+                u[f] = t
+                dist[f] = d
+        worst = 0.0
+        for j in range(s0, s1):
+            if dist[j] > worst:
+                worst = dist[j]
+        emax[r] = worst
+        ok[r] = worst <= e2[r]
+        k = k1
 
 
 @njit(cache=True, nogil=True, error_model="numpy")
@@ -680,6 +826,7 @@ def _sample_kernel(cm, i0, i1, work, arc, e2, sample, ok) -> None:  # pragma: no
     ub = np.empty(sample)
     qxb = np.empty(sample)
     qyb = np.empty(sample)
+    ib = np.empty(sample, dtype=np.intp)
     for r in range(len(i0)):
         a = i0[r]
         L = i1[r] - a - 1
@@ -695,25 +842,34 @@ def _sample_kernel(cm, i0, i1, work, arc, e2, sample, ok) -> None:  # pragma: no
         dy = cm[r, 2, 1]
         ex = cm[r, 3, 0]
         ey = cm[r, 3, 1]
-        for j in range(n):
-            k = a + 1 + stride * j
-            qxb[j] = work[k, 0] - ex
-            qyb[j] = work[k, 1] - ey
-            ub[j] = (arc[k] - arc[a]) / den
-        for _ in range(4):
-            for j in range(n):
-                uk = ub[j]
-                ub[j] = newton_param(ax, ay, bx, by, dx, dy, qxb[j], qyb[j], uk)
         lim = e2[r] * e2[r]
         good = 0.0 <= lim
-        for j in range(n):
-            k = a + 1 + stride * j
-            uk = ub[j]
-            rx = ((ax * uk + bx) * uk + dx) * uk - (work[k, 0] - ex)
-            ry = ((ay * uk + by) * uk + dy) * uk - (work[k, 1] - ey)
-            if not rx * rx + ry * ry <= lim:
-                good = False
+        # in strided chunks (each spread over the piece): a failing piece mostly stops
+        # after the first (each point's Newton steps are its own: the same verdict)
+        nck = max(1, -(-n // _SAMPLE_CHUNK))
+        for c in range(nck):
+            if not good:
                 break
+            m = 0
+            for j in range(c, n, nck):
+                k = a + 1 + stride * j
+                ib[m] = k
+                qxb[m] = work[k, 0] - ex
+                qyb[m] = work[k, 1] - ey
+                ub[m] = (arc[k] - arc[a]) / den
+                m += 1
+            for _ in range(4):
+                for j in range(m):
+                    uk = ub[j]
+                    ub[j] = newton_param(ax, ay, bx, by, dx, dy, qxb[j], qyb[j], uk)
+            for j in range(m):
+                k = ib[j]
+                uk = ub[j]
+                rx = ((ax * uk + bx) * uk + dx) * uk - (work[k, 0] - ex)
+                ry = ((ay * uk + by) * uk + dy) * uk - (work[k, 1] - ey)
+                if not rx * rx + ry * ry <= lim:
+                    good = False
+                    break
         ok[r] = good
 
 
@@ -874,24 +1030,6 @@ def _ragged(starts: np.ndarray, counts: np.ndarray) -> tuple[np.ndarray, np.ndar
     return owner, off
 
 
-@njit(cache=True, nogil=True)
-def _piece_sample_kernel(i0, i1, stride, cnt, arc, work, pid, pts, u):  # pragma: no cover
-    """:meth:`_BatchFitter._piece_sample` compiled: point j of piece r is input point
-    i0[r] + 1 + stride[r] * j, its parameter its arc length from i0[r] over the piece's."""
-    o = 0
-    for r in range(i0.shape[0]):
-        a = i0[r]
-        span = arc[i1[r]] - arc[a]
-        den = span if span > 0 else 1.0
-        for j in range(cnt[r]):
-            ix = a + 1 + stride[r] * j
-            pid[o] = r
-            pts[o, 0] = work[ix, 0]
-            pts[o, 1] = work[ix, 1]
-            u[o] = (arc[ix] - arc[a]) / den
-            o += 1
-
-
 def _halves(a: np.ndarray, b: np.ndarray, k: np.ndarray) -> np.ndarray:
     """Pieces (a, k) and (k, b) for every split piece, in order: (2n, 2)."""
     return np.stack([np.stack([a, k], axis=1), np.stack([k, b], axis=1)], axis=1).reshape(-1, 2)
@@ -909,75 +1047,101 @@ def _chain_phase(idx: np.ndarray, k: int) -> np.ndarray:
     return (idx - idx[chain_start]) % k
 
 
-def _handle_lengths(u, pid, pts, p0, p3, t0, t3, m):
-    """Schneider's handle lengths per piece: the cubic p0, p0 + al t0, p3 - be t3, p3 nearest
-    (least squares) to the points ``pts`` at the parameters ``u`` (piece ``pid`` each):
-    (al, be, det, c11, c22) of the 2x2 normal equations (al, be inf/NaN where det is 0)."""
-    sums = np.zeros((5, m))
-    _handle_sums(np.ascontiguousarray(u, dtype=np.float64),
-                 np.ascontiguousarray(pid, dtype=np.intp),
-                 np.ascontiguousarray(pts, dtype=np.float64),
-                 np.ascontiguousarray(p0, dtype=np.float64),
-                 np.ascontiguousarray(p3, dtype=np.float64),
-                 np.ascontiguousarray(t0, dtype=np.float64),
-                 np.ascontiguousarray(t3, dtype=np.float64), sums)
-    c11, c12, c22, x1, x2 = sums
-    with np.errstate(divide="ignore", invalid="ignore"):
-        det = c11 * c22 - c12 * c12
-        al = (x1 * c22 - x2 * c12) / det
-        be = (c11 * x2 - c12 * x1) / det
-    return al, be, det, c11, c22
+@njit(cache=True, nogil=True, inline="always")
+def _piece_points(a, b, work, arc, sample, pxb, pyb, ub):  # pragma: no cover (compiled)
+    """The input points strictly inside the piece a..b (input indices; at most ``sample``,
+    evenly strided: the least-squares fits' sample) into ``pxb``, ``pyb`` and their
+    chord-length parameters (arc length over the piece's) into ``ub``; returns their
+    number."""
+    L = b - a - 1
+    stride = max(1, -(-L // sample))
+    n = -(-L // stride)
+    span = arc[b] - arc[a]
+    den = span if span > 0 else 1.0
+    for j in range(n):
+        ix = a + 1 + stride * j
+        pxb[j] = work[ix, 0]
+        pyb[j] = work[ix, 1]
+        ub[j] = (arc[ix] - arc[a]) / den
+    return n
 
 
-@njit(cache=True, nogil=True)
-def _handle_sums(u, pid, pts, p0, p3, t0, t3, sums) -> None:  # pragma: no cover (compiled)
-    """:func:`_handle_lengths`' sums per piece (compiled, in the order of the points, as
-    the former np.bincount): c11, c12, c22 of the normal matrix and the right side x1, x2
-    into ``sums`` (5, m)."""
-    for i in range(len(u)):
-        r = pid[i]
-        uk = u[i]
+@njit(cache=True, nogil=True, error_model="numpy", inline="always")
+def _handle_solve(n, pxb, pyb, ub, p0x, p0y, p3x, p3y, t0x, t0y, t3x,
+                  t3y):  # pragma: no cover (compiled)
+    """Schneider's handle lengths of one piece: the cubic p0, p0 + al t0, p3 - be t3, p3
+    nearest (least squares) to the points at the parameters ``ub`` (sums in the order of
+    the points): (al, be, det, c11, c22) of the 2x2 normal equations (al, be inf/NaN where
+    det is 0)."""
+    c11 = 0.0
+    c12 = 0.0
+    c22 = 0.0
+    x1 = 0.0
+    x2 = 0.0
+    for j in range(n):
+        uk = ub[j]
         s = 1.0 - uk
         b0 = s * s * s
         b1 = 3 * s * s * uk
         b2 = 3 * s * uk * uk
         b3 = uk * uk * uk
-        a1x = b1 * t0[r, 0]
-        a1y = b1 * t0[r, 1]
-        a2x = -b2 * t3[r, 0]
-        a2y = -b2 * t3[r, 1]
-        rx = pts[i, 0] - (b0 + b1) * p0[r, 0] - (b2 + b3) * p3[r, 0]
-        ry = pts[i, 1] - (b0 + b1) * p0[r, 1] - (b2 + b3) * p3[r, 1]
-        sums[0, r] += a1x * a1x + a1y * a1y
-        sums[1, r] += a1x * a2x + a1y * a2y
-        sums[2, r] += a2x * a2x + a2y * a2y
-        sums[3, r] += rx * a1x + ry * a1y
-        sums[4, r] += rx * a2x + ry * a2y
+        a1x = b1 * t0x
+        a1y = b1 * t0y
+        a2x = -b2 * t3x
+        a2y = -b2 * t3y
+        rx = pxb[j] - (b0 + b1) * p0x - (b2 + b3) * p3x
+        ry = pyb[j] - (b0 + b1) * p0y - (b2 + b3) * p3y
+        c11 += a1x * a1x + a1y * a1y
+        c12 += a1x * a2x + a1y * a2y
+        c22 += a2x * a2x + a2y * a2y
+        x1 += rx * a1x + ry * a1y
+        x2 += rx * a2x + ry * a2y
+    det = c11 * c22 - c12 * c12
+    al = (x1 * c22 - x2 * c12) / det
+    be = (c11 * x2 - c12 * x1) / det
+    return al, be, det, c11, c22
+
+
+@njit(cache=True, nogil=True, error_model="numpy", inline="always")
+def _nearest_params(p0x, p0y, p1x, p1y, p2x, p2y, p3x, p3y, n, pxb, pyb, ub, qxb, qyb,
+                    steps):  # pragma: no cover (compiled)
+    """The power coefficients (a, b, d, e: x, y each) of the cubic p0..p3 (power_coeffs'
+    arithmetic), and ``steps`` Newton steps of each point's parameter ``ub`` (in place,
+    step by step over the points: the loop vectorises) towards its nearest point (as
+    :func:`_newton_kernel`); ``qxb``, ``qyb`` get the points relative to the start."""
+    ax = -p0x + 3.0 * (p1x - p2x)
+    ax += p3x
+    ay = -p0y + 3.0 * (p1y - p2y)
+    ay += p3y
+    bx = 3.0 * (p0x + p2x) - 6.0 * p1x
+    by = 3.0 * (p0y + p2y) - 6.0 * p1y
+    dx = 3.0 * (p1x - p0x)
+    dy = 3.0 * (p1y - p0y)
+    for j in range(n):
+        qxb[j] = pxb[j] - p0x
+        qyb[j] = pyb[j] - p0y
+    for _ in range(steps):
+        for j in range(n):
+            uk = ub[j]
+            ub[j] = newton_param(ax, ay, bx, by, dx, dy, qxb[j], qyb[j], uk)
+    return ax, ay, bx, by, dx, dy
 
 
 @njit(cache=True, nogil=True, error_model="numpy")
-def _gn_rounds(ps, pts, u, p0, p3, t0, t3, al, be, chord, rounds) -> None:  # pragma: no cover
-    """:meth:`_BatchFitter._gauss_newton`'s rounds (compiled), in place on the handle
-    lengths ``al``, ``be`` and the sample points' parameters ``u``: piece r's sample points
-    are ps[r] .. ps[r + 1] - 1 of ``pts``. Per round and piece: the cubic's power
-    coefficients, 2 Newton steps per point (as :func:`_newton_kernel`), the unit normal at
-    the nearest point and the signed distance along it, the 2x2 normal equations of the
-    handle lengths, a damped step (the numbers of the former numpy version, bit for bit)."""
-    nmax = 0
-    for r in range(len(al)):
-        nmax = max(nmax, ps[r + 1] - ps[r])
-    ub = np.empty(nmax)
-    qxb = np.empty(nmax)
-    qyb = np.empty(nmax)
-    rxb = np.empty(nmax)
-    ryb = np.empty(nmax)
-    txb = np.empty(nmax)
-    tyb = np.empty(nmax)
-    nb = np.empty(nmax)
-    resb = np.empty(nmax)
-    j1b = np.empty(nmax)
-    j2b = np.empty(nmax)
-    for r in range(len(al)):
+def _ls_kernel(i0, i1, work, arc, sample, p0, p3, t0, t3, chord, ctrl,
+               ok) -> None:  # pragma: no cover (compiled)
+    """:meth:`_BatchFitter._least_squares` one piece at a time (compiled): Schneider's
+    handle lengths at chord-length parameters, twice 2 Newton steps of the parameters and
+    the handles again; a handle not positive or over twice the chord (or a singular
+    system) is a third of the chord, ``ok[r]`` False. The numbers of the former numpy
+    version (:func:`_handle_sums`, :func:`_newton_kernel`), bit for bit."""
+    pxb = np.empty(sample)
+    pyb = np.empty(sample)
+    ub = np.empty(sample)
+    qxb = np.empty(sample)
+    qyb = np.empty(sample)
+    for r in range(i0.shape[0]):
+        n = _piece_points(i0[r], i1[r], work, arc, sample, pxb, pyb, ub)
         p0x = p0[r, 0]
         p0y = p0[r, 1]
         p3x = p3[r, 0]
@@ -986,48 +1150,94 @@ def _gn_rounds(ps, pts, u, p0, p3, t0, t3, al, be, chord, rounds) -> None:  # pr
         t0y = t0[r, 1]
         t3x = t3[r, 0]
         t3y = t3[r, 1]
-        lim = 0.25 * chord[r]
-        a_ = al[r]
-        b_ = be[r]
+        c = chord[r]
+        good = False
+        for it in range(3):
+            al, be, det, c11, c22 = _handle_solve(n, pxb, pyb, ub, p0x, p0y, p3x, p3y, t0x,
+                                                  t0y, t3x, t3y)
+            good = ((abs(det) > 1e-12 * (c11 * c22 + 1e-300)) and al > 0 and be > 0
+                    and al < 2.0 * c and be < 2.0 * c)
+            if not good:
+                al = c / 3.0
+                be = c / 3.0
+            p1x = p0x + al * t0x
+            p1y = p0y + al * t0y
+            p2x = p3x - be * t3x
+            p2y = p3y - be * t3y
+            ctrl[r, 0, 0] = p0x
+            ctrl[r, 0, 1] = p0y
+            ctrl[r, 1, 0] = p1x
+            ctrl[r, 1, 1] = p1y
+            ctrl[r, 2, 0] = p2x
+            ctrl[r, 2, 1] = p2y
+            ctrl[r, 3, 0] = p3x
+            ctrl[r, 3, 1] = p3y
+            if it == 2:
+                break
+            _nearest_params(p0x, p0y, p1x, p1y, p2x, p2y, p3x, p3y, n, pxb, pyb, ub, qxb,
+                            qyb, 2)
+        ok[r] = good
+
+
+@njit(cache=True, nogil=True, error_model="numpy")
+def _gn_kernel(i0, i1, work, arc, sample, p0, p3, t0, t3, chord, rounds, ctrl,
+               ok) -> None:  # pragma: no cover (compiled)
+    """:meth:`_BatchFitter._gauss_newton` one piece at a time (compiled): Schneider's
+    handle lengths at chord-length parameters to start (a third of the chord where not
+    positive or over twice the chord), then per round the cubic's power coefficients, 2
+    Newton steps per point, the unit normal at the nearest point and the signed distance
+    along it, the 2x2 normal equations of the handle lengths, a damped step; ``ok[r]``:
+    both handles positive and under twice the chord (else a third of it). The numbers of
+    the former numpy version, bit for bit."""
+    pxb = np.empty(sample)
+    pyb = np.empty(sample)
+    ub = np.empty(sample)
+    qxb = np.empty(sample)
+    qyb = np.empty(sample)
+    rxb = np.empty(sample)
+    ryb = np.empty(sample)
+    txb = np.empty(sample)
+    tyb = np.empty(sample)
+    nb = np.empty(sample)
+    resb = np.empty(sample)
+    j1b = np.empty(sample)
+    j2b = np.empty(sample)
+    fb = np.empty(sample, dtype=np.bool_)
+    for r in range(i0.shape[0]):
+        n = _piece_points(i0[r], i1[r], work, arc, sample, pxb, pyb, ub)
+        p0x = p0[r, 0]
+        p0y = p0[r, 1]
+        p3x = p3[r, 0]
+        p3y = p3[r, 1]
+        t0x = t0[r, 0]
+        t0y = t0[r, 1]
+        t3x = t3[r, 0]
+        t3y = t3[r, 1]
+        c = chord[r]
+        a_, b_, _d, _c11, _c22 = _handle_solve(n, pxb, pyb, ub, p0x, p0y, p3x, p3y, t0x,
+                                               t0y, t3x, t3y)
+        if not (a_ > 0 and b_ > 0 and a_ < 2.0 * c and b_ < 2.0 * c):
+            a_ = c / 3.0
+            b_ = c / 3.0
+        lim = 0.25 * c
         for _ in range(rounds):
             p1x = p0x + a_ * t0x
             p1y = p0y + a_ * t0y
             p2x = p3x - b_ * t3x
             p2y = p3y - b_ * t3y
-            ax = -p0x + 3.0 * (p1x - p2x)
-            ax += p3x
-            ay = -p0y + 3.0 * (p1y - p2y)
-            ay += p3y
-            bx = 3.0 * (p0x + p2x) - 6.0 * p1x
-            by = 3.0 * (p0y + p2y) - 6.0 * p1y
-            dx = 3.0 * (p1x - p0x)
-            dy = 3.0 * (p1y - p0y)
+            ax, ay, bx, by, dx, dy = _nearest_params(p0x, p0y, p1x, p1y, p2x, p2y, p3x, p3y,
+                                                     n, pxb, pyb, ub, qxb, qyb, 2)
             ex = p0x
             ey = p0y
-            c11 = 0.0
-            c12 = 0.0
-            c22 = 0.0
-            x1 = 0.0
-            x2 = 0.0
-            k0 = ps[r]
-            n = ps[r + 1] - k0
-            for j in range(n):  # (step by step over the piece's points: vectorises)
-                qxb[j] = pts[k0 + j, 0] - ex
-                qyb[j] = pts[k0 + j, 1] - ey
-                ub[j] = u[k0 + j]
-            for _i in range(2):
-                for j in range(n):
-                    uk = ub[j]
-                    ub[j] = newton_param(ax, ay, bx, by, dx, dy, qxb[j], qyb[j], uk)
             for j in range(n):
                 uk = ub[j]
-                u[k0 + j] = uk
-                rxb[j] = ((ax * uk + bx) * uk + dx) * uk + ex - pts[k0 + j, 0]
-                ryb[j] = ((ay * uk + by) * uk + dy) * uk + ey - pts[k0 + j, 1]
+                rxb[j] = ((ax * uk + bx) * uk + dx) * uk + ex - pxb[j]
+                ryb[j] = ((ay * uk + by) * uk + dy) * uk + ey - pyb[j]
                 txb[j] = (3.0 * ax * uk + 2.0 * bx) * uk + dx
                 tyb[j] = (3.0 * ay * uk + 2.0 * by) * uk + dy
+            hypot_into(txb, tyb, n, nb, fb)
             for j in range(n):
-                dn = math.hypot(txb[j], tyb[j])
+                dn = nb[j]
                 nb[j] = dn if dn > 0.0 else 1.0
             for j in range(n):
                 uk = ub[j]
@@ -1038,6 +1248,11 @@ def _gn_rounds(ps, pts, u, p0, p3, t0, t3, al, be, chord, rounds) -> None:  # pr
                 sk = 1.0 - uk
                 j1b[j] = 3 * sk * sk * uk * (nx * t0x + ny * t0y)
                 j2b[j] = -3 * sk * uk * uk * (nx * t3x + ny * t3y)
+            c11 = 0.0
+            c12 = 0.0
+            c22 = 0.0
+            x1 = 0.0
+            x2 = 0.0
             for j in range(n):
                 j1 = j1b[j]
                 j2 = j2b[j]
@@ -1061,61 +1276,77 @@ def _gn_rounds(ps, pts, u, p0, p3, t0, t3, al, be, chord, rounds) -> None:  # pr
                 v = b_ + min(max(db, -lim), lim)
                 h = 0.5 * b_
                 b_ = v if (v >= h or v != v) else h
-        al[r] = a_
-        be[r] = b_
+        good = (np.isfinite(a_) and np.isfinite(b_) and a_ > 0 and b_ > 0 and a_ < 2.0 * c
+                and b_ < 2.0 * c)
+        if not good:
+            a_ = c / 3.0
+            b_ = c / 3.0
+        ok[r] = good
+        ctrl[r, 0, 0] = p0x
+        ctrl[r, 0, 1] = p0y
+        ctrl[r, 1, 0] = p0x + a_ * t0x
+        ctrl[r, 1, 1] = p0y + a_ * t0y
+        ctrl[r, 2, 0] = p3x - b_ * t3x
+        ctrl[r, 2, 1] = p3y - b_ * t3y
+        ctrl[r, 3, 0] = p3x
+        ctrl[r, 3, 1] = p3y
 
 
 @njit(cache=True, nogil=True, error_model="numpy")
-def _gn_free_sums(ps, pts, u, ctrl, N, g) -> None:  # pragma: no cover (compiled)
+def _gn_free_sums(i0, i1, work, arc, sample, ps, pts, u, ctrl, first, N,
+                  g) -> None:  # pragma: no cover (compiled)
     """:meth:`_BatchFitter._gauss_newton_free`'s normal equations of one round (compiled),
-    per piece r (sample points ps[r] .. ps[r + 1] - 1, cubic ``ctrl[r]``): 2 Newton steps per
-    point from ``u`` (updated; as :func:`_newton_kernel`), the unit normal at the nearest
-    point and the signed distance along it, the Jacobian of the distance in the two inner
-    control points; sums in the order of the points (as the former np.bincount) into ``N``
-    (m, 4, 4) and ``g`` (m, 4) (minus the gradient)."""
-    nmax = 0
-    for r in range(len(ps) - 1):
-        nmax = max(nmax, ps[r + 1] - ps[r])
-    ub = np.empty(nmax)
-    qxb = np.empty(nmax)
-    qyb = np.empty(nmax)
-    jb = np.empty((4, nmax))
-    resb = np.empty(nmax)
-    for r in range(len(ps) - 1):
-        p0x = ctrl[r, 0, 0]
-        p0y = ctrl[r, 0, 1]
-        p1x = ctrl[r, 1, 0]
-        p1y = ctrl[r, 1, 1]
-        p2x = ctrl[r, 2, 0]
-        p2y = ctrl[r, 2, 1]
-        ax = -p0x + 3.0 * (p1x - p2x)
-        ax += ctrl[r, 3, 0]
-        ay = -p0y + 3.0 * (p1y - p2y)
-        ay += ctrl[r, 3, 1]
-        bx = 3.0 * (p0x + p2x) - 6.0 * p1x
-        by = 3.0 * (p0y + p2y) - 6.0 * p1y
-        dx = 3.0 * (p1x - p0x)
-        dy = 3.0 * (p1y - p0y)
-        ex = p0x
-        ey = p0y
+    per piece r (its sample points: :func:`_piece_points`, kept in pts[ps[r]] ..
+    pts[ps[r + 1] - 1] on the ``first`` round, their parameters in ``u``, chord length ones
+    on the first round; cubic ``ctrl[r]``): 2 Newton steps
+    per point from ``u`` (updated; as :func:`_newton_kernel`), the unit normal at the
+    nearest point and the signed distance along it, the Jacobian of the distance in the two
+    inner control points; sums in the order of the points (as the former np.bincount) into
+    ``N`` (m, 4, 4) and ``g`` (m, 4, 1) (minus the gradient), made ready for the solve."""
+    pxb = np.empty(sample)
+    pyb = np.empty(sample)
+    ub = np.empty(sample)
+    qxb = np.empty(sample)
+    qyb = np.empty(sample)
+    jb = np.empty((4, sample))
+    resb = np.empty(sample)
+    txb = np.empty(sample)
+    tyb = np.empty(sample)
+    nb = np.empty(sample)
+    fb = np.empty(sample, dtype=np.bool_)
+    for r in range(i0.shape[0]):
         k0 = ps[r]
         n = ps[r + 1] - k0
-        for j in range(n):
-            qxb[j] = pts[k0 + j, 0] - ex
-            qyb[j] = pts[k0 + j, 1] - ey
-            ub[j] = u[k0 + j]
-        for _i in range(2):
+        if first:
+            _piece_points(i0[r], i1[r], work, arc, sample, pxb, pyb, ub)
             for j in range(n):
-                uk = ub[j]
-                ub[j] = newton_param(ax, ay, bx, by, dx, dy, qxb[j], qyb[j], uk)
+                pts[k0 + j, 0] = pxb[j]
+                pts[k0 + j, 1] = pyb[j]
+        else:
+            for j in range(n):
+                pxb[j] = pts[k0 + j, 0]
+                pyb[j] = pts[k0 + j, 1]
+                ub[j] = u[k0 + j]
+        p0x = ctrl[r, 0, 0]
+        p0y = ctrl[r, 0, 1]
+        ax, ay, bx, by, dx, dy = _nearest_params(
+            p0x, p0y, ctrl[r, 1, 0], ctrl[r, 1, 1], ctrl[r, 2, 0], ctrl[r, 2, 1],
+            ctrl[r, 3, 0], ctrl[r, 3, 1], n, pxb, pyb, ub, qxb, qyb, 2)
+        ex = p0x
+        ey = p0y
         for j in range(n):
             uk = ub[j]
             u[k0 + j] = uk
-            rx = ((ax * uk + bx) * uk + dx) * uk + ex - pts[k0 + j, 0]
-            ry = ((ay * uk + by) * uk + dy) * uk + ey - pts[k0 + j, 1]
-            tx = (3.0 * ax * uk + 2.0 * bx) * uk + dx
-            ty = (3.0 * ay * uk + 2.0 * by) * uk + dy
-            dn = math.hypot(tx, ty)
+            txb[j] = (3.0 * ax * uk + 2.0 * bx) * uk + dx
+            tyb[j] = (3.0 * ay * uk + 2.0 * by) * uk + dy
+        hypot_into(txb, tyb, n, nb, fb)
+        for j in range(n):
+            uk = ub[j]
+            rx = ((ax * uk + bx) * uk + dx) * uk + ex - pxb[j]
+            ry = ((ay * uk + by) * uk + dy) * uk + ey - pyb[j]
+            tx = txb[j]
+            ty = tyb[j]
+            dn = nb[j]
             if not dn > 0.0:
                 dn = 1.0
             nx = -ty / dn
@@ -1128,17 +1359,136 @@ def _gn_free_sums(ps, pts, u, ctrl, N, g) -> None:  # pragma: no cover (compiled
             jb[1, j] = b1 * ny
             jb[2, j] = b2 * nx
             jb[3, j] = b2 * ny
+        # the 14 sums in one pass (each in the order of the points, as before; their
+        # chains of additions independent of each other, so they overlap)
+        n00 = 0.0
+        n01 = 0.0
+        n02 = 0.0
+        n03 = 0.0
+        n11 = 0.0
+        n12 = 0.0
+        n13 = 0.0
+        n22 = 0.0
+        n23 = 0.0
+        n33 = 0.0
+        g0 = 0.0
+        g1 = 0.0
+        g2 = 0.0
+        g3 = 0.0
+        for j in range(n):
+            j0 = jb[0, j]
+            j1 = jb[1, j]
+            j2 = jb[2, j]
+            j3 = jb[3, j]
+            rs = resb[j]
+            n00 += j0 * j0
+            n01 += j0 * j1
+            n02 += j0 * j2
+            n03 += j0 * j3
+            n11 += j1 * j1
+            n12 += j1 * j2
+            n13 += j1 * j3
+            n22 += j2 * j2
+            n23 += j2 * j3
+            n33 += j3 * j3
+            g0 += j0 * rs
+            g1 += j1 * rs
+            g2 += j2 * rs
+            g3 += j3 * rs
+        N[r, 0, 0] = n00
+        N[r, 0, 1] = n01
+        N[r, 1, 0] = n01
+        N[r, 0, 2] = n02
+        N[r, 2, 0] = n02
+        N[r, 0, 3] = n03
+        N[r, 3, 0] = n03
+        N[r, 1, 1] = n11
+        N[r, 1, 2] = n12
+        N[r, 2, 1] = n12
+        N[r, 1, 3] = n13
+        N[r, 3, 1] = n13
+        N[r, 2, 2] = n22
+        N[r, 2, 3] = n23
+        N[r, 3, 2] = n23
+        N[r, 3, 3] = n33
+        g[r, 0, 0] = -g0
+        g[r, 1, 0] = -g1
+        g[r, 2, 0] = -g2
+        g[r, 3, 0] = -g3
+        # non-finite sums are 0; the diagonal gets 1e-9 of the trace (summed in order, as
+        # np.trace) + 1e-12 (as N + reg * eye(4): the others + reg * 0)
         for i in range(4):
-            for i2 in range(i, 4):
-                acc = 0.0
-                for j in range(n):
-                    acc += jb[i, j] * jb[i2, j]
-                N[r, i, i2] = acc
-                N[r, i2, i] = acc
-            acc = 0.0
-            for j in range(n):
-                acc += jb[i, j] * resb[j]
-            g[r, i] = -acc
+            if not np.isfinite(g[r, i, 0]):
+                g[r, i, 0] = 0.0
+            for i2 in range(4):
+                if not np.isfinite(N[r, i, i2]):
+                    N[r, i, i2] = 0.0
+        reg = 1e-9 * (((N[r, 0, 0] + N[r, 1, 1]) + N[r, 2, 2]) + N[r, 3, 3]) + 1e-12
+        for i in range(4):
+            for i2 in range(4):
+                N[r, i, i2] = N[r, i, i2] + reg * (1.0 if i == i2 else 0.0)
+
+
+@njit(cache=True, nogil=True)
+def _gn_free_step(ctrl, d, chord) -> None:  # pragma: no cover (compiled)
+    """:meth:`_BatchFitter._gauss_newton_free`'s step of one round (compiled): the solution
+    ``d`` (m, 4, 1) where finite (else 0), clipped to a quarter of the chord either way (as
+    np.clip), added to the two inner control points."""
+    for r in range(ctrl.shape[0]):
+        lim = 0.25 * chord[r]
+        nlim = -lim
+        for i in range(4):
+            v = d[r, i, 0]
+            if not np.isfinite(v):
+                v = 0.0
+            v = v if v > nlim else nlim  # (np.clip: max, then min)
+            v = v if v < lim else lim
+            ctrl[r, 1 + i // 2, i % 2] += v
+
+
+@njit(cache=True, nogil=True, error_model="numpy")
+def _triangle_kernel(A, B, q, t_out, t_in, ok, p0, qq, p3,
+                     sig) -> None:  # pragma: no cover (compiled)
+    """:meth:`_BatchFitter._triangle` per piece (compiled; the numbers of the former numpy
+    version): the tangents' determinant, the chord's length (libm's hypot), the handle
+    lengths along the tangents to their meeting point, ok where both are positive (over
+    1e-9 of the chord, at most 1e3 chords) on a non-degenerate chord and determinant, the
+    apex p0 + al t0 (p0 where not ok), the determinant's sign."""
+    for r in range(A.shape[0]):
+        a = A[r]
+        b = B[r]
+        p0x = q[a, 0]
+        p0y = q[a, 1]
+        p3x = q[b, 0]
+        p3y = q[b, 1]
+        t0x = t_out[a, 0]
+        t0y = t_out[a, 1]
+        t3x = t_in[b, 0]
+        t3y = t_in[b, 1]
+        det = t0x * t3y - t0y * t3x
+        chx = p3x - p0x
+        chy = p3y - p0y
+        lc = math.hypot(chx, chy)
+        al = (chx * t3y - chy * t3x) / det
+        be = (t0x * chy - t0y * chx) / det
+        good = ((lc > 0.0) and (abs(det) >= 1e-9) and (al > 1e-9 * lc) and (be > 1e-9 * lc)
+                and (al <= 1e3 * lc) and (be <= 1e3 * lc))
+        w = al if good else 0.0
+        ok[r] = good
+        p0[r, 0] = p0x
+        p0[r, 1] = p0y
+        p3[r, 0] = p3x
+        p3[r, 1] = p3y
+        qq[r, 0] = p0x + w * t0x
+        qq[r, 1] = p0y + w * t0y
+        if det > 0.0:
+            sig[r] = 1.0
+        elif det < 0.0:
+            sig[r] = -1.0
+        elif det == 0.0:
+            sig[r] = 0.0
+        else:
+            sig[r] = det  # (NaN, as np.sign)
 
 
 class _BatchFitter:
@@ -1190,24 +1540,19 @@ class _BatchFitter:
 
     # -- the one-parameter family ---------------------------------------------------------
     def _triangle(self, A: np.ndarray, B: np.ndarray):
-        p0, p3 = self.q[A], self.q[B]
-        t0, t3 = self.t_out[A], self.t_in[B]
-        det = t0[:, 0] * t3[:, 1] - t0[:, 1] * t3[:, 0]
-        ch = p3 - p0
-        lc = np.hypot(ch[:, 0], ch[:, 1])
-        with np.errstate(divide="ignore", invalid="ignore"):
-            al = (ch[:, 0] * t3[:, 1] - ch[:, 1] * t3[:, 0]) / det
-            be = (t0[:, 0] * ch[:, 1] - t0[:, 1] * ch[:, 0]) / det
-        ok = (
-            (lc > 0.0)
-            & (np.abs(det) >= 1e-9)
-            & (al > 1e-9 * lc)
-            & (be > 1e-9 * lc)
-            & (al <= 1e3 * lc)
-            & (be <= 1e3 * lc)
-        )
-        qq = p0 + np.where(ok, al, 0.0)[:, None] * t0
-        return ok, p0, qq, p3, np.sign(det)
+        """Per piece A..B: whether its end tangents meet in front of both ends (the
+        triangle exists), the ends, the apex (p0 where not) and the orientation (compiled,
+        :func:`_triangle_kernel`)."""
+        A = np.ascontiguousarray(A, dtype=np.intp)
+        B = np.ascontiguousarray(B, dtype=np.intp)
+        m = len(A)
+        ok = np.empty(m, dtype=bool)
+        p0 = np.empty((m, 2))
+        qq = np.empty((m, 2))
+        p3 = np.empty((m, 2))
+        sig = np.empty(m)
+        _triangle_kernel(A, B, self.q, self.t_out, self.t_in, ok, p0, qq, p3, sig)
+        return ok, p0, qq, p3, sig
 
     @staticmethod
     def _ctrl(p0, qq, p3, t):
@@ -1230,7 +1575,7 @@ class _BatchFitter:
         return self._ctrl(p0, qq, p3, t)
 
     def _accept(self, ctrl: np.ndarray, i0: np.ndarray, i1: np.ndarray, e2: np.ndarray,
-                A: np.ndarray | None = None):
+                A: np.ndarray | None = None, full: bool = False):
         """Per piece: bound of the max input-point error, pass/fail of both sides of the
         guarantee, and the flat per-point errors (with the offsets of each piece).
 
@@ -1242,7 +1587,12 @@ class _BatchFitter:
         input segment is the design up to the rounding of its ends, so the curve keeps
         closer to it than the rounding allows. Both sides compiled, one piece at a time
         (:func:`_accept_points`, :func:`_accept_pairs`); a piece stops at its first pair
-        over the bound."""
+        over the bound.
+
+        Only the passing pieces' bounds and errors are final unless ``full``: a failing
+        piece stops at its first point that the seeded search leaves over the bound
+        (:func:`_accept_quick`: the same verdicts); with ``full`` every point's error is
+        (for the split points)."""
         m = len(ctrl)
         i0 = np.ascontiguousarray(i0, dtype=np.intp)
         i1 = np.ascontiguousarray(i1, dtype=np.intp)
@@ -1253,22 +1603,20 @@ class _BatchFitter:
         cm = power_coeffs_many(ctrl)
         u = np.empty(total)
         dist = np.empty(total)
-        emax0 = np.empty(m)
-        far = np.empty(total, dtype=np.intp)
-        nfar = _accept_points(cm, i0, i1, starts, self.work, self.arc, e2, u, dist, emax0,
-                              far)
-        emax = emax0
-        if nfar:
-            far = far[:nfar]
-            pid = np.searchsorted(starts, far, side="right") - 1
-            pts = self.work[i0[pid] + far - starts[pid]]
-            used, inv = np.unique(pid, return_inverse=True)  # (only their cubics)
-            tu, td = nearest_on_cubics(ctrl[used], inv, pts)
-            better = td < dist[far]
-            u[far[better]] = tu[better]
-            dist[far[better]] = td[better]
-            emax = np.maximum.reduceat(dist, starts)
-        ok = emax <= e2
+        emax = np.empty(m)
+        ctrl = np.ascontiguousarray(ctrl, dtype=np.float64)
+        if full:
+            far = np.empty(total, dtype=np.intp)
+            nfar = _accept_points(cm, i0, i1, starts, self.work, self.arc, e2, u, dist, emax,
+                                  far)
+            ok = emax <= e2
+            if nfar:
+                _accept_far(ctrl, cm, i0, i1, starts, self.work, e2, far[:nfar], _SEED_U,
+                            _SEED_BASIS, u, dist, emax, ok)
+        else:
+            ok = np.empty(m, dtype=bool)
+            _accept_quick(ctrl, cm, i0, i1, starts, self.work, self.arc, e2, _SEED_U,
+                          _SEED_BASIS, u, dist, emax, ok)
         qa = _NO_QUANTA
         if self.quant is not None and A is not None:
             qa = np.ascontiguousarray(self.quant[A], dtype=np.float64)
@@ -1314,7 +1662,8 @@ class _BatchFitter:
             if len(A):
                 i0, i1 = self.kept[A], self.kept[B]
                 ctrl = self._dichotomy(p0[ok], qq[ok], p3[ok], sig[ok], i0, i1)
-                good, emax, dist, starts = self._accept(ctrl, i0, i1, self.e_per[A], A)
+                good, emax, dist, starts = self._accept(ctrl, i0, i1, self.e_per[A], A,
+                                                        full=True)
                 if self.quant is not None:
                     rq = np.flatnonzero(self.quant[A] > 0.0)
                     if len(rq):
@@ -1658,9 +2007,14 @@ class _BatchFitter:
                 return passed, ctrl_all, em_all
         ctrl = self._dichotomy(p0[w], qq[w], p3[w], sig[w], i0, i1, _MERGE_SAMPLE)
         # screen on a sample of the points first: the full test only where it can pass
-        lk = self._sample_ok(ctrl, i0, i1, self.e_per[a])
-        if self.quant is not None:
-            lk |= self.quant[a] > 0.0  # (the least-squares cubic may pass where this fails)
+        # (not on rounded input: the least-squares cubic may pass where this fails)
+        if self.quant is None:
+            lk = self._sample_ok(ctrl, i0, i1, self.e_per[a])
+        else:
+            lk = self.quant[a] > 0.0
+            ex = np.flatnonzero(~lk)
+            if len(ex):
+                lk[ex] = self._sample_ok(ctrl[ex], i0[ex], i1[ex], self.e_per[a[ex]])
         if not lk.any():
             self._second_try(A, B, fresh, fresh, passed, ctrl_all, em_all)
             self._remember_failed(key[fresh & ~passed])
@@ -1767,45 +2121,23 @@ class _BatchFitter:
         self._cubics = [(A[keep], B[keep], C[keep], E[keep])]
         return True
 
-    def _piece_sample(self, i0: np.ndarray, i1: np.ndarray):
-        """The input points strictly inside each piece i0..i1 (at most ``_BISECT_SAMPLE``,
-        evenly strided) for the least-squares fits: (piece of each (K,), points (K, 2),
-        chord-length parameters (K,))."""
-        L = i1 - i0 - 1
-        stride = np.maximum(1, -(-L // _BISECT_SAMPLE))
-        cnt = -(-L // stride)
-        total = int(cnt.sum())
-        pid = np.empty(total, dtype=np.intp)
-        pts = np.empty((total, 2))
-        u = np.empty(total)
-        _piece_sample_kernel(np.asarray(i0, dtype=np.intp), np.asarray(i1, dtype=np.intp),
-                             stride.astype(np.intp), cnt.astype(np.intp), self.arc,
-                             self.work, pid, pts, u)
-        return pid, pts, u
-
     def _least_squares(self, A: np.ndarray, B: np.ndarray, i0: np.ndarray, i1: np.ndarray):
         """Per piece: the cubic with the piece's end points and end tangents whose two
         handle lengths minimise the squared distances of (a sample of) its input points at
         their parameters (chord length, then twice the nearest point's), Schneider's
-        fit; (ctrl (m, 4, 2), ok (m,): positive handles no longer than twice the chord)."""
+        fit; (ctrl (m, 4, 2), ok (m,): positive handles no longer than twice the chord).
+        Compiled, one piece at a time (:func:`_ls_kernel`)."""
         m = len(A)
         p0, p3 = self.q[A], self.q[B]
-        t0, t3 = self.t_out[A], self.t_in[B]
-        pid, pts, u = self._piece_sample(i0, i1)
         chord = np.hypot(*(p3 - p0).T)
-        ctrl = np.zeros((m, 4, 2))
-        ok = np.zeros(m, dtype=bool)
-        for it in range(3):
-            al, be, det, c11, c22 = _handle_lengths(u, pid, pts, p0, p3, t0, t3, m)
-            ok = (np.abs(det) > 1e-12 * (c11 * c22 + 1e-300)) & (al > 0) & (be > 0)
-            ok &= (al < 2.0 * chord) & (be < 2.0 * chord)
-            al = np.where(ok, al, chord / 3.0)
-            be = np.where(ok, be, chord / 3.0)
-            ctrl = np.stack([p0, p0 + al[:, None] * t0, p3 - be[:, None] * t3, p3], axis=1)
-            if it == 2:
-                break
-            cf = gather_coeffs(power_coeffs_many(ctrl), pid)
-            u, _ = newton_nearest_many(cf, pts.T, u, 2)
+        ctrl = np.empty((m, 4, 2))
+        ok = np.empty(m, dtype=bool)
+        _ls_kernel(np.ascontiguousarray(i0, dtype=np.intp),
+                   np.ascontiguousarray(i1, dtype=np.intp), self.work, self.arc,
+                   _BISECT_SAMPLE, np.ascontiguousarray(p0, dtype=np.float64),
+                   np.ascontiguousarray(p3, dtype=np.float64),
+                   np.ascontiguousarray(self.t_out[A], dtype=np.float64),
+                   np.ascontiguousarray(self.t_in[B], dtype=np.float64), chord, ctrl, ok)
         return ctrl, ok
 
     def _gauss_newton(self, A: np.ndarray, B: np.ndarray, i0: np.ndarray, i1: np.ndarray,
@@ -1817,30 +2149,20 @@ class _BatchFitter:
         (:meth:`_least_squares`: handles for fixed parameters, then new parameters) creeps
         towards that minimum (a design cubic sampled exactly, handles 102 / 81: still 91 /
         92 after 50 rounds); this reaches it in 3. Returns (ctrl (m, 4, 2), ok (m,):
-        positive handles no longer than twice the chord)."""
+        positive handles no longer than twice the chord). Compiled, one piece at a time
+        (:func:`_gn_kernel`)."""
         m = len(A)
         p0, p3 = self.q[A], self.q[B]
-        t0, t3 = self.t_out[A], self.t_in[B]
-        pid, pts, u = self._piece_sample(i0, i1)
         chord = np.hypot(*(p3 - p0).T)
-        # start: Schneider's handles at chord-length parameters
-        al, be, _, _, _ = _handle_lengths(u, pid, pts, p0, p3, t0, t3, m)
-        bad = ~((al > 0) & (be > 0) & (al < 2.0 * chord) & (be < 2.0 * chord))
-        al = np.where(bad, chord / 3.0, al)
-        be = np.where(bad, chord / 3.0, be)
-        ps = np.r_[0, np.cumsum(np.bincount(pid, minlength=m))]
-        al = np.ascontiguousarray(al, dtype=np.float64)
-        be = np.ascontiguousarray(be, dtype=np.float64)
-        _gn_rounds(ps, np.ascontiguousarray(pts, dtype=np.float64),
-                   np.ascontiguousarray(u, dtype=np.float64), np.ascontiguousarray(p0),
-                   np.ascontiguousarray(p3), np.ascontiguousarray(t0, dtype=np.float64),
-                   np.ascontiguousarray(t3, dtype=np.float64), al, be,
-                   np.ascontiguousarray(chord), rounds)
-        ok = np.isfinite(al) & np.isfinite(be) & (al > 0) & (be > 0)
-        ok &= (al < 2.0 * chord) & (be < 2.0 * chord)
-        al = np.where(ok, al, chord / 3.0)
-        be = np.where(ok, be, chord / 3.0)
-        ctrl = np.stack([p0, p0 + al[:, None] * t0, p3 - be[:, None] * t3, p3], axis=1)
+        ctrl = np.empty((m, 4, 2))
+        ok = np.empty(m, dtype=bool)
+        _gn_kernel(np.ascontiguousarray(i0, dtype=np.intp),
+                   np.ascontiguousarray(i1, dtype=np.intp), self.work, self.arc,
+                   _BISECT_SAMPLE, np.ascontiguousarray(p0, dtype=np.float64),
+                   np.ascontiguousarray(p3, dtype=np.float64),
+                   np.ascontiguousarray(self.t_out[A], dtype=np.float64),
+                   np.ascontiguousarray(self.t_in[B], dtype=np.float64), chord, rounds, ctrl,
+                   ok)
         return ctrl, ok
 
     def _bulging_segments(self, ab: np.ndarray, line: np.ndarray) -> np.ndarray:
@@ -1896,26 +2218,23 @@ class _BatchFitter:
         free (the end tangents too: they are estimates from rounded points), Gauss-Newton on
         the normal distances; ok where each end tangent turned at most ``_GN_TURN``."""
         m = len(A)
-        pid, pts, u = self._piece_sample(i0, i1)
-        ctrl = ctrl.copy()
+        i0 = np.ascontiguousarray(i0, dtype=np.intp)
+        i1 = np.ascontiguousarray(i1, dtype=np.intp)
+        L = i1 - i0 - 1
+        cnt = -(-L // np.maximum(1, -(-L // _BISECT_SAMPLE)))
+        ps = np.r_[0, np.cumsum(cnt)]
+        ctrl = np.array(ctrl, dtype=np.float64)
         chord = np.hypot(*(ctrl[:, 3] - ctrl[:, 0]).T)
-        ps = np.r_[0, np.cumsum(np.bincount(pid, minlength=m))]
-        pts = np.ascontiguousarray(pts, dtype=np.float64)
-        u = np.array(u, dtype=np.float64)
-        for _ in range(rounds):
-            N = np.zeros((m, 4, 4))
-            g = np.zeros((m, 4))
-            _gn_free_sums(ps, pts, u, ctrl, N, g)
-            N = np.where(np.isfinite(N), N, 0.0)
-            g = np.where(np.isfinite(g), g, 0.0)
-            N += (1e-9 * np.trace(N, axis1=1, axis2=2) + 1e-12)[:, None, None] * np.eye(4)
+        u = np.empty(int(ps[-1]))
+        pts = np.empty((len(u), 2))
+        for it in range(rounds):
+            N = np.empty((m, 4, 4))
+            g = np.empty((m, 4, 1))
+            _gn_free_sums(i0, i1, self.work, self.arc, _BISECT_SAMPLE, ps, pts, u, ctrl,
+                          it == 0, N, g)
             with np.errstate(divide="ignore", invalid="ignore"):
-                d = np.linalg.solve(N, g[:, :, None])[:, :, 0]
-            d = np.where(np.isfinite(d), d, 0.0)
-            lim = 0.25 * chord[:, None]
-            d = np.clip(d, -lim, lim)
-            ctrl[:, 1] += d[:, :2]
-            ctrl[:, 2] += d[:, 2:]
+                d = np.linalg.solve(N, g)
+            _gn_free_step(ctrl, d, chord)
         h0 = ctrl[:, 1] - ctrl[:, 0]
         h3 = ctrl[:, 3] - ctrl[:, 2]
         t0, t3 = self.t_out[A], self.t_in[B]
@@ -2600,7 +2919,12 @@ def _polyline_distance_over(samp, poly, lim, k=_NEAR_SEGMENTS):
     compiled, :func:`_over_kernel`)."""
     n = len(poly)
     if n <= 2 * k + 2:
-        return point_polyline_distance(samp, poly)
+        if n < 2:
+            return point_polyline_distance(samp, poly)
+        d = np.empty(len(samp))
+        _brute_kernel(np.ascontiguousarray(samp, dtype=np.float64),
+                      np.ascontiguousarray(poly, dtype=np.float64), d)
+        return d
     samp = np.ascontiguousarray(samp, dtype=np.float64)
     poly = np.ascontiguousarray(poly, dtype=np.float64)
     d = np.empty(len(samp))
@@ -2608,6 +2932,14 @@ def _polyline_distance_over(samp, poly, lim, k=_NEAR_SEGMENTS):
         _over_kernel(samp, np.hypot(*np.diff(samp, axis=0).T), poly,
                      np.hypot(*np.diff(poly, axis=0).T), float(lim), k, d)
     return d
+
+
+@njit(cache=True, nogil=True)
+def _brute_kernel(samp, poly, out):  # pragma: no cover (compiled)
+    """:func:`point_polyline_distance` of the samples to a short polyline (2 points or
+    more) compiled: :func:`_brute_d`, its arithmetic."""
+    for t in range(samp.shape[0]):
+        out[t] = _brute_d(samp[t, 0], samp[t, 1], poly, 0, poly.shape[0])
 
 
 @njit(cache=True, nogil=True)
@@ -2642,11 +2974,11 @@ def _over_kernel(samp, sstep, poly, pstep, lim, k, out):  # pragma: no cover (co
         at = lo - 1
         px = samp[t, 0]
         py = samp[t, 1]
-        d = _win_d(px, py, poly, 0, n - 1, at, k)
-        if d > lim and n > 16 * k + 2:
-            d = _win_d(px, py, poly, 0, n - 1, at, 16 * k)
+        d = _win_d(px, py, poly, 0, n - 1, at, k, cum, np.inf)
+        if d > lim and n > 16 * k + 2:  # (the narrower window's distance bounds these)
+            d = _win_d(px, py, poly, 0, n - 1, at, 16 * k, cum, d)
         if d > lim:
-            d = _brute_d(px, py, poly, 0, n)
+            d = _full_d(px, py, poly, 0, n, at, cum, d)
         out[t] = d
 
 
@@ -2665,21 +2997,19 @@ def _polyline_checks(C4, cub, msz, W, wstep, first, last, lim, k,
     sx = np.empty(mmax)
     sy = np.empty(mmax)
     cs = np.empty(mmax)
+    dxb = np.empty(mmax)
+    dyb = np.empty(mmax)
+    hb = np.empty(mmax)
+    fb = np.empty(mmax, dtype=np.bool_)
     for i in range(first.shape[0]):
         ms = msz[i]
         step = 1.0 / (ms - 1)
         for t in range(ms):
             u = t * step if t < ms - 1 else 1.0
             if cub[i]:
-                v = 1.0 - u
-                b0 = v * v * v
-                b1 = 3.0 * v * v * u
-                b2 = 3.0 * v * u * u
-                b3 = u * u * u
-                sx[t] = ((b0 * C4[i, 0, 0] + b1 * C4[i, 1, 0]) + b2 * C4[i, 2, 0]) \
-                    + b3 * C4[i, 3, 0]
-                sy[t] = ((b0 * C4[i, 0, 1] + b1 * C4[i, 1, 1]) + b2 * C4[i, 2, 1]) \
-                    + b3 * C4[i, 3, 1]
+                b0, b1, b2, b3 = bernstein_weights(u)
+                sx[t] = bernstein_point(b0, b1, b2, b3, C4, i, 0)
+                sy[t] = bernstein_point(b0, b1, b2, b3, C4, i, 1)
             else:
                 sx[t] = C4[i, 0, 0] + u * (C4[i, 1, 0] - C4[i, 0, 0])
                 sy[t] = C4[i, 0, 1] + u * (C4[i, 1, 1] - C4[i, 0, 1])
@@ -2702,9 +3032,13 @@ def _polyline_checks(C4, cub, msz, W, wstep, first, last, lim, k,
             cum[0] = 0.0
             for t in range(n - 1):
                 cum[t + 1] = cum[t] + wstep[f + t]
+            for t in range(ms - 1):
+                dxb[t] = sx[t + 1] - sx[t]
+                dyb[t] = sy[t + 1] - sy[t]
+            hypot_into(dxb, dyb, ms - 1, hb, fb)
             cs[0] = 0.0
             for t in range(ms - 1):
-                cs[t + 1] = cs[t] + math.hypot(sx[t + 1] - sx[t], sy[t + 1] - sy[t])
+                cs[t + 1] = cs[t] + hb[t]
             scale = cs[ms - 1] > 0.0
             r = cum[n - 1] / cs[ms - 1] if scale else 1.0
             nseg = n - 1
@@ -2721,11 +3055,11 @@ def _polyline_checks(C4, cub, msz, W, wstep, first, last, lim, k,
                 at = lo - 1
                 px = sx[t]
                 py = sy[t]
-                d = _win_d(px, py, W, f, nseg, at, k)
+                d = _win_d(px, py, W, f, nseg, at, k, cum, np.inf)
                 if d > lm and n > 16 * k + 2:
-                    d = _win_d(px, py, W, f, nseg, at, 16 * k)
+                    d = _win_d(px, py, W, f, nseg, at, 16 * k, cum, d)
                 if d > lm:
-                    d = _brute_d(px, py, W, f, n)
+                    d = _full_d(px, py, W, f, n, at, cum, d)
                 if d > lm:
                     good = False
                     break
@@ -2733,29 +3067,104 @@ def _polyline_checks(C4, cub, msz, W, wstep, first, last, lim, k,
 
 
 @njit(cache=True, nogil=True, inline="always")
-def _win_d(px, py, W, f, ns, at, k):  # pragma: no cover (compiled)
-    """One sample's distance to the segments at - k .. at + k (clipped) of the polyline
-    W[f..f + ns] (1 / the squared length not taken: the windowed arithmetic)."""
-    lo = max(0, min(at - k, ns - 1))
-    hi = min(ns - 1, max(at + k, 0))
-    best = np.inf
-    for j in range(lo, hi + 1):
-        ax = W[f + j, 0]
-        ay = W[f + j, 1]
-        vx = W[f + j + 1, 0] - ax
-        vy = W[f + j + 1, 1] - ay
-        dx = px - ax
-        dy = py - ay
-        den = vx * vx + vy * vy
+def _seg_d2(px, py, W, j, brute):  # pragma: no cover (compiled)
+    """The squared distance of (px, py) to the segment W[j]..W[j + 1]: the windowed
+    arithmetic (a division by the squared length), or with ``brute`` that of
+    :func:`point_polyline_distance` (1 / the squared length)."""
+    ax = W[j, 0]
+    ay = W[j, 1]
+    vx = W[j + 1, 0] - ax
+    vy = W[j + 1, 1] - ay
+    dx = px - ax
+    dy = py - ay
+    den = vx * vx + vy * vy
+    if brute:
+        inv = 1.0 / den if den > 1e-300 else 0.0
+        u = min(max((dx * vx + dy * vy) * inv, 0.0), 1.0)
+    else:
         u = 0.0
         if den > 0.0:
             u = min(1.0, max(0.0, (dx * vx + dy * vy) / den))
-        ex = dx - u * vx
-        ey = dy - u * vy
-        d2 = ex * ex + ey * ey
+    ex = dx - u * vx
+    ey = dy - u * vy
+    return ex * ex + ey * ey
+
+
+@njit(cache=True, nogil=True, inline="always")
+def _scan_d(px, py, W, f, lo, hi, at, cum, brute, ub):  # pragma: no cover (compiled)
+    """The distance of (px, py) to the nearest of the segments lo .. hi of the polyline
+    W[f..] (``cum`` its cumulated step lengths from W[f]; :func:`_seg_d2`'s arithmetic):
+    from the segment at ``at`` (clipped) outwards, and segments that cannot be nearer than
+    the nearest so far (or than ``ub``, a known upper bound of the answer up to the
+    rounding) are skipped: a point X of segment i lies within the polyline's length
+    between W[f + j] and X of W[f + j], so its distance is at least |p - W[f + j]| minus
+    that length (with a margin for the rounding; the skipped run found by bisection of
+    ``cum``). The smallest squared distance is the same number as over all of them."""
+    c = min(max(at, lo), hi)
+    best = np.inf
+    sb = np.inf
+    tol = 1e-9 * (1.0 + cum[hi + 1] - cum[lo])
+    j = c
+    while j <= hi:
+        bound = min(sb, ub)
+        if bound < np.inf:
+            dx = px - W[f + j, 0]
+            dy = py - W[f + j, 1]
+            e = math.sqrt(dx * dx + dy * dy)
+            room = e - bound - tol - 1e-9 * e
+            if room > 0.0:  # segments j .. i - 1 are all farther than the nearest
+                a = j
+                b = hi + 1
+                while a < b:  # the first i with cum[i + 1] - cum[j] >= room
+                    mid = (a + b) >> 1
+                    if cum[mid + 1] - cum[j] < room:
+                        a = mid + 1
+                    else:
+                        b = mid
+                if a > j:
+                    j = a
+                    continue
+        d2 = _seg_d2(px, py, W, f + j, brute)
         if d2 < best:
             best = d2
+            sb = math.sqrt(best)
+        j += 1
+    j = c - 1
+    while j >= lo:
+        bound = min(sb, ub)
+        dx = px - W[f + j + 1, 0]
+        dy = py - W[f + j + 1, 1]
+        e = math.sqrt(dx * dx + dy * dy)
+        room = e - bound - tol - 1e-9 * e
+        if room > 0.0:  # segments i + 1 .. j are all farther than the nearest
+            a = lo
+            b = j + 1
+            while a < b:  # the first i with cum[j + 1] - cum[i] < room
+                mid = (a + b) >> 1
+                if cum[j + 1] - cum[mid] < room:
+                    b = mid
+                else:
+                    a = mid + 1
+            if a <= j:
+                j = a - 1
+                continue
+        d2 = _seg_d2(px, py, W, f + j, brute)
+        if d2 < best:
+            best = d2
+            sb = math.sqrt(best)
+        j -= 1
     return math.sqrt(best)
+
+
+@njit(cache=True, nogil=True, inline="always")
+def _win_d(px, py, W, f, ns, at, k, cum, ub):  # pragma: no cover (compiled)
+    """One sample's distance to the segments at - k .. at + k (clipped) of the polyline
+    W[f..f + ns] (1 / the squared length not taken: the windowed arithmetic); ``cum`` its
+    cumulated step lengths from W[f], ``ub`` an upper bound of the answer (or inf)
+    (:func:`_scan_d`)."""
+    lo = max(0, min(at - k, ns - 1))
+    hi = min(ns - 1, max(at + k, 0))
+    return _scan_d(px, py, W, f, lo, hi, at, cum, False, ub)
 
 
 @njit(cache=True, nogil=True, inline="always")
@@ -2764,21 +3173,18 @@ def _brute_d(px, py, W, f, n):  # pragma: no cover (compiled)
     n >= 2: its arithmetic (1 / the squared length)."""
     best = np.inf
     for j in range(n - 1):
-        ax = W[f + j, 0]
-        ay = W[f + j, 1]
-        vx = W[f + j + 1, 0] - ax
-        vy = W[f + j + 1, 1] - ay
-        den = vx * vx + vy * vy
-        inv = 1.0 / den if den > 1e-300 else 0.0
-        dx = px - ax
-        dy = py - ay
-        u = min(max((dx * vx + dy * vy) * inv, 0.0), 1.0)
-        ex = dx - u * vx
-        ey = dy - u * vy
-        d2 = ex * ex + ey * ey
+        d2 = _seg_d2(px, py, W, f + j, True)
         if d2 < best:
             best = d2
     return math.sqrt(best)
+
+
+@njit(cache=True, nogil=True, inline="always")
+def _full_d(px, py, W, f, n, at, cum, ub):  # pragma: no cover (compiled)
+    """:func:`_brute_d` (the same number) from the segment at ``at`` outwards
+    (:func:`_scan_d`; ``cum`` the cumulated step lengths from W[f], ``ub`` an upper bound
+    of the answer up to the rounding, or inf)."""
+    return _scan_d(px, py, W, f, 0, n - 2, at, cum, True, ub)
 
 
 #: rounded input, after the joints: a segment is repaired where the design estimate (the

@@ -208,29 +208,93 @@ def nearest_on_cubic_each(
     for ns in np.unique(nsp).tolist():
         sel = np.flatnonzero(nsp == ns)
         _sampled_candidates(c, pid[sel], p[sel], ns, sel, best_u, best_d2, (u0, lo, hi, ok))
-    # Newton from every candidate (the arithmetic of _power_coeffs and cubic_eval)
-    p0, p1, p2, p3 = c[:, 0], c[:, 1], c[:, 2], c[:, 3]
-    coef = (
-        -p0 + 3.0 * p1 - 3.0 * p2 + p3,
-        3.0 * p0 - 6.0 * p1 + 3.0 * p2,
-        -3.0 * p0 + 3.0 * p1,
-        p0,
-    )
-    if len(c) == 1:  # one cubic (nearest_on_cubic): no per-point copies
-        cf = np.array(coef)[:, 0, :, None]
-        cq = np.broadcast_to(c, (k, 4, 2))
-    else:
-        cf = gather_coeffs(np.stack(coef, axis=1), pid)
-        cq = c[pid]
-    pt = p.T
-    for m in range(_NEAREST_CANDIDATES):
-        u = newton_nearest_many(cf, pt, u0[m], iters, lo=lo[m], hi=hi[m], downhill=True)[0]
-        r = _bernstein_each(cq, u) - p
-        dn = r[:, 0] * r[:, 0] + r[:, 1] * r[:, 1]
-        better = ok[m] & (dn < best_d2)
-        best_u = np.where(better, u, best_u)
-        best_d2 = np.where(better, dn, best_d2)
+    # Newton from every candidate (the arithmetic of _power_coeffs and cubic_eval), compiled
+    _refine_kernel(np.ascontiguousarray(c), pid, p, u0, lo, hi, ok, iters, best_u, best_d2)
     return best_u, np.sqrt(best_d2)
+
+
+#: points per chunk of :func:`_refine_kernel` (its Newton steps run over a chunk at a time)
+_REFINE_CHUNK = 256
+
+
+@njit(cache=True, nogil=True)
+def _refine_kernel(c, pid, p, u0, lo, hi, ok, iters, best_u,
+                   best_d2):  # type: ignore[no-untyped-def]
+    """:func:`nearest_on_cubic_each`'s refinement (compiled): per candidate m and point k
+    (its cubic c[pid[k]]), ``iters`` Newton steps from u0[m, k] inside lo[m, k] .. hi[m, k]
+    (:func:`_newton_kernel`'s downhill steps, the power coefficients of the former numpy
+    version: a = ((-p0 + 3 p1) - 3 p2) + p3, b = (3 p0 - 6 p1) + 3 p2, d = -3 p0 + 3 p1),
+    the point of the cubic there (:func:`_bernstein_each`'s arithmetic) and, where ok[m, k]
+    and nearer than best_d2[k], it replaces best_u[k], best_d2[k] (in place). Candidate by
+    candidate, as before; the same numbers."""
+    k_n = pid.shape[0]
+    nc = _REFINE_CHUNK
+    cb = np.empty((8, nc))
+    ub = np.empty(nc)
+    for m in range(u0.shape[0]):
+        for c0 in range(0, k_n, nc):
+            n = min(nc, k_n - c0)
+            for j in range(n):
+                k = c0 + j
+                g = pid[k]
+                p0x = c[g, 0, 0]
+                p0y = c[g, 0, 1]
+                p1x = c[g, 1, 0]
+                p1y = c[g, 1, 1]
+                p2x = c[g, 2, 0]
+                p2y = c[g, 2, 1]
+                p3x = c[g, 3, 0]
+                p3y = c[g, 3, 1]
+                cb[0, j] = ((-p0x + 3.0 * p1x) - 3.0 * p2x) + p3x
+                cb[1, j] = ((-p0y + 3.0 * p1y) - 3.0 * p2y) + p3y
+                cb[2, j] = (3.0 * p0x - 6.0 * p1x) + 3.0 * p2x
+                cb[3, j] = (3.0 * p0y - 6.0 * p1y) + 3.0 * p2y
+                cb[4, j] = -3.0 * p0x + 3.0 * p1x
+                cb[5, j] = -3.0 * p0y + 3.0 * p1y
+                cb[6, j] = p[k, 0] - p0x
+                cb[7, j] = p[k, 1] - p0y
+                ub[j] = u0[m, k]
+            for _ in range(iters):
+                for j in range(n):
+                    k = c0 + j
+                    ax = cb[0, j]
+                    ay = cb[1, j]
+                    bx = cb[2, j]
+                    by = cb[3, j]
+                    dx = cb[4, j]
+                    dy = cb[5, j]
+                    lo_k = lo[m, k]
+                    hi_k = hi[m, k]
+                    uk = ub[j]
+                    rx = ((ax * uk + bx) * uk + dx) * uk - cb[6, j]  # B(u) - p
+                    ry = ((ay * uk + by) * uk + dy) * uk - cb[7, j]
+                    d1x = (3.0 * ax * uk + 2.0 * bx) * uk + dx  # B'(u)
+                    d1y = (3.0 * ay * uk + 2.0 * by) * uk + dy
+                    f = d1x * rx + d1y * ry  # f = B'·(B - p)
+                    fp = (6.0 * ax * uk + 2.0 * bx) * rx + (6.0 * ay * uk + 2.0 * by) * ry
+                    fp += d1x * d1x  # f' = B''·(B - p) + |B'|^2
+                    fp += d1y * d1y
+                    if fp <= 0.0:  # not convex here: halve the way downhill
+                        end = hi_k if f < 0.0 else lo_k
+                        uk = 0.5 * (uk + end)
+                    else:
+                        uk -= f / fp
+                    ub[j] = min(max(uk, lo_k), hi_k)
+            for j in range(n):
+                k = c0 + j
+                if not ok[m, k]:
+                    continue
+                g = pid[k]
+                t = ub[j]
+                s = 1.0 - t
+                rx = ((((s * s * s) * c[g, 0, 0] + (3.0 * s * s * t) * c[g, 1, 0])
+                       + (3.0 * s * t * t) * c[g, 2, 0]) + (t * t * t) * c[g, 3, 0]) - p[k, 0]
+                ry = ((((s * s * s) * c[g, 0, 1] + (3.0 * s * s * t) * c[g, 1, 1])
+                       + (3.0 * s * t * t) * c[g, 2, 1]) + (t * t * t) * c[g, 3, 1]) - p[k, 1]
+                dn = rx * rx + ry * ry
+                if dn < best_d2[k]:
+                    best_u[k] = t
+                    best_d2[k] = dn
 
 
 def sampled_upper_d2(ctrl: object, pid: object, pts: object, *, seeds: int = 48) -> np.ndarray:
@@ -267,14 +331,9 @@ def _upper_kernel(c, pid, p, su, out):  # type: ignore[no-untyped-def]
         g = pid[i]
         if g != last:
             for j in range(n):
-                t = su[j]
-                s = 1.0 - t
-                b0 = s * s * s
-                b1 = 3.0 * s * s * t
-                b2 = 3.0 * s * t * t
-                b3 = t * t * t
-                sx[j] = ((b0 * c[g, 0, 0] + b1 * c[g, 1, 0]) + b2 * c[g, 2, 0]) + b3 * c[g, 3, 0]
-                sy[j] = ((b0 * c[g, 0, 1] + b1 * c[g, 1, 1]) + b2 * c[g, 2, 1]) + b3 * c[g, 3, 1]
+                b0, b1, b2, b3 = bernstein_weights(su[j])
+                sx[j] = bernstein_point(b0, b1, b2, b3, c, g, 0)
+                sy[j] = bernstein_point(b0, b1, b2, b3, c, g, 1)
             last = g
         px = p[i, 0]
         py = p[i, 1]
@@ -332,16 +391,9 @@ def _candidates_kernel(cc, su, ci, p, out, spx, spy, best_u, best_d2, u0, lo, hi
     ns = n - 1
     for g in range(cc.shape[0]):
         for j in range(n):
-            t = su[j]
-            s = 1.0 - t
-            b0 = s * s * s
-            b1 = 3.0 * s * s * t
-            b2 = 3.0 * s * t * t
-            b3 = t * t * t
-            spx[g, j] = ((b0 * cc[g, 0, 0] + b1 * cc[g, 1, 0]) + b2 * cc[g, 2, 0]) \
-                + b3 * cc[g, 3, 0]
-            spy[g, j] = ((b0 * cc[g, 0, 1] + b1 * cc[g, 1, 1]) + b2 * cc[g, 2, 1]) \
-                + b3 * cc[g, 3, 1]
+            b0, b1, b2, b3 = bernstein_weights(su[j])
+            spx[g, j] = bernstein_point(b0, b1, b2, b3, cc, g, 0)
+            spy[g, j] = bernstein_point(b0, b1, b2, b3, cc, g, 1)
     d2 = np.empty(n)
     tv = np.empty(nc + 1)
     tj = np.empty(nc + 1, dtype=np.int64)
@@ -675,6 +727,52 @@ def _newton_step(cf, p, u, c0, c1, lo, hi, one_lo, one_hi, downhill):  # type: i
         u[k] = min(max(uk, lo_k), hi_k)
 
 
+#: :func:`hypot_into`'s common range (both in it: libm's hypot is this arithmetic)
+_HYPOT_LARGE = 2.0 ** 511
+_HYPOT_TINY = 2.0 ** -459
+_HYPOT_RATIO = 2.0 ** -26
+
+
+@njit(cache=True, nogil=True, inline="always")
+def _hypot_common(x, y):  # type: ignore[no-untyped-def]
+    """(h, ok): ok where |x| and |y| are in the common range (the larger at most 2^511, the
+    smaller at least 2^-459 and over 2^-26 of the larger: finite, no scaling, not widely
+    varying), h then libm's hypot(x, y) (glibc's correction of sqrt(x² + y²) after Borges,
+    without FMA: the same operations, so the same number); branch-free, so a loop of it
+    vectorises."""
+    x = abs(x)
+    y = abs(y)
+    ax = y if x < y else x
+    ay = x if x < y else y
+    ok = (ax <= _HYPOT_LARGE) & (ay >= _HYPOT_TINY) & (ay > ax * _HYPOT_RATIO)
+    h = math.sqrt(ax * ax + ay * ay)
+    d1 = h - ay
+    t1a = ax * (2.0 * d1 - ax)
+    t2a = (d1 - 2.0 * (ax - ay)) * d1
+    d2 = h - ax
+    t1b = 2.0 * d2 * (ax - 2.0 * ay)
+    t2b = (4.0 * d2 - ay) * ay + d2 * d2
+    near = h <= 2.0 * ay
+    t1 = t1a if near else t1b
+    t2 = t2a if near else t2b
+    hh = h if ok else 1.0  # (no division by 0 outside the range: libm's value there)
+    return h - (t1 + t2) / (2.0 * hh), ok
+
+
+@njit(cache=True, nogil=True, inline="always")
+def hypot_into(xs, ys, n, out, flag):  # type: ignore[no-untyped-def]
+    """out[j] = math.hypot(xs[j], ys[j]) for j < n, the same numbers, faster: the common
+    range (:func:`_hypot_common`) in a loop that vectorises, the rest (zeros, huge, tiny,
+    widely varying, NaN) by libm's hypot in a second pass (``flag`` a bool work array)."""
+    for j in range(n):
+        h, ok = _hypot_common(xs[j], ys[j])
+        out[j] = h
+        flag[j] = ok
+    for j in range(n):
+        if not flag[j]:
+            out[j] = math.hypot(xs[j], ys[j])
+
+
 @njit(cache=True, nogil=True, inline="always")
 def newton_param(ax, ay, bx, by, dx, dy, qx, qy, uk):  # type: ignore[no-untyped-def]
     """One Newton step of the parameter ``uk`` of the cubic a u^3 + b u^2 + d u (power form,
@@ -757,9 +855,7 @@ def nearest_on_cubics(
     k = len(p)
     if k == 0:
         return np.zeros(0), np.zeros(0)
-    su = np.linspace(0.0, 1.0, seeds + 1)
-    s = 1.0 - su
-    basis = np.stack([s**3, 3.0 * s * s * su, 3.0 * s * su * su, su**3], axis=1)  # (S, 4)
+    su, basis = seed_basis(seeds)
     samp = np.empty((len(c), len(su), 2))  # (M, S, 2): np.einsum("sk,mkd->msd", basis, c)
     _samples_kernel(basis, np.ascontiguousarray(c), samp)
     t_out = np.empty(k)
@@ -769,19 +865,85 @@ def nearest_on_cubics(
     return t_out, d_out
 
 
+def seed_basis(seeds: int = 48) -> tuple[np.ndarray, np.ndarray]:
+    """The sample parameters of :func:`nearest_on_cubics` (``seeds + 1`` of them, evenly
+    spread over [0, 1]) and their Bernstein basis (S, 4)."""
+    su = np.linspace(0.0, 1.0, seeds + 1)
+    s = 1.0 - su
+    return su, np.stack([s**3, 3.0 * s * s * su, 3.0 * s * su * su, su**3], axis=1)
+
+
 @njit(cache=True, nogil=True)
 def _samples_kernel(basis, c, out):  # type: ignore[no-untyped-def]
     """out[m, s] = sum over k of basis[s, k] * c[m, k], summed in order (the numbers of
     the former ``np.einsum("sk,mkd->msd", basis, c)``)."""
     for m in range(c.shape[0]):
-        for i in range(basis.shape[0]):
-            b0 = basis[i, 0]
-            b1 = basis[i, 1]
-            b2 = basis[i, 2]
-            b3 = basis[i, 3]
-            for d in range(2):
-                out[m, i, d] = ((b0 * c[m, 0, d] + b1 * c[m, 1, d]) + b2 * c[m, 2, d]) \
-                    + b3 * c[m, 3, d]
+        bernstein_samples(basis, c, m, out[m])
+
+
+@njit(cache=True, nogil=True, inline="always")
+def bernstein_weights(t):  # type: ignore[no-untyped-def]
+    """The cubic Bernstein weights at t, cubic_eval's arithmetic: (1 - t)³, 3 (1 - t)² t,
+    3 (1 - t) t², t³ (each multiplied left to right)."""
+    s = 1.0 - t
+    return s * s * s, 3.0 * s * s * t, 3.0 * s * t * t, t * t * t
+
+
+@njit(cache=True, nogil=True, inline="always")
+def bernstein_point(b0, b1, b2, b3, c, m, d):  # type: ignore[no-untyped-def]
+    """Coordinate d of the cubic c[m] (control points, (M, 4, 2)) at the weights b0..b3,
+    summed in order ((b0 c0 + b1 c1) + b2 c2) + b3 c3 (cubic_eval's and np.einsum's
+    numbers): the one sampling loop of the compiled kernels."""
+    return ((b0 * c[m, 0, d] + b1 * c[m, 1, d]) + b2 * c[m, 2, d]) + b3 * c[m, 3, d]
+
+
+@njit(cache=True, nogil=True, inline="always")
+def bernstein_samples(basis, c, m, out):  # type: ignore[no-untyped-def]
+    """out[i] = the cubic c[m] at the sample i of ``basis`` (S, 4) (:func:`bernstein_point`)."""
+    for i in range(basis.shape[0]):
+        b0 = basis[i, 0]
+        b1 = basis[i, 1]
+        b2 = basis[i, 2]
+        b3 = basis[i, 3]
+        for d in range(2):
+            out[i, d] = bernstein_point(b0, b1, b2, b3, c, m, d)
+
+
+@njit(cache=True, nogil=True, inline="always")
+def seeded_nearest(cm, m, samp, su, iters, px, py):  # type: ignore[no-untyped-def]
+    """One point's :func:`_seeded_kernel` (its numbers): the nearest of the samples
+    ``samp`` (S, 2) of cubic m (power coefficients ``cm``), Newton from there, the better of
+    both: (t, distance)."""
+    j = 0
+    best = np.inf
+    for i in range(samp.shape[0]):
+        ex = px - samp[i, 0]
+        ey = py - samp[i, 1]
+        v = ex * ex + ey * ey
+        if v != v:
+            j = i
+            best = v
+            break
+        if i == 0 or v < best:
+            j = i
+            best = v
+    ax = cm[m, 0, 0]
+    ay = cm[m, 0, 1]
+    bx = cm[m, 1, 0]
+    by = cm[m, 1, 1]
+    dx = cm[m, 2, 0]
+    dy = cm[m, 2, 1]
+    qx = px - cm[m, 3, 0]
+    qy = py - cm[m, 3, 1]
+    uk = su[j]
+    for _ in range(iters):
+        uk = newton_param(ax, ay, bx, by, dx, dy, qx, qy, uk)
+    rx = ((ax * uk + bx) * uk + dx) * uk - qx
+    ry = ((ay * uk + by) * uk + dy) * uk - qy
+    dn = rx * rx + ry * ry
+    if dn < best:
+        return uk, math.sqrt(dn)
+    return su[j], math.sqrt(best)
 
 
 #: points per chunk of :func:`_seeded_kernel` (its Newton steps run over a chunk at a time)
