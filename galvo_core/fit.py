@@ -4537,6 +4537,27 @@ def _lone_sides(W, K, smooth, v, w, quant, p, t, ok, ok_other, after=False) -> n
     return sel & ok
 
 
+#: a least-squares line's input points are collinear where none lies farther than this many
+#: quanta from it
+_STRAIGHT_SLACK = 0.1
+
+
+def _collinear(W, a, b, p, t, quant) -> np.ndarray:
+    """Per line through ``p`` along the unit ``t``: do the input points a..b (global
+    indices, ends included) all lie on it (within ``_STRAIGHT_SLACK`` quanta)? Rounded points
+    of a slightly curved stretch scatter about their least-squares line by up to the rounding
+    as those of a straight line do; points that are collinear are a straight design line (or
+    a curve that stays inside one row of rounding squares: its points are then on that line
+    too)."""
+    if len(a) == 0:
+        return np.zeros(0, dtype=bool)
+    own, off = _ragged(np.arange(len(a)), b - a + 1)
+    d = W[a[own] + off] - p[own]
+    across = np.abs(d[:, 0] * t[own, 1] - d[:, 1] * t[own, 0])
+    err = np.maximum.reduceat(across, np.cumsum(b - a + 1) - (b - a + 1))
+    return err <= _STRAIGHT_SLACK * quant
+
+
 def _corners_on_the_design(W, K, Q, arc, smooth, rnd, first, last, quant, eps) -> None:
     """Rounded input: the corners (thinned vertices that are not smooth; a closed path's
     seam too) move inside their rounding squares onto an estimate of the design's corner.
@@ -4587,14 +4608,14 @@ def _corners_on_the_design(W, K, Q, arc, smooth, rnd, first, last, quant, eps) -
     p_in, t_in, ok_in = _local_fits(W, arc, lo_i, K[vi], K[vi])
     p_out, t_out, ok_out = _local_fits(W, arc, k, hi_o, k)
     # a side that is a line (its other end a corner too): its least-squares line
-    lin = ~smooth[vi - 1]
-    if lin.any():
-        p, t, ok = _local_lines(W, K[vi - 1][lin], K[vi][lin], K[vi][lin])
-        p_in[lin], t_in[lin], ok_in[lin] = p, t, ok
-    lin = ~smooth[vo + 1]
-    if lin.any():
-        p, t, ok = _local_lines(W, k[lin], K[vo + 1][lin], k[lin])
-        p_out[lin], t_out[lin], ok_out[lin] = p, t, ok
+    lin_in = ~smooth[vi - 1]
+    if lin_in.any():
+        p, t, ok = _local_lines(W, K[vi - 1][lin_in], K[vi][lin_in], K[vi][lin_in])
+        p_in[lin_in], t_in[lin_in], ok_in[lin_in] = p, t, ok
+    lin_out = ~smooth[vo + 1]
+    if lin_out.any():
+        p, t, ok = _local_lines(W, k[lin_out], K[vo + 1][lin_out], k[lin_out])
+        p_out[lin_out], t_out[lin_out], ok_out[lin_out] = p, t, ok
     # a side that is a line written as its two ends only (no least-squares line) beside a
     # curve side: the line through those two rounded ends, long enough to give a direction
     # (the curve side of such a corner is not checked as a line below: the fitter checks
@@ -4609,6 +4630,16 @@ def _corners_on_the_design(W, K, Q, arc, smooth, rnd, first, last, quant, eps) -
     # a side of two points meeting a curve at a middling angle: neither estimate is good
     both &= ~lone | (np.abs(cr) >= _LONE_SINE) | (np.abs(cr) < _CORNER_SINE)
     sharp = both & (np.abs(cr) >= _CORNER_SINE)
+    # a shallow corner between a curve and a least-squares line whose points are collinear:
+    # on that line (the mean would tilt the whole line by the curve's error at its end)
+    lin_in &= ok_in & ~lone_in
+    lin_out &= ok_out & ~lone_out
+    lin_in[lin_in] = _collinear(W, K[vi - 1][lin_in], K[vi][lin_in], p_in[lin_in],
+                                t_in[lin_in], quant[vi][lin_in])
+    lin_out[lin_out] = _collinear(W, k[lin_out], K[vo + 1][lin_out], p_out[lin_out],
+                                  t_out[lin_out], quant[vo][lin_out])
+    est = np.where((both & ~sharp & lin_in & ~lin_out)[:, None], p_in, est)
+    est = np.where((both & ~sharp & lin_out & ~lin_in)[:, None], p_out, est)
     if sharp.any():
         d = p_out[sharp] - p_in[sharp]
         ti, to = t_in[sharp], t_out[sharp]
