@@ -579,10 +579,12 @@ def main() -> None:
     ap.add_argument("--no-fonts", action="store_true")
     ap.add_argument("--inputs", default="whole,exact")
     ap.add_argument("--json")
-    ap.add_argument("--tables", action="store_true", help="with --summary: per style too")
+    ap.add_argument("--tables", action="store_true",
+                    help="with --summary: per style, every tolerance and the corpus too")
     ap.add_argument("--corpus-table", metavar="JSON", help="only print a run's corpus table")
     ap.add_argument("--summary", metavar="JSON", nargs="+",
-                    help="only print the summary of the font rows of these runs' JSON")
+                    help="only print the summary of the font rows of these runs' JSON "
+                         "(with --json: write them merged)")
     ap.add_argument("--ours-only", action="store_true",
                     help="re-run only ours beside the peer rows of --peers-json")
     ap.add_argument("--peers-json", metavar="JSON", nargs="+",
@@ -601,12 +603,12 @@ def main() -> None:
         dump(out, a.json)
         return
     if a.summary:
-        rows = load_runs(a.summary)["fonts"]
-        summary(rows)
-        if a.tables:
-            print()
-            per_style_table(rows)
-            grid_table(rows)
+        out = load_runs(a.summary)
+        if a.tables:  # per style, every tolerance, the corpus
+            print_tables(out)
+        elif out["fonts"]:
+            summary(out["fonts"])
+        dump(out, a.json)  # the runs merged into one file (--peers-json takes it)
         return
     if a.corpus_table:
         with open(a.corpus_table) as f:
