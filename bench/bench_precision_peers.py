@@ -502,8 +502,11 @@ def load_runs(files) -> dict:
     out: dict = {"fonts": [], "corpus": []}
     seen, seen_files = set(), set()
     for fn in files:
-        with open(fn) as f:
-            d = json.load(f)
+        try:
+            with open(fn) as f:
+                d = json.load(f)
+        except (OSError, ValueError) as e:
+            raise SystemExit(f"error: {fn}: {getattr(e, 'strerror', None) or e}") from None
         for r in d.get("fonts", []):
             k = (case(r), r["input"], r["peer"], r["tol"])
             if k not in seen:
@@ -593,9 +596,6 @@ def main() -> None:
     if a.ours_only:
         if not a.peers_json:
             raise SystemExit("error: --ours-only: give the stored runs with --peers-json")
-        for fn in a.peers_json:
-            if not os.path.isfile(fn):
-                raise SystemExit(f"error: {fn}: no such file")
         out = ours_only(load_runs(a.peers_json), with_corpus=True)
         print(f"ours: galvo_core at {code_version()}; peers: stored rows of "
               f"{', '.join(a.peers_json)}")
