@@ -30,7 +30,7 @@ options, fonts.py): the same rows per typeface and em (tables name them "style e
 
 Ours only, the peers' rows stored (``--ours-only --peers-json A.json [B.json ...]``): re-runs
 only ours (the fit as it is in this checkout) on the typefaces and corpus files of the stored
-runs and prints the side-by-side tables again with the stored peer rows (several CPU minwo;
+runs and prints the side-by-side tables again with the stored peer rows (several CPU minutes;
 the peers' inputs and corners do not depend on our fit). bench/precision_peers_s6.json
 holds the sixth session's peer rows (training set whole + exact, held-out whole, corpus).
 
