@@ -31,7 +31,7 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, os.path.join(HERE, ".."))
 sys.path.insert(0, HERE)
 
-from fonts import FONT_DIR, STYLES, TEXT, contours, dense, glyph_set  # noqa: E402
+from fonts import TEXT, contours, dense, font_file, glyph_set  # noqa: E402
 
 from galvo_core.geometry import flatten_cubic, point_polyline_distance  # noqa: E402
 
@@ -67,14 +67,14 @@ class FontCase:
 
 
 def _tangents(seg) -> tuple[np.ndarray, np.ndarray]:
+    """Start and end tangents of a ("line" | "quad" | "cubic", p0, ..., p1) segment (a
+    control point on its end: the next one)."""
     if seg[0] == "line":
         d = seg[2] - seg[1]
         return d, d
-    t0, t1 = seg[2] - seg[1], seg[3] - seg[2]
-    if not np.any(t0):
-        t0 = seg[3] - seg[1]
-    if not np.any(t1):
-        t1 = seg[3] - seg[1]
+    pts = seg[1:]
+    t0 = next((q - pts[0] for q in pts[1:] if np.any(q != pts[0])), pts[-1] - pts[0])
+    t1 = next((pts[-1] - q for q in pts[-2::-1] if np.any(q != pts[-1])), pts[-1] - pts[0])
     return t0, t1
 
 
@@ -84,12 +84,14 @@ def _turn_deg(a: np.ndarray, b: np.ndarray) -> float:
     return math.degrees(abs(math.atan2(a[0] * b[1] - a[1] * b[0], float(a @ b))))
 
 
-def font_case(style: str, whole: bool, em: float = 1000.0, chord: float = 0.002) -> FontCase:
-    gs = glyph_set(style, em=em, whole=whole, chord=chord)
-    f = os.path.join(FONT_DIR, STYLES[style])
-    cs = contours(f, TEXT, em)
+def font_case(style: str, whole: bool, em: float = 1000.0, chord: float = 0.002,
+              text: str = TEXT) -> FontCase:
+    """``style``: a name of fonts.STYLES or fonts.HELDOUT, or a TTF/OTF path."""
+    gs = glyph_set(style, em=em, whole=whole, chord=chord, text=text)
+    f = font_file(style)
+    cs = contours(f, text, em)
     glyph: list[int] = []
-    for k, ch in enumerate(TEXT):
+    for k, ch in enumerate(text):
         glyph += [k] * len(contours(f, ch, em))
     if len(glyph) != len(cs) or len(cs) != len(gs.points):
         raise RuntimeError("fonts.py changed: contours do not match glyph_set")
@@ -109,7 +111,7 @@ def font_case(style: str, whole: bool, em: float = 1000.0, chord: float = 0.002)
              if _turn_deg(_tangents(segs[k - 1])[1], _tangents(segs[k])[0]) > FONT_CORNER_DEG]
         c = sorted(set(min(i, len(p) - 2) for i in c)) if len(p) > 2 else []
         corners.append(np.array(c, dtype=np.intp))
-    return FontCase(style, whole, gs.points, gs.truth, gs.own_segments, corners, glyph)
+    return FontCase(gs.style, whole, gs.points, gs.truth, gs.own_segments, corners, glyph)
 
 
 # --- turn-angle corners (corpus) -----------------------------------------------------------

@@ -4,7 +4,9 @@
 #                                     and the tables printed (thin, fit, precision, precision
 #                                     speed, peers on the typefaces and the corpus)
 #   FIT_STAGES="precision peers" bash bench/run_fit.sh   -> only those stages
-# Stages: thin fit precision speed peers.
+#   FIT_STAGES=peers-ours bash bench/run_fit.sh   -> ours re-run beside the stored peer rows
+#                                     (bench/precision_peers_s6.json; PEERS_JSON to name others)
+# Stages: thin fit precision speed peers (peers-ours: only on request).
 # Peers: fit-curve and paper (npm, versions pinned in bench/js/package.json, into
 # bench/node_modules, gitignored); Debian packages potrace, python3-fontforge, inkscape and
 # the DejaVu fonts (fonts-dejavu-core, fonts-dejavu-extra), installed with apt-get when
@@ -26,11 +28,15 @@ if has thin || has fit || has peers; then
       "paper@$(node -p "require('./bench/js/package.json').dependencies.paper")"
   fi
 fi
-if has precision || has peers; then
+if has precision || has peers || has peers-ours; then
   "$PY" -c "import fontTools" 2>/dev/null || "$PY" -m pip install -q "fontTools>=4.40"
   need=()
   [ -f /usr/share/fonts/truetype/dejavu/DejaVuSans.ttf ] || need+=(fonts-dejavu-core)
   [ -f /usr/share/fonts/truetype/dejavu/DejaVuSans-ExtraLight.ttf ] || need+=(fonts-dejavu-extra)
+  if has peers || has peers-ours; then  # the held-out typefaces of the stored peer rows
+    [ -f /usr/share/fonts/truetype/inconsolata/Inconsolata.otf ] || need+=(fonts-inconsolata)
+    [ -f /usr/share/fonts/opentype/cantarell/Cantarell-Regular.otf ] || need+=(fonts-cantarell)
+  fi
   if has peers; then
     command -v potrace >/dev/null || need+=(potrace)
     /usr/bin/python3 -c "import fontforge" 2>/dev/null || need+=(python3-fontforge)
@@ -57,4 +63,11 @@ if has speed; then "$PY" bench/bench_precision_speed.py --reps 3; fi
 if has peers; then
   echo "potrace $(potrace --version | head -1 | cut -d' ' -f2)  fontforge $(/usr/bin/python3 -c 'import fontforge; print(fontforge.version())' 2>/dev/null)  $(inkscape --version 2>/dev/null | head -1 | cut -d' ' -f1-2)"
   "$PY" bench/bench_precision_peers.py --corpus --json bench/out/precision_peers.json "$@"
+fi
+if has peers-ours; then
+  # only ours re-run; the peers' rows (typefaces and corpus) read from the stored runs
+  # shellcheck disable=SC2086
+  "$PY" bench/bench_precision_peers.py --ours-only \
+    --peers-json ${PEERS_JSON:-bench/precision_peers_s6.json} \
+    --json bench/out/precision_peers_ours.json "$@"
 fi
