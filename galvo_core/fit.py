@@ -495,6 +495,52 @@ def _bound_pair(ax, ay, bx, by, dx, dy, ex, ey, a0, a1, b0, b1, u0, u1,
     return math.sqrt(perp * perp + over * over)
 
 
+@njit(cache=True, nogil=True, inline="always")
+def _piece_start(cm, r, i0, i1, starts, arc, u, dist):  # pragma: no cover (compiled)
+    """The acceptance tests' per-piece set-up: piece r's power coefficients (ax, ay, bx, by,
+    dx, dy, ex, ey), its first input point, its first flat index, its point count and arc
+    span (1 where none); its ends' parameters and distances set (0 and 1, distance 0)."""
+    base = i0[r]
+    s = starts[r]
+    cnt = i1[r] - base + 1
+    span = arc[i1[r]] - arc[base]
+    u[s] = 0.0
+    dist[s] = 0.0
+    u[s + cnt - 1] = 1.0
+    dist[s + cnt - 1] = 0.0
+    return (cm[r, 0, 0], cm[r, 0, 1], cm[r, 1, 0], cm[r, 1, 1], cm[r, 2, 0], cm[r, 2, 1],
+            cm[r, 3, 0], cm[r, 3, 1], base, s, cnt, span if span > 0 else 1.0)
+
+
+@njit(cache=True, nogil=True, inline="always")
+def _chunk_newton(ax, ay, bx, by, dx, dy, ex, ey, work, arc, base, den, j0, step, stop, ib,
+                  ub, qxb, qyb, db):  # pragma: no cover (compiled)
+    """The acceptance tests' points of a piece (coefficients as :func:`_piece_start`'s)
+    j0, j0 + step, .. before ``stop`` (relative to its first input point ``base``), into
+    the chunk buffers: ``ib`` their places, ``ub`` their parameters (6 Newton steps from
+    arc length, as :func:`_newton_kernel`, bit for bit), ``db`` their distances; returns
+    how many."""
+    n = 0
+    for jj in range(j0, stop, step):
+        k = base + jj
+        ib[n] = jj
+        qxb[n] = work[k, 0] - ex
+        qyb[n] = work[k, 1] - ey
+        ub[n] = (arc[k] - arc[base]) / den
+        n += 1
+    for _ in range(6):  # (step by step over the chunk: the loop vectorises)
+        for j in range(n):
+            uk = ub[j]
+            ub[j] = newton_param(ax, ay, bx, by, dx, dy, qxb[j], qyb[j], uk)
+    for j in range(n):
+        k = base + ib[j]
+        uk = ub[j]
+        rx = ((ax * uk + bx) * uk + dx) * uk - (work[k, 0] - ex)
+        ry = ((ay * uk + by) * uk + dy) * uk - (work[k, 1] - ey)
+        db[j] = math.sqrt(rx * rx + ry * ry)
+    return n
+
+
 @njit(cache=True, nogil=True)
 def _accept_points(cm, i0, i1, starts, work, arc, e2, u, dist, emax0,
                    far) -> int:  # pragma: no cover (compiled)
@@ -509,44 +555,15 @@ def _accept_points(cm, i0, i1, starts, work, arc, e2, u, dist, emax0,
     qxb = np.empty(_ACCEPT_CHUNK)
     qyb = np.empty(_ACCEPT_CHUNK)
     db = np.empty(_ACCEPT_CHUNK)
+    ib = np.empty(_ACCEPT_CHUNK, dtype=np.intp)
     for r in range(len(i0)):
-        ax = cm[r, 0, 0]
-        ay = cm[r, 0, 1]
-        bx = cm[r, 1, 0]
-        by = cm[r, 1, 1]
-        dx = cm[r, 2, 0]
-        dy = cm[r, 2, 1]
-        ex = cm[r, 3, 0]
-        ey = cm[r, 3, 1]
-        base = i0[r]
-        s = starts[r]
-        cnt = i1[r] - base + 1
-        span = arc[i1[r]] - arc[base]
-        den = span if span > 0 else 1.0
-        u[s] = 0.0
-        dist[s] = 0.0
-        u[s + cnt - 1] = 1.0
-        dist[s + cnt - 1] = 0.0
+        ax, ay, bx, by, dx, dy, ex, ey, base, s, cnt, den = _piece_start(
+            cm, r, i0, i1, starts, arc, u, dist)
         worst = 0.0
         nan = False
         for c0 in range(1, cnt - 1, _ACCEPT_CHUNK):
-            c1 = min(cnt - 1, c0 + _ACCEPT_CHUNK)
-            n = c1 - c0
-            for j in range(n):
-                k = base + c0 + j
-                qxb[j] = work[k, 0] - ex
-                qyb[j] = work[k, 1] - ey
-                ub[j] = (arc[k] - arc[base]) / den
-            for _ in range(6):  # (step by step over the chunk: the loop vectorises)
-                for j in range(n):
-                    uk = ub[j]
-                    ub[j] = newton_param(ax, ay, bx, by, dx, dy, qxb[j], qyb[j], uk)
-            for j in range(n):
-                k = base + c0 + j
-                uk = ub[j]
-                rx = ((ax * uk + bx) * uk + dx) * uk - (work[k, 0] - ex)
-                ry = ((ay * uk + by) * uk + dy) * uk - (work[k, 1] - ey)
-                db[j] = math.sqrt(rx * rx + ry * ry)
+            n = _chunk_newton(ax, ay, bx, by, dx, dy, ex, ey, work, arc, base, den, c0, 1,
+                              min(cnt - 1, c0 + _ACCEPT_CHUNK), ib, ub, qxb, qyb, db)
             for j in range(n):
                 d = db[j]
                 u[s + c0 + j] = ub[j]
@@ -705,47 +722,16 @@ def _accept_quick(ctrl, cm, i0, i1, starts, work, arc, e2, su, basis, u, dist, e
     ib = np.empty(nc, dtype=np.intp)
     samp = np.empty((basis.shape[0], 2))
     for r in range(len(i0)):
-        ax = cm[r, 0, 0]
-        ay = cm[r, 0, 1]
-        bx = cm[r, 1, 0]
-        by = cm[r, 1, 1]
-        dx = cm[r, 2, 0]
-        dy = cm[r, 2, 1]
-        ex = cm[r, 3, 0]
-        ey = cm[r, 3, 1]
-        base = i0[r]
-        s = starts[r]
-        cnt = i1[r] - base + 1
-        span = arc[i1[r]] - arc[base]
-        den = span if span > 0 else 1.0
-        u[s] = 0.0
-        dist[s] = 0.0
-        u[s + cnt - 1] = 1.0
-        dist[s + cnt - 1] = 0.0
+        ax, ay, bx, by, dx, dy, ex, ey, base, s, cnt, den = _piece_start(
+            cm, r, i0, i1, starts, arc, u, dist)
         lim = e2[r]
         nck = max(1, -(-(cnt - 2) // nc))
         worst = 0.0
         good = True
         sampled = False
         for c in range(nck):
-            n = 0
-            for jj in range(1 + c, cnt - 1, nck):
-                k = base + jj
-                ib[n] = jj
-                qxb[n] = work[k, 0] - ex
-                qyb[n] = work[k, 1] - ey
-                ub[n] = (arc[k] - arc[base]) / den
-                n += 1
-            for _ in range(6):  # (step by step over the chunk: the loop vectorises)
-                for j in range(n):
-                    uk = ub[j]
-                    ub[j] = newton_param(ax, ay, bx, by, dx, dy, qxb[j], qyb[j], uk)
-            for j in range(n):
-                k = base + ib[j]
-                uk = ub[j]
-                rx = ((ax * uk + bx) * uk + dx) * uk - (work[k, 0] - ex)
-                ry = ((ay * uk + by) * uk + dy) * uk - (work[k, 1] - ey)
-                db[j] = math.sqrt(rx * rx + ry * ry)
+            n = _chunk_newton(ax, ay, bx, by, dx, dy, ex, ey, work, arc, base, den, 1 + c, nck,
+                              cnt - 1, ib, ub, qxb, qyb, db)
             for j in range(n):
                 d = db[j]
                 f = s + ib[j]
