@@ -2880,16 +2880,21 @@ def _seg_fits(W, ctrl, first, last, bound, h) -> bool:
     loc = W[first:last + 1]
     if len(ctrl) == 2:
         d = point_segment_distance(loc, ctrl[0], ctrl[1])
+    else:
+        _, d = nearest_on_cubic(ctrl, loc, seeds=64, iters=8)
+    if d.max() > bound:
+        return False
+    if last > first:  # (compiled: the arithmetic below)
+        return bool(_samples_within(np.ascontiguousarray(ctrl, dtype=np.float64), h, W,
+                                    first, last, bound - 0.5 * h))
+    if len(ctrl) == 2:
         length = float(np.hypot(*(ctrl[1] - ctrl[0])))
         m = max(2, math.ceil(length / h) + 1)
         samp = ctrl[0] + np.linspace(0.0, 1.0, m)[:, None] * (ctrl[1] - ctrl[0])
     else:
-        _, d = nearest_on_cubic(ctrl, loc, seeds=64, iters=8)
         length = float(np.hypot(*np.diff(ctrl, axis=0).T).sum())  # >= the arc length
         m = max(16, math.ceil(length / h) + 1)
         samp = cubic_eval(ctrl, np.linspace(0.0, 1.0, m))
-    if d.max() > bound:
-        return False
     return bool(_polyline_distance_over(samp, loc, bound - 0.5 * h).max() <= bound - 0.5 * h)
 
 
@@ -3376,6 +3381,67 @@ def _stretch_targets(W, est, valid, f, e, q):
     return pts
 
 
+#: no cubic yet (:func:`_ls_step`)
+_NO_CTRL = np.zeros((0, 2))
+
+
+@njit(cache=True, nogil=True)
+def _ls_step(ctrl, t, tg, s, b1, b2) -> None:  # pragma: no cover (compiled)
+    """:func:`_ls_cubic`'s elementwise part (the former numpy arithmetic, the same
+    numbers): where ``ctrl`` is a cubic, a Newton step of each target's parameter ``t``
+    (in place) towards its nearest point on it (no step where the second derivative is
+    not positive; clipped to [0, 1]); then s = 1 - t and the weights b1 = 3 s² t,
+    b2 = 3 s t²."""
+    n = t.shape[0]
+    if ctrl.shape[0] == 4:
+        ex1x = ctrl[1, 0] - ctrl[0, 0]
+        ex1y = ctrl[1, 1] - ctrl[0, 1]
+        ex2x = ctrl[2, 0] - ctrl[1, 0]
+        ex2y = ctrl[2, 1] - ctrl[1, 1]
+        ex3x = ctrl[3, 0] - ctrl[2, 0]
+        ex3y = ctrl[3, 1] - ctrl[2, 1]
+        q0x = (ctrl[2, 0] - 2.0 * ctrl[1, 0]) + ctrl[0, 0]
+        q0y = (ctrl[2, 1] - 2.0 * ctrl[1, 1]) + ctrl[0, 1]
+        q1x = (ctrl[3, 0] - 2.0 * ctrl[2, 0]) + ctrl[1, 0]
+        q1y = (ctrl[3, 1] - 2.0 * ctrl[2, 1]) + ctrl[1, 1]
+        c3 = ctrl.reshape(1, 4, 2)
+        for k in range(n):
+            tk = t[k]
+            sk = 1.0 - tk
+            w0 = sk * sk
+            w1 = 2.0 * sk * tk
+            w2 = tk * tk
+            d1x = 3.0 * ((w0 * ex1x + w1 * ex2x) + w2 * ex3x)
+            d1y = 3.0 * ((w0 * ex1y + w1 * ex2y) + w2 * ex3y)
+            d2x = 6.0 * (sk * q0x + tk * q1x)
+            d2y = 6.0 * (sk * q0y + tk * q1y)
+            b0, bb1, bb2, b3 = bernstein_weights(tk)
+            rx = bernstein_point(b0, bb1, bb2, b3, c3, 0, 0) - tg[k, 0]
+            ry = bernstein_point(b0, bb1, bb2, b3, c3, 0, 1) - tg[k, 1]
+            den = (d1x * d1x + d1y * d1y) + (rx * d2x + ry * d2y)
+            dt = (rx * d1x + ry * d1y) / den if den > 0.0 else 0.0
+            v = tk - dt
+            if v == v:  # (np.clip's: NaN kept, else max(v, 0) then min(v, 1), ties to the bound)
+                v = v if v > 0.0 else 0.0
+                v = v if v < 1.0 else 1.0
+            t[k] = v
+    for k in range(n):
+        tk = t[k]
+        sk = 1.0 - tk
+        s[k] = sk
+        b1[k] = 3.0 * sk * sk * tk
+        b2[k] = 3.0 * sk * tk * tk
+
+
+@njit(cache=True, nogil=True)
+def _ls_rest(tg, s3, t3, p0, p3, r) -> None:  # pragma: no cover (compiled)
+    """:func:`_ls_cubic`'s residuals r = tg - s³ p0 - t³ p3 (the former numpy arithmetic;
+    s³, t³ numpy's powers)."""
+    for k in range(tg.shape[0]):
+        r[k, 0] = (tg[k, 0] - s3[k] * p0[0]) - t3[k] * p3[0]
+        r[k, 1] = (tg[k, 1] - s3[k] * p0[1]) - t3[k] * p3[1]
+
+
 def _ls_cubic(p0, p3, tg):
     """The cubic from p0 to p3 whose inner control points fit the targets ``tg`` best
     (least squares, parameters re-fitted by Newton steps towards the nearest points); None
@@ -3386,25 +3452,17 @@ def _ls_cubic(p0, p3, tg):
         return None
     t = np.r_[0.0, np.cumsum(c)] / tot
     ctrl = None
+    s = np.empty(len(t))
+    b1 = np.empty(len(t))
+    b2 = np.empty(len(t))
+    r = np.empty((len(t), 2))
     for it in range(_STRETCH_ITERS + 1):
-        s = 1.0 - t
-        if ctrl is not None:  # a Newton step of each target's parameter
-            d1 = 3.0 * ((s * s)[:, None] * (ctrl[1] - ctrl[0])
-                        + (2.0 * s * t)[:, None] * (ctrl[2] - ctrl[1])
-                        + (t * t)[:, None] * (ctrl[3] - ctrl[2]))
-            d2 = 6.0 * (s[:, None] * (ctrl[2] - 2.0 * ctrl[1] + ctrl[0])
-                        + t[:, None] * (ctrl[3] - 2.0 * ctrl[2] + ctrl[1]))
-            r = cubic_eval(ctrl, t) - tg
-            den = (d1 * d1).sum(axis=1) + (r * d2).sum(axis=1)
-            dt = np.where(den > 0.0, (r * d1).sum(axis=1) / np.where(den > 0.0, den, 1.0),
-                          0.0)
-            t = np.clip(t - dt, 0.0, 1.0)
-            s = 1.0 - t
-            if it == _STRETCH_ITERS:
-                return ctrl
-        b1 = 3.0 * s * s * t
-        b2 = 3.0 * s * t * t
-        r = tg - (s ** 3)[:, None] * p0 - (t ** 3)[:, None] * p3
+        # (compiled: a Newton step of each target's parameter towards its nearest point
+        # where there is a cubic, then the weights; the products below stay numpy's, BLAS)
+        _ls_step(ctrl if ctrl is not None else _NO_CTRL, t, tg, s, b1, b2)
+        if it == _STRETCH_ITERS:
+            return ctrl
+        _ls_rest(tg, s ** 3, t ** 3, p0, p3, r)
         a11, a12, a22 = b1 @ b1, b1 @ b2, b2 @ b2
         det = a11 * a22 - a12 * a12
         if not det > 1e-12 * max(a11 * a22, 1e-300):
@@ -3421,6 +3479,12 @@ def _design_off(W, est, valid, ctrl, f, e, h, limit=math.inf):
     (at most h apart) to the polyline of the estimates (else the points); None when d1 is
     over ``limit``. Both measured against polylines (the samples, the estimates), exactly
     where over ``_STRETCH_EXACT`` h."""
+    if e > f:  # (compiled: the arithmetic below)
+        r = np.empty(2)
+        if not _design_off_kernel(W, est, valid, np.ascontiguousarray(ctrl, dtype=np.float64),
+                                  f, e, h, limit, r):
+            return None
+        return float(r[0]), float(r[1])
     if len(ctrl) == 2:
         length = float(np.hypot(*(ctrl[1] - ctrl[0])))
         m = max(2, math.ceil(length / h) + 1)
@@ -3440,6 +3504,123 @@ def _design_off(W, est, valid, ctrl, f, e, h, limit=math.inf):
         return None
     poly = np.where(valid[f:e + 1, None], est[f:e + 1], W[f:e + 1])
     return d1, float(_polyline_distance_over(samp, poly, _STRETCH_EXACT * h).max())
+
+
+@njit(cache=True, nogil=True)
+def _seg_samples(ctrl, h):  # pragma: no cover (compiled)
+    """The samples of the segment ``ctrl`` (2 or 4 points) at most h apart that
+    :func:`_seg_fits` and :func:`_design_off` take: m = max(2 (16 for a cubic),
+    ceil(length / h) + 1) (the length the chord's, or the control polygon's summed in
+    order) at np.linspace(0, 1, m), cubic_eval's arithmetic or the line's ctrl[0] +
+    t (ctrl[1] - ctrl[0]) (the same numbers)."""
+    cub = ctrl.shape[0] == 4
+    if cub:
+        length = (math.hypot(ctrl[1, 0] - ctrl[0, 0], ctrl[1, 1] - ctrl[0, 1])
+                  + math.hypot(ctrl[2, 0] - ctrl[1, 0], ctrl[2, 1] - ctrl[1, 1])) \
+            + math.hypot(ctrl[3, 0] - ctrl[2, 0], ctrl[3, 1] - ctrl[2, 1])
+        m = max(16, int(math.ceil(length / h)) + 1)
+    else:
+        length = math.hypot(ctrl[1, 0] - ctrl[0, 0], ctrl[1, 1] - ctrl[0, 1])
+        m = max(2, int(math.ceil(length / h)) + 1)
+    samp = np.empty((m, 2))
+    c3 = ctrl.reshape(1, ctrl.shape[0], 2)
+    step = 1.0 / (m - 1)
+    for t in range(m):
+        u = t * step if t < m - 1 else 1.0
+        if cub:
+            b0, b1, b2, b3 = bernstein_weights(u)
+            samp[t, 0] = bernstein_point(b0, b1, b2, b3, c3, 0, 0)
+            samp[t, 1] = bernstein_point(b0, b1, b2, b3, c3, 0, 1)
+        else:
+            samp[t, 0] = ctrl[0, 0] + u * (ctrl[1, 0] - ctrl[0, 0])
+            samp[t, 1] = ctrl[0, 1] + u * (ctrl[1, 1] - ctrl[0, 1])
+    return samp
+
+
+@njit(cache=True, nogil=True)
+def _samples_within(ctrl, h, W, first, last, lim):  # pragma: no cover (compiled)
+    """:func:`_seg_fits`' polyline side compiled (last > first): whether the samples
+    (:func:`_seg_samples`) all lie within ``lim`` of the polyline W[first..last]
+    (:func:`_polyline_distance_over`'s numbers; NaN fails)."""
+    samp = _seg_samples(ctrl, h)
+    d = _distance_over(samp, W[first:last + 1], lim, _NEAR_SEGMENTS)
+    for t in range(d.shape[0]):
+        if not d[t] <= lim:
+            return False
+    return True
+
+
+@njit(cache=True, nogil=True)
+def _design_off_kernel(W, est, valid, ctrl, f, e, h, limit, out):  # pragma: no cover
+    """:func:`_design_off` compiled (e > f): its samples (np.linspace's and cubic_eval's
+    arithmetic, the line's ctrl[0] + t (ctrl[1] - ctrl[0])), its targets in the same order
+    and :func:`_polyline_distance_over` (the brute force or :func:`_over_kernel`, the step
+    lengths libm's hypot), so the same numbers; out[0], out[1] get (d1, d2); returns
+    False when d1 is over ``limit``."""
+    samp = _seg_samples(ctrl, h)
+    m = samp.shape[0]
+    lim = _STRETCH_EXACT * h
+    n = e - f + 1
+    tp = np.empty((2 * n, 2))
+    nt = 0
+    for g in range(f, e + 1):
+        if valid[g]:
+            tp[nt, 0] = est[g, 0]
+            tp[nt, 1] = est[g, 1]
+            nt += 1
+            if g < e and valid[g + 1]:
+                tp[nt, 0] = 0.5 * (est[g, 0] + est[g + 1, 0])
+                tp[nt, 1] = 0.5 * (est[g, 1] + est[g + 1, 1])
+                nt += 1
+    d1 = 0.0
+    if nt:
+        d = _distance_over(tp[:nt], samp, lim, 64)
+        d1 = d[0]
+        for t in range(1, nt):  # (np.max: NaN wins)
+            if not d[t] <= d1 and d1 == d1:
+                d1 = d[t]
+    out[0] = d1
+    if d1 > limit:
+        return False
+    poly = np.empty((n, 2))
+    for g in range(f, e + 1):
+        src = est if valid[g] else W
+        poly[g - f, 0] = src[g, 0]
+        poly[g - f, 1] = src[g, 1]
+    d = _distance_over(samp, poly, lim, _NEAR_SEGMENTS)
+    d2 = d[0]
+    for t in range(1, m):
+        if not d[t] <= d2 and d2 == d2:
+            d2 = d[t]
+    out[1] = d2
+    return True
+
+
+@njit(cache=True, nogil=True)
+def _distance_over(samp, poly, lim, k):  # pragma: no cover (compiled)
+    """:func:`_polyline_distance_over` compiled, for polylines of 2 points or more."""
+    n = poly.shape[0]
+    ms = samp.shape[0]
+    d = np.empty(ms)
+    if n <= 2 * k + 2:
+        _brute_kernel(samp, poly, d)
+        return d
+    fl = np.empty(max(n, ms), dtype=np.bool_)
+    dx = np.empty(max(n, ms))
+    dy = np.empty(max(n, ms))
+    pstep = np.empty(n - 1)
+    for t in range(n - 1):
+        dx[t] = poly[t + 1, 0] - poly[t, 0]
+        dy[t] = poly[t + 1, 1] - poly[t, 1]
+    hypot_into(dx, dy, n - 1, pstep, fl)
+    sstep = np.empty(max(ms - 1, 0))
+    for t in range(ms - 1):
+        dx[t] = samp[t + 1, 0] - samp[t, 0]
+        dy[t] = samp[t + 1, 1] - samp[t, 1]
+    hypot_into(dx, dy, ms - 1, sstep, fl)
+    if ms:
+        _over_kernel(samp, sstep, poly, pstep, lim, k, d)
+    return d
 
 
 def _estimates_off(points, is_cubic, tail, gfirst, glast, sr, est, valid):
