@@ -3364,10 +3364,55 @@ def _side_estimates(W, arc, g, ps, pe, quant, k, side, smooth, gap, span,
                 out[i, sd, 2] = 1.0
 
 
+@njit(cache=True, nogil=True)
+def _targets_kernel(W, est, valid, f, e, step, most):  # pragma: no cover (compiled)
+    """:func:`_stretch_targets` compiled (e > f), the same numbers: the points (estimates
+    where valid) with each step cut into ceil(length / step) (at least 1) equal parts
+    (libm's hypot; (i - start) / n, then d0 + frac (d1 - d0)), the last point; more than
+    ``most`` thinned to the rows np.linspace(0, len - 1, most).round() (halves to even)."""
+    n = e - f + 1
+    d = np.empty((n, 2))
+    for g in range(f, e + 1):
+        src = est if valid[g] else W
+        d[g - f, 0] = src[g, 0]
+        d[g - f, 1] = src[g, 1]
+    cnt = np.empty(n - 1, dtype=np.int64)
+    tot = 0
+    for i in range(n - 1):
+        gap = math.hypot(d[i + 1, 0] - d[i, 0], d[i + 1, 1] - d[i, 1])
+        cnt[i] = max(int(math.ceil(gap / step)), 1)
+        tot += cnt[i]
+    pts = np.empty((tot + 1, 2))
+    r = 0
+    for i in range(n - 1):
+        for j in range(cnt[i]):
+            fr = j / cnt[i]
+            pts[r, 0] = d[i, 0] + fr * (d[i + 1, 0] - d[i, 0])
+            pts[r, 1] = d[i, 1] + fr * (d[i + 1, 1] - d[i, 1])
+            r += 1
+    pts[tot, 0] = d[n - 1, 0]
+    pts[tot, 1] = d[n - 1, 1]
+    if tot + 1 <= most:
+        return pts
+    out = np.empty((most, 2))
+    sp = tot / (most - 1)
+    for i in range(most):
+        x = i * sp if i < most - 1 else float(tot)
+        k = math.floor(x)
+        h = x - k
+        if h > 0.5 or (h == 0.5 and k % 2 == 1):
+            k += 1
+        out[i, 0] = pts[int(k), 0]
+        out[i, 1] = pts[int(k), 1]
+    return out
+
+
 def _stretch_targets(W, est, valid, f, e, q):
     """The design polyline of the input points f..e: each smooth point's estimate (else the
     point), the long gaps filled every ``_STRETCH_STEP`` quanta (at most
     ``_STRETCH_TARGETS`` points, evenly taken)."""
+    if e > f:  # (compiled: the arithmetic below)
+        return _targets_kernel(W, est, valid, f, e, _STRETCH_STEP * q, _STRETCH_TARGETS)
     d = np.where(valid[f:e + 1, None], est[f:e + 1], W[f:e + 1])
     if len(d) < 2:
         return d

@@ -153,9 +153,42 @@ def nearest_on_cubic(
     """
     c = _ctrl(ctrl)
     p = np.asarray(pts, dtype=np.float64).reshape(-1, 2)
+    if len(p):  # (one cubic: nearest_on_cubic_each's steps without its grouping)
+        cc = np.ascontiguousarray(c[None])
+        ns = int(_seed_counts(cc, seeds)[0])
+        best_u = np.empty(len(p))
+        best_d2 = np.empty(len(p))
+        if _nearest_one_kernel(cc, np.linspace(0.0, 1.0, ns + 1), np.ascontiguousarray(p),
+                               iters, min(_NEAREST_CANDIDATES, ns + 1), best_u, best_d2):
+            return best_u, np.sqrt(best_d2)
     return nearest_on_cubic_each(
         c[None], np.zeros(len(p), dtype=np.intp), p, seeds=seeds, iters=iters
     )
+
+
+@njit(cache=True, nogil=True)
+def _nearest_one_kernel(cc, su, p, iters, nc, best_u, best_d2):  # type: ignore[no-untyped-def]
+    """:func:`nearest_on_cubic_each` for the one cubic cc[0] (its numbers: the samples at
+    ``su`` and candidates of :func:`_candidates_kernel`, the refinement of
+    :func:`_refine_kernel`); False (nothing decided) where two sampled minima tie (the
+    caller then takes nearest_on_cubic_each, which selects those by numpy)."""
+    k = p.shape[0]
+    ns = su.shape[0] - 1
+    spx = np.empty((1, ns + 1))
+    spy = np.empty((1, ns + 1))
+    u0 = np.zeros((_NEAREST_CANDIDATES, k))
+    lo = np.zeros((_NEAREST_CANDIDATES, k))
+    hi = np.ones((_NEAREST_CANDIDATES, k))
+    ok = np.zeros((_NEAREST_CANDIDATES, k), dtype=np.bool_)
+    tie = np.zeros(k, dtype=np.bool_)
+    pid = np.zeros(k, dtype=np.int64)
+    out = np.arange(k)
+    _candidates_kernel(cc, su, pid, p, out, spx, spy, best_u, best_d2, u0, lo, hi, ok, nc,
+                       tie)
+    if tie.any():
+        return False
+    _refine_kernel(cc, pid, p, u0, lo, hi, ok, iters, best_u, best_d2)
+    return True
 
 
 def _seed_counts(c: np.ndarray, seeds: int) -> np.ndarray:

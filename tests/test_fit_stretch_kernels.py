@@ -94,6 +94,21 @@ def _ls_cubic_numpy(p0, p3, tg):
     return ctrl
 
 
+def _stretch_targets_numpy(W, est, valid, f, e, q):
+    """The former :func:`fit._stretch_targets`."""
+    d = np.where(valid[f:e + 1, None], est[f:e + 1], W[f:e + 1])
+    if len(d) < 2:
+        return d
+    gap = np.hypot(*np.diff(d, axis=0).T)
+    n = np.maximum(np.ceil(gap / (fitmod._STRETCH_STEP * q)).astype(np.intp), 1)
+    seg = np.repeat(np.arange(len(gap)), n)
+    frac = (np.arange(int(n.sum())) - np.repeat(np.cumsum(n) - n, n)) / np.repeat(n, n)
+    pts = np.vstack([d[seg] + frac[:, None] * (d[seg + 1] - d[seg]), d[-1:]])
+    if len(pts) > fitmod._STRETCH_TARGETS:
+        pts = pts[np.linspace(0, len(pts) - 1, fitmod._STRETCH_TARGETS).round().astype(np.intp)]
+    return pts
+
+
 def _arc(rng, n):
     """A smooth arc of n points 1-2 units apart rounded to whole units (W), its unrounded
     points a little disturbed (the estimates), most of them valid."""
@@ -173,6 +188,10 @@ def test_ls_cubic_compiled_is_the_numpy_one(seed: int) -> None:
         if len(ctrl) != 4:
             continue
         tg = fitmod._stretch_targets(W, est, valid, f, e, 1.0)
+        # (the targets themselves: the former numpy ones, thinned or not, gaps filled)
+        for q in (1.0, 0.3):
+            assert np.array_equal(fitmod._stretch_targets(W, est, valid, f, e, q),
+                                  _stretch_targets_numpy(W, est, valid, f, e, q))
         want = _ls_cubic_numpy(ctrl[0], ctrl[-1], tg)
         got = fitmod._ls_cubic(ctrl[0], ctrl[-1], tg)
         if want is None:
@@ -185,3 +204,25 @@ def test_ls_cubic_compiled_is_the_numpy_one(seed: int) -> None:
     assert np.array_equal(fitmod._ls_cubic(tg[0], tg[-1], tg), _ls_cubic_numpy(tg[0], tg[-1], tg))
     assert fitmod._ls_cubic(tg[0], tg[0], np.zeros((6, 2))) is None
     assert cases >= 8
+
+
+def test_nearest_on_one_cubic_is_nearest_on_cubic_each() -> None:
+    """The one-cubic path of nearest_on_cubic gives nearest_on_cubic_each's numbers, on
+    plain arcs, loops and cusps (more samples), and where two sampled minima tie (the
+    centre of a symmetric arc: handed over to nearest_on_cubic_each)."""
+    from galvo_core.geometry import nearest_on_cubic_each
+
+    rng = np.random.default_rng(7)
+    cubics = [rng.normal(size=(4, 2)) * 50.0 for _ in range(40)]
+    cubics.append(np.array([[0.0, 0.0], [100.0, 100.0], [0.0, 100.0], [100.0, 0.0]]))  # loop
+    cubics.append(np.array([[0.0, 0.0], [10.0, 10.0], [-10.0, 10.0], [0.0, 0.0]]))
+    sym = np.array([[-50.0, 0.0], [-50.0, 40.0], [50.0, 40.0], [50.0, 0.0]])
+    cubics.append(sym)
+    for c in cubics:
+        pts = np.concatenate([rng.normal(size=(60, 2)) * 60.0, c + 0.25, [[0.0, -5.0]]])
+        for seeds, iters in ((64, 8), (48, 6)):
+            t, d = nearest_on_cubic(c, pts, seeds=seeds, iters=iters)
+            te, de = nearest_on_cubic_each(c[None], np.zeros(len(pts), dtype=np.intp), pts,
+                                           seeds=seeds, iters=iters)
+            assert np.array_equal(t, te) and np.array_equal(d, de)
+    assert nearest_on_cubic(sym, np.zeros((0, 2)))[0].shape == (0,)
