@@ -512,35 +512,6 @@ def _piece_start(cm, r, i0, i1, starts, arc, u, dist):  # pragma: no cover (comp
             cm[r, 3, 0], cm[r, 3, 1], base, s, cnt, span if span > 0 else 1.0)
 
 
-@njit(cache=True, nogil=True, inline="always")
-def _chunk_newton(ax, ay, bx, by, dx, dy, ex, ey, work, arc, base, den, j0, step, stop, ib,
-                  ub, qxb, qyb, db):  # pragma: no cover (compiled)
-    """The acceptance tests' points of a piece (coefficients as :func:`_piece_start`'s)
-    j0, j0 + step, .. before ``stop`` (relative to its first input point ``base``), into
-    the chunk buffers: ``ib`` their places, ``ub`` their parameters (6 Newton steps from
-    arc length, as :func:`_newton_kernel`, bit for bit), ``db`` their distances; returns
-    how many."""
-    n = 0
-    for jj in range(j0, stop, step):
-        k = base + jj
-        ib[n] = jj
-        qxb[n] = work[k, 0] - ex
-        qyb[n] = work[k, 1] - ey
-        ub[n] = (arc[k] - arc[base]) / den
-        n += 1
-    for _ in range(6):  # (step by step over the chunk: the loop vectorises)
-        for j in range(n):
-            uk = ub[j]
-            ub[j] = newton_param(ax, ay, bx, by, dx, dy, qxb[j], qyb[j], uk)
-    for j in range(n):
-        k = base + ib[j]
-        uk = ub[j]
-        rx = ((ax * uk + bx) * uk + dx) * uk - (work[k, 0] - ex)
-        ry = ((ay * uk + by) * uk + dy) * uk - (work[k, 1] - ey)
-        db[j] = math.sqrt(rx * rx + ry * ry)
-    return n
-
-
 @njit(cache=True, nogil=True)
 def _accept_points(cm, i0, i1, starts, work, arc, e2, u, dist, emax0,
                    far) -> int:  # pragma: no cover (compiled)
@@ -549,37 +520,11 @@ def _accept_points(cm, i0, i1, starts, work, arc, e2, u, dist, emax0,
     interior point's parameter (6 Newton steps from arc length, as :func:`_newton_kernel`,
     bit for bit) and distance into ``u``, ``dist`` (the ends: 0 and 1, distance 0), the
     piece's largest distance into ``emax0`` (NaN if any is), and the flat indices of the
-    points over ``e2[r]`` in pieces within 4 e2[r] into ``far``; returns their number."""
-    nfar = 0
-    ub = np.empty(_ACCEPT_CHUNK)
-    qxb = np.empty(_ACCEPT_CHUNK)
-    qyb = np.empty(_ACCEPT_CHUNK)
-    db = np.empty(_ACCEPT_CHUNK)
-    ib = np.empty(_ACCEPT_CHUNK, dtype=np.intp)
-    for r in range(len(i0)):
-        ax, ay, bx, by, dx, dy, ex, ey, base, s, cnt, den = _piece_start(
-            cm, r, i0, i1, starts, arc, u, dist)
-        worst = 0.0
-        nan = False
-        for c0 in range(1, cnt - 1, _ACCEPT_CHUNK):
-            n = _chunk_newton(ax, ay, bx, by, dx, dy, ex, ey, work, arc, base, den, c0, 1,
-                              min(cnt - 1, c0 + _ACCEPT_CHUNK), ib, ub, qxb, qyb, db)
-            for j in range(n):
-                d = db[j]
-                u[s + c0 + j] = ub[j]
-                dist[s + c0 + j] = d
-                if d > worst:
-                    worst = d
-                elif d != d:
-                    nan = True
-        emax0[r] = np.nan if nan else worst
-        lim = e2[r]
-        if not nan and worst > lim and worst <= 4.0 * lim:
-            for j in range(1, cnt - 1):
-                if dist[s + j] > lim:
-                    far[nfar] = s + j
-                    nfar += 1
-    return nfar
+    points over ``e2[r]`` in pieces within 4 e2[r] into ``far``; returns their number
+    (:func:`_accept_kernel` in full)."""
+    return _accept_kernel(np.empty((0, 4, 2)), cm, i0, i1, starts, work, arc, e2,
+                          np.empty(0), np.empty((0, 4)), u, dist, emax0,
+                          np.empty(0, dtype=np.bool_), far, False)
 
 
 @njit(cache=True, nogil=True, error_model="numpy")
@@ -713,14 +658,27 @@ def _accept_quick(ctrl, cm, i0, i1, starts, work, arc, e2, su, basis, u, dist, e
     that stays over, or that Newton leaves over 4 e2[r] (or NaN): :func:`_accept_points`
     and :func:`_accept_far` fail it then too. A passing piece ends with the numbers of
     both (its points' ``u``, ``dist``, and ``emax[r]`` their largest); a failing piece's
-    others are left unset."""
-    nc = _QUICK_CHUNK
+    others are left unset (:func:`_accept_kernel` with ``quick``)."""
+    _accept_kernel(ctrl, cm, i0, i1, starts, work, arc, e2, su, basis, u, dist, emax, ok,
+                   np.empty(0, dtype=np.intp), True)
+
+
+@njit(cache=True, nogil=True)
+def _accept_kernel(ctrl, cm, i0, i1, starts, work, arc, e2, su, basis, u, dist, emax, ok,
+                   far, quick) -> int:  # pragma: no cover (compiled)
+    """The point side of the acceptance test, both ways: :func:`_accept_points` (contiguous
+    chunks of ``_ACCEPT_CHUNK`` points, every point's numbers, the far points listed) and,
+    with ``quick``, :func:`_accept_quick` (strided chunks of ``_QUICK_CHUNK``, the seeded
+    search at once, a piece stopped at its first point left over). One per-piece set-up
+    and one chunk loop (each point's 6 Newton steps and distance) serve both."""
+    nc = _QUICK_CHUNK if quick else _ACCEPT_CHUNK
     ub = np.empty(nc)
     qxb = np.empty(nc)
     qyb = np.empty(nc)
     db = np.empty(nc)
     ib = np.empty(nc, dtype=np.intp)
     samp = np.empty((basis.shape[0], 2))
+    nfar = 0
     for r in range(len(i0)):
         ax, ay, bx, by, dx, dy, ex, ey, base, s, cnt, den = _piece_start(
             cm, r, i0, i1, starts, arc, u, dist)
@@ -728,10 +686,42 @@ def _accept_quick(ctrl, cm, i0, i1, starts, work, arc, e2, su, basis, u, dist, e
         nck = max(1, -(-(cnt - 2) // nc))
         worst = 0.0
         good = True
+        nan = False
         sampled = False
         for c in range(nck):
-            n = _chunk_newton(ax, ay, bx, by, dx, dy, ex, ey, work, arc, base, den, 1 + c, nck,
-                              cnt - 1, ib, ub, qxb, qyb, db)
+            if quick:  # (chunk c: every nck-th point from 1 + c)
+                j0, stop, step = 1 + c, cnt - 1, nck
+            else:
+                j0, step = 1 + c * nc, 1
+                stop = min(cnt - 1, j0 + nc)
+            n = 0
+            for jj in range(j0, stop, step):
+                k = base + jj
+                ib[n] = jj
+                qxb[n] = work[k, 0] - ex
+                qyb[n] = work[k, 1] - ey
+                ub[n] = (arc[k] - arc[base]) / den
+                n += 1
+            for _ in range(6):  # (step by step over the chunk: the loop vectorises)
+                for j in range(n):
+                    uk = ub[j]
+                    ub[j] = newton_param(ax, ay, bx, by, dx, dy, qxb[j], qyb[j], uk)
+            for j in range(n):
+                k = base + ib[j]
+                uk = ub[j]
+                rx = ((ax * uk + bx) * uk + dx) * uk - (work[k, 0] - ex)
+                ry = ((ay * uk + by) * uk + dy) * uk - (work[k, 1] - ey)
+                db[j] = math.sqrt(rx * rx + ry * ry)
+            if not quick:
+                for j in range(n):
+                    d = db[j]
+                    u[s + ib[j]] = ub[j]
+                    dist[s + ib[j]] = d
+                    if d > worst:
+                        worst = d
+                    elif d != d:
+                        nan = True
+                continue
             for j in range(n):
                 d = db[j]
                 f = s + ib[j]
@@ -759,9 +749,18 @@ def _accept_quick(ctrl, cm, i0, i1, starts, work, arc, e2, su, basis, u, dist, e
                     worst = d
             if not good:
                 break
-        if good:
-            emax[r] = worst
-        ok[r] = good
+        if quick:
+            if good:
+                emax[r] = worst
+            ok[r] = good
+            continue
+        emax[r] = np.nan if nan else worst
+        if not nan and worst > lim and worst <= 4.0 * lim:
+            for j in range(1, cnt - 1):
+                if dist[s + j] > lim:
+                    far[nfar] = s + j
+                    nfar += 1
+    return nfar
 
 
 @njit(cache=True, nogil=True)
