@@ -2883,18 +2883,8 @@ def _seg_fits(W, ctrl, first, last, bound, h) -> bool:
         _, d = nearest_on_cubic(ctrl, loc, seeds=64, iters=8)
     if d.max() > bound:
         return False
-    if last > first:  # (compiled: the arithmetic below)
-        return bool(_samples_within(np.ascontiguousarray(ctrl, dtype=np.float64), h, W,
-                                    first, last, bound - 0.5 * h))
-    if len(ctrl) == 2:
-        length = float(np.hypot(*(ctrl[1] - ctrl[0])))
-        m = max(2, math.ceil(length / h) + 1)
-        samp = ctrl[0] + np.linspace(0.0, 1.0, m)[:, None] * (ctrl[1] - ctrl[0])
-    else:
-        length = float(np.hypot(*np.diff(ctrl, axis=0).T).sum())  # >= the arc length
-        m = max(16, math.ceil(length / h) + 1)
-        samp = cubic_eval(ctrl, np.linspace(0.0, 1.0, m))
-    return bool(_polyline_distance_over(samp, loc, bound - 0.5 * h).max() <= bound - 0.5 * h)
+    return bool(_samples_within(np.ascontiguousarray(ctrl, dtype=np.float64), h, W, first,
+                                last, bound - 0.5 * h))
 
 
 #: samples in order along a polyline are measured first against this many of its segments
@@ -3365,7 +3355,7 @@ def _side_estimates(W, arc, g, ps, pe, quant, k, side, smooth, gap, span,
 
 @njit(cache=True, nogil=True)
 def _targets_kernel(W, est, valid, f, e, step, most):  # pragma: no cover (compiled)
-    """:func:`_stretch_targets` compiled (e > f), the same numbers: the points (estimates
+    """:func:`_stretch_targets` compiled, the same numbers: the points (estimates
     where valid) with each step cut into ceil(length / step) (at least 1) equal parts
     (libm's hypot; (i - start) / n, then d0 + frac (d1 - d0)), the last point; more than
     ``most`` thinned to the rows np.linspace(0, len - 1, most).round() (halves to even)."""
@@ -3410,19 +3400,7 @@ def _stretch_targets(W, est, valid, f, e, q):
     """The design polyline of the input points f..e: each smooth point's estimate (else the
     point), the long gaps filled every ``_STRETCH_STEP`` quanta (at most
     ``_STRETCH_TARGETS`` points, evenly taken)."""
-    if e > f:  # (compiled: the arithmetic below)
-        return _targets_kernel(W, est, valid, f, e, _STRETCH_STEP * q, _STRETCH_TARGETS)
-    d = np.where(valid[f:e + 1, None], est[f:e + 1], W[f:e + 1])
-    if len(d) < 2:
-        return d
-    gap = np.hypot(*np.diff(d, axis=0).T)
-    n = np.maximum(np.ceil(gap / (_STRETCH_STEP * q)).astype(np.intp), 1)
-    seg = np.repeat(np.arange(len(gap)), n)
-    frac = (np.arange(int(n.sum())) - np.repeat(np.cumsum(n) - n, n)) / np.repeat(n, n)
-    pts = np.vstack([d[seg] + frac[:, None] * (d[seg + 1] - d[seg]), d[-1:]])
-    if len(pts) > _STRETCH_TARGETS:  # evenly thinned out
-        pts = pts[np.linspace(0, len(pts) - 1, _STRETCH_TARGETS).round().astype(np.intp)]
-    return pts
+    return _targets_kernel(W, est, valid, f, e, _STRETCH_STEP * q, _STRETCH_TARGETS)
 
 
 #: no cubic yet (:func:`_ls_step`)
@@ -3523,31 +3501,11 @@ def _design_off(W, est, valid, ctrl, f, e, h, limit=math.inf):
     (at most h apart) to the polyline of the estimates (else the points); None when d1 is
     over ``limit``. Both measured against polylines (the samples, the estimates), exactly
     where over ``_STRETCH_EXACT`` h."""
-    if e > f:  # (compiled: the arithmetic below)
-        r = np.empty(2)
-        if not _design_off_kernel(W, est, valid, np.ascontiguousarray(ctrl, dtype=np.float64),
-                                  f, e, h, limit, r):
-            return None
-        return float(r[0]), float(r[1])
-    if len(ctrl) == 2:
-        length = float(np.hypot(*(ctrl[1] - ctrl[0])))
-        m = max(2, math.ceil(length / h) + 1)
-        samp = ctrl[0] + np.linspace(0.0, 1.0, m)[:, None] * (ctrl[1] - ctrl[0])
-    else:
-        length = float(np.hypot(*np.diff(ctrl, axis=0).T).sum())
-        m = max(16, math.ceil(length / h) + 1)
-        samp = cubic_eval(ctrl, np.linspace(0.0, 1.0, m))
-    v = np.flatnonzero(valid[f:e + 1]) + f
-    d1 = 0.0
-    if len(v):
-        v2 = v[:-1][np.diff(v) == 1]
-        key = np.concatenate([2 * v, 2 * v2 + 1])
-        tp = np.concatenate([est[v], 0.5 * (est[v2] + est[v2 + 1])])[np.argsort(key)]
-        d1 = float(_polyline_distance_over(tp, samp, _STRETCH_EXACT * h, 64).max())
-    if d1 > limit:
+    r = np.empty(2)  # (compiled: :func:`_design_off_kernel`)
+    if not _design_off_kernel(W, est, valid, np.ascontiguousarray(ctrl, dtype=np.float64), f, e,
+                              h, limit, r):
         return None
-    poly = np.where(valid[f:e + 1, None], est[f:e + 1], W[f:e + 1])
-    return d1, float(_polyline_distance_over(samp, poly, _STRETCH_EXACT * h).max())
+    return float(r[0]), float(r[1])
 
 
 @njit(cache=True, nogil=True)
@@ -3583,7 +3541,7 @@ def _seg_samples(ctrl, h):  # pragma: no cover (compiled)
 
 @njit(cache=True, nogil=True)
 def _samples_within(ctrl, h, W, first, last, lim):  # pragma: no cover (compiled)
-    """:func:`_seg_fits`' polyline side compiled (last > first): whether the samples
+    """:func:`_seg_fits`' polyline side compiled: whether the samples
     (:func:`_seg_samples`) all lie within ``lim`` of the polyline W[first..last]
     (:func:`_polyline_distance_over`'s numbers; NaN fails)."""
     samp = _seg_samples(ctrl, h)
@@ -3596,7 +3554,7 @@ def _samples_within(ctrl, h, W, first, last, lim):  # pragma: no cover (compiled
 
 @njit(cache=True, nogil=True)
 def _design_off_kernel(W, est, valid, ctrl, f, e, h, limit, out):  # pragma: no cover
-    """:func:`_design_off` compiled (e > f): its samples (np.linspace's and cubic_eval's
+    """:func:`_design_off` compiled: its samples (np.linspace's and cubic_eval's
     arithmetic, the line's ctrl[0] + t (ctrl[1] - ctrl[0])), its targets in the same order
     and :func:`_polyline_distance_over` (the brute force or :func:`_over_kernel`, the step
     lengths libm's hypot), so the same numbers; out[0], out[1] get (d1, d2); returns
@@ -3642,10 +3600,15 @@ def _design_off_kernel(W, est, valid, ctrl, f, e, h, limit, out):  # pragma: no 
 
 @njit(cache=True, nogil=True)
 def _distance_over(samp, poly, lim, k):  # pragma: no cover (compiled)
-    """:func:`_polyline_distance_over` compiled, for polylines of 2 points or more."""
+    """:func:`_polyline_distance_over` compiled (a one-point polyline: the distance to it,
+    libm's hypot, as :func:`point_polyline_distance`)."""
     n = poly.shape[0]
     ms = samp.shape[0]
     d = np.empty(ms)
+    if n == 1:
+        for t in range(ms):
+            d[t] = math.hypot(samp[t, 0] - poly[0, 0], samp[t, 1] - poly[0, 1])
+        return d
     if n <= 2 * k + 2:
         _brute_kernel(samp, poly, d)
         return d

@@ -226,3 +226,21 @@ def test_nearest_on_one_cubic_is_nearest_on_cubic_each() -> None:
                                            seeds=seeds, iters=iters)
             assert np.array_equal(t, te) and np.array_equal(d, de)
     assert nearest_on_cubic(sym, np.zeros((0, 2)))[0].shape == (0,)
+
+
+def test_one_input_point_measured_as_before() -> None:
+    """A segment over one input point (f == e): the distances to that point, as the former
+    code had them (point_polyline_distance of a one-point polyline)."""
+    rng = np.random.default_rng(9)
+    W, est, valid = _arc(rng, 50)
+    for f in (3, 10, 20):
+        for ctrl in (np.stack([W[f] + 0.3, W[f] + [2.0, 1.0]]),
+                     np.array([W[f], W[f] + [1.0, 2.0], W[f] + [3.0, 2.0], W[f] + [4.0, 0.0]])):
+            for h in (0.25, 0.1):
+                assert fitmod._design_off(W, est, valid, ctrl, f, f, h) \
+                    == _design_off_numpy(W, est, valid, ctrl, f, f, h)
+                for bound in (1.0, 3.0, 5.0):
+                    assert fitmod._seg_fits(W, ctrl, f, f, bound, h) \
+                        == _seg_fits_numpy(W, ctrl, f, f, bound, h)
+        assert np.array_equal(fitmod._stretch_targets(W, est, valid, f, f, 1.0),
+                              _stretch_targets_numpy(W, est, valid, f, f, 1.0))
