@@ -4513,6 +4513,10 @@ _LONE_SINE = 0.9
 #: ... and moves it by at least this many half quanta (less is within the estimate's
 #: own error: the input point stays)
 _LONE_MIN_MOVE = 0.2
+#: a corner turning by more than 120 degrees (the cosine of its turn below this) stays on
+#: its input point: at such a tip an error d in either side's estimated offset moves the
+#: tangents' crossing by d / sin(interior angle) along the tip, more than the rounding
+_TIP_COS = -0.5
 
 
 def _lone_sides(W, K, smooth, v, w, quant, p, t, ok, ok_other, after=False) -> np.ndarray:
@@ -4559,22 +4563,21 @@ def _collinear(W, a, b, p, t, quant) -> np.ndarray:
 
 
 def _corners_on_the_design(W, K, Q, arc, smooth, rnd, first, last, quant, eps) -> None:
-    """Rounded input: the corners (thinned vertices that are not smooth; a closed path's
-    seam too) move inside their rounding squares onto an estimate of the design's corner.
-    Per side, the input points of the thinned segment on that side give a position and a
-    tangent at the corner: their least-squares line where the segment is a line (its
-    other end a corner too), else a least-squares quadratic (over at least
-    ``_CORNER_POINTS`` input points of the path). The corner is the
-    intersection of the two tangent lines where they cross at an angle, else the mean of
-    the two positions. A side that is a line over two input points only (no least-squares
-    line) beside a curve side is the line through its two rounded ends
-    (:func:`_lone_sides`), intersected with the curve's tangent where they cross at
-    ``_LONE_SINE`` or more; at a middling angle (``_CORNER_SINE`` to ``_LONE_SINE``: an
-    error in the line's offset would move the intersection far) the corner stays. A corner
-    stays where a line from it to a neighbouring thinned point would miss its input points
-    by more than ``eps`` (per thinned point), so the lines keep their bound (the curve side
-    of a corner with a two-point side is not held to that: the fitter tests its cubics
-    against the bound, and a line there is made valid by :func:`_valid_lines`). In place
+    """Rounded input: the corners (thinned vertices that are not smooth; a closed path's seam too)
+    move inside their rounding squares onto an estimate of the design's corner. Per side, the
+    input points of the thinned segment on that side give a position and a tangent at the
+    corner: their least-squares line where the segment is a line (its other end a corner too),
+    else a least-squares quadratic (over at least ``_CORNER_POINTS`` input points of the path).
+    The corner is the intersection of the two tangent lines where they cross at an angle, else
+    the mean of the two positions; a tip (a turn of more than 120 degrees, ``_TIP_COS``) stays.
+    A side that is a line over two input points only (no least-squares line) beside a curve side
+    is the line through its two rounded ends (:func:`_lone_sides`), intersected with the curve's
+    tangent where they cross at ``_LONE_SINE`` or more; at a middling angle (``_CORNER_SINE`` to
+    ``_LONE_SINE``: an error in the line's offset would move the intersection far) the corner
+    stays. A corner stays where a line from it to a neighbouring thinned point would miss its
+    input points by more than ``eps`` (per thinned point), so the lines keep their bound (the
+    curve side of a corner with a two-point side is not held to that: the fitter tests its
+    cubics against the bound, and a line there is made valid by :func:`_valid_lines`). In place
     on ``Q``."""
     n = len(Q)
     is_first = np.zeros(n, dtype=bool)
@@ -4629,6 +4632,8 @@ def _corners_on_the_design(W, K, Q, arc, smooth, rnd, first, last, quant, eps) -
     lone = lone_in | lone_out
     # a side of two points meeting a curve at a middling angle: neither estimate is good
     both &= ~lone | (np.abs(cr) >= _LONE_SINE) | (np.abs(cr) < _CORNER_SINE)
+    # an acute tip (a turn of more than 120 degrees): the crossing is too uncertain
+    both &= (t_in * t_out).sum(axis=1) >= _TIP_COS
     sharp = both & (np.abs(cr) >= _CORNER_SINE)
     # a shallow corner between a curve and a least-squares line whose points are collinear:
     # on that line (the mean would tilt the whole line by the curve's error at its end)
