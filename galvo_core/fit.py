@@ -4513,9 +4513,9 @@ _LONE_SINE = 0.9
 #: ... and moves it by at least this many half quanta (less is within the estimate's
 #: own error: the input point stays)
 _LONE_MIN_MOVE = 0.2
-#: a corner turning by more than 120 degrees (the cosine of its turn below this) stays on
-#: its input point: at such a tip an error d in either side's estimated offset moves the
-#: tangents' crossing by d / sin(interior angle) along the tip, more than the rounding
+#: a corner turning by more than 120 degrees (the cosine of its turn below this) moves only
+#: across its axis: at such a tip an error d in either side's estimated offset moves the
+#: tangents' crossing by d / sin(interior angle) along the axis, more than the rounding
 _TIP_COS = -0.5
 
 
@@ -4569,7 +4569,8 @@ def _corners_on_the_design(W, K, Q, arc, smooth, rnd, first, last, quant, eps) -
     corner: their least-squares line where the segment is a line (its other end a corner too),
     else a least-squares quadratic (over at least ``_CORNER_POINTS`` input points of the path).
     The corner is the intersection of the two tangent lines where they cross at an angle, else
-    the mean of the two positions; a tip (a turn of more than 120 degrees, ``_TIP_COS``) stays.
+    the mean of the two positions; a tip (a turn of more than 120 degrees, ``_TIP_COS``) keeps
+    only the estimate's move across its axis.
     A side that is a line over two input points only (no least-squares line) beside a curve side
     is the line through its two rounded ends (:func:`_lone_sides`), intersected with the curve's
     tangent where they cross at ``_LONE_SINE`` or more; at a middling angle (``_CORNER_SINE`` to
@@ -4632,8 +4633,7 @@ def _corners_on_the_design(W, K, Q, arc, smooth, rnd, first, last, quant, eps) -
     lone = lone_in | lone_out
     # a side of two points meeting a curve at a middling angle: neither estimate is good
     both &= ~lone | (np.abs(cr) >= _LONE_SINE) | (np.abs(cr) < _CORNER_SINE)
-    # an acute tip (a turn of more than 120 degrees): the crossing is too uncertain
-    both &= (t_in * t_out).sum(axis=1) >= _TIP_COS
+    tip = both & ((t_in * t_out).sum(axis=1) < _TIP_COS)
     sharp = both & (np.abs(cr) >= _CORNER_SINE)
     # a shallow corner between a curve and a least-squares line whose points are collinear:
     # on that line (the mean would tilt the whole line by the curve's error at its end)
@@ -4650,6 +4650,12 @@ def _corners_on_the_design(W, K, Q, arc, smooth, rnd, first, last, quant, eps) -
         ti, to = t_in[sharp], t_out[sharp]
         s = (d[:, 0] * to[:, 1] - d[:, 1] * to[:, 0]) / cr[sharp]
         est[sharp] = p_in[sharp] + s[:, None] * ti
+    if tip.any():
+        # at a tip only the move across the tip's axis is kept
+        ax = t_in[tip] - t_out[tip]
+        ax /= np.hypot(*ax.T)[:, None]
+        mv = est[tip] - W[K[vo[tip]]]
+        est[tip] -= (mv * ax).sum(axis=1)[:, None] * ax
     vi, vo, est = vi[both], vo[both], est[both]
     lone_in, lone_out = lone_in[both], lone_out[both]
     wk = W[K[vo]]

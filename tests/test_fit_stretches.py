@@ -146,11 +146,12 @@ _TIP = [[704, -25], [704, -24], [704, -23], [704, -22], [704, -21], [705, -20], 
         [683, 6], [682, 5]]
 
 
-def test_an_acute_tip_stays_on_its_input_point():
+def test_an_acute_tip_moves_only_across_its_axis():
     """Where the outline turns back by more than 120 degrees, the crossing of the two sides'
-    estimated tangents moves along the tip by an offset error over the sine of the narrow
-    angle: here it cut the tip by 0.97 units. The fitted tip is no farther from the design's
-    than the rounded input point is (0.613)."""
+    estimated tangents moves along the tip's axis by an offset error over the sine of the
+    narrow angle: here it cut the tip by 0.97 units. Only the move across the axis is kept,
+    and the fitted tip is no farther from the design's than the rounded input point is
+    (0.613)."""
     w = np.array(_TIP, dtype=float)
     fp = fit_paths([w], [False])[0]
     assert not check_fit(w, fp, 0.02, 0.02, report=True)["violation"]
