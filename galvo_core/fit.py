@@ -2558,6 +2558,10 @@ def _fit_concatenated(
     with np.errstate(invalid="ignore", divide="ignore"):
         fitter.fit(np.stack([pa[curve], pb[curve]], axis=1), pa[~curve])
     ca, cb, ctrl, bound, fla = fitter.results()
+    if move_q is not None and (move_q > 0.0).any():
+        ca, cb, ctrl, bound, fla = _lone_lines_out(
+            W, K, Q, arc, t_in, t_out, np.repeat(e_per, tlen), eps_sum,
+            np.repeat(move_q, tlen), ca, cb, ctrl, bound, fla)
     la = fla
     lb = la + 1
     owner = np.repeat(np.arange(len(todo)), tlen)  # thinned index -> position in todo
@@ -2637,6 +2641,121 @@ def _fit_concatenated(
     for x in (is_cubic, points, first, last):
         x.setflags(write=False)
     return is_cubic, points, first, last, seg_cut.tolist(), pt_cut.tolist(), worst.tolist()
+
+
+#: rounded input: a cubic's end segment (thinned) with a gap between two of its input
+#: points of at least ``_LONE_LENGTH`` quanta and this share of the segment's length (a
+#: design line, written as its two rounded ends) ...
+_LONE_SHARE = 0.5
+#: ... over which the cubic strays this many quanta or more from the gap's chord (the design
+#: line is within q/sqrt(2) of that chord: a cubic held only by the bound may end up the
+#: rounding's width on the other side of it), is re-fitted without that segment, which
+#: becomes a line (the cubic's tangent there the line's direction)
+_LONE_BULGE = 0.3
+#: ... the cubic sampled at this many parameters
+_LONE_SAMPLES = 65
+
+
+def _lone_lines_out(W, K, Q, arc, t_in, t_out, e_per, eps_sum, quant, ca, cb, ctrl, bound,
+                    la):
+    """Rounded input (``quant`` per thinned point, 0: not moved): the cubics that swallow a
+    design line at one of their ends (``_LONE_SHARE``, ``_LONE_BULGE``) are re-fitted over
+    their other segments, that end segment made a line. Returns (ca, cb, ctrl, bound, la)
+    with those cubics replaced; ``t_in``, ``t_out`` changed in place at the new joints."""
+    if len(ca) == 0:
+        return ca, cb, ctrl, bound, la
+    q = quant[ca]
+    step = np.r_[np.hypot(*np.diff(W, axis=0).T), 0.0]
+    ts = np.linspace(0.0, 1.0, _LONE_SAMPLES)
+    mt = 1.0 - ts
+    bern = np.stack([mt ** 3, 3 * mt * mt * ts, 3 * mt * ts * ts, ts ** 3], axis=1)
+    cand = (q > 0.0) & (cb - ca >= 2)
+    if not cand.any():
+        return ca, cb, ctrl, bound, la
+    samples = np.einsum("tj,cjd->ctd", bern, ctrl)  # (C, T, 2)
+
+    def swallowed(u, v):
+        # per cubic: its segment u..v (thinned) holds a long gap that the cubic bulges over
+        ku, kv = K[u], K[v]
+        d = W[kv] - W[ku]
+        ln = np.hypot(d[:, 0], d[:, 1])
+        r = np.flatnonzero(cand)
+        ok = np.zeros(len(ca), dtype=bool)
+        if len(r) == 0:
+            return ok
+        own, off = _ragged(r, kv[r] - ku[r])
+        own = r[own]
+        g_at = ku[own] + off
+        gl = step[g_at]
+        best = np.zeros(len(ca))
+        np.maximum.at(best, own, gl)
+        # the longest gap's start per cubic (the first of equal ones)
+        first = np.full(len(ca), -len(W) - 1)
+        hit = gl >= best[own]
+        np.maximum.at(first, own[hit], -g_at[hit])
+        g = -first[r]
+        big = (best[r] >= _LONE_LENGTH * q[r]) & (best[r] >= _LONE_SHARE * ln[r])
+        r, g = r[big], g[big]
+        if len(r) == 0:
+            return ok
+        a0, a1 = W[g], W[g + 1]
+        e = a1 - a0
+        e2 = (e * e).sum(axis=1)
+        rel = samples[r] - a0[:, None, :]
+        s = (rel * e[:, None, :]).sum(axis=2) / e2[:, None]
+        perp = np.abs(rel[:, :, 0] * e[:, None, 1] - rel[:, :, 1] * e[:, None, 0])
+        perp /= np.sqrt(e2)[:, None]
+        inside = (s > 0.05) & (s < 0.95)
+        bul = np.where(inside, perp, 0.0).max(axis=1)
+        ok[r[bul >= _LONE_BULGE * q[r]]] = True
+        return ok
+
+    ce = swallowed(cb - 1, cb)
+    cs = swallowed(ca, ca + 1) & ((cb - ca - ce) >= 2)
+    fix = ce | cs
+    if not fix.any():
+        return ca, cb, ctrl, bound, la
+    # the rest of each such cubic re-fitted (a copy of the tangents: a re-fit that does not
+    # hold leaves the cubic and its tangents as they were)
+    fi = np.flatnonzero(fix)
+    fi = fi[np.argsort(ca[fi], kind="stable")]  # in path order
+    na, nb = (ca + cs)[fi], (cb - ce)[fi]
+    ti2, to2 = t_in.copy(), t_out.copy()
+    for u, v, at in (((cb - 1)[ce], cb[ce], (cb - 1)[ce]), (ca[cs], (ca + 1)[cs], (ca + 1)[cs])):
+        d = Q[v] - Q[u]
+        t = d / np.hypot(d[:, 0], d[:, 1])[:, None]
+        ti2[at] = t
+        to2[at] = t
+    one = nb - na == 1
+    f2 = _BatchFitter(W, K, ti2, to2, e_per, eps_sum, arc, q=Q)
+    f2.quant = quant
+    with np.errstate(invalid="ignore", divide="ignore"):
+        f2.fit(np.stack([na[~one], nb[~one]], axis=1), None)
+    a3, b3, c3, bd3, l3 = f2.results()
+    # per fixed cubic: the re-fit holds where it is one cubic (or the one segment left a line)
+    pos = np.flatnonzero(~one)
+    nc = np.bincount(np.searchsorted(na[~one], a3, side="right") - 1, minlength=len(pos))
+    nl = np.bincount(np.searchsorted(na[~one], l3, side="right") - 1, minlength=len(pos))
+    good = one.copy()
+    good[pos] = (nc == 1) & (nl == 0)
+    if not good.any():
+        return ca, cb, ctrl, bound, la
+    fix[fi[~good]] = False
+    ce &= fix
+    cs &= fix
+    for at in ((cb - 1)[ce], (ca + 1)[cs]):
+        t_in[at] = ti2[at]
+        t_out[at] = to2[at]
+    held = np.isin(a3, na[good])
+    new_lines = [(cb - 1)[ce], ca[cs], na[one & good]]
+    extra = np.concatenate([la] + new_lines)
+    keep = ~fix
+    ca2 = np.concatenate([ca[keep], a3[held]])
+    cb2 = np.concatenate([cb[keep], b3[held]])
+    ctrl2 = np.concatenate([ctrl[keep], c3[held]])
+    bound2 = np.concatenate([bound[keep], bd3[held]])
+    o = np.argsort(ca2, kind="stable")
+    return ca2[o], cb2[o], ctrl2[o], bound2[o], np.sort(extra)
 
 
 def _moved_ends_error(W, points, is_cubic, tail, step, gfirst, glast, seg_owner, worst):
