@@ -3321,10 +3321,8 @@ _STRETCH_TARGETS = 128
 #: q: a design line between two rounded points)
 _STRETCH_GAP = 8.0
 #: ... a segment split in two (one more segment) only when no repair keeps the count, at
-#: most this share of the rounded paths' segments (and one): the budget is shared by the
-#: paths fitted together, so one split more somewhere must not starve another path (0.02
-#: left DejaVu Sans Bold "y" at em 1000 0.630 from the design once a tip elsewhere took one)
-_STRETCH_SPLITS = 0.025
+#: most this share of the rounded paths' segments (and one)
+_STRETCH_SPLITS = 0.02
 #: ... at input points at least this many points from either end of the segment
 _STRETCH_PIECE = 4
 #: ... an estimate holds with this many input points on either side of it in its window
@@ -4634,10 +4632,15 @@ _LONE_SINE = 0.9
 #: ... and moves it by at least this many half quanta (less is within the estimate's
 #: own error: the input point stays)
 _LONE_MIN_MOVE = 0.2
-#: a corner turning by more than 120 degrees (the cosine of its turn below this) moves only
-#: across its axis: at such a tip an error d in either side's estimated offset moves the
-#: tangents' crossing by d / sin(interior angle) along the axis, more than the rounding
+#: a corner turning by more than 120 degrees (the cosine of its turn below this) is a tip: an
+#: error d in either side's estimated offset moves the tangents' crossing by d / sin(interior
+#: angle) along the tip's axis, more than the rounding ...
 _TIP_COS = -0.5
+#: ... so a crossing that cuts the tip (moves the corner inward along its axis) by more than
+#: this many quanta moves across the axis only (serif "g" at em 400: the crossing cut the
+#: tip by 0.55 quanta, the fit 1.055 from the design; a tip's rounded point is within
+#: q/sqrt(2) of the design's outline, and smaller cuts and moves outward hold)
+_TIP_CUT = 0.45
 
 
 def _lone_sides(W, K, smooth, v, w, quant, p, t, ok, ok_other, after=False) -> np.ndarray:
@@ -4690,8 +4693,9 @@ def _corners_on_the_design(W, K, Q, arc, smooth, rnd, first, last, quant, eps) -
     corner: their least-squares line where the segment is a line (its other end a corner too),
     else a least-squares quadratic (over at least ``_CORNER_POINTS`` input points of the path).
     The corner is the intersection of the two tangent lines where they cross at an angle, else
-    the mean of the two positions; a tip (a turn of more than 120 degrees, ``_TIP_COS``) keeps
-    only the estimate's move across its axis.
+    the mean of the two positions; at a tip (a turn of more than 120 degrees, ``_TIP_COS``) a
+    crossing that cuts the tip by more than ``_TIP_CUT`` quanta keeps only its move across
+    the tip's axis.
     A side that is a line over two input points only (no least-squares line) beside a curve side
     is the line through its two rounded ends (:func:`_lone_sides`), intersected with the curve's
     tangent where they cross at ``_LONE_SINE`` or more; at a middling angle (``_CORNER_SINE`` to
@@ -4772,11 +4776,13 @@ def _corners_on_the_design(W, K, Q, arc, smooth, rnd, first, last, quant, eps) -
         s = (d[:, 0] * to[:, 1] - d[:, 1] * to[:, 0]) / cr[sharp]
         est[sharp] = p_in[sharp] + s[:, None] * ti
     if tip.any():
-        # at a tip only the move across the tip's axis is kept
+        # a tip cut by more than _TIP_CUT quanta: only the move across the tip's axis kept
         ax = t_in[tip] - t_out[tip]
         ax /= np.hypot(*ax.T)[:, None]
         mv = est[tip] - W[K[vo[tip]]]
-        est[tip] -= (mv * ax).sum(axis=1)[:, None] * ax
+        al = (mv * ax).sum(axis=1)
+        cut = al < -_TIP_CUT * quant[vo[tip]]
+        est[tip] -= np.where(cut, al, 0.0)[:, None] * ax
     vi, vo, est = vi[both], vo[both], est[both]
     lone_in, lone_out = lone_in[both], lone_out[both]
     wk = W[K[vo]]
