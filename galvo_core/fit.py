@@ -2665,43 +2665,40 @@ def _lone_lines_out(W, K, Q, arc, t_in, t_out, e_per, eps_sum, quant, ca, cb, ct
     if len(ca) == 0:
         return ca, cb, ctrl, bound, la
     q = quant[ca]
-    step = np.r_[np.hypot(*np.diff(W, axis=0).T), 0.0]
-    ts = np.linspace(0.0, 1.0, _LONE_SAMPLES)
-    mt = 1.0 - ts
-    bern = np.stack([mt ** 3, 3 * mt * mt * ts, 3 * mt * ts * ts, ts ** 3], axis=1)
     cand = (q > 0.0) & (cb - ca >= 2)
     if not cand.any():
         return ca, cb, ctrl, bound, la
-    samples = np.einsum("tj,cjd->ctd", bern, ctrl)  # (C, T, 2)
+    step = np.r_[np.hypot(*np.diff(W, axis=0).T), 0.0]
+    # the gaps long enough for any path (few: a design line's two rounded ends)
+    big = np.flatnonzero(step >= _LONE_LENGTH * float(q[cand].min()))
+    if len(big) == 0:
+        return ca, cb, ctrl, bound, la
+    ts = np.linspace(0.0, 1.0, _LONE_SAMPLES)
+    mt = 1.0 - ts
+    bern = np.stack([mt ** 3, 3 * mt * mt * ts, 3 * mt * ts * ts, ts ** 3], axis=1)
 
     def swallowed(u, v):
         # per cubic: its segment u..v (thinned) holds a long gap that the cubic bulges over
-        ku, kv = K[u], K[v]
-        d = W[kv] - W[ku]
-        ln = np.hypot(d[:, 0], d[:, 1])
-        r = np.flatnonzero(cand)
         ok = np.zeros(len(ca), dtype=bool)
+        ku, kv = K[u], K[v]
+        lo = np.searchsorted(big, ku)
+        hi = np.searchsorted(big, kv)
+        r = np.flatnonzero(cand & (hi > lo))
         if len(r) == 0:
             return ok
-        own, off = _ragged(r, kv[r] - ku[r])
-        own = r[own]
-        g_at = ku[own] + off
-        gl = step[g_at]
-        best = np.zeros(len(ca))
-        np.maximum.at(best, own, gl)
-        # the longest gap's start per cubic (the first of equal ones)
-        first = np.full(len(ca), -len(W) - 1)
-        hit = gl >= best[own]
-        np.maximum.at(first, own[hit], -g_at[hit])
-        g = -first[r]
-        big = (best[r] >= _LONE_LENGTH * q[r]) & (best[r] >= _LONE_SHARE * ln[r])
-        r, g = r[big], g[big]
+        # the longest gap in each (the first of equal ones)
+        g = np.array([big[a + int(np.argmax(step[big[a:b]]))] for a, b in
+                      zip(lo[r].tolist(), hi[r].tolist(), strict=True)], dtype=np.intp)
+        d = W[kv[r]] - W[ku[r]]
+        ln = np.hypot(d[:, 0], d[:, 1])
+        keep = (step[g] >= _LONE_LENGTH * q[r]) & (step[g] >= _LONE_SHARE * ln)
+        r, g = r[keep], g[keep]
         if len(r) == 0:
             return ok
         a0, a1 = W[g], W[g + 1]
         e = a1 - a0
         e2 = (e * e).sum(axis=1)
-        rel = samples[r] - a0[:, None, :]
+        rel = np.einsum("tj,cjd->ctd", bern, ctrl[r]) - a0[:, None, :]
         s = (rel * e[:, None, :]).sum(axis=2) / e2[:, None]
         perp = np.abs(rel[:, :, 0] * e[:, None, 1] - rel[:, :, 1] * e[:, None, 0])
         perp /= np.sqrt(e2)[:, None]
