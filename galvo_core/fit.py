@@ -2561,7 +2561,7 @@ def _fit_concatenated(
     if move_q is not None and (move_q > 0.0).any():
         ca, cb, ctrl, bound, fla = _lone_lines_out(
             W, K, Q, arc, t_in, t_out, np.repeat(e_per, tlen), eps_sum,
-            np.repeat(move_q, tlen), ca, cb, ctrl, bound, fla)
+            np.repeat(move_q, tlen), np.repeat(rounding[:, 0], tlen), ca, cb, ctrl, bound, fla)
     la = fla
     lb = la + 1
     owner = np.repeat(np.arange(len(todo)), tlen)  # thinned index -> position in todo
@@ -2656,8 +2656,8 @@ _LONE_BULGE = 0.3
 _LONE_SAMPLES = 65
 
 
-def _lone_lines_out(W, K, Q, arc, t_in, t_out, e_per, eps_sum, quant, ca, cb, ctrl, bound,
-                    la):
+def _lone_lines_out(W, K, Q, arc, t_in, t_out, e_per, eps_sum, quant, eps, ca, cb, ctrl,
+                    bound, la):
     """Rounded input (``quant`` per thinned point, 0: not moved): the cubics that swallow a
     design line at one of their ends (``_LONE_SHARE``, ``_LONE_BULGE``) are re-fitted over
     their other segments, that end segment made a line. Returns (ca, cb, ctrl, bound, la)
@@ -2704,7 +2704,10 @@ def _lone_lines_out(W, K, Q, arc, t_in, t_out, e_per, eps_sum, quant, ca, cb, ct
         perp /= np.sqrt(e2)[:, None]
         inside = (s > 0.05) & (s < 0.95)
         bul = np.where(inside, perp, 0.0).max(axis=1)
-        ok[r[bul >= _LONE_BULGE * q[r]]] = True
+        r = r[bul >= _LONE_BULGE * q[r]]
+        # ... where the line between the segment's (moved) ends holds its input points
+        err = _line_errors(W, np.stack([Q[u[r]], Q[v[r]]], axis=1), ku[r], kv[r])
+        ok[r[err <= eps[u[r]]]] = True
         return ok
 
     ce = swallowed(cb - 1, cb)
