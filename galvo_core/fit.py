@@ -2615,6 +2615,11 @@ def _fit_concatenated(
     with np.errstate(invalid="ignore", divide="ignore"):
         fitter.fit(np.stack([pa[curve], pb[curve]], axis=1), pa[~curve])
     ca, cb, ctrl, bound, fla = fitter.results()
+    if move_q is not None and (move_q > 0.0).any():
+        ca, cb, ctrl, bound, fla = _lone_lines_out(
+            W, K, Q, arc, t_in, t_out, np.repeat(e_per, tlen), eps_sum,
+            np.repeat(move_q, tlen), np.repeat(rounding[:, 0], tlen), ca, cb, ctrl, bound, fla,
+            coarse=fitter.coarse)
     la = fla
     lb = la + 1
     owner = np.repeat(np.arange(len(todo)), tlen)  # thinned index -> position in todo
@@ -2694,6 +2699,124 @@ def _fit_concatenated(
     for x in (is_cubic, points, first, last):
         x.setflags(write=False)
     return is_cubic, points, first, last, seg_cut.tolist(), pt_cut.tolist(), worst.tolist()
+
+
+#: rounded input: a cubic's end segment (thinned) with a gap between two of its input
+#: points of at least ``_LONE_LENGTH`` quanta and this share of the segment's length (a
+#: design line, written as its two rounded ends) ...
+_LONE_SHARE = 0.5
+#: ... over which the cubic strays this many quanta or more from the gap's chord (the design
+#: line is within q/sqrt(2) of that chord: a cubic held only by the bound may end up the
+#: rounding's width on the other side of it), is re-fitted without that segment, which
+#: becomes a line (the cubic's tangent there the line's direction)
+_LONE_BULGE = 0.3
+#: ... the cubic sampled at this many parameters
+_LONE_SAMPLES = 65
+
+
+def _lone_lines_out(W, K, Q, arc, t_in, t_out, e_per, eps_sum, quant, eps, ca, cb, ctrl,
+                    bound, la, coarse=None):
+    """Rounded input (``quant`` per thinned point, 0: not moved): the cubics that swallow a
+    design line at one of their ends (``_LONE_SHARE``, ``_LONE_BULGE``) are re-fitted over
+    their other segments, that end segment made a line. Returns (ca, cb, ctrl, bound, la)
+    with those cubics replaced; ``t_in``, ``t_out`` changed in place at the new joints.
+    ``coarse``: the fitter's chords of coarse curves (:func:`_coarse_chords`), for the re-fit."""
+    if len(ca) == 0:
+        return ca, cb, ctrl, bound, la
+    q = quant[ca]
+    cand = (q > 0.0) & (cb - ca >= 2)
+    if not cand.any():
+        return ca, cb, ctrl, bound, la
+    step = np.r_[np.hypot(*np.diff(W, axis=0).T), 0.0]
+    # the gaps long enough for any path (few: a design line's two rounded ends)
+    big = np.flatnonzero(step >= _LONE_LENGTH * float(q[cand].min()))
+    if len(big) == 0:
+        return ca, cb, ctrl, bound, la
+    ts = np.linspace(0.0, 1.0, _LONE_SAMPLES)
+    mt = 1.0 - ts
+    bern = np.stack([mt ** 3, 3 * mt * mt * ts, 3 * mt * ts * ts, ts ** 3], axis=1)
+
+    def swallowed(u, v):
+        # per cubic: its segment u..v (thinned) holds a long gap that the cubic bulges over
+        ok = np.zeros(len(ca), dtype=bool)
+        ku, kv = K[u], K[v]
+        lo = np.searchsorted(big, ku)
+        hi = np.searchsorted(big, kv)
+        r = np.flatnonzero(cand & (hi > lo))
+        if len(r) == 0:
+            return ok
+        # the longest gap in each (the first of equal ones)
+        g = np.array([big[a + int(np.argmax(step[big[a:b]]))] for a, b in
+                      zip(lo[r].tolist(), hi[r].tolist(), strict=True)], dtype=np.intp)
+        d = W[kv[r]] - W[ku[r]]
+        ln = np.hypot(d[:, 0], d[:, 1])
+        keep = (step[g] >= _LONE_LENGTH * q[r]) & (step[g] >= _LONE_SHARE * ln)
+        r, g = r[keep], g[keep]
+        if len(r) == 0:
+            return ok
+        a0, a1 = W[g], W[g + 1]
+        e = a1 - a0
+        e2 = (e * e).sum(axis=1)
+        rel = np.einsum("tj,cjd->ctd", bern, ctrl[r]) - a0[:, None, :]
+        s = (rel * e[:, None, :]).sum(axis=2) / e2[:, None]
+        perp = np.abs(rel[:, :, 0] * e[:, None, 1] - rel[:, :, 1] * e[:, None, 0])
+        perp /= np.sqrt(e2)[:, None]
+        inside = (s > 0.05) & (s < 0.95)
+        bul = np.where(inside, perp, 0.0).max(axis=1)
+        r = r[bul >= _LONE_BULGE * q[r]]
+        # ... where the line between the segment's (moved) ends holds its input points
+        err = _line_errors(W, np.stack([Q[u[r]], Q[v[r]]], axis=1), ku[r], kv[r])
+        ok[r[err <= eps[u[r]]]] = True
+        return ok
+
+    ce = swallowed(cb - 1, cb)
+    cs = swallowed(ca, ca + 1) & ((cb - ca - ce) >= 2)
+    fix = ce | cs
+    if not fix.any():
+        return ca, cb, ctrl, bound, la
+    # the rest of each such cubic re-fitted (a copy of the tangents: a re-fit that does not
+    # hold leaves the cubic and its tangents as they were)
+    fi = np.flatnonzero(fix)
+    fi = fi[np.argsort(ca[fi], kind="stable")]  # in path order
+    na, nb = (ca + cs)[fi], (cb - ce)[fi]
+    ti2, to2 = t_in.copy(), t_out.copy()
+    for u, v, at in (((cb - 1)[ce], cb[ce], (cb - 1)[ce]), (ca[cs], (ca + 1)[cs], (ca + 1)[cs])):
+        d = Q[v] - Q[u]
+        t = d / np.hypot(d[:, 0], d[:, 1])[:, None]
+        ti2[at] = t
+        to2[at] = t
+    one = nb - na == 1
+    f2 = _BatchFitter(W, K, ti2, to2, e_per, eps_sum, arc, q=Q)
+    f2.quant = quant
+    if coarse is not None:
+        f2.coarse = coarse
+    with np.errstate(invalid="ignore", divide="ignore"):
+        f2.fit(np.stack([na[~one], nb[~one]], axis=1), None)
+    a3, b3, c3, bd3, l3 = f2.results()
+    # per fixed cubic: the re-fit holds where it is one cubic (or the one segment left a line)
+    pos = np.flatnonzero(~one)
+    nc = np.bincount(np.searchsorted(na[~one], a3, side="right") - 1, minlength=len(pos))
+    nl = np.bincount(np.searchsorted(na[~one], l3, side="right") - 1, minlength=len(pos))
+    good = one.copy()
+    good[pos] = (nc == 1) & (nl == 0)
+    if not good.any():
+        return ca, cb, ctrl, bound, la
+    fix[fi[~good]] = False
+    ce &= fix
+    cs &= fix
+    for at in ((cb - 1)[ce], (ca + 1)[cs]):
+        t_in[at] = ti2[at]
+        t_out[at] = to2[at]
+    held = np.isin(a3, na[good])
+    new_lines = [(cb - 1)[ce], ca[cs], na[one & good]]
+    extra = np.concatenate([la] + new_lines)
+    keep = ~fix
+    ca2 = np.concatenate([ca[keep], a3[held]])
+    cb2 = np.concatenate([cb[keep], b3[held]])
+    ctrl2 = np.concatenate([ctrl[keep], c3[held]])
+    bound2 = np.concatenate([bound[keep], bd3[held]])
+    o = np.argsort(ca2, kind="stable")
+    return ca2[o], cb2[o], ctrl2[o], bound2[o], np.sort(extra)
 
 
 def _moved_ends_error(W, points, is_cubic, tail, step, gfirst, glast, seg_owner, worst):
@@ -4759,6 +4882,15 @@ _LONE_SINE = 0.9
 #: ... and moves it by at least this many half quanta (less is within the estimate's
 #: own error: the input point stays)
 _LONE_MIN_MOVE = 0.2
+#: a corner turning by more than 120 degrees (the cosine of its turn below this) is a tip: an
+#: error d in either side's estimated offset moves the tangents' crossing by d / sin(interior
+#: angle) along the tip's axis, more than the rounding ...
+_TIP_COS = -0.5
+#: ... so a crossing that cuts the tip (moves the corner inward along its axis) by more than
+#: this many quanta moves across the axis only (serif "g" at em 400: the crossing cut the
+#: tip by 0.55 quanta, the fit 1.055 from the design; a tip's rounded point is within
+#: q/sqrt(2) of the design's outline, and smaller cuts and moves outward hold)
+_TIP_CUT = 0.45
 
 
 def _lone_sides(W, K, smooth, v, w, quant, p, t, ok, ok_other, after=False) -> np.ndarray:
@@ -4805,22 +4937,23 @@ def _collinear(W, a, b, p, t, quant) -> np.ndarray:
 
 
 def _corners_on_the_design(W, K, Q, arc, smooth, rnd, first, last, quant, eps) -> None:
-    """Rounded input: the corners (thinned vertices that are not smooth; a closed path's
-    seam too) move inside their rounding squares onto an estimate of the design's corner.
-    Per side, the input points of the thinned segment on that side give a position and a
-    tangent at the corner: their least-squares line where the segment is a line (its
-    other end a corner too), else a least-squares quadratic (over at least
-    ``_CORNER_POINTS`` input points of the path). The corner is the
-    intersection of the two tangent lines where they cross at an angle, else the mean of
-    the two positions. A side that is a line over two input points only (no least-squares
-    line) beside a curve side is the line through its two rounded ends
-    (:func:`_lone_sides`), intersected with the curve's tangent where they cross at
-    ``_LONE_SINE`` or more; at a middling angle (``_CORNER_SINE`` to ``_LONE_SINE``: an
-    error in the line's offset would move the intersection far) the corner stays. A corner
-    stays where a line from it to a neighbouring thinned point would miss its input points
-    by more than ``eps`` (per thinned point), so the lines keep their bound (the curve side
-    of a corner with a two-point side is not held to that: the fitter tests its cubics
-    against the bound, and a line there is made valid by :func:`_valid_lines`). In place
+    """Rounded input: the corners (thinned vertices that are not smooth; a closed path's seam too)
+    move inside their rounding squares onto an estimate of the design's corner. Per side, the
+    input points of the thinned segment on that side give a position and a tangent at the
+    corner: their least-squares line where the segment is a line (its other end a corner too),
+    else a least-squares quadratic (over at least ``_CORNER_POINTS`` input points of the path).
+    The corner is the intersection of the two tangent lines where they cross at an angle, else
+    the mean of the two positions; at a tip (a turn of more than 120 degrees, ``_TIP_COS``) a
+    crossing that cuts the tip by more than ``_TIP_CUT`` quanta keeps only its move across
+    the tip's axis.
+    A side that is a line over two input points only (no least-squares line) beside a curve side
+    is the line through its two rounded ends (:func:`_lone_sides`), intersected with the curve's
+    tangent where they cross at ``_LONE_SINE`` or more; at a middling angle (``_CORNER_SINE`` to
+    ``_LONE_SINE``: an error in the line's offset would move the intersection far) the corner
+    stays. A corner stays where a line from it to a neighbouring thinned point would miss its
+    input points by more than ``eps`` (per thinned point), so the lines keep their bound (the
+    curve side of a corner with a two-point side is not held to that: the fitter tests its
+    cubics against the bound, and a line there is made valid by :func:`_valid_lines`). In place
     on ``Q``."""
     n = len(Q)
     is_first = np.zeros(n, dtype=bool)
@@ -4875,6 +5008,7 @@ def _corners_on_the_design(W, K, Q, arc, smooth, rnd, first, last, quant, eps) -
     lone = lone_in | lone_out
     # a side of two points meeting a curve at a middling angle: neither estimate is good
     both &= ~lone | (np.abs(cr) >= _LONE_SINE) | (np.abs(cr) < _CORNER_SINE)
+    tip = both & ((t_in * t_out).sum(axis=1) < _TIP_COS)
     sharp = both & (np.abs(cr) >= _CORNER_SINE)
     # a shallow corner between a curve and a least-squares line whose points are collinear:
     # on that line (the mean would tilt the whole line by the curve's error at its end)
@@ -4891,6 +5025,14 @@ def _corners_on_the_design(W, K, Q, arc, smooth, rnd, first, last, quant, eps) -
         ti, to = t_in[sharp], t_out[sharp]
         s = (d[:, 0] * to[:, 1] - d[:, 1] * to[:, 0]) / cr[sharp]
         est[sharp] = p_in[sharp] + s[:, None] * ti
+    if tip.any():
+        # a tip cut by more than _TIP_CUT quanta: only the move across the tip's axis kept
+        ax = t_in[tip] - t_out[tip]
+        ax /= np.hypot(*ax.T)[:, None]
+        mv = est[tip] - W[K[vo[tip]]]
+        al = (mv * ax).sum(axis=1)
+        cut = al < -_TIP_CUT * quant[vo[tip]]
+        est[tip] -= np.where(cut, al, 0.0)[:, None] * ax
     vi, vo, est = vi[both], vo[both], est[both]
     lone_in, lone_out = lone_in[both], lone_out[both]
     wk = W[K[vo]]
