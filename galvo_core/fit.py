@@ -2728,8 +2728,12 @@ def _lone_lines_out(W, K, Q, arc, t_in, t_out, e_per, eps_sum, quant, eps, ca, c
     if not cand.any():
         return ca, cb, ctrl, bound, la
     step = np.r_[np.hypot(*np.diff(W, axis=0).T), 0.0]
-    # the gaps long enough for any path (few: a design line's two rounded ends)
-    big = np.flatnonzero(step >= _LONE_LENGTH * float(q[cand].min()))
+    # the gaps long enough for any path (few: a design line's two rounded ends), not the
+    # chords of a coarsely flattened curve (no design lines)
+    long_ = step >= _LONE_LENGTH * float(q[cand].min())
+    if coarse is not None:
+        long_ &= ~coarse
+    big = np.flatnonzero(long_)
     if len(big) == 0:
         return ca, cb, ctrl, bound, la
     ts = np.linspace(0.0, 1.0, _LONE_SAMPLES)
@@ -2793,12 +2797,15 @@ def _lone_lines_out(W, K, Q, arc, t_in, t_out, e_per, eps_sum, quant, eps, ca, c
     with np.errstate(invalid="ignore", divide="ignore"):
         f2.fit(np.stack([na[~one], nb[~one]], axis=1), None)
     a3, b3, c3, bd3, l3 = f2.results()
-    # per fixed cubic: the re-fit holds where it is one cubic (or the one segment left a line)
+    # per fixed cubic: the re-fit holds where it is one cubic over exactly its rest (or the
+    # one segment left a line). (The re-fit's own merge rounds may join the rests of two
+    # neighbouring cubics: such a cubic matches neither, and both stay as they were.)
     pos = np.flatnonzero(~one)
-    nc = np.bincount(np.searchsorted(na[~one], a3, side="right") - 1, minlength=len(pos))
-    nl = np.bincount(np.searchsorted(na[~one], l3, side="right") - 1, minlength=len(pos))
+    span = np.int64(len(K) + 1)
+    key3 = a3.astype(np.int64) * span + b3
+    keyp = na.astype(np.int64) * span + nb
     good = one.copy()
-    good[pos] = (nc == 1) & (nl == 0)
+    good[pos] = np.isin(keyp[pos], key3)
     if not good.any():
         return ca, cb, ctrl, bound, la
     fix[fi[~good]] = False
@@ -2807,7 +2814,7 @@ def _lone_lines_out(W, K, Q, arc, t_in, t_out, e_per, eps_sum, quant, eps, ca, c
     for at in ((cb - 1)[ce], (ca + 1)[cs]):
         t_in[at] = ti2[at]
         t_out[at] = to2[at]
-    held = np.isin(a3, na[good])
+    held = np.isin(key3, keyp[good & ~one])
     new_lines = [(cb - 1)[ce], ca[cs], na[one & good]]
     extra = np.concatenate([la] + new_lines)
     keep = ~fix

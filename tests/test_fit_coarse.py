@@ -80,3 +80,43 @@ def test_a_spoolers_coarse_letter_is_fitted_as_curves():
     # (before: 231 segments, three in four of them lines, for 339 points)
     assert len(fp.segments) <= len(p.points) // 4
     assert cubics >= 0.6 * len(fp.segments)
+
+
+def test_the_swallowed_line_refit_leaves_no_hole(monkeypatch):
+    # the re-fit of cubics that swallow a design line (fit._lone_lines_out), made to run on
+    # every long chord of the spooler's coarse "S" (its chords not told apart from design
+    # lines): the path's segments still follow one another and keep the bound (the re-fit's
+    # merge rounds once joined two cubics' rests and left a hole of five thinned points)
+    from pathlib import Path
+
+    from galvo_core.hpgl import read_file
+
+    f = (Path(__file__).resolve().parents[2] / "shared" / "corpus" / "plt"
+         / "chrisand1998__gravostyle-spooler-hpgl-to-gcode__samplespoolerhpgl.spl")
+    if not f.is_file():
+        pytest.skip(f"corpus file {f} not present")
+    real = fm._lone_lines_out
+    init = fm._BatchFitter.__init__
+    calls = []
+
+    def every_chord(*args, coarse=None):
+        calls.append(len(args[10]))
+
+        def with_chords(self, *a, **kw):  # (the re-fit still knows the chords)
+            init(self, *a, **kw)
+            if coarse is not None and len(coarse) == len(self.work):
+                self.coarse = coarse
+
+        monkeypatch.setattr(fm._BatchFitter, "__init__", with_chords)
+        try:
+            return real(*args, coarse=None)
+        finally:
+            monkeypatch.setattr(fm._BatchFitter, "__init__", init)
+
+    monkeypatch.setattr(fm, "_lone_lines_out", every_chord)
+    p = max(read_file(f).paths, key=lambda p: len(p.points))
+    fp = fm.fit_paths([p.points], [p.closed])[0]
+    assert calls
+    segs = fp.segments
+    assert all(a.last == b.first for a, b in zip(segs[:-1], segs[1:], strict=True))
+    assert not fm.check_fit(p.points, fp, 0.02, 0.02, report=True)["violation"]
