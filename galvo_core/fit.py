@@ -2616,6 +2616,7 @@ def _fit_concatenated(
         fitter.fit(np.stack([pa[curve], pb[curve]], axis=1), pa[~curve])
     ca, cb, ctrl, bound, fla = fitter.results()
     if move_q is not None and (move_q > 0.0).any():
+        assert rounding is not None  # (move_q comes from it)
         ca, cb, ctrl, bound, fla = _lone_lines_out(
             W, K, Q, arc, t_in, t_out, np.repeat(e_per, tlen), eps_sum,
             np.repeat(move_q, tlen), np.repeat(rounding[:, 0], tlen), ca, cb, ctrl, bound, fla,
