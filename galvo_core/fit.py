@@ -2713,6 +2713,7 @@ _LONE_SHARE = 0.5
 _LONE_BULGE = 0.3
 #: ... the cubic sampled at this many parameters
 _LONE_SAMPLES = 65
+_LONE_BASIS = seed_basis(_LONE_SAMPLES - 1)[1]
 
 
 def _lone_lines_out(W, K, Q, arc, t_in, t_out, e_per, eps_sum, quant, eps, ca, cb, ctrl,
@@ -2737,9 +2738,6 @@ def _lone_lines_out(W, K, Q, arc, t_in, t_out, e_per, eps_sum, quant, eps, ca, c
     big = np.flatnonzero(long_)
     if len(big) == 0:
         return ca, cb, ctrl, bound, la
-    ts = np.linspace(0.0, 1.0, _LONE_SAMPLES)
-    mt = 1.0 - ts
-    bern = np.stack([mt ** 3, 3 * mt * mt * ts, 3 * mt * ts * ts, ts ** 3], axis=1)
 
     def swallowed(u, v):
         # per cubic: its segment u..v (thinned) holds a long gap that the cubic bulges over
@@ -2762,7 +2760,7 @@ def _lone_lines_out(W, K, Q, arc, t_in, t_out, e_per, eps_sum, quant, eps, ca, c
         a0, a1 = W[g], W[g + 1]
         e = a1 - a0
         e2 = (e * e).sum(axis=1)
-        rel = np.einsum("tj,cjd->ctd", bern, ctrl[r]) - a0[:, None, :]
+        rel = np.einsum("tj,cjd->ctd", _LONE_BASIS, ctrl[r]) - a0[:, None, :]
         s = (rel * e[:, None, :]).sum(axis=2) / e2[:, None]
         perp = np.abs(rel[:, :, 0] * e[:, None, 1] - rel[:, :, 1] * e[:, None, 0])
         perp /= np.sqrt(e2)[:, None]
