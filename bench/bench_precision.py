@@ -43,6 +43,18 @@ def fitted_dense(fp, h: float = 0.002) -> np.ndarray:
     return np.vstack([parts[0]] + [p[1:] for p in parts[1:]])
 
 
+def add_chord_option(ap) -> None:
+    ap.add_argument("--chord", type=float, default=0.002,
+                    help="chord height (units) the curves are flattened to before rounding: "
+                         "0.002 dense (the default), 0.01-1 as coarse CAD/plotter exports write")
+
+
+def chord_label(label: str | None, chord: float) -> str | None:
+    if chord != 0.002:
+        label = (label + "; " if label else "") + f"curves flattened to chord height {chord:g}"
+    return label
+
+
 def run(style: str, whole: bool, em: float, text: str = TEXT, *, chord: float = 0.002,
         **kw) -> dict:
     gs = glyph_set(style, em=em, whole=whole, text=text, chord=chord)
@@ -81,9 +93,7 @@ def main() -> None:
     ap.add_argument("--json")
     ap.add_argument("--e-per", type=float)
     ap.add_argument("--eps-line", type=float)
-    ap.add_argument("--chord", type=float, default=0.002,
-                    help="chord height (units) the curves are flattened to before rounding: "
-                         "0.002 dense (the default), 0.1-1 as coarse CAD/plotter exports write")
+    add_chord_option(ap)
     ap.add_argument("--whole-only", action="store_true", help="leave out the exact rows")
     a = ap.parse_args()
     styles, text, ems = font_options(a)
@@ -93,9 +103,7 @@ def main() -> None:
     if a.eps_line:
         kw["eps_line"] = a.eps_line
     rows = []
-    label = run_label(text, ems)
-    if a.chord != 0.002:
-        label = (label + "; " if label else "") + f"curves flattened to chord height {a.chord:g}"
+    label = chord_label(run_label(text, ems), a.chord)
     if label:
         print(label)
     print("| style | input | points | own | segments | x own | to true curve "

@@ -22,6 +22,8 @@ For each place (a point of the plane where our fit is far from the true design c
   pin the design down to well under the rounding, no simple bound).
 
 Usage: python bench/bench_precision_worst.py [--styles sans,...] [--top 10] [--json F]
+       [--chord H]   (the curves flattened to chord height H before rounding, as in
+                      bench_precision.py; default 0.002)
        python bench/bench_precision_worst.py --set heldout [--em 700] [--text T] [--font F.otf]
 (the font options as in bench_precision.py; see fonts.py)
 """
@@ -40,7 +42,7 @@ import numpy as np
 sys.path.insert(0, os.path.join(os.path.dirname(__file__), ".."))
 sys.path.insert(0, os.path.dirname(__file__))
 
-from bench_precision import fitted_dense  # noqa: E402
+from bench_precision import add_chord_option, chord_label, fitted_dense  # noqa: E402
 from fonts import (  # noqa: E402
     TEXT,
     add_font_options,
@@ -211,8 +213,9 @@ def classify(segs, lab_seg, arc_pos, seglens):
     return "inside a curve", []
 
 
-def worst_places(style: str, top: int, em: float = 1000.0, text: str = TEXT):
-    gs = glyph_set(style, em=em, whole=True, text=text)
+def worst_places(style: str, top: int, em: float = 1000.0, text: str = TEXT, *,
+                 chord: float = 0.002):
+    gs = glyph_set(style, em=em, whole=True, text=text, chord=chord)
     cs = contours(font_file(style), text, em)
     fps = fitmod.fit_paths(gs.points, [True] * len(gs.points))
     cands = []
@@ -287,18 +290,19 @@ def main() -> None:
     add_font_options(ap)
     ap.add_argument("--top", type=int, default=10)
     ap.add_argument("--json")
+    add_chord_option(ap)
     a = ap.parse_args()
     styles, text, ems = font_options(a)
     fitmod.warm_up()
     allrows = []
-    label = run_label(text, ems)
+    label = chord_label(run_label(text, ems), a.chord)
     if label:
         print(label)
     print("| style | glyph | at (x, y) | kind | fit | rounded polyline | oracle bound |")
     print("| --- | --- | --- | --- | ---: | ---: | ---: |")
     for em, st in itertools.product(ems, styles):
         with font_errors(st):
-            rows = worst_places(st, a.top, em, text)
+            rows = worst_places(st, a.top, em, text, chord=a.chord)
         name = style_name(st) + (f" em {em:g}" if len(ems) > 1 else "")
         for r in rows:
             r["glyph"] = glyph_of(r["x"], st, em, text)
