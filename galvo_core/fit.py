@@ -4855,14 +4855,18 @@ def _on_the_design(W, K, Q, arc, t_in, t_out, smooth, quant, tlen, eps) -> None:
     # (over at least _SIDE_POINTS input points: a short thinned segment is rounding)
     k_first = np.repeat(K[first], tlen)
     k_last = np.repeat(K[last], tlen)
+    # (and within _CORNER_ARC quanta of arc, as the corners' sides)
+    garc = _global_arc(W)
     co = np.flatnonzero(~smooth & rnd & ~is_last)
     if len(co):
-        hi = np.maximum(K[co + 1], np.minimum(K[co] + _SIDE_POINTS - 1, k_last[co]))
+        hi = np.maximum(K[co + 1], _window_hi(garc, K[co], np.minimum(
+            K[co] + _SIDE_POINTS - 1, k_last[co]), _CORNER_ARC * quant[co]))
         _, tan, ok = _local_fits(W, arc, K[co], hi, K[co])
         t_out[co[ok]] = tan[ok]
     ci = np.flatnonzero(~smooth & rnd & ~is_first)
     if len(ci):
-        lo = np.minimum(K[ci - 1], np.maximum(K[ci] - _SIDE_POINTS + 1, k_first[ci]))
+        lo = np.minimum(K[ci - 1], _window_lo(garc, K[ci], np.maximum(
+            K[ci] - _SIDE_POINTS + 1, k_first[ci]), _CORNER_ARC * quant[ci]))
         _, tan, ok = _local_fits(W, arc, lo, K[ci], K[ci])
         t_in[ci[ok]] = tan[ok]
     _corners_on_the_design(W, K, Q, arc, smooth, rnd, first, last, quant, eps)
