@@ -165,3 +165,42 @@ def test_an_acute_tip_is_not_cut():
     tip = np.array([[706.4453125, 32.421875]])
     rounded = np.hypot(*(tip[0] - w[30]))
     assert point_polyline_distance(tip, dense)[0] <= rounded + 0.01
+
+
+#: DejaVu Serif "8" at em 1000, its left tip (the two bowls' crossing) flattened at chord
+#: height 0.01 unit before rounding (bench_precision.py --chord 0.01): 41 points 3-5 units
+#: apart, not the dense run of 1-2 unit steps a chord height of 0.002 gives
+_SPARSE_TIP = [
+    [6587, 414], [6583, 412], [6580, 410], [6577, 409], [6574, 407], [6570, 406], [6567, 404],
+    [6563, 403], [6560, 401], [6556, 400], [6552, 398], [6549, 397], [6545, 396], [6541, 395],
+    [6537, 394], [6533, 393], [6529, 392], [6525, 391], [6521, 390], [6516, 389], [6512, 388],
+    [6517, 388], [6521, 387], [6525, 386], [6530, 385], [6534, 384], [6538, 384], [6542, 383],
+    [6546, 382], [6550, 380], [6554, 379], [6558, 378], [6562, 377], [6566, 375], [6570, 374],
+    [6573, 373], [6577, 371], [6581, 370], [6584, 368], [6588, 366], [6591, 365],
+]
+#: ... and the design there: two quadratics meeting at the tip
+_SPARSE_TIP_DESIGN = [
+    ((6624.76, 444.09), (6585.45, 401.37), (6512.21, 388.18)),
+    ((6512.21, 388.18), (6595.21, 376.95), (6641.6, 326.9)),
+]
+
+
+def test_a_sparse_tip_is_estimated_over_the_design_near_it():
+    """Input flattened coarser (a few units between points) fits a tip's sides over the same
+    arc length of the design as dense input does, not over 20 points: 20 points here reach
+    80 units along each bowl, where a quadratic no longer follows it, and the crossing of its
+    tangents put the tip 0.642 from the design (the rounded point is 0.36 from it)."""
+    w = np.array(_SPARSE_TIP, dtype=float)
+    fp = fit_paths([w], [False])[0]
+    assert not check_fit(w, fp, 0.02, 0.02, report=True)["violation"]
+    dense = np.vstack([flatten_cubic(s.points, 0.002) if s.kind == "cubic"
+                       else np.asarray(s.points) for s in fp.segments])
+    t = np.linspace(0.0, 1.0, 2001)[:, None]
+    design = np.vstack([(1 - t) ** 2 * np.array(a) + 2 * t * (1 - t) * np.array(b)
+                        + t ** 2 * np.array(c) for a, b, c in _SPARSE_TIP_DESIGN])
+    tip = np.array(_SPARSE_TIP_DESIGN[1][0])
+    near_d = design[np.hypot(*(design - tip).T) < 6.0]
+    near_f = dense[np.hypot(*(dense - tip).T) < 6.0]
+    far = max(point_polyline_distance(near_d, dense).max(),
+              point_polyline_distance(near_f, design).max())
+    assert far <= 0.55
