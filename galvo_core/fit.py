@@ -4856,16 +4856,15 @@ def _on_the_design(W, K, Q, arc, t_in, t_out, smooth, quant, tlen, eps) -> None:
     k_first = np.repeat(K[first], tlen)
     k_last = np.repeat(K[last], tlen)
     # (and within _CORNER_ARC quanta of arc, as the corners' sides)
-    garc = _global_arc(W)
     co = np.flatnonzero(~smooth & rnd & ~is_last)
     if len(co):
-        hi = np.maximum(K[co + 1], _window_hi(garc, K[co], np.minimum(
+        hi = np.maximum(K[co + 1], _window_hi(arc, K[co], np.minimum(
             K[co] + _SIDE_POINTS - 1, k_last[co]), _CORNER_ARC * quant[co]))
         _, tan, ok = _local_fits(W, arc, K[co], hi, K[co])
         t_out[co[ok]] = tan[ok]
     ci = np.flatnonzero(~smooth & rnd & ~is_first)
     if len(ci):
-        lo = np.minimum(K[ci - 1], _window_lo(garc, K[ci], np.maximum(
+        lo = np.minimum(K[ci - 1], _window_lo(arc, K[ci], np.maximum(
             K[ci] - _SIDE_POINTS + 1, k_first[ci]), _CORNER_ARC * quant[ci]))
         _, tan, ok = _local_fits(W, arc, lo, K[ci], K[ci])
         t_in[ci[ok]] = tan[ok]
@@ -4892,24 +4891,23 @@ _CORNER_ARC = 60.0
 _WINDOW_MIN = 4
 
 
-def _window_lo(garc, k, lo, reach):
-    """The first input point index >= ``lo`` of the window ending at ``k`` (global indices)
-    whose arc length (``garc``: cumulative over the concatenated points) is within ``reach``
-    of k's, keeping at least ``_WINDOW_MIN`` points (not before ``lo``)."""
-    a = np.searchsorted(garc, garc[k] - reach, side="left")
-    return np.maximum(lo, np.minimum(a, k - (_WINDOW_MIN - 1)))
+def _window_lo(arc, k, lo, reach):
+    """The first input point index >= ``lo`` (at most ``_CORNER_POINTS`` - 1 before ``k``,
+    in k's path; global indices, ``arc`` per path) of the window ending at ``k`` whose arc
+    length is within ``reach`` of k's, keeping at least ``_WINDOW_MIN`` points (not before
+    ``lo``)."""
+    idx = k[:, None] - np.arange(_CORNER_POINTS)[None, :]
+    inside = (idx >= lo[:, None]) & (
+        arc[k][:, None] - arc[np.maximum(idx, 0)] <= reach[:, None])
+    return np.maximum(lo, np.minimum(k - inside.sum(axis=1) + 1, k - (_WINDOW_MIN - 1)))
 
 
-def _window_hi(garc, k, hi, reach):
+def _window_hi(arc, k, hi, reach):
     """:func:`_window_lo` forwards: the last index <= ``hi`` within ``reach`` of k's arc."""
-    a = np.searchsorted(garc, garc[k] + reach, side="right") - 1
-    return np.minimum(hi, np.maximum(a, k + (_WINDOW_MIN - 1)))
-
-
-def _global_arc(W):
-    """Cumulative arc length over the concatenated points (jumps between paths included:
-    windows are clipped to their path anyway)."""
-    return np.r_[0.0, np.cumsum(np.hypot(*np.diff(W, axis=0).T))]
+    idx = k[:, None] + np.arange(_CORNER_POINTS)[None, :]
+    inside = (idx <= hi[:, None]) & (
+        arc[np.minimum(idx, len(arc) - 1)] - arc[k][:, None] <= reach[:, None])
+    return np.minimum(hi, np.maximum(k + inside.sum(axis=1) - 1, k + (_WINDOW_MIN - 1)))
 
 
 #: a side written as its two rounded ends only gives the corner a direction where it is at
@@ -5014,11 +5012,10 @@ def _corners_on_the_design(W, K, Q, arc, smooth, rnd, first, last, quant, eps) -
     pid_i = np.searchsorted(last, vi)
     pid_o = np.searchsorted(last, vo)
     # (and within _CORNER_ARC quanta of arc: coarser input, the same stretch of the design)
-    garc = _global_arc(W)
     reach = _CORNER_ARC * quant[vo]
-    lo_i = np.minimum(K[vi - 1], _window_lo(garc, K[vi], np.maximum(
+    lo_i = np.minimum(K[vi - 1], _window_lo(arc, K[vi], np.maximum(
         K[vi] - _CORNER_POINTS + 1, K[first[pid_i]]), reach))
-    hi_o = np.maximum(K[vo + 1], _window_hi(garc, k, np.minimum(
+    hi_o = np.maximum(K[vo + 1], _window_hi(arc, k, np.minimum(
         k + _CORNER_POINTS - 1, K[last[pid_o]]), reach))
     # ... but not past the corner at the run's other end (a short run of lines that barely
     # turn: a window across other corners estimates nothing)
