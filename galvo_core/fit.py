@@ -4887,8 +4887,9 @@ _CORNER_POINTS = _SIDE_POINTS
 #: of sans "R" at chord height 0.01 0.667 from the design, serif "8" 0.642), down to
 #: ``_WINDOW_MIN`` points
 _CORNER_ARC = 60.0
-#: an arc-limited window keeps at least this many input points (the quadratic's 3 and one)
-_WINDOW_MIN = 4
+#: an arc-limited window keeps at least this many input points (a quadratic over 4 points of
+#: a coarse circle, 70-unit chords, follows their rounding: test_fit_coarse.py)
+_WINDOW_MIN = 6
 
 
 def _window_lo(arc, k, lo, reach):
