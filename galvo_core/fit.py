@@ -108,6 +108,7 @@ from galvo_core.geometry import (
     seeded_nearest,
 )
 from galvo_core.job import gc_paused
+from galvo_core.parallel import run_chunks
 from galvo_core.precision import path_quanta
 from galvo_core.runs import segmented_cumsum, split_pieces_many
 from galvo_core.thin import check_positive, thin_many
@@ -1024,6 +1025,12 @@ def _ragged(starts: np.ndarray, counts: np.ndarray) -> tuple[np.ndarray, np.ndar
     return owner, off
 
 
+def _sampled_weights(i0: np.ndarray, i1: np.ndarray, sample: int) -> np.ndarray:
+    """Per piece i0..i1: how many of its interior points a kernel sampling at most
+    ``sample`` of them treats (the work weight of :func:`galvo_core.parallel.run_chunks`)."""
+    return np.minimum(np.maximum(i1 - i0 - 1, 0), sample)
+
+
 def _halves(a: np.ndarray, b: np.ndarray, k: np.ndarray) -> np.ndarray:
     """Pieces (a, k) and (k, b) for every split piece, in order: (2n, 2)."""
     return np.stack([np.stack([a, k], axis=1), np.stack([k, b], axis=1)], axis=1).reshape(-1, 2)
@@ -1562,13 +1569,15 @@ class _BatchFitter:
         crosses zero (Illinois false position inside the bracket [0, 1]); each piece on its
         own, compiled (:func:`_dichotomy_kernel`). Returns the pieces' cubics (m, 4, 2)."""
         t = np.empty(len(p0))
-        _dichotomy_kernel(np.ascontiguousarray(p0, dtype=np.float64),
-                          np.ascontiguousarray(qq, dtype=np.float64),
-                          np.ascontiguousarray(p3, dtype=np.float64),
-                          np.ascontiguousarray(sig, dtype=np.float64),
-                          np.ascontiguousarray(i0, dtype=np.intp),
-                          np.ascontiguousarray(i1, dtype=np.intp), self.work, self.arc,
-                          sample, max_iter, self.eps_sum if eps_sum is None else eps_sum, t)
+        args = [np.ascontiguousarray(a, dtype=np.float64) for a in (p0, qq, p3, sig)]
+        args += [np.ascontiguousarray(a, dtype=np.intp) for a in (i0, i1)]
+        eps_s = self.eps_sum if eps_sum is None else eps_sum
+
+        def chunk(lo: int, hi: int) -> None:
+            _dichotomy_kernel(*(a[lo:hi] for a in args), self.work, self.arc, sample,
+                              max_iter, eps_s, t[lo:hi])
+
+        run_chunks(chunk, _sampled_weights(args[4], args[5], sample) * max_iter)
         return self._ctrl(p0, qq, p3, t)
 
     def _accept(self, ctrl: np.ndarray, i0: np.ndarray, i1: np.ndarray, e2: np.ndarray,
@@ -1612,13 +1621,20 @@ class _BatchFitter:
                             _SEED_BASIS, u, dist, emax, ok)
         else:
             ok = np.empty(m, dtype=bool)
-            _accept_quick(ctrl, cm, i0, i1, starts, self.work, self.arc, e2, _SEED_U,
-                          _SEED_BASIS, u, dist, emax, ok)
         qa, coarse = _NO_QUANTA, _NO_COARSE
         if self.quant is not None and A is not None:
             qa = np.ascontiguousarray(self.quant[A], dtype=np.float64)
             coarse = self.coarse
-        _accept_pairs(cm, i0, i1, starts, self.work, u, e2, qa, coarse, ok)
+
+        def chunk(lo: int, hi: int) -> None:
+            if not full:
+                _accept_quick(ctrl[lo:hi], cm[lo:hi], i0[lo:hi], i1[lo:hi], starts[lo:hi],
+                              self.work, self.arc, e2[lo:hi], _SEED_U, _SEED_BASIS, u, dist,
+                              emax[lo:hi], ok[lo:hi])
+            _accept_pairs(cm[lo:hi], i0[lo:hi], i1[lo:hi], starts[lo:hi], self.work, u,
+                          e2[lo:hi], qa[lo:hi] if len(qa) else qa, coarse, ok[lo:hi])
+
+        run_chunks(chunk, cnt)
         return ok, emax, dist, starts
 
     def fit(self, curve_pieces: np.ndarray, line_pieces: np.ndarray | None = None) -> None:
@@ -2079,9 +2095,16 @@ class _BatchFitter:
         strided) within ``e2`` of the cubic (Newton from arc length; a cheap necessary
         condition of :meth:`_accept`, up to Newton's local minima)."""
         ok = np.empty(len(ctrl), dtype=bool)
-        _sample_kernel(power_coeffs_many(ctrl), np.ascontiguousarray(i0, dtype=np.intp),
-                       np.ascontiguousarray(i1, dtype=np.intp), self.work, self.arc,
-                       np.ascontiguousarray(e2, dtype=np.float64), sample, ok)
+        cm = power_coeffs_many(ctrl)
+        i0 = np.ascontiguousarray(i0, dtype=np.intp)
+        i1 = np.ascontiguousarray(i1, dtype=np.intp)
+        e2 = np.ascontiguousarray(e2, dtype=np.float64)
+
+        def chunk(lo: int, hi: int) -> None:
+            _sample_kernel(cm[lo:hi], i0[lo:hi], i1[lo:hi], self.work, self.arc, e2[lo:hi],
+                           sample, ok[lo:hi])
+
+        run_chunks(chunk, _sampled_weights(i0, i1, sample))
         return ok
 
     def _merge_round(self) -> bool:
@@ -2130,12 +2153,15 @@ class _BatchFitter:
         chord = np.hypot(*(p3 - p0).T)
         ctrl = np.empty((m, 4, 2))
         ok = np.empty(m, dtype=bool)
-        _ls_kernel(np.ascontiguousarray(i0, dtype=np.intp),
-                   np.ascontiguousarray(i1, dtype=np.intp), self.work, self.arc,
-                   _BISECT_SAMPLE, np.ascontiguousarray(p0, dtype=np.float64),
-                   np.ascontiguousarray(p3, dtype=np.float64),
-                   np.ascontiguousarray(self.t_out[A], dtype=np.float64),
-                   np.ascontiguousarray(self.t_in[B], dtype=np.float64), chord, ctrl, ok)
+        ii = [np.ascontiguousarray(a, dtype=np.intp) for a in (i0, i1)]
+        ff = [np.ascontiguousarray(a, dtype=np.float64)
+              for a in (p0, p3, self.t_out[A], self.t_in[B], chord)]
+
+        def chunk(lo: int, hi: int) -> None:
+            _ls_kernel(*(a[lo:hi] for a in ii), self.work, self.arc, _BISECT_SAMPLE,
+                       *(a[lo:hi] for a in ff), ctrl[lo:hi], ok[lo:hi])
+
+        run_chunks(chunk, _sampled_weights(ii[0], ii[1], _BISECT_SAMPLE) * 3)
         return ctrl, ok
 
     def _gauss_newton(self, A: np.ndarray, B: np.ndarray, i0: np.ndarray, i1: np.ndarray,
@@ -2154,13 +2180,15 @@ class _BatchFitter:
         chord = np.hypot(*(p3 - p0).T)
         ctrl = np.empty((m, 4, 2))
         ok = np.empty(m, dtype=bool)
-        _gn_kernel(np.ascontiguousarray(i0, dtype=np.intp),
-                   np.ascontiguousarray(i1, dtype=np.intp), self.work, self.arc,
-                   _BISECT_SAMPLE, np.ascontiguousarray(p0, dtype=np.float64),
-                   np.ascontiguousarray(p3, dtype=np.float64),
-                   np.ascontiguousarray(self.t_out[A], dtype=np.float64),
-                   np.ascontiguousarray(self.t_in[B], dtype=np.float64), chord, rounds, ctrl,
-                   ok)
+        ii = [np.ascontiguousarray(a, dtype=np.intp) for a in (i0, i1)]
+        ff = [np.ascontiguousarray(a, dtype=np.float64)
+              for a in (p0, p3, self.t_out[A], self.t_in[B], chord)]
+
+        def chunk(lo: int, hi: int) -> None:
+            _gn_kernel(*(a[lo:hi] for a in ii), self.work, self.arc, _BISECT_SAMPLE,
+                       *(a[lo:hi] for a in ff), rounds, ctrl[lo:hi], ok[lo:hi])
+
+        run_chunks(chunk, _sampled_weights(ii[0], ii[1], _BISECT_SAMPLE) * (rounds + 1))
         return ctrl, ok
 
     def _bulging_segments(self, ab: np.ndarray, line: np.ndarray) -> np.ndarray:
@@ -2225,14 +2253,20 @@ class _BatchFitter:
         chord = np.hypot(*(ctrl[:, 3] - ctrl[:, 0]).T)
         u = np.empty(int(ps[-1]))
         pts = np.empty((len(u), 2))
-        for it in range(rounds):
-            N = np.empty((m, 4, 4))
-            g = np.empty((m, 4, 1))
-            _gn_free_sums(i0, i1, self.work, self.arc, _BISECT_SAMPLE, ps, pts, u, ctrl,
-                          it == 0, N, g)
-            with np.errstate(divide="ignore", invalid="ignore"):
-                d = np.linalg.solve(N, g)
-            _gn_free_step(ctrl, d, chord)
+
+        def chunk(lo: int, hi: int) -> None:
+            # (every piece's rounds on its own: a chunk of pieces runs all of them)
+            c = ctrl[lo:hi]
+            for it in range(rounds):
+                N = np.empty((hi - lo, 4, 4))
+                g = np.empty((hi - lo, 4, 1))
+                _gn_free_sums(i0[lo:hi], i1[lo:hi], self.work, self.arc, _BISECT_SAMPLE,
+                              ps[lo:hi + 1], pts, u, c, it == 0, N, g)
+                with np.errstate(divide="ignore", invalid="ignore"):
+                    d = np.linalg.solve(N, g)
+                _gn_free_step(c, d, chord[lo:hi])
+
+        run_chunks(chunk, cnt * rounds)
         h0 = ctrl[:, 1] - ctrl[:, 0]
         h3 = ctrl[:, 3] - ctrl[:, 2]
         t0, t3 = self.t_out[A], self.t_in[B]
@@ -3042,8 +3076,13 @@ def _seg_fits_many(W, wstep, ctrls, first, last, bound, h):
         C4[r, :len(c)] = c
     lim = bound[go] - 0.5 * h[go]
     res = np.empty(len(go), dtype=np.bool_)
-    _polyline_checks(C4, cub[go], m[go], W, wstep, first[go], last[go], lim, _NEAR_SEGMENTS,
-                     res)
+    cg, mg, fg, lg = cub[go], m[go], first[go], last[go]
+
+    def chunk(lo: int, hi: int) -> None:
+        _polyline_checks(C4[lo:hi], cg[lo:hi], mg[lo:hi], W, wstep, fg[lo:hi], lg[lo:hi],
+                         lim[lo:hi], _NEAR_SEGMENTS, res[lo:hi])
+
+    run_chunks(chunk, mg + lg - fg)
     ok[go] = res
     return ok
 
@@ -3419,9 +3458,16 @@ def _stretch_estimates(W, arc, ps, pe, quant):
     est = np.zeros_like(W)
     valid = np.zeros(len(W), dtype=np.bool_)
     if len(ps):
-        _quad_estimates(W, arc, np.asarray(ps, dtype=np.int64), np.asarray(pe, dtype=np.int64),
-                        np.asarray(quant, dtype=np.float64), _JOINT_SIDE, _STRETCH_SIDE,
-                        _JOINT_SMOOTH, _STRETCH_GAP, _STRETCH_SPAN, est, valid)
+        ps = np.asarray(ps, dtype=np.int64)
+        pe = np.asarray(pe, dtype=np.int64)
+        quant = np.asarray(quant, dtype=np.float64)
+
+        def chunk(lo: int, hi: int) -> None:  # (each path writes only its own points)
+            _quad_estimates(W, arc, ps[lo:hi], pe[lo:hi], quant[lo:hi], _JOINT_SIDE,
+                            _STRETCH_SIDE, _JOINT_SMOOTH, _STRETCH_GAP, _STRETCH_SPAN, est,
+                            valid)
+
+        run_chunks(chunk, pe - ps + 1)
     return est, valid
 
 
@@ -4073,7 +4119,12 @@ def _smooth_stretches(W, arc, points, is_cubic, tail, step, gfirst, glast, seg_o
     # screened first with a compiled upper bound (the nearest of 17 samples, then Newton),
     # measured as below only where that reaches the threshold
     ub = np.empty(len(sr))
-    _screen_segments(points, tail, is_cubic, gfirst, glast, sr, est, valid, thr, ub)
+
+    def chunk(lo: int, hi: int) -> None:
+        _screen_segments(points, tail, is_cubic, gfirst, glast, sr[lo:hi], est, valid,
+                         thr[lo:hi], ub[lo:hi])
+
+    run_chunks(chunk, glast[sr] - gfirst[sr] + 1)
     off = np.zeros(len(sr))
     cand = np.flatnonzero(ub >= thr)
     if len(cand):
