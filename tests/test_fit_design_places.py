@@ -158,3 +158,33 @@ def test_a_cubic_does_not_swallow_a_design_line_written_as_two_points():
     assert point_polyline_distance(line, fit).max() <= rounded + 0.05
     over = fit[(fit[:, 0] > b[0]) & (fit[:, 0] < a[0]) & (np.abs(fit[:, 1] - a[1]) < 3)]
     assert np.abs(over[:, 1] - a[1]).max() <= rounded + 0.05
+
+
+#: Cantarell "m" at em 1500 (s8-pl; a piece of its outline, open): the second stem's right
+#: side, a vertical design line at x = 6874.5 written as its two rounded ends (x = 6874),
+#: runs tangentially into a cubic whose first rounded points stay on x = 6874
+_CANTARELL_M = [
+    ("line", (6754.5, 0.0), (6874.5, 0.0)),
+    ("line", (6874.5, 0.0), (6874.5, 474.0)),
+    ("cubic", (6874.5, 474.0), (6874.5, 504.0), (6871.5, 531.0), (6864.0, 556.5)),
+    ("cubic", (6864.0, 556.5), (6919.5, 606.0), (6988.5, 633.0), (7062.0, 633.0)),
+]
+
+
+def test_a_joint_at_the_end_of_a_long_line_does_not_tilt_it():
+    """The joint of the long thinned line (x = 6874 from y = 0 to 496) and the cubic after it
+    moved 0.18 across the line onto the curve's estimate: the whole line tilted, 0.67 from the
+    design line at its joint with the curve where the rounded input is 0.5 from it. A joint
+    beside a long line moves along the line only."""
+    w = _rounded(_CANTARELL_M)
+    fp = fit_paths([w], [False])[0]
+    assert not check_fit(w, fp, 0.02, 0.02, report=True)["violation"]
+    fit = np.vstack([flatten_cubic(s.points, 0.002) if s.kind == "cubic"
+                     else np.linspace(*np.asarray(s.points), 500) for s in fp.segments])
+    a, b = np.array([6874.5, 0.0]), np.array([6874.5, 474.0])
+    line = a + np.linspace(0.0, 1.0, 475)[:, None] * (b - a)
+    rounded = point_polyline_distance(line, w).max()
+    assert rounded == 0.5
+    assert point_polyline_distance(line, fit).max() <= rounded + 0.02
+    along = fit[(fit[:, 1] > 1.0) & (fit[:, 1] < b[1])]
+    assert np.abs(along[:, 0] - b[0]).max() <= rounded + 0.02
