@@ -39,6 +39,7 @@ from another checkout, e.g. /work/main, to compare)
 from __future__ import annotations
 
 import argparse
+import importlib
 import itertools
 import json
 import math
@@ -51,7 +52,8 @@ _CODE = next((sys.argv[i + 1] for i, v in enumerate(sys.argv[:-1]) if v == "--co
 sys.path.insert(0, os.path.abspath(_CODE) if _CODE else os.path.join(os.path.dirname(__file__),
                                                                      ".."))
 sys.path.insert(0, os.path.dirname(__file__))
-
+# (imported first: bench_precision puts this checkout first on sys.path, --code must win)
+importlib.import_module("galvo_core.fit")
 from bench_precision import fitted_dense  # noqa: E402
 from fonts import (  # noqa: E402
     TEXT,

@@ -2591,6 +2591,10 @@ def _fit_concatenated(
     in_todo[todo] = True
     K = K[np.repeat(in_todo, klen)]
     tlen = klen[todo]
+    coarse = None
+    if rounding is not None and (rounding[:, 1] > 0.0).any():
+        coarse = _coarse_chords(W, woff[todo], wlen[todo], rounding[:, 1])
+        K, tlen = _gap_ends_kept(W, K, tlen, rounding[:, 1], coarse)
     kend = np.cumsum(tlen) - 1  # each path's last thinned point
     Q = W[K]
     is_kend = np.zeros(len(Q), dtype=bool)
@@ -2611,7 +2615,8 @@ def _fit_concatenated(
     fitter = _BatchFitter(W, K, t_in, t_out, np.repeat(e_per, tlen), eps_sum, arc, q=Q)
     if rounding is not None and (rounding[:, 1] > 0.0).any():
         fitter.quant = np.repeat(rounding[:, 1], tlen)
-        fitter.coarse = _coarse_chords(W, woff[todo], wlen[todo], rounding[:, 1])
+        assert coarse is not None  # (set above with the same condition)
+        fitter.coarse = coarse
     with np.errstate(invalid="ignore", divide="ignore"):
         fitter.fit(np.stack([pa[curve], pb[curve]], axis=1), pa[~curve])
     ca, cb, ctrl, bound, fla = fitter.results()
@@ -2702,6 +2707,62 @@ def _fit_concatenated(
     return is_cubic, points, first, last, seg_cut.tolist(), pt_cut.tolist(), worst.tolist()
 
 
+#: rounded input: the ends of a gap of at least ``_LONE_LENGTH`` quanta between two input
+#: points (a design line written as its two rounded ends) inside a thinned segment are kept
+#: as thinned points where some input point of that segment lies this many quanta or more off
+#: the gap's line (the segment holds a curve's end beside the line)
+_GAP_OFF = 0.75
+
+
+def _gap_ends_kept(W, K, tlen, quanta, coarse):
+    """Rounded input (``quanta`` per path, 0: exact): ``K`` (the thinned points, global
+    indices, each path's in order; ``tlen`` per path) with the ends of each long gap
+    (``_LONE_LENGTH``; not a chord of a coarse curve, ``coarse``) added where the thinning
+    left one of them inside a thinned segment (the gap at its other end) that also holds
+    points off the gap's line
+    (``_GAP_OFF``): the thinning keeps a curve's end and the design line after it in one
+    segment where they are nearly collinear, and the curve piece then swallows the line
+    (a cubic through its two rounded ends may bulge over it by the rounding; sans-light "J" at
+    em 400: 0.90 from the design where the rounded input is 0.40). Returns (K, tlen)."""
+    q_k = np.repeat(quanta, tlen)
+    if len(K) < 2 or not (q_k > 0.0).any():
+        return K, tlen
+    qmin = float(quanta[quanta > 0.0].min())
+    lo, hi = int(K[0]), int(K[-1])
+    d = np.diff(W[lo:hi + 1], axis=0)
+    g = np.flatnonzero(d[:, 0] * d[:, 0] + d[:, 1] * d[:, 1] >= (_LONE_LENGTH * qmin) ** 2) + lo
+    if len(g) == 0:
+        return K, tlen
+    g = g[~coarse[g]]
+    seg = np.searchsorted(K, g, side="right") - 1  # the thinned segment K[seg]..K[seg + 1]
+    last = np.cumsum(tlen) - 1
+    ok = (seg >= 0) & (seg < len(K) - 1)
+    seg = np.clip(seg, 0, len(K) - 2)
+    ok &= ~np.isin(seg, last)  # not across two paths
+    ok &= (K[seg] != g) | (K[seg + 1] != g + 1)  # not a thinned segment already
+    ok &= (K[seg] == g) | (K[seg + 1] == g + 1)  # at one end of it (the other is added)
+    q = q_k[seg]
+    ok &= (q > 0.0) & (np.hypot(*(W[g + 1] - W[g]).T) >= _LONE_LENGTH * q)
+    g, seg, q = g[ok], seg[ok], q[ok]
+    if len(g) == 0:
+        return K, tlen
+    a, b = K[seg], K[seg + 1]
+    own, off = _ragged(np.arange(len(g)), b - a + 1)
+    e = W[g + 1] - W[g]
+    e = e / np.hypot(e[:, 0], e[:, 1])[:, None]
+    r = W[a[own] + off] - W[g][own]
+    across = np.abs(r[:, 0] * e[own, 1] - r[:, 1] * e[own, 0])
+    far = np.maximum.reduceat(across, np.cumsum(b - a + 1) - (b - a + 1)) >= _GAP_OFF * q
+    if not far.any():
+        return K, tlen
+    add = np.setdiff1d(np.r_[g[far], g[far] + 1], K)
+    if len(add) == 0:
+        return K, tlen
+    path = np.searchsorted(last, np.searchsorted(K, add) - 1)  # (the segment's start's path)
+    K2 = np.sort(np.concatenate([K, add]))
+    return K2, tlen + np.bincount(path, minlength=len(tlen))
+
+
 #: rounded input: a cubic's end segment (thinned) with a gap between two of its input
 #: points of at least ``_LONE_LENGTH`` quanta and this share of the segment's length (a
 #: design line, written as its two rounded ends) ...
@@ -2713,6 +2774,9 @@ _LONE_SHARE = 0.5
 _LONE_BULGE = 0.3
 #: ... the cubic sampled at this many parameters
 _LONE_SAMPLES = 65
+#: ... and replaced where the re-fit of the rest takes at most this many segments (serif-italic
+#: "R" at em 400: the rest of a cubic over a 44-unit design line needed a cubic and a line)
+_LONE_REFIT = 2
 _LONE_BASIS = seed_basis(_LONE_SAMPLES - 1)[1]
 
 
@@ -2796,15 +2860,20 @@ def _lone_lines_out(W, K, Q, arc, t_in, t_out, e_per, eps_sum, quant, eps, ca, c
     with np.errstate(invalid="ignore", divide="ignore"):
         f2.fit(np.stack([na[~one], nb[~one]], axis=1), None)
     a3, b3, c3, bd3, l3 = f2.results()
-    # per fixed cubic: the re-fit holds where it is one cubic over exactly its rest (or the
-    # one segment left a line). (The re-fit's own merge rounds may join the rests of two
-    # neighbouring cubics: such a cubic matches neither, and both stay as they were.)
+    # per fixed cubic: the re-fit holds where its segments (at most _LONE_REFIT of them,
+    # cubics and lines) cover exactly its rest (or the one segment left a line). (The
+    # re-fit's own merge rounds may join the rests of two neighbouring cubics: such a cubic
+    # lies in neither, and both stay as they were.)
     pos = np.flatnonzero(~one)
-    span = np.int64(len(K) + 1)
-    key3 = a3.astype(np.int64) * span + b3
-    keyp = na.astype(np.int64) * span + nb
+    sa = np.concatenate([a3, l3]).astype(np.intp)
+    sb = np.concatenate([b3, l3 + 1]).astype(np.intp)
+    pc = np.searchsorted(na[pos], sa, side="right") - 1  # the rest each one starts in
+    inside = (pc >= 0) & (sb <= nb[pos][np.maximum(pc, 0)])
+    pc = np.where(inside, pc, len(pos))
+    cover = np.bincount(pc, weights=sb - sa, minlength=len(pos) + 1)[:len(pos)]
+    count = np.bincount(pc, minlength=len(pos) + 1)[:len(pos)]
     good = one.copy()
-    good[pos] = np.isin(keyp[pos], key3)
+    good[pos] = (cover == (nb - na)[pos]) & (count <= _LONE_REFIT)
     if not good.any():
         return ca, cb, ctrl, bound, la
     fix[fi[~good]] = False
@@ -2813,8 +2882,11 @@ def _lone_lines_out(W, K, Q, arc, t_in, t_out, e_per, eps_sum, quant, eps, ca, c
     for at in ((cb - 1)[ce], (ca + 1)[cs]):
         t_in[at] = ti2[at]
         t_out[at] = to2[at]
-    held = np.isin(key3, keyp[good & ~one])
-    new_lines = [(cb - 1)[ce], ca[cs], na[one & good]]
+    took = np.zeros(len(pos) + 1, dtype=bool)
+    took[:len(pos)] = good[pos]
+    held = took[pc[:len(a3)]]
+    held_l = took[pc[len(a3):]]
+    new_lines = [(cb - 1)[ce], ca[cs], na[one & good], l3[held_l]]
     extra = np.concatenate([la] + new_lines)
     keep = ~fix
     ca2 = np.concatenate([ca[keep], a3[held]])
@@ -4721,17 +4793,21 @@ def _solve3(lu, piv, good, rx, ry, cx, cy) -> None:  # pragma: no cover (compile
 
 
 def _local_fits(
-    W: np.ndarray, arc: np.ndarray, lo: np.ndarray, hi: np.ndarray, at: np.ndarray
+    W: np.ndarray, arc: np.ndarray, lo: np.ndarray, hi: np.ndarray, at: np.ndarray,
+    res: np.ndarray | None = None,
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Least-squares quadratics x(s), y(s) in arc length s through the input points lo..hi
     (inclusive global indices) of each window, evaluated at the point ``at``: (position
     (V, 2), unit tangent (V, 2) in the path's direction, ok (V,): at least 4 points and a
-    well-conditioned fit)."""
+    well-conditioned fit). ``res`` (V,): filled with the largest distance of a window's
+    input point to its quadratic where ok (inf elsewhere)."""
     cnt = hi - lo + 1
     v = len(lo)
     pos = np.zeros((v, 2))
     tan = np.zeros((v, 2))
     ok = cnt >= 4
+    if res is not None:
+        res[:] = np.inf
     if not ok.any():
         return pos, tan, ok
     okk = np.flatnonzero(ok)
@@ -4756,6 +4832,16 @@ def _local_fits(
     good &= ln > 0.0
     tan[okk] = t / np.where(ln > 0.0, ln, 1.0)[:, None]
     ok[okk] = good
+    if res is not None and good.any():
+        g = np.flatnonzero(good)
+        a, b, c = lo[okk[g]], hi[okk[g]], at[okk[g]]
+        own, off = _ragged(np.arange(len(g)), b - a + 1)
+        i = a[own] + off
+        u = (arc[i] - arc[c[own]]) / np.maximum(arc[b] - arc[a], 1e-300)[own]
+        fx = cx[g, 0][own] + u * (cx[g, 1][own] + u * cx[g, 2][own])
+        fy = cy[g, 0][own] + u * (cy[g, 1][own] + u * cy[g, 2][own])
+        d = np.hypot(W[i, 0] - fx, W[i, 1] - fy)
+        res[okk[g]] = np.maximum.reduceat(d, np.cumsum(b - a + 1) - (b - a + 1))
     return pos, tan, ok
 
 
@@ -4895,6 +4981,10 @@ _CORNER_SINE = 0.25
 #: side is its thinned segment): the position at a sharp tip between two curves is then
 #: nearer the design (sans-bold "8": 0.64 -> under 0.63 from the true curve)
 _CORNER_POINTS = _SIDE_POINTS
+#: ... and give no estimate where one of its input points lies this many quanta or more off
+#: its quadratic (the window spans another corner: sans-light "J" at em 400, a 16-unit side
+#: fitted across its far corner moved the corner 0.5 away from the design's, 0.90 from it)
+_CORNER_RES = 1.0
 
 
 #: a side written as its two rounded ends only gives the corner a direction where it is at
@@ -5008,8 +5098,14 @@ def _corners_on_the_design(W, K, Q, arc, smooth, rnd, first, last, quant, eps) -
     next_c = np.minimum.accumulate(np.where(stop, idx, n - 1)[::-1])[::-1]
     lo_i = np.maximum(lo_i, K[prev_c[vi - 1]])
     hi_o = np.minimum(hi_o, K[next_c[vo + 1]])
-    p_in, t_in, ok_in = _local_fits(W, arc, lo_i, K[vi], K[vi])
-    p_out, t_out, ok_out = _local_fits(W, arc, k, hi_o, k)
+    r_in = np.empty(len(vi))
+    r_out = np.empty(len(vo))
+    p_in, t_in, ok_in = _local_fits(W, arc, lo_i, K[vi], K[vi], r_in)
+    p_out, t_out, ok_out = _local_fits(W, arc, k, hi_o, k, r_out)
+    # a curve side whose points miss their quadratic by more than _CORNER_RES quanta spans
+    # another corner (a run the curve-run rules left smooth across one): no estimate
+    ok_in &= r_in <= _CORNER_RES * quant[vi]
+    ok_out &= r_out <= _CORNER_RES * quant[vo]
     # a side that is a line (its other end a corner too): its least-squares line
     lin_in = ~smooth[vi - 1]
     if lin_in.any():
@@ -5033,6 +5129,17 @@ def _corners_on_the_design(W, K, Q, arc, smooth, rnd, first, last, quant, eps) -
     # a side of two points meeting a curve at a middling angle: neither estimate is good
     both &= ~lone | (np.abs(cr) >= _LONE_SINE) | (np.abs(cr) < _CORNER_SINE)
     tip = both & ((t_in * t_out).sum(axis=1) < _TIP_COS)
+    # a tip beside a design line written as its two rounded ends (one long input step) that
+    # the curve-run rules put in a curve run: the quadratic over that side spans the line's
+    # far end, and its tangent's error moves the crossing by the error over the sine of the
+    # small interior angle (serif-italic "g" at em 400, 155 degrees: 0.78 from the design's
+    # tip where the input point is 0.46): the tip stays
+    gap_in = ((K[vi] - K[vi - 1]) == 1) & (
+        np.hypot(*(W[K[vi]] - W[K[vi - 1]]).T) >= _LONE_LENGTH * quant[vi])
+    gap_out = ((K[vo + 1] - K[vo]) == 1) & (
+        np.hypot(*(W[K[vo + 1]] - W[K[vo]]).T) >= _LONE_LENGTH * quant[vo])
+    both &= ~(tip & (gap_in | gap_out))
+    tip &= both
     sharp = both & (np.abs(cr) >= _CORNER_SINE)
     # a shallow corner between a curve and a least-squares line whose points are collinear:
     # on that line (the mean would tilt the whole line by the curve's error at its end)

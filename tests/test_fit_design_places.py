@@ -188,3 +188,71 @@ def test_a_joint_at_the_end_of_a_long_line_does_not_tilt_it():
     assert point_polyline_distance(line, fit).max() <= rounded + 0.02
     along = fit[(fit[:, 1] > 1.0) & (fit[:, 1] < b[1])]
     assert np.abs(along[:, 0] - b[0]).max() <= rounded + 0.02
+
+
+def _fit_dense(fp) -> np.ndarray:
+    return np.vstack([flatten_cubic(s.points, 0.002) if s.kind == "cubic"
+                      else np.linspace(*np.asarray(s.points), 200) for s in fp.segments])
+
+
+def _line_gap(a, b, w, fit) -> tuple[float, float]:
+    """(rounded input, fit): the largest distance of the design line a..b to each."""
+    a, b = np.asarray(a, dtype=np.float64), np.asarray(b, dtype=np.float64)
+    line = a + np.linspace(0.0, 1.0, 201)[:, None] * (b - a)
+    return (float(point_polyline_distance(line, w).max()),
+            float(point_polyline_distance(line, fit).max()))
+
+
+#: Cantarell "a" at em 1500 (s8-pl; a piece of its outline, open): the bowl's cubic ends
+#: vertically at a design line x = 535.5 from y = 469.5 to 421.5, written as its two rounded
+#: ends (x = 536); the curve's last rounded points are nearly on that line
+_CANTARELL_A = [
+    ("cubic", (340.5, 630.0), (469.5, 630.0), (535.5, 576.0), (535.5, 469.5)),
+    ("line", (535.5, 469.5), (535.5, 421.5)),
+    ("cubic", (535.5, 421.5), (211.5, 418.5), (70.5, 351.0), (70.5, 196.5)),
+]
+
+
+def test_a_design_line_inside_a_thinned_segment_is_not_swallowed():
+    """The thinning kept the curve's end (535, 490) .. (536, 470) and the design line's 48-unit
+    gap in one segment: the curve piece took the gap, its cubic bulged 0.25 past the rounded
+    line, 0.75 from the design where the rounded input is 0.5 from it. The ends of such a gap
+    are kept as thinned points: the design line is a line of its own."""
+    w = _rounded(_CANTARELL_A)
+    fp = fit_paths([w], [False])[0]
+    assert not check_fit(w, fp, 0.02, 0.02, report=True)["violation"]
+    rounded, fit = _line_gap((535.5, 469.5), (535.5, 421.5), w, _fit_dense(fp))
+    assert rounded == 0.5
+    assert fit <= rounded + 0.02
+
+
+#: DejaVu Sans ExtraLight "J" at em 400 (s8-pl; its outline): the bowl ends in a horizontal
+#: design line of 11.9 units, then a 90-degree corner and a 16-unit vertical line (each
+#: written as its two rounded ends), then another corner
+_SANS_LIGHT_J = _as_cubics([
+    ("line", (2855.0781, 291.6016), (2874.6094, 291.6016)),
+    ("line", (2874.6094, 291.6016), (2874.6094, 20.3125)),
+    ("quad", (2874.6094, 20.3125), (2874.6094, -27.7344), (2861.7188, -49.4141)),
+    ("quad", (2861.7188, -49.4141), (2848.8281, -71.0938), (2820.3125, -71.0938)),
+    ("line", (2820.3125, -71.0938), (2808.3984, -71.0938)),
+    ("line", (2808.3984, -71.0938), (2808.3984, -54.8828)),
+    ("line", (2808.3984, -54.8828), (2817.9688, -54.8828)),
+    ("quad", (2817.9688, -54.8828), (2838.2812, -54.8828), (2846.6797, -38.4766)),
+    ("quad", (2846.6797, -38.4766), (2855.0781, -22.0703), (2855.0781, 20.3125)),
+    ("line", (2855.0781, 20.3125), (2855.0781, 291.6016)),
+])
+
+
+def test_a_corner_estimate_across_another_corner_is_not_used():
+    """The corner at (2808, -71) had the curve-run rules' smooth runs on both sides: its side
+    after it, fitted as a quadratic over 20 points, turned the next corner (2808, -55) too,
+    and the crossing of the two tangents moved the corner 0.5 away from the design's, 0.90
+    from it where the rounded input is 0.40. A side whose points miss their quadratic by a
+    quantum gives no estimate: the corner stays."""
+    w = _rounded(_SANS_LIGHT_J)[:-1]
+    fp = fit_paths([w], [True])[0]
+    assert not check_fit(w, fp, 0.02, 0.02, report=True)["violation"]
+    corner = np.array([2808.3984, -71.0938])
+    rounded = float(point_polyline_distance(corner[None], np.vstack([w, w[:1]]))[0])
+    assert rounded < 0.45
+    assert _local_distance(_SANS_LIGHT_J, fp, corner, 2.0) <= max(0.6, rounded + 0.02)
