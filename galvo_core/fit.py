@@ -2594,7 +2594,7 @@ def _fit_concatenated(
     coarse = None
     if rounding is not None and (rounding[:, 1] > 0.0).any():
         coarse = _coarse_chords(W, woff[todo], wlen[todo], rounding[:, 1])
-        K, tlen = _gap_ends_kept(W, K, tlen, rounding[:, 1], coarse)
+        K, tlen = _gap_ends_kept(W, K, tlen, rounding[:, 1], rounding[:, 0], coarse)
     kend = np.cumsum(tlen) - 1  # each path's last thinned point
     Q = W[K]
     is_kend = np.zeros(len(Q), dtype=bool)
@@ -2712,19 +2712,23 @@ def _fit_concatenated(
 #: as thinned points where some input point of that segment lies this many quanta or more off
 #: the gap's line (the segment holds a curve's end beside the line)
 _GAP_OFF = 0.75
+#: ... and that is at least this many times as long as the input steps beside it
+_GAP_RATIO = 3.0
 
 
-def _gap_ends_kept(W, K, tlen, quanta, coarse):
+def _gap_ends_kept(W, K, tlen, quanta, eps, coarse):
     """Rounded input (``quanta`` per path, 0: exact): ``K`` (the thinned points, global
     indices, each path's in order; ``tlen`` per path) with the ends of each long gap
     (``_LONE_LENGTH``; not a chord of a coarse curve, ``coarse``) added where the thinning
     left one of them inside a thinned segment (the gap at its other end) that also holds
-    points off the gap's line
-    (``_GAP_OFF``): the thinning keeps a curve's end and the design line after it in one
-    segment where they are nearly collinear, and the curve piece then swallows the line
-    (a cubic through its two rounded ends may bulge over it by the rounding; sans-light "J" at
-    em 400: 0.90 from the design where the rounded input is 0.40). Returns (K, tlen)."""
+    points off the gap's line (``_GAP_OFF``), the gap at least ``_GAP_RATIO`` times the input
+    steps beside it, and the rest of the segment within ``eps`` (per path, the line bound)
+    of its chord: the thinning keeps a curve's end and the design line after it in one
+    segment where they are nearly collinear, and the curve piece then swallows the line (a
+    cubic through its two rounded ends may bulge over it by the rounding; Cantarell "a" at
+    em 1500: 0.75 from the design where the rounded input is 0.5). Returns (K, tlen)."""
     q_k = np.repeat(quanta, tlen)
+    eps_k = np.repeat(eps, tlen)
     if len(K) < 2 or not (q_k > 0.0).any():
         return K, tlen
     qmin = float(quanta[quanta > 0.0].min())
@@ -2743,6 +2747,11 @@ def _gap_ends_kept(W, K, tlen, quanta, coarse):
     ok &= (K[seg] == g) | (K[seg + 1] == g + 1)  # at one end of it (the other is added)
     q = q_k[seg]
     ok &= (q > 0.0) & (np.hypot(*(W[g + 1] - W[g]).T) >= _LONE_LENGTH * q)
+    # ... a design line among dense points: at least _GAP_RATIO times the input step before
+    # and after it (a walk of long steps, each like the next, has no such gap)
+    nb = np.maximum(np.hypot(*(W[np.maximum(g - 1, 0)] - W[g]).T),
+                    np.hypot(*(W[np.minimum(g + 2, len(W) - 1)] - W[g + 1]).T))
+    ok &= np.hypot(*(W[g + 1] - W[g]).T) >= _GAP_RATIO * nb
     g, seg, q = g[ok], seg[ok], q[ok]
     if len(g) == 0:
         return K, tlen
@@ -2755,7 +2764,17 @@ def _gap_ends_kept(W, K, tlen, quanta, coarse):
     far = np.maximum.reduceat(across, np.cumsum(b - a + 1) - (b - a + 1)) >= _GAP_OFF * q
     if not far.any():
         return K, tlen
-    add = np.setdiff1d(np.r_[g[far], g[far] + 1], K)
+    # the point kept: the gap's end inside the segment; the rest of the segment, a line from
+    # its other end to that point, must still hold its input points within eps (the thinning's
+    # promise for the whole segment)
+    g, seg, a, b = g[far], seg[far], a[far], b[far]
+    at_end = b == g + 1
+    v = np.where(at_end, g, g + 1)
+    r0 = np.where(at_end, a, v)
+    r1 = np.where(at_end, v, b)
+    err = _line_errors(W, np.stack([W[r0], W[r1]], axis=1), r0, r1)
+    keep = err <= eps_k[seg]
+    add = np.setdiff1d(v[keep], K)
     if len(add) == 0:
         return K, tlen
     path = np.searchsorted(last, np.searchsorted(K, add) - 1)  # (the segment's start's path)
