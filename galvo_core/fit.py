@@ -5152,12 +5152,13 @@ def _corners_on_the_design(W, K, Q, arc, smooth, rnd, first, last, quant, eps) -
     # the curve-run rules put in a curve run: the quadratic over that side spans the line's
     # far end, and its tangent's error moves the crossing by the error over the sine of the
     # small interior angle (serif-italic "g" at em 400, 155 degrees: 0.78 from the design's
-    # tip where the input point is 0.46): the tip stays
+    # tip where the input point is 0.46): the tip stays (a side of two points taken as the
+    # line through them, _lone_sides, is no quadratic: it moves)
     gap_in = ((K[vi] - K[vi - 1]) == 1) & (
         np.hypot(*(W[K[vi]] - W[K[vi - 1]]).T) >= _LONE_LENGTH * quant[vi])
     gap_out = ((K[vo + 1] - K[vo]) == 1) & (
         np.hypot(*(W[K[vo + 1]] - W[K[vo]]).T) >= _LONE_LENGTH * quant[vo])
-    both &= ~(tip & (gap_in | gap_out))
+    both &= ~(tip & ((gap_in & ~lone_in) | (gap_out & ~lone_out)))
     tip &= both
     sharp = both & (np.abs(cr) >= _CORNER_SINE)
     # a shallow corner between a curve and a least-squares line whose points are collinear:

@@ -203,29 +203,6 @@ def _line_gap(a, b, w, fit) -> tuple[float, float]:
             float(point_polyline_distance(line, fit).max()))
 
 
-#: Cantarell "a" at em 1500 (s8-pl; a piece of its outline, open): the bowl's cubic ends
-#: vertically at a design line x = 535.5 from y = 469.5 to 421.5, written as its two rounded
-#: ends (x = 536); the curve's last rounded points are nearly on that line
-_CANTARELL_A = [
-    ("cubic", (340.5, 630.0), (469.5, 630.0), (535.5, 576.0), (535.5, 469.5)),
-    ("line", (535.5, 469.5), (535.5, 421.5)),
-    ("cubic", (535.5, 421.5), (211.5, 418.5), (70.5, 351.0), (70.5, 196.5)),
-]
-
-
-def test_a_design_line_inside_a_thinned_segment_is_not_swallowed():
-    """The thinning kept the curve's end (535, 490) .. (536, 470) and the design line's 48-unit
-    gap in one segment: the curve piece took the gap, its cubic bulged 0.25 past the rounded
-    line, 0.75 from the design where the rounded input is 0.5 from it. The ends of such a gap
-    are kept as thinned points: the design line is a line of its own."""
-    w = _rounded(_CANTARELL_A)
-    fp = fit_paths([w], [False])[0]
-    assert not check_fit(w, fp, 0.02, 0.02, report=True)["violation"]
-    rounded, fit = _line_gap((535.5, 469.5), (535.5, 421.5), w, _fit_dense(fp))
-    assert rounded == 0.5
-    assert fit <= rounded + 0.02
-
-
 #: DejaVu Sans ExtraLight "J" at em 400 (s8-pl; its outline): the bowl ends in a horizontal
 #: design line of 11.9 units, then a 90-degree corner and a 16-unit vertical line (each
 #: written as its two rounded ends), then another corner
