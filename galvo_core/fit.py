@@ -2625,6 +2625,10 @@ def _fit_concatenated(
     in_todo[todo] = True
     K = K[np.repeat(in_todo, klen)]
     tlen = klen[todo]
+    coarse = None
+    if rounding is not None and (rounding[:, 1] > 0.0).any():
+        coarse = _coarse_chords(W, woff[todo], wlen[todo], rounding[:, 1])
+        K, tlen = _gap_ends_kept(W, K, tlen, rounding[:, 1], rounding[:, 0], coarse)
     kend = np.cumsum(tlen) - 1  # each path's last thinned point
     Q = W[K]
     is_kend = np.zeros(len(Q), dtype=bool)
@@ -2645,7 +2649,8 @@ def _fit_concatenated(
     fitter = _BatchFitter(W, K, t_in, t_out, np.repeat(e_per, tlen), eps_sum, arc, q=Q)
     if rounding is not None and (rounding[:, 1] > 0.0).any():
         fitter.quant = np.repeat(rounding[:, 1], tlen)
-        fitter.coarse = _coarse_chords(W, woff[todo], wlen[todo], rounding[:, 1])
+        assert coarse is not None  # (set above with the same condition)
+        fitter.coarse = coarse
     with np.errstate(invalid="ignore", divide="ignore"):
         fitter.fit(np.stack([pa[curve], pb[curve]], axis=1), pa[~curve])
     ca, cb, ctrl, bound, fla = fitter.results()
@@ -2736,6 +2741,81 @@ def _fit_concatenated(
     return is_cubic, points, first, last, seg_cut.tolist(), pt_cut.tolist(), worst.tolist()
 
 
+#: rounded input: the ends of a gap of at least ``_LONE_LENGTH`` quanta between two input
+#: points (a design line written as its two rounded ends) inside a thinned segment are kept
+#: as thinned points where some input point of that segment lies this many quanta or more off
+#: the gap's line (the segment holds a curve's end beside the line)
+_GAP_OFF = 0.75
+#: ... and that is at least this many times as long as the input steps beside it
+_GAP_RATIO = 3.0
+
+
+def _gap_ends_kept(W, K, tlen, quanta, eps, coarse):
+    """Rounded input (``quanta`` per path, 0: exact): ``K`` (the thinned points, global
+    indices, each path's in order; ``tlen`` per path) with the ends of each long gap
+    (``_LONE_LENGTH``; not a chord of a coarse curve, ``coarse``) added where the thinning
+    left one of them inside a thinned segment (the gap at its other end) that also holds
+    points off the gap's line (``_GAP_OFF``), the gap at least ``_GAP_RATIO`` times the input
+    steps beside it, and the rest of the segment within ``eps`` (per path, the line bound)
+    of its chord: the thinning keeps a curve's end and the design line after it in one
+    segment where they are nearly collinear, and the curve piece then swallows the line (a
+    cubic through its two rounded ends may bulge over it by the rounding; Cantarell "a" at
+    em 1500: 0.75 from the design where the rounded input is 0.5). Returns (K, tlen)."""
+    q_k = np.repeat(quanta, tlen)
+    eps_k = np.repeat(eps, tlen)
+    if len(K) < 2 or not (q_k > 0.0).any():
+        return K, tlen
+    qmin = float(quanta[quanta > 0.0].min())
+    lo, hi = int(K[0]), int(K[-1])
+    d = np.diff(W[lo:hi + 1], axis=0)
+    g = np.flatnonzero(d[:, 0] * d[:, 0] + d[:, 1] * d[:, 1] >= (_LONE_LENGTH * qmin) ** 2) + lo
+    if len(g) == 0:
+        return K, tlen
+    g = g[~coarse[g]]
+    seg = np.searchsorted(K, g, side="right") - 1  # the thinned segment K[seg]..K[seg + 1]
+    last = np.cumsum(tlen) - 1
+    ok = (seg >= 0) & (seg < len(K) - 1)
+    seg = np.clip(seg, 0, len(K) - 2)
+    ok &= ~np.isin(seg, last)  # not across two paths
+    ok &= (K[seg] != g) | (K[seg + 1] != g + 1)  # not a thinned segment already
+    ok &= (K[seg] == g) | (K[seg + 1] == g + 1)  # at one end of it (the other is added)
+    q = q_k[seg]
+    ok &= (q > 0.0) & (np.hypot(*(W[g + 1] - W[g]).T) >= _LONE_LENGTH * q)
+    # ... a design line among dense points: at least _GAP_RATIO times the input step before
+    # and after it (a walk of long steps, each like the next, has no such gap)
+    nb = np.maximum(np.hypot(*(W[np.maximum(g - 1, 0)] - W[g]).T),
+                    np.hypot(*(W[np.minimum(g + 2, len(W) - 1)] - W[g + 1]).T))
+    ok &= np.hypot(*(W[g + 1] - W[g]).T) >= _GAP_RATIO * nb
+    g, seg, q = g[ok], seg[ok], q[ok]
+    if len(g) == 0:
+        return K, tlen
+    a, b = K[seg], K[seg + 1]
+    own, off = _ragged(np.arange(len(g)), b - a + 1)
+    e = W[g + 1] - W[g]
+    e = e / np.hypot(e[:, 0], e[:, 1])[:, None]
+    r = W[a[own] + off] - W[g][own]
+    across = np.abs(r[:, 0] * e[own, 1] - r[:, 1] * e[own, 0])
+    far = np.maximum.reduceat(across, np.cumsum(b - a + 1) - (b - a + 1)) >= _GAP_OFF * q
+    if not far.any():
+        return K, tlen
+    # the point kept: the gap's end inside the segment; the rest of the segment, a line from
+    # its other end to that point, must still hold its input points within eps (the thinning's
+    # promise for the whole segment)
+    g, seg, a, b = g[far], seg[far], a[far], b[far]
+    at_end = b == g + 1
+    v = np.where(at_end, g, g + 1)
+    r0 = np.where(at_end, a, v)
+    r1 = np.where(at_end, v, b)
+    err = _line_errors(W, np.stack([W[r0], W[r1]], axis=1), r0, r1)
+    keep = err <= eps_k[seg]
+    add = np.setdiff1d(v[keep], K)
+    if len(add) == 0:
+        return K, tlen
+    path = np.searchsorted(last, np.searchsorted(K, add) - 1)  # (the segment's start's path)
+    K2 = np.sort(np.concatenate([K, add]))
+    return K2, tlen + np.bincount(path, minlength=len(tlen))
+
+
 #: rounded input: a cubic's end segment (thinned) with a gap between two of its input
 #: points of at least ``_LONE_LENGTH`` quanta and this share of the segment's length (a
 #: design line, written as its two rounded ends) ...
@@ -2747,6 +2827,9 @@ _LONE_SHARE = 0.5
 _LONE_BULGE = 0.3
 #: ... the cubic sampled at this many parameters
 _LONE_SAMPLES = 65
+#: ... and replaced where the re-fit of the rest takes at most this many segments (serif-italic
+#: "R" at em 400: the rest of a cubic over a 44-unit design line needed a cubic and a line)
+_LONE_REFIT = 2
 _LONE_BASIS = seed_basis(_LONE_SAMPLES - 1)[1]
 
 
@@ -2830,15 +2913,20 @@ def _lone_lines_out(W, K, Q, arc, t_in, t_out, e_per, eps_sum, quant, eps, ca, c
     with np.errstate(invalid="ignore", divide="ignore"):
         f2.fit(np.stack([na[~one], nb[~one]], axis=1), None)
     a3, b3, c3, bd3, l3 = f2.results()
-    # per fixed cubic: the re-fit holds where it is one cubic over exactly its rest (or the
-    # one segment left a line). (The re-fit's own merge rounds may join the rests of two
-    # neighbouring cubics: such a cubic matches neither, and both stay as they were.)
+    # per fixed cubic: the re-fit holds where its segments (at most _LONE_REFIT of them,
+    # cubics and lines) cover exactly its rest (or the one segment left a line). (The
+    # re-fit's own merge rounds may join the rests of two neighbouring cubics: such a cubic
+    # lies in neither, and both stay as they were.)
     pos = np.flatnonzero(~one)
-    span = np.int64(len(K) + 1)
-    key3 = a3.astype(np.int64) * span + b3
-    keyp = na.astype(np.int64) * span + nb
+    sa = np.concatenate([a3, l3]).astype(np.intp)
+    sb = np.concatenate([b3, l3 + 1]).astype(np.intp)
+    pc = np.searchsorted(na[pos], sa, side="right") - 1  # the rest each one starts in
+    inside = (pc >= 0) & (sb <= nb[pos][np.maximum(pc, 0)])
+    pc = np.where(inside, pc, len(pos))
+    cover = np.bincount(pc, weights=sb - sa, minlength=len(pos) + 1)[:len(pos)]
+    count = np.bincount(pc, minlength=len(pos) + 1)[:len(pos)]
     good = one.copy()
-    good[pos] = np.isin(keyp[pos], key3)
+    good[pos] = (cover == (nb - na)[pos]) & (count <= _LONE_REFIT)
     if not good.any():
         return ca, cb, ctrl, bound, la
     fix[fi[~good]] = False
@@ -2847,8 +2935,11 @@ def _lone_lines_out(W, K, Q, arc, t_in, t_out, e_per, eps_sum, quant, eps, ca, c
     for at in ((cb - 1)[ce], (ca + 1)[cs]):
         t_in[at] = ti2[at]
         t_out[at] = to2[at]
-    held = np.isin(key3, keyp[good & ~one])
-    new_lines = [(cb - 1)[ce], ca[cs], na[one & good]]
+    took = np.zeros(len(pos) + 1, dtype=bool)
+    took[:len(pos)] = good[pos]
+    held = took[pc[:len(a3)]]
+    held_l = took[pc[len(a3):]]
+    new_lines = [(cb - 1)[ce], ca[cs], na[one & good], l3[held_l]]
     extra = np.concatenate([la] + new_lines)
     keep = ~fix
     ca2 = np.concatenate([ca[keep], a3[held]])
@@ -2905,6 +2996,10 @@ _JOINT_MOVE = 0.15
 _JOINT_SHARES = (1.0, 2.0 / 3.0, 1.0 / 3.0)
 #: curve-to-polyline checks sample the moved segments at most this far apart (units of q)
 _JOINT_STEP = 0.05
+#: a line at least this many quanta long beside a joint only lets the joint move along it
+#: (cantarell "m" at em 1500: the joint of a vertical design line and the curve it runs into
+#: moved 0.18 across the line, tilting it 0.67 from the design; the rounded input is 0.5)
+_JOINT_LINE = 8.0
 
 
 def _joint_estimates(W, arc, g, ps, pe, k, side=4):
@@ -2966,6 +3061,20 @@ def _joints_on_the_design(W, arc, points, is_cubic, tail, step, gfirst, glast, s
     est, tan, res, ok = _joint_estimates(W, arc, g, ps, pe, _JOINT_SIDE)
     h = 0.5 * q[:, None]
     v = np.clip(est, W[g] - h, W[g] + h)
+    # a long line beside the joint (``_JOINT_LINE``) keeps its direction: only the move
+    # along it (a move across tilts the whole line, its far end fixed, off the design line
+    # its input points were rounded from); a joint between two long lines stays
+    da = W[g] - points[tail[j - 1] - 1]
+    db = points[tail[j]] - W[g]
+    la = ~is_cubic[j - 1] & (np.hypot(da[:, 0], da[:, 1]) >= _JOINT_LINE * q)
+    lb = ~is_cubic[j] & (np.hypot(db[:, 0], db[:, 1]) >= _JOINT_LINE * q)
+    if (la | lb).any():
+        d = np.where(la[:, None], da, db)
+        ln = np.hypot(d[:, 0], d[:, 1])
+        d = d / np.where(ln > 0.0, ln, 1.0)[:, None]
+        along = W[g] + ((v - W[g]) * d).sum(axis=1)[:, None] * d
+        v = np.where((la | lb)[:, None], np.clip(along, W[g] - h, W[g] + h), v)
+        v = np.where((la & lb)[:, None], W[g], v)
     mv = np.hypot(*(v - W[g]).T)
     keep = ok & (res <= _JOINT_SMOOTH * q) & (mv >= _JOINT_MOVE * q)
     j, g, v, q, own = j[keep], g[keep], v[keep], q[keep], own[keep]
@@ -4754,17 +4863,21 @@ def _solve3(lu, piv, good, rx, ry, cx, cy) -> None:  # pragma: no cover (compile
 
 
 def _local_fits(
-    W: np.ndarray, arc: np.ndarray, lo: np.ndarray, hi: np.ndarray, at: np.ndarray
+    W: np.ndarray, arc: np.ndarray, lo: np.ndarray, hi: np.ndarray, at: np.ndarray,
+    res: np.ndarray | None = None,
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Least-squares quadratics x(s), y(s) in arc length s through the input points lo..hi
     (inclusive global indices) of each window, evaluated at the point ``at``: (position
     (V, 2), unit tangent (V, 2) in the path's direction, ok (V,): at least 4 points and a
-    well-conditioned fit)."""
+    well-conditioned fit). ``res`` (V,): filled with the largest distance of a window's
+    input point to its quadratic where ok (inf elsewhere)."""
     cnt = hi - lo + 1
     v = len(lo)
     pos = np.zeros((v, 2))
     tan = np.zeros((v, 2))
     ok = cnt >= 4
+    if res is not None:
+        res[:] = np.inf
     if not ok.any():
         return pos, tan, ok
     okk = np.flatnonzero(ok)
@@ -4789,6 +4902,16 @@ def _local_fits(
     good &= ln > 0.0
     tan[okk] = t / np.where(ln > 0.0, ln, 1.0)[:, None]
     ok[okk] = good
+    if res is not None and good.any():
+        g = np.flatnonzero(good)
+        a, b, c = lo[okk[g]], hi[okk[g]], at[okk[g]]
+        own, off = _ragged(np.arange(len(g)), b - a + 1)
+        i = a[own] + off
+        u = (arc[i] - arc[c[own]]) / np.maximum(arc[b] - arc[a], 1e-300)[own]
+        fx = cx[g, 0][own] + u * (cx[g, 1][own] + u * cx[g, 2][own])
+        fy = cy[g, 0][own] + u * (cy[g, 1][own] + u * cy[g, 2][own])
+        d = np.hypot(W[i, 0] - fx, W[i, 1] - fy)
+        res[okk[g]] = np.maximum.reduceat(d, np.cumsum(b - a + 1) - (b - a + 1))
     return pos, tan, ok
 
 
@@ -4928,6 +5051,10 @@ _CORNER_SINE = 0.25
 #: side is its thinned segment): the position at a sharp tip between two curves is then
 #: nearer the design (sans-bold "8": 0.64 -> under 0.63 from the true curve)
 _CORNER_POINTS = _SIDE_POINTS
+#: ... and give no estimate where one of its input points lies this many quanta or more off
+#: its quadratic (the window spans another corner: sans-light "J" at em 400, a 16-unit side
+#: fitted across its far corner moved the corner 0.5 away from the design's, 0.90 from it)
+_CORNER_RES = 1.0
 
 
 #: a side written as its two rounded ends only gives the corner a direction where it is at
@@ -5041,8 +5168,14 @@ def _corners_on_the_design(W, K, Q, arc, smooth, rnd, first, last, quant, eps) -
     next_c = np.minimum.accumulate(np.where(stop, idx, n - 1)[::-1])[::-1]
     lo_i = np.maximum(lo_i, K[prev_c[vi - 1]])
     hi_o = np.minimum(hi_o, K[next_c[vo + 1]])
-    p_in, t_in, ok_in = _local_fits(W, arc, lo_i, K[vi], K[vi])
-    p_out, t_out, ok_out = _local_fits(W, arc, k, hi_o, k)
+    r_in = np.empty(len(vi))
+    r_out = np.empty(len(vo))
+    p_in, t_in, ok_in = _local_fits(W, arc, lo_i, K[vi], K[vi], r_in)
+    p_out, t_out, ok_out = _local_fits(W, arc, k, hi_o, k, r_out)
+    # a curve side whose points miss their quadratic by more than _CORNER_RES quanta spans
+    # another corner (a run the curve-run rules left smooth across one): no estimate
+    ok_in &= r_in <= _CORNER_RES * quant[vi]
+    ok_out &= r_out <= _CORNER_RES * quant[vo]
     # a side that is a line (its other end a corner too): its least-squares line
     lin_in = ~smooth[vi - 1]
     if lin_in.any():
@@ -5066,6 +5199,18 @@ def _corners_on_the_design(W, K, Q, arc, smooth, rnd, first, last, quant, eps) -
     # a side of two points meeting a curve at a middling angle: neither estimate is good
     both &= ~lone | (np.abs(cr) >= _LONE_SINE) | (np.abs(cr) < _CORNER_SINE)
     tip = both & ((t_in * t_out).sum(axis=1) < _TIP_COS)
+    # a tip beside a design line written as its two rounded ends (one long input step) that
+    # the curve-run rules put in a curve run: the quadratic over that side spans the line's
+    # far end, and its tangent's error moves the crossing by the error over the sine of the
+    # small interior angle (serif-italic "g" at em 400, 155 degrees: 0.78 from the design's
+    # tip where the input point is 0.46): the tip stays (a side of two points taken as the
+    # line through them, _lone_sides, is no quadratic: it moves)
+    gap_in = ((K[vi] - K[vi - 1]) == 1) & (
+        np.hypot(*(W[K[vi]] - W[K[vi - 1]]).T) >= _LONE_LENGTH * quant[vi])
+    gap_out = ((K[vo + 1] - K[vo]) == 1) & (
+        np.hypot(*(W[K[vo + 1]] - W[K[vo]]).T) >= _LONE_LENGTH * quant[vo])
+    both &= ~(tip & ((gap_in & ~lone_in) | (gap_out & ~lone_out)))
+    tip &= both
     sharp = both & (np.abs(cr) >= _CORNER_SINE)
     # a shallow corner between a curve and a least-squares line whose points are collinear:
     # on that line (the mean would tilt the whole line by the curve's error at its end)
