@@ -104,6 +104,7 @@ from galvo_core.geometry import (
     sampled_upper_d2,
 )
 from galvo_core.job import gc_paused
+from galvo_core.minimax import minimax_cubics
 from galvo_core.precision import path_quanta
 from galvo_core.runs import segmented_cumsum, split_pieces_many
 from galvo_core.thin import check_positive, thin_many
@@ -150,6 +151,9 @@ _GN_ROUNDS = 4
 #: rounded input: the candidate with free end tangents too, each turned at most this much
 _GN_FREE = True
 _GN_TURN = math.radians(5.0)
+#: rounded input: a free Gauss-Newton cubic that fails is refined towards the least worst
+#: error (galvo_core.minimax; False: off, for measurements)
+_MINIMAX = True
 _RESPLIT_CANDIDATES = 3
 #: ... in this order (the middle one first)
 _RESPLIT_ORDER = (1, 0, 2)
@@ -1957,6 +1961,8 @@ class _BatchFitter:
             if len(v):
                 cf_, okf = self._gauss_newton_free(A[v], B[v], i0[v], i1[v], cg[v])
                 okf &= _handles_in_order(cf_)
+                # (the minimax refinement's starts: the free cubic, else the other)
+                free_v, free_c = v, np.where(okf[:, None, None], cf_, cg[v])
                 v, cf_ = v[okf], cf_[okf]
                 if len(v):
                     sk = self._sample_ok(cf_, i0[v], i1[v], self.e_per[A[v]])
@@ -1966,7 +1972,28 @@ class _BatchFitter:
                     passed[v[g]] = True
                     ctrl_all[v[g]] = cf_[g]
                     em_all[v[g]] = e[g]
+                if _MINIMAX and len(free_v):
+                    self._minimax_candidate(free_v, free_c, A, i0, i1, passed, ctrl_all,
+                                            em_all)
         return passed, ctrl_all, em_all
+
+    def _minimax_candidate(self, v, start, A, i0, i1, passed, ctrl_all, em_all) -> None:
+        """Rounded input: the pieces ``v`` whose free Gauss-Newton cubic (``start``)
+        failed, its inner control points moved to bring the worst input point under the
+        bound (:func:`galvo_core.minimax.minimax_cubics`), under the same test; in place."""
+        rest = ~passed[v]
+        v, start = v[rest], start[rest]
+        if len(v) == 0:
+            return
+        cm, okm = minimax_cubics(self.work, self.arc, i0[v], i1[v], start, self.e_per[A[v]])
+        okm &= _handles_in_order(cm)
+        v, cm = v[okm], cm[okm]
+        if len(v) == 0:
+            return
+        g, e, _, _ = self._accept(cm, i0[v], i1[v], self.e_per[A[v]], A[v])
+        passed[v[g]] = True
+        ctrl_all[v[g]] = cm[g]
+        em_all[v[g]] = e[g]
 
     def _exact(self, A: np.ndarray) -> np.ndarray:
         """Per piece starting at thinned point A: True on exact input (no rounding) and on
