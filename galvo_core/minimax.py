@@ -41,6 +41,9 @@ MINIMAX_LAWSON = 8
 MINIMAX_RADIUS = 0.5
 #: only starts whose worst point is within this many times the target are refined
 MINIMAX_START = 3.0
+#: the points whose residual is at least this share of the largest one take part in a
+#: round's Lawson iteration
+_ACTIVE = 0.5
 #: stop at this fraction of the bound (the acceptance test measures again, exactly)
 MINIMAX_TARGET = 0.995
 
@@ -112,6 +115,8 @@ def _minimax_kernel(work, arc, i0, i1, ctrl, target, rounds, lawson, radius, sta
         for j in range(n):
             u[j] = (arc[a + j] - arc[a]) / span
         lim = target[r]
+        best = math.inf
+        stale = 0
         for it in range(rounds + 1):
             ax = -p0x + 3.0 * (p1x - p2x) + p3x
             ay = -p0y + 3.0 * (p1y - p2y) + p3y
@@ -120,11 +125,13 @@ def _minimax_kernel(work, arc, i0, i1, ctrl, target, rounds, lawson, radius, sta
             dx = 3.0 * (p1x - p0x)
             dy = 3.0 * (p1y - p0y)
             emax = 0.0
+            rmax = 0.0
+            steps = 3 if it == 0 else 2
             for j in range(n):
                 qx = work[a + j, 0] - p0x
                 qy = work[a + j, 1] - p0y
                 uk = u[j]
-                for _ in range(3):
+                for _ in range(steps):
                     uk = newton_param(ax, ay, bx, by, dx, dy, qx, qy, uk)
                 u[j] = uk
                 rx = ((ax * uk + bx) * uk + dx) * uk - qx
@@ -137,34 +144,59 @@ def _minimax_kernel(work, arc, i0, i1, ctrl, target, rounds, lawson, radius, sta
                 tn = math.sqrt(tx * tx + ty * ty)
                 if not tn > 0.0:
                     tn = 1.0
-                nx = -ty / tn
-                ny = tx / tn
-                res[j] = nx * rx + ny * ry
-                sk = 1.0 - uk
-                b1 = 3.0 * sk * sk * uk
-                b2 = 3.0 * sk * uk * uk
-                jac[j, 0] = b1 * nx
-                jac[j, 1] = b1 * ny
-                jac[j, 2] = b2 * nx
-                jac[j, 3] = b2 * ny
+                res[j] = (-ty * rx + tx * ry) / tn
+                if abs(res[j]) > rmax:
+                    rmax = abs(res[j])
+                u[j] = uk
             if emax <= lim:
                 ok[r] = True
                 break
             if it == rounds or not emax <= start * lim:
                 break
+            # stalled: no round in the last two brought the worst point 1 % lower
+            if emax < 0.99 * best:
+                best = emax
+                stale = 0
+            else:
+                stale += 1
+                if stale >= 2:
+                    break
+            # the points that can decide the worst error (the others' weights vanish in
+            # Lawson's iteration anyway): residual within a share of the largest
+            na = 0
             for j in range(n):
+                if abs(res[j]) >= _ACTIVE * rmax:
+                    uk = u[j]
+                    tx = (3.0 * ax * uk + 2.0 * bx) * uk + dx
+                    ty = (3.0 * ay * uk + 2.0 * by) * uk + dy
+                    tn = math.sqrt(tx * tx + ty * ty)
+                    if not tn > 0.0:
+                        tn = 1.0
+                    nx = -ty / tn
+                    ny = tx / tn
+                    sk = 1.0 - uk
+                    b1 = 3.0 * sk * sk * uk
+                    b2 = 3.0 * sk * uk * uk
+                    jac[na, 0] = b1 * nx
+                    jac[na, 1] = b1 * ny
+                    jac[na, 2] = b2 * nx
+                    jac[na, 3] = b2 * ny
+                    w[na] = res[j]  # (its residual, moved below)
+                    na += 1
+            for j in range(na):
+                res[j] = w[j]
                 w[j] = 1.0
             found = False
             for _k in range(lawson):
                 for i in range(4):
                     for i2 in range(i, 4):
                         acc = 0.0
-                        for j in range(n):
+                        for j in range(na):
                             acc += w[j] * jac[j, i] * jac[j, i2]
                         N[i, i2] = acc
                         N[i2, i] = acc
                     acc = 0.0
-                    for j in range(n):
+                    for j in range(na):
                         acc += w[j] * jac[j, i] * res[j]
                     g[i] = -acc
                 tr = N[0, 0] + N[1, 1] + N[2, 2] + N[3, 3]
@@ -185,14 +217,14 @@ def _minimax_kernel(work, arc, i0, i1, ctrl, target, rounds, lawson, radius, sta
                     d[i] = dt[i]
                 found = True
                 ws = 0.0
-                for j in range(n):
+                for j in range(na):
                     rr = abs(res[j] + jac[j, 0] * d[0] + jac[j, 1] * d[1]
                              + jac[j, 2] * d[2] + jac[j, 3] * d[3])
                     w[j] *= rr
                     ws += w[j]
                 if not ws > 0.0:
                     break
-                for j in range(n):
+                for j in range(na):
                     w[j] /= ws
             if not found:
                 break
