@@ -1371,6 +1371,7 @@ class _BatchFitter:
         first = np.flatnonzero(head)
         last = first + size - 1
         pick = np.flatnonzero(size >= _GREEDY_MIN)
+        assert self.quant is not None  # (called on rounded input only)
         pick = pick[(self.quant[A[first[pick]]] > 0.0) & self._exact(A[first[pick]])]
         if len(pick) == 0:
             return False
