@@ -107,6 +107,7 @@ from galvo_core.geometry import (
     seeded_nearest,
 )
 from galvo_core.job import gc_paused
+from galvo_core.minimax import minimax_cubics
 from galvo_core.precision import path_quanta
 from galvo_core.runs import segmented_cumsum, split_pieces_many
 from galvo_core.thin import check_positive, thin_many
@@ -153,6 +154,11 @@ _GN_ROUNDS = 4
 #: rounded input: the candidate with free end tangents too, each turned at most this much
 _GN_FREE = True
 _GN_TURN = math.radians(5.0)
+#: rounded input: a free Gauss-Newton cubic that fails is refined towards the least worst
+#: error (galvo_core.minimax; False: off, for measurements)
+_MINIMAX = True
+#: rounded input: the greedy refit also from each chain's end (False: off, for measurements)
+_GREEDY_BACK = True
 _RESPLIT_CANDIDATES = 3
 #: ... in this order (the middle one first)
 _RESPLIT_ORDER = (1, 0, 2)
@@ -1690,6 +1696,107 @@ class _BatchFitter:
             if not (self._resplit_round(0) | self._resplit_round(1) | self._resplit_round(2)):
                 break
         self._greedy_round()
+        if _GREEDY_BACK and self.quant is not None:
+            self._greedy_back_round()
+
+    def _greedy_back_round(self) -> bool:
+        """Rounded input whose rounding is a fair share of the bound (:meth:`_exact`):
+        :meth:`_greedy_round` from each chain's end backwards (each cubic reaching back to
+        the earliest thinned point where one passes). On rounded input a cubic may reach a
+        little past a design joint within the bound, so the forward pass lags a little
+        more at every joint and can end with one cubic more than the design has (a closed
+        4-cubic oval in 5); from the other end the lags fall elsewhere. Replaced where it
+        takes fewer segments than the chain has now. True when something changed."""
+        A, B, C, E, isl = self._all_segments()
+        n = len(A)
+        if n < _GREEDY_MIN:
+            return False
+        cub = ~isl
+        smooth = (self.t_in[B[:-1]] == self.t_out[B[:-1]]).all(axis=1)
+        adj = cub[:-1] & cub[1:] & (B[:-1] == A[1:]) & smooth
+        head = np.r_[True, ~adj]
+        cid = np.cumsum(head) - 1
+        size = np.bincount(cid)
+        first = np.flatnonzero(head)
+        last = first + size - 1
+        pick = np.flatnonzero(size >= _GREEDY_MIN)
+        assert self.quant is not None  # (called on rounded input only)
+        pick = pick[(self.quant[A[first[pick]]] > 0.0) & self._exact(A[first[pick]])]
+        if len(pick) == 0:
+            return False
+        old = size[pick]
+        firstseg = first[pick]
+        # (negated thinned indices: the forward search's arithmetic, backwards)
+        cur = -B[last[pick]]
+        end = -A[firstseg]
+
+        def cap(c, i):  # the earliest start tried for the end -c: _GREEDY_SPAN old segments
+            cs = np.searchsorted(B, -c, side="left")
+            return -A[np.maximum(cs - _GREEDY_SPAN + 1, firstseg[i])]
+
+        bnd = cap(cur, np.arange(len(cur)))
+        lo = cur.copy()
+        hi = bnd + 1
+        made = np.zeros(len(pick), dtype=np.intp)
+        live = np.ones(len(pick), dtype=bool)
+        done = np.zeros(len(pick), dtype=bool)
+        best_c = np.zeros((len(pick), 4, 2))
+        best_e = np.zeros(len(pick))
+        out_k: list[np.ndarray] = []
+        out_a: list[np.ndarray] = []
+        out_b: list[np.ndarray] = []
+        out_c: list[np.ndarray] = []
+        out_e: list[np.ndarray] = []
+        while live.any():
+            w = np.flatnonzero(live)
+            mid = np.where(hi[w] > bnd[w], bnd[w], (lo[w] + hi[w]) // 2)
+            ok, ctrl, em = self._try(-mid, -cur[w])
+            g = w[ok]
+            lo[g] = mid[ok]
+            best_c[g] = ctrl[ok]
+            best_e[g] = em[ok]
+            hi[w[~ok]] = mid[~ok]
+            settled = w[(hi[w] - lo[w] <= 1) | (lo[w] == bnd[w])]
+            if len(settled) == 0:
+                continue
+            none = settled[lo[settled] == cur[settled]]
+            # no cubic to cur: the old segment ending there stays
+            os_ = np.searchsorted(B, -cur[none])
+            has = (os_ < n) & (B[np.minimum(os_, n - 1)] == -cur[none])
+            live[none[~has]] = False
+            none, os_ = none[has], os_[has]
+            lo[none] = -A[os_]
+            best_c[none] = C[os_]
+            best_e[none] = E[os_]
+            s = settled[lo[settled] > cur[settled]]
+            out_k.append(s)
+            out_a.append(-lo[s])
+            out_b.append(-cur[s])
+            out_c.append(best_c[s].copy())
+            out_e.append(best_e[s].copy())
+            made[s] += 1
+            fin = s[lo[s] == end[s]]
+            done[fin] = made[fin] < old[fin]
+            live[fin] = False
+            go = s[lo[s] < end[s]]
+            live[go[made[go] + 1 >= old[go]]] = False
+            go = go[live[go]]
+            cur[go] = lo[go]
+            bnd[go] = cap(cur[go], go)
+            hi[go] = bnd[go] + 1
+        if not done.any():
+            return False
+        k = np.concatenate(out_k)
+        keep_new = done[k]
+        drop = np.isin(cid, pick[done])
+        A2 = np.concatenate([A[~drop], np.concatenate(out_a)[keep_new]])
+        B2 = np.concatenate([B[~drop], np.concatenate(out_b)[keep_new]])
+        C2 = np.concatenate([C[~drop], np.concatenate(out_c)[keep_new]])
+        E2 = np.concatenate([E[~drop], np.concatenate(out_e)[keep_new]])
+        L2 = np.concatenate([isl[~drop], np.zeros(int(keep_new.sum()), dtype=bool)])
+        o = np.argsort(A2, kind="stable")
+        self._store(A2[o], B2[o], C2[o], E2[o], L2[o])
+        return True
 
     def _greedy_round(self) -> bool:
         """Chains of at least ``_GREEDY_MIN`` adjacent cubics meeting at smooth vertices
@@ -2276,6 +2383,8 @@ class _BatchFitter:
             if len(v):
                 cf_, okf = self._gauss_newton_free(A[v], B[v], i0[v], i1[v], cg[v])
                 okf &= _handles_in_order(cf_)
+                # (the minimax refinement's starts: the free cubic, else the other)
+                free_v, free_c = v, np.where(okf[:, None, None], cf_, cg[v])
                 v, cf_ = v[okf], cf_[okf]
                 if len(v):
                     sk = self._sample_ok(cf_, i0[v], i1[v], self.e_per[A[v]])
@@ -2285,7 +2394,28 @@ class _BatchFitter:
                     passed[v[g]] = True
                     ctrl_all[v[g]] = cf_[g]
                     em_all[v[g]] = e[g]
+                if _MINIMAX and len(free_v):
+                    self._minimax_candidate(free_v, free_c, A, i0, i1, passed, ctrl_all,
+                                            em_all)
         return passed, ctrl_all, em_all
+
+    def _minimax_candidate(self, v, start, A, i0, i1, passed, ctrl_all, em_all) -> None:
+        """Rounded input: the pieces ``v`` whose free Gauss-Newton cubic (``start``)
+        failed, its inner control points moved to bring the worst input point under the
+        bound (:func:`galvo_core.minimax.minimax_cubics`), under the same test; in place."""
+        rest = ~passed[v]
+        v, start = v[rest], start[rest]
+        if len(v) == 0:
+            return
+        cm, okm = minimax_cubics(self.work, self.arc, i0[v], i1[v], start, self.e_per[A[v]])
+        okm &= _handles_in_order(cm)
+        v, cm = v[okm], cm[okm]
+        if len(v) == 0:
+            return
+        g, e, _, _ = self._accept(cm, i0[v], i1[v], self.e_per[A[v]], A[v])
+        passed[v[g]] = True
+        ctrl_all[v[g]] = cm[g]
+        em_all[v[g]] = e[g]
 
     def _exact(self, A: np.ndarray) -> np.ndarray:
         """Per piece starting at thinned point A: True on exact input (no rounding) and on
