@@ -44,8 +44,18 @@ MINIMAX_START = 3.0
 #: the points whose residual is at least this share of the largest one take part in a
 #: round's Lawson iteration
 _ACTIVE = 0.5
+#: the rounds move the cubic for the points within this share of the worst distance at the
+#: last full pass (the others are measured again once these pass)
+_WATCH = 0.8
+#: ... and at first a strided sample of about this many points
+_SAMPLE = 48
 #: stop at this fraction of the bound (the acceptance test measures again, exactly)
 MINIMAX_TARGET = 0.995
+
+
+#: work done (diagnostics): points measured in full passes, watched-point measures, 4 x 4
+#: solves, rounds
+COUNTS = np.zeros(4, dtype=np.int64)
 
 
 @njit(cache=True, nogil=True)
@@ -82,17 +92,44 @@ def _solve4(N, g, lam, d):  # type: ignore[no-untyped-def]  # pragma: no cover (
     return True
 
 
+@njit(cache=True, nogil=True, inline="always")
+def _point(work, k, p0x, p0y, ax, ay, bx, by, dx, dy, uk, steps):  # type: ignore[no-untyped-def]  # pragma: no cover (compiled)
+    """Input point ``k``'s nearest parameter (``steps`` Newton steps from ``uk``), its
+    distance and its signed normal residual: (u, e, res)."""
+    qx = work[k, 0] - p0x
+    qy = work[k, 1] - p0y
+    for _ in range(steps):
+        uk = newton_param(ax, ay, bx, by, dx, dy, qx, qy, uk)
+    rx = ((ax * uk + bx) * uk + dx) * uk - qx
+    ry = ((ay * uk + by) * uk + dy) * uk - qy
+    e = math.sqrt(rx * rx + ry * ry)
+    tx = (3.0 * ax * uk + 2.0 * bx) * uk + dx
+    ty = (3.0 * ay * uk + 2.0 * by) * uk + dy
+    tn = math.sqrt(tx * tx + ty * ty)
+    if not tn > 0.0:
+        tn = 1.0
+    return uk, e, (-ty * rx + tx * ry) / tn
+
+
 @njit(cache=True, nogil=True, error_model="numpy")
 def _minimax_kernel(work, arc, i0, i1, ctrl, target, rounds, lawson, radius, start,
-                    out, ok):  # type: ignore[no-untyped-def]  # pragma: no cover (compiled)
-    """:func:`minimax_cubics`, one piece at a time (compiled)."""
+                    out, ok, cnt):  # type: ignore[no-untyped-def]  # pragma: no cover (compiled)
+    """:func:`minimax_cubics`, one piece at a time (compiled). The rounds see only the
+    *watched* points (those within ``_WATCH`` of the worst distance at the last full
+    pass); all points are measured again only when the watched ones are all within the
+    target, and the ones then over ``_WATCH`` of the worst are watched too (an exchange
+    method: a long piece's hundreds of points cost two or three full passes, not one per
+    round)."""
     nmax = 1
     for r in range(len(i0)):
         nmax = max(nmax, i1[r] - i0[r] + 1)
     u = np.empty(nmax)
+    e_all = np.empty(nmax)
     res = np.empty(nmax)
     jac = np.empty((nmax, 4))
     w = np.empty(nmax)
+    wl = np.empty(nmax, dtype=np.intp)
+    inw = np.zeros(nmax, dtype=np.bool_)
     N = np.empty((4, 4))
     g = np.empty(4)
     d = np.zeros(4)
@@ -109,14 +146,29 @@ def _minimax_kernel(work, arc, i0, i1, ctrl, target, rounds, lawson, radius, sta
         p2y = ctrl[r, 2, 1]
         p3x = ctrl[r, 3, 0]
         p3y = ctrl[r, 3, 1]
+        out[r, 0, 0] = p0x
+        out[r, 0, 1] = p0y
+        out[r, 3, 0] = p3x
+        out[r, 3, 1] = p3y
         span = arc[i1[r]] - arc[a]
         if not span > 0.0 or n < 3:
             continue
         for j in range(n):
             u[j] = (arc[a + j] - arc[a]) / span
+            inw[j] = False
         lim = target[r]
         best = math.inf
         stale = 0
+        lrel = 1e-9
+        # the first rounds watch a strided sample of the points
+        stride = max(1, n // _SAMPLE)
+        nw = 0
+        for j in range(stride // 2, n, stride):
+            inw[j] = True
+            wl[nw] = j
+            nw += 1
+        full = False  # (this round measures every point)
+        steps = 3  # (the first full pass starts from arc-length parameters)
         for it in range(rounds + 1):
             ax = -p0x + 3.0 * (p1x - p2x) + p3x
             ay = -p0y + 3.0 * (p1y - p2y) + p3y
@@ -125,33 +177,45 @@ def _minimax_kernel(work, arc, i0, i1, ctrl, target, rounds, lawson, radius, sta
             dx = 3.0 * (p1x - p0x)
             dy = 3.0 * (p1y - p0y)
             emax = 0.0
-            rmax = 0.0
-            steps = 3 if it == 0 else 2
-            for j in range(n):
-                qx = work[a + j, 0] - p0x
-                qy = work[a + j, 1] - p0y
-                uk = u[j]
-                for _ in range(steps):
-                    uk = newton_param(ax, ay, bx, by, dx, dy, qx, qy, uk)
+            ws = 3 if it == 0 else 2
+            for t in range(nw):
+                j = wl[t]
+                uk, e, rs = _point(work, a + j, p0x, p0y, ax, ay, bx, by, dx, dy, u[j], ws)
                 u[j] = uk
-                rx = ((ax * uk + bx) * uk + dx) * uk - qx
-                ry = ((ay * uk + by) * uk + dy) * uk - qy
-                e = math.sqrt(rx * rx + ry * ry)
+                res[j] = rs
                 if not e <= emax:
                     emax = e
-                tx = (3.0 * ax * uk + 2.0 * bx) * uk + dx
-                ty = (3.0 * ay * uk + 2.0 * by) * uk + dy
-                tn = math.sqrt(tx * tx + ty * ty)
-                if not tn > 0.0:
-                    tn = 1.0
-                res[j] = (-ty * rx + tx * ry) / tn
-                if abs(res[j]) > rmax:
-                    rmax = abs(res[j])
-                u[j] = uk
-            if emax <= lim:
-                ok[r] = True
+            # (the sample's worst is at most the piece's: a far start is given up)
+            if it == 0 and not emax <= start * lim:
                 break
-            if it == rounds or not emax <= start * lim:
+            if emax <= lim:  # the watched points pass: measure them all
+                full = True
+            cnt[1] += nw
+            cnt[3] += 1
+            if full:
+                cnt[0] += n
+                emax = 0.0
+                for j in range(n):
+                    uk, e, rs = _point(work, a + j, p0x, p0y, ax, ay, bx, by, dx, dy, u[j],
+                                       steps)
+                    u[j] = uk
+                    res[j] = rs
+                    e_all[j] = e
+                    if not e <= emax:
+                        emax = e
+                steps = 2
+                if emax <= lim:
+                    ok[r] = True
+                    break
+                for j in range(n):  # (the exchange: the new near-worst points watched)
+                    if e_all[j] >= _WATCH * emax and not inw[j]:
+                        inw[j] = True
+                        wl[nw] = j
+                        nw += 1
+                full = False
+                best = math.inf  # (a new set of points: progress is measured afresh)
+                stale = 0
+            if it == rounds:
                 break
             # stalled: no round in the last two brought the worst point 1 % lower
             if emax < 0.99 * best:
@@ -163,8 +227,12 @@ def _minimax_kernel(work, arc, i0, i1, ctrl, target, rounds, lawson, radius, sta
                     break
             # the points that can decide the worst error (the others' weights vanish in
             # Lawson's iteration anyway): residual within a share of the largest
+            rmax = 0.0
+            for t in range(nw):
+                rmax = max(rmax, abs(res[wl[t]]))
             na = 0
-            for j in range(n):
+            for t in range(nw):
+                j = wl[t]
                 if abs(res[j]) >= _ACTIVE * rmax:
                     uk = u[j]
                     tx = (3.0 * ax * uk + 2.0 * bx) * uk + dx
@@ -181,11 +249,9 @@ def _minimax_kernel(work, arc, i0, i1, ctrl, target, rounds, lawson, radius, sta
                     jac[na, 1] = b1 * ny
                     jac[na, 2] = b2 * nx
                     jac[na, 3] = b2 * ny
-                    w[na] = res[j]  # (its residual, moved below)
+                    e_all[na] = res[j]  # (the active residuals, packed; e_all is rebuilt
+                    w[na] = 1.0         # at the next full pass)
                     na += 1
-            for j in range(na):
-                res[j] = w[j]
-                w[j] = 1.0
             found = False
             for _k in range(lawson):
                 for i in range(4):
@@ -197,14 +263,15 @@ def _minimax_kernel(work, arc, i0, i1, ctrl, target, rounds, lawson, radius, sta
                         N[i2, i] = acc
                     acc = 0.0
                     for j in range(na):
-                        acc += w[j] * jac[j, i] * res[j]
+                        acc += w[j] * jac[j, i] * e_all[j]
                     g[i] = -acc
                 tr = N[0, 0] + N[1, 1] + N[2, 2] + N[3, 3]
                 if not tr > 0.0:
                     break
-                lam = 1e-9 * tr
+                lam = lrel * tr
                 good = False
                 for _t in range(24):  # damped until the step is inside the radius
+                    cnt[2] += 1
                     if _solve4(N, g, lam, dt):
                         big = max(max(abs(dt[0]), abs(dt[1])), max(abs(dt[2]), abs(dt[3])))
                         if big <= radius:
@@ -213,12 +280,14 @@ def _minimax_kernel(work, arc, i0, i1, ctrl, target, rounds, lawson, radius, sta
                     lam = max(4.0 * lam, 1e-6 * tr)
                 if not good:
                     break
+                # (the next solve starts near this damping: most need the same)
+                lrel = max(1e-9, 0.25 * lam / tr)
                 for i in range(4):
                     d[i] = dt[i]
                 found = True
                 ws = 0.0
                 for j in range(na):
-                    rr = abs(res[j] + jac[j, 0] * d[0] + jac[j, 1] * d[1]
+                    rr = abs(e_all[j] + jac[j, 0] * d[0] + jac[j, 1] * d[1]
                              + jac[j, 2] * d[2] + jac[j, 3] * d[3])
                     w[j] *= rr
                     ws += w[j]
@@ -232,14 +301,10 @@ def _minimax_kernel(work, arc, i0, i1, ctrl, target, rounds, lawson, radius, sta
             p1y += d[1]
             p2x += d[2]
             p2y += d[3]
-        out[r, 0, 0] = p0x
-        out[r, 0, 1] = p0y
         out[r, 1, 0] = p1x
         out[r, 1, 1] = p1y
         out[r, 2, 0] = p2x
         out[r, 2, 1] = p2y
-        out[r, 3, 0] = p3x
-        out[r, 3, 1] = p3y
 
 
 def minimax_cubics(work: np.ndarray, arc: np.ndarray, i0: np.ndarray, i1: np.ndarray,
@@ -257,5 +322,6 @@ def minimax_cubics(work: np.ndarray, arc: np.ndarray, i0: np.ndarray, i1: np.nda
                     np.ascontiguousarray(i1, dtype=np.intp),
                     np.ascontiguousarray(ctrl, dtype=np.float64),
                     np.ascontiguousarray(MINIMAX_TARGET * np.asarray(bound, dtype=np.float64)),
-                    MINIMAX_ROUNDS, MINIMAX_LAWSON, MINIMAX_RADIUS, MINIMAX_START, out, ok)
+                    MINIMAX_ROUNDS, MINIMAX_LAWSON, MINIMAX_RADIUS, MINIMAX_START, out, ok,
+                    COUNTS)
     return out, ok
