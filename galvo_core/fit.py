@@ -157,8 +157,11 @@ _GN_TURN = math.radians(5.0)
 #: rounded input: a free Gauss-Newton cubic that fails is refined towards the least worst
 #: error (galvo_core.minimax; False: off, for measurements)
 _MINIMAX = True
+#: ... only where every sampled input point of the start is within this many times the
+#: bound (the near misses: the refinement rarely brings a farther start under it)
+_MINIMAX_NEAR = 1.3
 #: rounded input: the greedy refit also from each chain's end (False: off, for measurements)
-_GREEDY_BACK = True
+_GREEDY_BACK = False
 _RESPLIT_CANDIDATES = 3
 #: ... in this order (the middle one first)
 _RESPLIT_ORDER = (1, 0, 2)
@@ -2405,6 +2408,12 @@ class _BatchFitter:
         bound (:func:`galvo_core.minimax.minimax_cubics`), under the same test; in place."""
         rest = ~passed[v]
         v, start = v[rest], start[rest]
+        if len(v) == 0:
+            return
+        # near misses only: a start whose sampled points are all within _MINIMAX_NEAR of
+        # the bound (a cheap necessary test; most pieces refined from farther fail anyway)
+        near = self._sample_ok(start, i0[v], i1[v], _MINIMAX_NEAR * self.e_per[A[v]])
+        v, start = v[near], start[near]
         if len(v) == 0:
             return
         cm, okm = minimax_cubics(self.work, self.arc, i0[v], i1[v], start, self.e_per[A[v]])

@@ -49,6 +49,8 @@ _ACTIVE = 0.5
 _WATCH = 0.8
 #: ... and at first a strided sample of about this many points
 _SAMPLE = 48
+#: a refined cubic stays near its start: no inner control-point coordinate moved farther (units)
+MINIMAX_MOVE = 0.5
 #: stop at this fraction of the bound (the acceptance test measures again, exactly)
 MINIMAX_TARGET = 0.995
 
@@ -113,7 +115,7 @@ def _point(work, k, p0x, p0y, ax, ay, bx, by, dx, dy, uk, steps):  # type: ignor
 
 @njit(cache=True, nogil=True, error_model="numpy")
 def _minimax_kernel(work, arc, i0, i1, ctrl, target, rounds, lawson, radius, start,
-                    out, ok, cnt):  # type: ignore[no-untyped-def]  # pragma: no cover (compiled)
+                    out, ok, cnt, active, watch, sample, move):  # type: ignore[no-untyped-def]  # pragma: no cover (compiled)
     """:func:`minimax_cubics`, one piece at a time (compiled). The rounds see only the
     *watched* points (those within ``_WATCH`` of the worst distance at the last full
     pass); all points are measured again only when the watched ones are all within the
@@ -161,7 +163,7 @@ def _minimax_kernel(work, arc, i0, i1, ctrl, target, rounds, lawson, radius, sta
         stale = 0
         lrel = 1e-9
         # the first rounds watch a strided sample of the points
-        stride = max(1, n // _SAMPLE)
+        stride = max(1, n // sample)
         nw = 0
         for j in range(stride // 2, n, stride):
             inw[j] = True
@@ -205,10 +207,15 @@ def _minimax_kernel(work, arc, i0, i1, ctrl, target, rounds, lawson, radius, sta
                         emax = e
                 steps = 2
                 if emax <= lim:
-                    ok[r] = True
+                    # ... and it stayed near its start (a near miss needs a small
+                    # correction; a cubic moved far to keep its worst points in is bent
+                    # off the design elsewhere, the bound on rounded points being loose)
+                    ok[r] = (max(abs(p1x - ctrl[r, 1, 0]), abs(p1y - ctrl[r, 1, 1]),
+                                 abs(p2x - ctrl[r, 2, 0]), abs(p2y - ctrl[r, 2, 1]))
+                             <= move)
                     break
                 for j in range(n):  # (the exchange: the new near-worst points watched)
-                    if e_all[j] >= _WATCH * emax and not inw[j]:
+                    if e_all[j] >= watch * emax and not inw[j]:
                         inw[j] = True
                         wl[nw] = j
                         nw += 1
@@ -233,7 +240,7 @@ def _minimax_kernel(work, arc, i0, i1, ctrl, target, rounds, lawson, radius, sta
             na = 0
             for t in range(nw):
                 j = wl[t]
-                if abs(res[j]) >= _ACTIVE * rmax:
+                if abs(res[j]) >= active * rmax:
                     uk = u[j]
                     tx = (3.0 * ax * uk + 2.0 * bx) * uk + dx
                     ty = (3.0 * ay * uk + 2.0 * by) * uk + dy
@@ -323,5 +330,5 @@ def minimax_cubics(work: np.ndarray, arc: np.ndarray, i0: np.ndarray, i1: np.nda
                     np.ascontiguousarray(ctrl, dtype=np.float64),
                     np.ascontiguousarray(MINIMAX_TARGET * np.asarray(bound, dtype=np.float64)),
                     MINIMAX_ROUNDS, MINIMAX_LAWSON, MINIMAX_RADIUS, MINIMAX_START, out, ok,
-                    COUNTS)
+                    COUNTS, _ACTIVE, _WATCH, _SAMPLE, MINIMAX_MOVE)
     return out, ok
