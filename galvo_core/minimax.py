@@ -308,6 +308,9 @@ def _minimax_kernel(work, arc, i0, i1, ctrl, target, rounds, lawson, radius, sta
             p1y += d[1]
             p2x += d[2]
             p2y += d[3]
+            if not (max(abs(p1x - ctrl[r, 1, 0]), abs(p1y - ctrl[r, 1, 1]),
+                        abs(p2x - ctrl[r, 2, 0]), abs(p2y - ctrl[r, 2, 1])) <= move):
+                break  # (moved too far: see below)
         out[r, 1, 0] = p1x
         out[r, 1, 1] = p1y
         out[r, 2, 0] = p2x
