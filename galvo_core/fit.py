@@ -160,6 +160,10 @@ _MINIMAX = True
 #: ... only where every sampled input point of the start is within this many times the
 #: bound (the near misses: the refinement rarely brings a farther start under it)
 _MINIMAX_NEAR = 1.3
+#: ... also in the greedy chain refit (:meth:`_BatchFitter._greedy_round`): fewer segments
+#: on cubic typefaces, but there the long refined cubics moved fitted joints and corners off
+#: the design (bench/RESULTS.md, "CFF counts, seventh session")
+_MINIMAX_GREEDY = True
 #: rounded input: the greedy refit also from each chain's end (False: off, for measurements)
 _GREEDY_BACK = False
 _RESPLIT_CANDIDATES = 3
@@ -1698,7 +1702,9 @@ class _BatchFitter:
         for _ in range(_RESPLIT_ROUNDS):
             if not (self._resplit_round(0) | self._resplit_round(1) | self._resplit_round(2)):
                 break
+        self._refine = _MINIMAX_GREEDY
         self._greedy_round()
+        self._refine = True
         if _GREEDY_BACK and self.quant is not None:
             self._greedy_back_round()
 
@@ -2408,7 +2414,7 @@ class _BatchFitter:
         bound (:func:`galvo_core.minimax.minimax_cubics`), under the same test; in place."""
         rest = ~passed[v]
         v, start = v[rest], start[rest]
-        if len(v) == 0:
+        if len(v) == 0 or not getattr(self, "_refine", True):
             return
         # near misses only: a start whose sampled points are all within _MINIMAX_NEAR of
         # the bound (a cheap necessary test; most pieces refined from farther fail anyway)
