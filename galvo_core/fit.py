@@ -65,7 +65,8 @@ dichotomy's splits fall on the data's crossings, not on the design's joints). A 
 cubic is screened first (a coarse dichotomy on a few points) and a range that failed is
 not tried again. Rounded input: corners move inside their rounding squares onto the
 intersection of the two sides' least-squares lines (or quadratics), and a long input
-segment (over ``_LONG_SEGMENT`` quanta) leaves a curve only part of the slack beside it.
+segment (over ``_LONG_SEGMENT`` quanta) leaves a curve only part of the slack beside it,
+unless it is a chord of a coarsely flattened curve (:func:`_coarse_chords`).
 The vertices move onto the design only on paths where q/√2 is at least ``_MOVE_SHARE`` of
 e_per (a move gains at most q/√2); there a line over a bulging stretch of the design is
 split on the design estimate (:func:`_split_bulging_lines`).
@@ -187,6 +188,11 @@ _MOVE_SHARE = 0.5
 #: only that share of the rounding slack beside it (at least ``_LONG_FLOOR``)
 _LONG_SEGMENT = 10.0
 _LONG_FLOOR = 0.5
+#: ... unless it is a chord of a coarsely flattened curve (:func:`_coarse_chords`): its
+#: neighbour at a gentle vertex at most this many times longer or shorter, the turn there
+#: more than this many quanta across the shorter side
+_COARSE_RATIO = 3.0
+_COARSE_NOISE = 1.5
 _ABSORB_TURN = math.radians(30)
 #: ... but on rounded input a line without input points between its ends, longer than this
 #: many times the bound, is the design's and stays
@@ -508,6 +514,23 @@ def _bound_pair(ax, ay, bx, by, dx, dy, ex, ey, a0, a1, b0, b1, u0, u1,
     return math.sqrt(perp * perp + over * over)
 
 
+@njit(cache=True, nogil=True, inline="always")
+def _piece_start(cm, r, i0, i1, starts, arc, u, dist):  # pragma: no cover (compiled)
+    """The acceptance tests' per-piece set-up: piece r's power coefficients (ax, ay, bx, by,
+    dx, dy, ex, ey), its first input point, its first flat index, its point count and arc
+    span (1 where none); its ends' parameters and distances set (0 and 1, distance 0)."""
+    base = i0[r]
+    s = starts[r]
+    cnt = i1[r] - base + 1
+    span = arc[i1[r]] - arc[base]
+    u[s] = 0.0
+    dist[s] = 0.0
+    u[s + cnt - 1] = 1.0
+    dist[s + cnt - 1] = 0.0
+    return (cm[r, 0, 0], cm[r, 0, 1], cm[r, 1, 0], cm[r, 1, 1], cm[r, 2, 0], cm[r, 2, 1],
+            cm[r, 3, 0], cm[r, 3, 1], base, s, cnt, span if span > 0 else 1.0)
+
+
 @njit(cache=True, nogil=True)
 def _accept_points(cm, i0, i1, starts, work, arc, e2, u, dist, emax0,
                    far) -> int:  # pragma: no cover (compiled)
@@ -516,75 +539,21 @@ def _accept_points(cm, i0, i1, starts, work, arc, e2, u, dist, emax0,
     interior point's parameter (6 Newton steps from arc length, as :func:`_newton_kernel`,
     bit for bit) and distance into ``u``, ``dist`` (the ends: 0 and 1, distance 0), the
     piece's largest distance into ``emax0`` (NaN if any is), and the flat indices of the
-    points over ``e2[r]`` in pieces within 4 e2[r] into ``far``; returns their number."""
-    nfar = 0
-    ub = np.empty(_ACCEPT_CHUNK)
-    qxb = np.empty(_ACCEPT_CHUNK)
-    qyb = np.empty(_ACCEPT_CHUNK)
-    db = np.empty(_ACCEPT_CHUNK)
-    for r in range(len(i0)):
-        ax = cm[r, 0, 0]
-        ay = cm[r, 0, 1]
-        bx = cm[r, 1, 0]
-        by = cm[r, 1, 1]
-        dx = cm[r, 2, 0]
-        dy = cm[r, 2, 1]
-        ex = cm[r, 3, 0]
-        ey = cm[r, 3, 1]
-        base = i0[r]
-        s = starts[r]
-        cnt = i1[r] - base + 1
-        span = arc[i1[r]] - arc[base]
-        den = span if span > 0 else 1.0
-        u[s] = 0.0
-        dist[s] = 0.0
-        u[s + cnt - 1] = 1.0
-        dist[s + cnt - 1] = 0.0
-        worst = 0.0
-        nan = False
-        for c0 in range(1, cnt - 1, _ACCEPT_CHUNK):
-            c1 = min(cnt - 1, c0 + _ACCEPT_CHUNK)
-            n = c1 - c0
-            for j in range(n):
-                k = base + c0 + j
-                qxb[j] = work[k, 0] - ex
-                qyb[j] = work[k, 1] - ey
-                ub[j] = (arc[k] - arc[base]) / den
-            for _ in range(6):  # (step by step over the chunk: the loop vectorises)
-                for j in range(n):
-                    uk = ub[j]
-                    ub[j] = newton_param(ax, ay, bx, by, dx, dy, qxb[j], qyb[j], uk)
-            for j in range(n):
-                k = base + c0 + j
-                uk = ub[j]
-                rx = ((ax * uk + bx) * uk + dx) * uk - (work[k, 0] - ex)
-                ry = ((ay * uk + by) * uk + dy) * uk - (work[k, 1] - ey)
-                db[j] = math.sqrt(rx * rx + ry * ry)
-            for j in range(n):
-                d = db[j]
-                u[s + c0 + j] = ub[j]
-                dist[s + c0 + j] = d
-                if d > worst:
-                    worst = d
-                elif d != d:
-                    nan = True
-        emax0[r] = np.nan if nan else worst
-        lim = e2[r]
-        if not nan and worst > lim and worst <= 4.0 * lim:
-            for j in range(1, cnt - 1):
-                if dist[s + j] > lim:
-                    far[nfar] = s + j
-                    nfar += 1
-    return nfar
+    points over ``e2[r]`` in pieces within 4 e2[r] into ``far``; returns their number
+    (:func:`_accept_kernel` in full)."""
+    return _accept_kernel(np.empty((0, 4, 2)), cm, i0, i1, starts, work, arc, e2,
+                          np.empty(0), np.empty((0, 4)), u, dist, emax0,
+                          np.empty(0, dtype=np.bool_), far, False)
 
 
 @njit(cache=True, nogil=True, error_model="numpy")
-def _accept_pairs(cm, i0, i1, starts, work, u, e2, qa, ok) -> None:  # pragma: no cover
+def _accept_pairs(cm, i0, i1, starts, work, u, e2, qa, coarse, ok) -> None:  # pragma: no cover
     """:meth:`_BatchFitter._accept`'s curve-to-polyline side (compiled): for each piece r
     still ``ok``, the bound (:func:`_bound_pair`) of every pair of consecutive input
     points, plus on rounded input (``qa[r]`` > 0, else qa of length 0) the rounding slack
-    the curve may not use beside a long input segment; ``ok[r]`` False where one is over
-    ``e2[r]``.
+    the curve may not use beside a long input segment (all of it beside one that
+    ``coarse`` marks, per point of ``work``: :func:`_coarse_chords`; length 0 with qa);
+    ``ok[r]`` False where one is over ``e2[r]``.
 
     A cheap upper bound first, for a chunk of pairs at a time (the loop vectorises); the
     exact bound only where it does not pass. Over u0..u1 the cubic keeps within S =
@@ -654,7 +623,8 @@ def _accept_pairs(cm, i0, i1, starts, work, u, e2, qa, ok) -> None:  # pragma: n
                 perp += sag + marg
                 over += sag + marg
                 # the slack (0 on short segments), a little over
-                f = min(max(_LONG_SEGMENT * q / lns, _LONG_FLOOR), 1.0)
+                f = 1.0 if quant and coarse[k] else min(max(_LONG_SEGMENT * q / lns,
+                                                             _LONG_FLOOR), 1.0)
                 room = lim - (sl * (1.0 - f) + 1e-9 * sl)
                 chk = px0 + py0 + px1 + py1 + tx + ty + sag + room  # (NaN, inf: no pass)
                 fb[j] = ((perp * perp + over * over <= room * room) & (room >= 0.0)
@@ -671,7 +641,7 @@ def _accept_pairs(cm, i0, i1, starts, work, u, e2, qa, ok) -> None:  # pragma: n
                                   u[s + c0 + j], u[s + c0 + j + 1], uu)
                 if quant:
                     f = 1.0
-                    if q > 0.0:
+                    if q > 0.0 and not coarse[k]:
                         f = min(max(_LONG_SEGMENT * q / math.hypot(b0 - a0, b1 - a1),
                                     _LONG_FLOOR), 1.0)
                     bnd = bnd + sl * (1.0 - f)
@@ -689,6 +659,7 @@ _SEED_U, _SEED_BASIS = seed_basis(48)
 _SEED_ITERS = 6
 #: no quanta (:func:`_accept_pairs` on exact input)
 _NO_QUANTA = np.zeros(0)
+_NO_COARSE = np.zeros(0, dtype=np.bool_)
 
 
 #: points per chunk of :func:`_accept_quick` (each chunk strided over the whole piece)
@@ -709,40 +680,44 @@ def _accept_quick(ctrl, cm, i0, i1, starts, work, arc, e2, su, basis, u, dist, e
     that stays over, or that Newton leaves over 4 e2[r] (or NaN): :func:`_accept_points`
     and :func:`_accept_far` fail it then too. A passing piece ends with the numbers of
     both (its points' ``u``, ``dist``, and ``emax[r]`` their largest); a failing piece's
-    others are left unset."""
-    nc = _QUICK_CHUNK
+    others are left unset (:func:`_accept_kernel` with ``quick``)."""
+    _accept_kernel(ctrl, cm, i0, i1, starts, work, arc, e2, su, basis, u, dist, emax, ok,
+                   np.empty(0, dtype=np.intp), True)
+
+
+@njit(cache=True, nogil=True)
+def _accept_kernel(ctrl, cm, i0, i1, starts, work, arc, e2, su, basis, u, dist, emax, ok,
+                   far, quick) -> int:  # pragma: no cover (compiled)
+    """The point side of the acceptance test, both ways: :func:`_accept_points` (contiguous
+    chunks of ``_ACCEPT_CHUNK`` points, every point's numbers, the far points listed) and,
+    with ``quick``, :func:`_accept_quick` (strided chunks of ``_QUICK_CHUNK``, the seeded
+    search at once, a piece stopped at its first point left over). One per-piece set-up
+    and one chunk loop (each point's 6 Newton steps and distance) serve both."""
+    nc = _QUICK_CHUNK if quick else _ACCEPT_CHUNK
     ub = np.empty(nc)
     qxb = np.empty(nc)
     qyb = np.empty(nc)
     db = np.empty(nc)
     ib = np.empty(nc, dtype=np.intp)
     samp = np.empty((basis.shape[0], 2))
+    nfar = 0
     for r in range(len(i0)):
-        ax = cm[r, 0, 0]
-        ay = cm[r, 0, 1]
-        bx = cm[r, 1, 0]
-        by = cm[r, 1, 1]
-        dx = cm[r, 2, 0]
-        dy = cm[r, 2, 1]
-        ex = cm[r, 3, 0]
-        ey = cm[r, 3, 1]
-        base = i0[r]
-        s = starts[r]
-        cnt = i1[r] - base + 1
-        span = arc[i1[r]] - arc[base]
-        den = span if span > 0 else 1.0
-        u[s] = 0.0
-        dist[s] = 0.0
-        u[s + cnt - 1] = 1.0
-        dist[s + cnt - 1] = 0.0
+        ax, ay, bx, by, dx, dy, ex, ey, base, s, cnt, den = _piece_start(
+            cm, r, i0, i1, starts, arc, u, dist)
         lim = e2[r]
         nck = max(1, -(-(cnt - 2) // nc))
         worst = 0.0
         good = True
+        nan = False
         sampled = False
         for c in range(nck):
+            if quick:  # (chunk c: every nck-th point from 1 + c)
+                j0, stop, step = 1 + c, cnt - 1, nck
+            else:
+                j0, step = 1 + c * nc, 1
+                stop = min(cnt - 1, j0 + nc)
             n = 0
-            for jj in range(1 + c, cnt - 1, nck):
+            for jj in range(j0, stop, step):
                 k = base + jj
                 ib[n] = jj
                 qxb[n] = work[k, 0] - ex
@@ -759,6 +734,16 @@ def _accept_quick(ctrl, cm, i0, i1, starts, work, arc, e2, su, basis, u, dist, e
                 rx = ((ax * uk + bx) * uk + dx) * uk - (work[k, 0] - ex)
                 ry = ((ay * uk + by) * uk + dy) * uk - (work[k, 1] - ey)
                 db[j] = math.sqrt(rx * rx + ry * ry)
+            if not quick:
+                for j in range(n):
+                    d = db[j]
+                    u[s + ib[j]] = ub[j]
+                    dist[s + ib[j]] = d
+                    if d > worst:
+                        worst = d
+                    elif d != d:
+                        nan = True
+                continue
             for j in range(n):
                 d = db[j]
                 f = s + ib[j]
@@ -786,9 +771,18 @@ def _accept_quick(ctrl, cm, i0, i1, starts, work, arc, e2, su, basis, u, dist, e
                     worst = d
             if not good:
                 break
-        if good:
-            emax[r] = worst
-        ok[r] = good
+        if quick:
+            if good:
+                emax[r] = worst
+            ok[r] = good
+            continue
+        emax[r] = np.nan if nan else worst
+        if not nan and worst > lim and worst <= 4.0 * lim:
+            for j in range(1, cnt - 1):
+                if dist[s + j] > lim:
+                    far[nfar] = s + j
+                    nfar += 1
+    return nfar
 
 
 @njit(cache=True, nogil=True)
@@ -1531,6 +1525,9 @@ class _BatchFitter:
         self.q = work[kept] if q is None else q
         #: per thinned point its path's quantum (None: exact input everywhere)
         self.quant: np.ndarray | None = None
+        #: per input segment work[k] -> work[k + 1]: a chord of a coarsely flattened curve
+        #: (:func:`_coarse_chords`), no design line
+        self.coarse = np.zeros(len(work), dtype=np.bool_)
         self.t_in = t_in
         self.t_out = t_out
         # the bound of a piece starting at thinned point k (its path's): e_per + rounding
@@ -1630,10 +1627,11 @@ class _BatchFitter:
             ok = np.empty(m, dtype=bool)
             _accept_quick(ctrl, cm, i0, i1, starts, self.work, self.arc, e2, _SEED_U,
                           _SEED_BASIS, u, dist, emax, ok)
-        qa = _NO_QUANTA
+        qa, coarse = _NO_QUANTA, _NO_COARSE
         if self.quant is not None and A is not None:
             qa = np.ascontiguousarray(self.quant[A], dtype=np.float64)
-        _accept_pairs(cm, i0, i1, starts, self.work, u, e2, qa, ok)
+            coarse = self.coarse
+        _accept_pairs(cm, i0, i1, starts, self.work, u, e2, qa, coarse, ok)
         return ok, emax, dist, starts
 
     def fit(self, curve_pieces: np.ndarray, line_pieces: np.ndarray | None = None) -> None:
@@ -2656,6 +2654,64 @@ def _closed_works(
     return works, n.tolist()
 
 
+def _coarse_chords(W: np.ndarray, starts: np.ndarray, lens: np.ndarray,
+                   quanta: np.ndarray) -> np.ndarray:
+    """Per input segment W[k] -> W[k + 1] (the last entry False): True where it is a chord
+    of a coarsely flattened curve rather than a line of the design. Rounded input only:
+    the paths W[starts[i]:starts[i] + lens[i]] whose quantum ``quanta[i]`` is over 0.
+
+    Typeface outlines and most CAD exports flatten curves finely, so an input segment over
+    ``_LONG_SEGMENT`` quanta is a line of the design, and a curve beside it may use only
+    part of the rounding slack (:func:`_accept_pairs`) and never swallow it
+    (:meth:`_BatchFitter._fixed_lines`). Files that flatten curves coarsely (chords of tens
+    or hundreds of units, each a few degrees from the next: engraving spoolers, old
+    plotter drivers) write long chords whose design is the curve bulging beside them, by
+    up to the whole bound: a curve beside such a chord may use all the slack. A long
+    segment is such a chord where at one of its ends it meets a segment of similar length
+    (within ``_COARSE_RATIO``) at a turn that is gentle (under ``_ABSORB_TURN``) yet more
+    than the rounding can make of a straight line (over ``_COARSE_NOISE`` quanta across the
+    shorter of the two). (A chord left as a line is still not absorbed into a cubic: trying
+    that on every chord of a noisy coarse walk doubled the fit's time on the generated
+    1 M-point file for 0.6 % fewer segments.)"""
+    out = np.zeros(len(W), dtype=np.bool_)
+    _coarse_kernel(np.ascontiguousarray(W, dtype=np.float64),
+                   np.ascontiguousarray(starts, dtype=np.intp),
+                   np.ascontiguousarray(lens, dtype=np.intp),
+                   np.ascontiguousarray(quanta, dtype=np.float64), out)
+    return out
+
+
+@njit(cache=True, nogil=True)
+def _coarse_kernel(W, starts, lens, quanta, out) -> None:  # pragma: no cover (compiled)
+    """:func:`_coarse_chords` (compiled): one pass per path over its segments."""
+    for i in range(len(starts)):
+        q = quanta[i]
+        if not q > 0.0:
+            continue
+        s = starts[i]
+        e = s + lens[i] - 1  # the path's segments: s .. e - 1
+        for k in range(s, e):
+            dx = W[k + 1, 0] - W[k, 0]
+            dy = W[k + 1, 1] - W[k, 1]
+            ln = math.sqrt(dx * dx + dy * dy)
+            if not ln > _LONG_SEGMENT * q:
+                continue
+            for j in (k - 1, k + 1):  # the neighbour at its start, at its end
+                if j < s or j >= e:
+                    continue
+                ex = W[j + 1, 0] - W[j, 0]
+                ey = W[j + 1, 1] - W[j, 1]
+                lj = math.sqrt(ex * ex + ey * ey)
+                lo = min(ln, lj)
+                hi = max(ln, lj)
+                if not (lo > 0.0 and hi <= _COARSE_RATIO * lo):
+                    continue
+                turn = abs(math.atan2(dx * ey - dy * ex, dx * ex + dy * ey))
+                if turn < _ABSORB_TURN and turn * lo > _COARSE_NOISE * q:
+                    out[k] = True
+                    break
+
+
 def _fit_concatenated(
     works: list[np.ndarray],
     kept_all: list[np.ndarray],
@@ -2700,9 +2756,16 @@ def _fit_concatenated(
     fitter = _BatchFitter(W, K, t_in, t_out, np.repeat(e_per, tlen), eps_sum, arc, q=Q)
     if rounding is not None and (rounding[:, 1] > 0.0).any():
         fitter.quant = np.repeat(rounding[:, 1], tlen)
+        fitter.coarse = _coarse_chords(W, woff[todo], wlen[todo], rounding[:, 1])
     with np.errstate(invalid="ignore", divide="ignore"):
         fitter.fit(np.stack([pa[curve], pb[curve]], axis=1), pa[~curve])
     ca, cb, ctrl, bound, fla = fitter.results()
+    if move_q is not None and (move_q > 0.0).any():
+        assert rounding is not None  # (move_q comes from it)
+        ca, cb, ctrl, bound, fla = _lone_lines_out(
+            W, K, Q, arc, t_in, t_out, np.repeat(e_per, tlen), eps_sum,
+            np.repeat(move_q, tlen), np.repeat(rounding[:, 0], tlen), ca, cb, ctrl, bound, fla,
+            coarse=fitter.coarse)
     la = fla
     lb = la + 1
     owner = np.repeat(np.arange(len(todo)), tlen)  # thinned index -> position in todo
@@ -2782,6 +2845,129 @@ def _fit_concatenated(
     for x in (is_cubic, points, first, last):
         x.setflags(write=False)
     return is_cubic, points, first, last, seg_cut.tolist(), pt_cut.tolist(), worst.tolist()
+
+
+#: rounded input: a cubic's end segment (thinned) with a gap between two of its input
+#: points of at least ``_LONE_LENGTH`` quanta and this share of the segment's length (a
+#: design line, written as its two rounded ends) ...
+_LONE_SHARE = 0.5
+#: ... over which the cubic strays this many quanta or more from the gap's chord (the design
+#: line is within q/sqrt(2) of that chord: a cubic held only by the bound may end up the
+#: rounding's width on the other side of it), is re-fitted without that segment, which
+#: becomes a line (the cubic's tangent there the line's direction)
+_LONE_BULGE = 0.3
+#: ... the cubic sampled at this many parameters
+_LONE_SAMPLES = 65
+_LONE_BASIS = seed_basis(_LONE_SAMPLES - 1)[1]
+
+
+def _lone_lines_out(W, K, Q, arc, t_in, t_out, e_per, eps_sum, quant, eps, ca, cb, ctrl,
+                    bound, la, coarse=None):
+    """Rounded input (``quant`` per thinned point, 0: not moved): the cubics that swallow a
+    design line at one of their ends (``_LONE_SHARE``, ``_LONE_BULGE``) are re-fitted over
+    their other segments, that end segment made a line. Returns (ca, cb, ctrl, bound, la)
+    with those cubics replaced; ``t_in``, ``t_out`` changed in place at the new joints.
+    ``coarse``: the fitter's chords of coarse curves (:func:`_coarse_chords`), for the re-fit."""
+    if len(ca) == 0:
+        return ca, cb, ctrl, bound, la
+    q = quant[ca]
+    cand = (q > 0.0) & (cb - ca >= 2)
+    if not cand.any():
+        return ca, cb, ctrl, bound, la
+    step = np.r_[np.hypot(*np.diff(W, axis=0).T), 0.0]
+    # the gaps long enough for any path (few: a design line's two rounded ends), not the
+    # chords of a coarsely flattened curve (no design lines)
+    long_ = step >= _LONE_LENGTH * float(q[cand].min())
+    if coarse is not None:
+        long_ &= ~coarse
+    big = np.flatnonzero(long_)
+    if len(big) == 0:
+        return ca, cb, ctrl, bound, la
+
+    def swallowed(u, v):
+        # per cubic: its segment u..v (thinned) holds a long gap that the cubic bulges over
+        ok = np.zeros(len(ca), dtype=bool)
+        ku, kv = K[u], K[v]
+        lo = np.searchsorted(big, ku)
+        hi = np.searchsorted(big, kv)
+        r = np.flatnonzero(cand & (hi > lo))
+        if len(r) == 0:
+            return ok
+        # the longest gap in each (the first of equal ones)
+        g = np.array([big[a + int(np.argmax(step[big[a:b]]))] for a, b in
+                      zip(lo[r].tolist(), hi[r].tolist(), strict=True)], dtype=np.intp)
+        d = W[kv[r]] - W[ku[r]]
+        ln = np.hypot(d[:, 0], d[:, 1])
+        keep = (step[g] >= _LONE_LENGTH * q[r]) & (step[g] >= _LONE_SHARE * ln)
+        r, g = r[keep], g[keep]
+        if len(r) == 0:
+            return ok
+        a0, a1 = W[g], W[g + 1]
+        e = a1 - a0
+        e2 = (e * e).sum(axis=1)
+        rel = np.einsum("tj,cjd->ctd", _LONE_BASIS, ctrl[r]) - a0[:, None, :]
+        s = (rel * e[:, None, :]).sum(axis=2) / e2[:, None]
+        perp = np.abs(rel[:, :, 0] * e[:, None, 1] - rel[:, :, 1] * e[:, None, 0])
+        perp /= np.sqrt(e2)[:, None]
+        inside = (s > 0.05) & (s < 0.95)
+        bul = np.where(inside, perp, 0.0).max(axis=1)
+        r = r[bul >= _LONE_BULGE * q[r]]
+        # ... where the line between the segment's (moved) ends holds its input points
+        err = _line_errors(W, np.stack([Q[u[r]], Q[v[r]]], axis=1), ku[r], kv[r])
+        ok[r[err <= eps[u[r]]]] = True
+        return ok
+
+    ce = swallowed(cb - 1, cb)
+    cs = swallowed(ca, ca + 1) & ((cb - ca - ce) >= 2)
+    fix = ce | cs
+    if not fix.any():
+        return ca, cb, ctrl, bound, la
+    # the rest of each such cubic re-fitted (a copy of the tangents: a re-fit that does not
+    # hold leaves the cubic and its tangents as they were)
+    fi = np.flatnonzero(fix)
+    fi = fi[np.argsort(ca[fi], kind="stable")]  # in path order
+    na, nb = (ca + cs)[fi], (cb - ce)[fi]
+    ti2, to2 = t_in.copy(), t_out.copy()
+    for u, v, at in (((cb - 1)[ce], cb[ce], (cb - 1)[ce]), (ca[cs], (ca + 1)[cs], (ca + 1)[cs])):
+        d = Q[v] - Q[u]
+        t = d / np.hypot(d[:, 0], d[:, 1])[:, None]
+        ti2[at] = t
+        to2[at] = t
+    one = nb - na == 1
+    f2 = _BatchFitter(W, K, ti2, to2, e_per, eps_sum, arc, q=Q)
+    f2.quant = quant
+    if coarse is not None:
+        f2.coarse = coarse
+    with np.errstate(invalid="ignore", divide="ignore"):
+        f2.fit(np.stack([na[~one], nb[~one]], axis=1), None)
+    a3, b3, c3, bd3, l3 = f2.results()
+    # per fixed cubic: the re-fit holds where it is one cubic over exactly its rest (or the
+    # one segment left a line). (The re-fit's own merge rounds may join the rests of two
+    # neighbouring cubics: such a cubic matches neither, and both stay as they were.)
+    pos = np.flatnonzero(~one)
+    span = np.int64(len(K) + 1)
+    key3 = a3.astype(np.int64) * span + b3
+    keyp = na.astype(np.int64) * span + nb
+    good = one.copy()
+    good[pos] = np.isin(keyp[pos], key3)
+    if not good.any():
+        return ca, cb, ctrl, bound, la
+    fix[fi[~good]] = False
+    ce &= fix
+    cs &= fix
+    for at in ((cb - 1)[ce], (ca + 1)[cs]):
+        t_in[at] = ti2[at]
+        t_out[at] = to2[at]
+    held = np.isin(key3, keyp[good & ~one])
+    new_lines = [(cb - 1)[ce], ca[cs], na[one & good]]
+    extra = np.concatenate([la] + new_lines)
+    keep = ~fix
+    ca2 = np.concatenate([ca[keep], a3[held]])
+    cb2 = np.concatenate([cb[keep], b3[held]])
+    ctrl2 = np.concatenate([ctrl[keep], c3[held]])
+    bound2 = np.concatenate([bound[keep], bd3[held]])
+    o = np.argsort(ca2, kind="stable")
+    return ca2[o], cb2[o], ctrl2[o], bound2[o], np.sort(extra)
 
 
 def _moved_ends_error(W, points, is_cubic, tail, step, gfirst, glast, seg_owner, worst):
@@ -3039,17 +3225,12 @@ def _seg_fits(W, ctrl, first, last, bound, h) -> bool:
     loc = W[first:last + 1]
     if len(ctrl) == 2:
         d = point_segment_distance(loc, ctrl[0], ctrl[1])
-        length = float(np.hypot(*(ctrl[1] - ctrl[0])))
-        m = max(2, math.ceil(length / h) + 1)
-        samp = ctrl[0] + np.linspace(0.0, 1.0, m)[:, None] * (ctrl[1] - ctrl[0])
     else:
         _, d = nearest_on_cubic(ctrl, loc, seeds=64, iters=8)
-        length = float(np.hypot(*np.diff(ctrl, axis=0).T).sum())  # >= the arc length
-        m = max(16, math.ceil(length / h) + 1)
-        samp = cubic_eval(ctrl, np.linspace(0.0, 1.0, m))
     if d.max() > bound:
         return False
-    return bool(_polyline_distance_over(samp, loc, bound - 0.5 * h).max() <= bound - 0.5 * h)
+    return bool(_samples_within(np.ascontiguousarray(ctrl, dtype=np.float64), h, W, first,
+                                last, bound - 0.5 * h))
 
 
 #: samples in order along a polyline are measured first against this many of its segments
@@ -3518,21 +3699,115 @@ def _side_estimates(W, arc, g, ps, pe, quant, k, side, smooth, gap, span,
                 out[i, sd, 2] = 1.0
 
 
+@njit(cache=True, nogil=True)
+def _targets_kernel(W, est, valid, f, e, step, most):  # pragma: no cover (compiled)
+    """:func:`_stretch_targets` compiled, the same numbers: the points (estimates
+    where valid) with each step cut into ceil(length / step) (at least 1) equal parts
+    (libm's hypot; (i - start) / n, then d0 + frac (d1 - d0)), the last point; more than
+    ``most`` thinned to the rows np.linspace(0, len - 1, most).round() (halves to even)."""
+    n = e - f + 1
+    d = np.empty((n, 2))
+    for g in range(f, e + 1):
+        src = est if valid[g] else W
+        d[g - f, 0] = src[g, 0]
+        d[g - f, 1] = src[g, 1]
+    cnt = np.empty(n - 1, dtype=np.int64)
+    tot = 0
+    for i in range(n - 1):
+        gap = math.hypot(d[i + 1, 0] - d[i, 0], d[i + 1, 1] - d[i, 1])
+        cnt[i] = max(int(math.ceil(gap / step)), 1)
+        tot += cnt[i]
+    pts = np.empty((tot + 1, 2))
+    r = 0
+    for i in range(n - 1):
+        for j in range(cnt[i]):
+            fr = j / cnt[i]
+            pts[r, 0] = d[i, 0] + fr * (d[i + 1, 0] - d[i, 0])
+            pts[r, 1] = d[i, 1] + fr * (d[i + 1, 1] - d[i, 1])
+            r += 1
+    pts[tot, 0] = d[n - 1, 0]
+    pts[tot, 1] = d[n - 1, 1]
+    if tot + 1 <= most:
+        return pts
+    out = np.empty((most, 2))
+    sp = tot / (most - 1)
+    for i in range(most):
+        x = i * sp if i < most - 1 else float(tot)
+        k = math.floor(x)
+        h = x - k
+        if h > 0.5 or (h == 0.5 and k % 2 == 1):
+            k += 1
+        out[i, 0] = pts[int(k), 0]
+        out[i, 1] = pts[int(k), 1]
+    return out
+
+
 def _stretch_targets(W, est, valid, f, e, q):
     """The design polyline of the input points f..e: each smooth point's estimate (else the
     point), the long gaps filled every ``_STRETCH_STEP`` quanta (at most
     ``_STRETCH_TARGETS`` points, evenly taken)."""
-    d = np.where(valid[f:e + 1, None], est[f:e + 1], W[f:e + 1])
-    if len(d) < 2:
-        return d
-    gap = np.hypot(*np.diff(d, axis=0).T)
-    n = np.maximum(np.ceil(gap / (_STRETCH_STEP * q)).astype(np.intp), 1)
-    seg = np.repeat(np.arange(len(gap)), n)
-    frac = (np.arange(int(n.sum())) - np.repeat(np.cumsum(n) - n, n)) / np.repeat(n, n)
-    pts = np.vstack([d[seg] + frac[:, None] * (d[seg + 1] - d[seg]), d[-1:]])
-    if len(pts) > _STRETCH_TARGETS:  # evenly thinned out
-        pts = pts[np.linspace(0, len(pts) - 1, _STRETCH_TARGETS).round().astype(np.intp)]
-    return pts
+    return _targets_kernel(W, est, valid, f, e, _STRETCH_STEP * q, _STRETCH_TARGETS)
+
+
+#: no cubic yet (:func:`_ls_step`)
+_NO_CTRL = np.zeros((0, 2))
+
+
+@njit(cache=True, nogil=True)
+def _ls_step(ctrl, t, tg, s, b1, b2) -> None:  # pragma: no cover (compiled)
+    """:func:`_ls_cubic`'s elementwise part (the former numpy arithmetic, the same
+    numbers): where ``ctrl`` is a cubic, a Newton step of each target's parameter ``t``
+    (in place) towards its nearest point on it (no step where the second derivative is
+    not positive; clipped to [0, 1]); then s = 1 - t and the weights b1 = 3 s² t,
+    b2 = 3 s t²."""
+    n = t.shape[0]
+    if ctrl.shape[0] == 4:
+        ex1x = ctrl[1, 0] - ctrl[0, 0]
+        ex1y = ctrl[1, 1] - ctrl[0, 1]
+        ex2x = ctrl[2, 0] - ctrl[1, 0]
+        ex2y = ctrl[2, 1] - ctrl[1, 1]
+        ex3x = ctrl[3, 0] - ctrl[2, 0]
+        ex3y = ctrl[3, 1] - ctrl[2, 1]
+        q0x = (ctrl[2, 0] - 2.0 * ctrl[1, 0]) + ctrl[0, 0]
+        q0y = (ctrl[2, 1] - 2.0 * ctrl[1, 1]) + ctrl[0, 1]
+        q1x = (ctrl[3, 0] - 2.0 * ctrl[2, 0]) + ctrl[1, 0]
+        q1y = (ctrl[3, 1] - 2.0 * ctrl[2, 1]) + ctrl[1, 1]
+        c3 = ctrl.reshape(1, 4, 2)
+        for k in range(n):
+            tk = t[k]
+            sk = 1.0 - tk
+            w0 = sk * sk
+            w1 = 2.0 * sk * tk
+            w2 = tk * tk
+            d1x = 3.0 * ((w0 * ex1x + w1 * ex2x) + w2 * ex3x)
+            d1y = 3.0 * ((w0 * ex1y + w1 * ex2y) + w2 * ex3y)
+            d2x = 6.0 * (sk * q0x + tk * q1x)
+            d2y = 6.0 * (sk * q0y + tk * q1y)
+            b0, bb1, bb2, b3 = bernstein_weights(tk)
+            rx = bernstein_point(b0, bb1, bb2, b3, c3, 0, 0) - tg[k, 0]
+            ry = bernstein_point(b0, bb1, bb2, b3, c3, 0, 1) - tg[k, 1]
+            den = (d1x * d1x + d1y * d1y) + (rx * d2x + ry * d2y)
+            dt = (rx * d1x + ry * d1y) / den if den > 0.0 else 0.0
+            v = tk - dt
+            if v == v:  # (np.clip's: NaN kept, else max(v, 0) then min(v, 1), ties to the bound)
+                v = v if v > 0.0 else 0.0
+                v = v if v < 1.0 else 1.0
+            t[k] = v
+    for k in range(n):
+        tk = t[k]
+        sk = 1.0 - tk
+        s[k] = sk
+        b1[k] = 3.0 * sk * sk * tk
+        b2[k] = 3.0 * sk * tk * tk
+
+
+@njit(cache=True, nogil=True)
+def _ls_rest(tg, s3, t3, p0, p3, r) -> None:  # pragma: no cover (compiled)
+    """:func:`_ls_cubic`'s residuals r = tg - s³ p0 - t³ p3 (the former numpy arithmetic;
+    s³, t³ numpy's powers)."""
+    for k in range(tg.shape[0]):
+        r[k, 0] = (tg[k, 0] - s3[k] * p0[0]) - t3[k] * p3[0]
+        r[k, 1] = (tg[k, 1] - s3[k] * p0[1]) - t3[k] * p3[1]
 
 
 def _ls_cubic(p0, p3, tg):
@@ -3545,25 +3820,17 @@ def _ls_cubic(p0, p3, tg):
         return None
     t = np.r_[0.0, np.cumsum(c)] / tot
     ctrl = None
+    s = np.empty(len(t))
+    b1 = np.empty(len(t))
+    b2 = np.empty(len(t))
+    r = np.empty((len(t), 2))
     for it in range(_STRETCH_ITERS + 1):
-        s = 1.0 - t
-        if ctrl is not None:  # a Newton step of each target's parameter
-            d1 = 3.0 * ((s * s)[:, None] * (ctrl[1] - ctrl[0])
-                        + (2.0 * s * t)[:, None] * (ctrl[2] - ctrl[1])
-                        + (t * t)[:, None] * (ctrl[3] - ctrl[2]))
-            d2 = 6.0 * (s[:, None] * (ctrl[2] - 2.0 * ctrl[1] + ctrl[0])
-                        + t[:, None] * (ctrl[3] - 2.0 * ctrl[2] + ctrl[1]))
-            r = cubic_eval(ctrl, t) - tg
-            den = (d1 * d1).sum(axis=1) + (r * d2).sum(axis=1)
-            dt = np.where(den > 0.0, (r * d1).sum(axis=1) / np.where(den > 0.0, den, 1.0),
-                          0.0)
-            t = np.clip(t - dt, 0.0, 1.0)
-            s = 1.0 - t
-            if it == _STRETCH_ITERS:
-                return ctrl
-        b1 = 3.0 * s * s * t
-        b2 = 3.0 * s * t * t
-        r = tg - (s ** 3)[:, None] * p0 - (t ** 3)[:, None] * p3
+        # (compiled: a Newton step of each target's parameter towards its nearest point
+        # where there is a cubic, then the weights; the products below stay numpy's, BLAS)
+        _ls_step(ctrl if ctrl is not None else _NO_CTRL, t, tg, s, b1, b2)
+        if it == _STRETCH_ITERS:
+            return ctrl
+        _ls_rest(tg, s ** 3, t ** 3, p0, p3, r)
         a11, a12, a22 = b1 @ b1, b1 @ b2, b2 @ b2
         det = a11 * a22 - a12 * a12
         if not det > 1e-12 * max(a11 * a22, 1e-300):
@@ -3580,25 +3847,133 @@ def _design_off(W, est, valid, ctrl, f, e, h, limit=math.inf):
     (at most h apart) to the polyline of the estimates (else the points); None when d1 is
     over ``limit``. Both measured against polylines (the samples, the estimates), exactly
     where over ``_STRETCH_EXACT`` h."""
-    if len(ctrl) == 2:
-        length = float(np.hypot(*(ctrl[1] - ctrl[0])))
-        m = max(2, math.ceil(length / h) + 1)
-        samp = ctrl[0] + np.linspace(0.0, 1.0, m)[:, None] * (ctrl[1] - ctrl[0])
-    else:
-        length = float(np.hypot(*np.diff(ctrl, axis=0).T).sum())
-        m = max(16, math.ceil(length / h) + 1)
-        samp = cubic_eval(ctrl, np.linspace(0.0, 1.0, m))
-    v = np.flatnonzero(valid[f:e + 1]) + f
-    d1 = 0.0
-    if len(v):
-        v2 = v[:-1][np.diff(v) == 1]
-        key = np.concatenate([2 * v, 2 * v2 + 1])
-        tp = np.concatenate([est[v], 0.5 * (est[v2] + est[v2 + 1])])[np.argsort(key)]
-        d1 = float(_polyline_distance_over(tp, samp, _STRETCH_EXACT * h, 64).max())
-    if d1 > limit:
+    r = np.empty(2)  # (compiled: :func:`_design_off_kernel`)
+    if not _design_off_kernel(W, est, valid, np.ascontiguousarray(ctrl, dtype=np.float64), f, e,
+                              h, limit, r):
         return None
-    poly = np.where(valid[f:e + 1, None], est[f:e + 1], W[f:e + 1])
-    return d1, float(_polyline_distance_over(samp, poly, _STRETCH_EXACT * h).max())
+    return float(r[0]), float(r[1])
+
+
+@njit(cache=True, nogil=True)
+def _seg_samples(ctrl, h):  # pragma: no cover (compiled)
+    """The samples of the segment ``ctrl`` (2 or 4 points) at most h apart that
+    :func:`_seg_fits` and :func:`_design_off` take: m = max(2 (16 for a cubic),
+    ceil(length / h) + 1) (the length the chord's, or the control polygon's summed in
+    order) at np.linspace(0, 1, m), cubic_eval's arithmetic or the line's ctrl[0] +
+    t (ctrl[1] - ctrl[0]) (the same numbers)."""
+    cub = ctrl.shape[0] == 4
+    if cub:
+        length = (math.hypot(ctrl[1, 0] - ctrl[0, 0], ctrl[1, 1] - ctrl[0, 1])
+                  + math.hypot(ctrl[2, 0] - ctrl[1, 0], ctrl[2, 1] - ctrl[1, 1])) \
+            + math.hypot(ctrl[3, 0] - ctrl[2, 0], ctrl[3, 1] - ctrl[2, 1])
+        m = max(16, int(math.ceil(length / h)) + 1)
+    else:
+        length = math.hypot(ctrl[1, 0] - ctrl[0, 0], ctrl[1, 1] - ctrl[0, 1])
+        m = max(2, int(math.ceil(length / h)) + 1)
+    samp = np.empty((m, 2))
+    c3 = ctrl.reshape(1, ctrl.shape[0], 2)
+    step = 1.0 / (m - 1)
+    for t in range(m):
+        u = t * step if t < m - 1 else 1.0
+        if cub:
+            b0, b1, b2, b3 = bernstein_weights(u)
+            samp[t, 0] = bernstein_point(b0, b1, b2, b3, c3, 0, 0)
+            samp[t, 1] = bernstein_point(b0, b1, b2, b3, c3, 0, 1)
+        else:
+            samp[t, 0] = ctrl[0, 0] + u * (ctrl[1, 0] - ctrl[0, 0])
+            samp[t, 1] = ctrl[0, 1] + u * (ctrl[1, 1] - ctrl[0, 1])
+    return samp
+
+
+@njit(cache=True, nogil=True)
+def _samples_within(ctrl, h, W, first, last, lim):  # pragma: no cover (compiled)
+    """:func:`_seg_fits`' polyline side compiled: whether the samples
+    (:func:`_seg_samples`) all lie within ``lim`` of the polyline W[first..last]
+    (:func:`_polyline_distance_over`'s numbers; NaN fails)."""
+    samp = _seg_samples(ctrl, h)
+    d = _distance_over(samp, W[first:last + 1], lim, _NEAR_SEGMENTS)
+    for t in range(d.shape[0]):
+        if not d[t] <= lim:
+            return False
+    return True
+
+
+@njit(cache=True, nogil=True)
+def _design_off_kernel(W, est, valid, ctrl, f, e, h, limit, out):  # pragma: no cover
+    """:func:`_design_off` compiled: its samples (np.linspace's and cubic_eval's
+    arithmetic, the line's ctrl[0] + t (ctrl[1] - ctrl[0])), its targets in the same order
+    and :func:`_polyline_distance_over` (the brute force or :func:`_over_kernel`, the step
+    lengths libm's hypot), so the same numbers; out[0], out[1] get (d1, d2); returns
+    False when d1 is over ``limit``."""
+    samp = _seg_samples(ctrl, h)
+    m = samp.shape[0]
+    lim = _STRETCH_EXACT * h
+    n = e - f + 1
+    tp = np.empty((2 * n, 2))
+    nt = 0
+    for g in range(f, e + 1):
+        if valid[g]:
+            tp[nt, 0] = est[g, 0]
+            tp[nt, 1] = est[g, 1]
+            nt += 1
+            if g < e and valid[g + 1]:
+                tp[nt, 0] = 0.5 * (est[g, 0] + est[g + 1, 0])
+                tp[nt, 1] = 0.5 * (est[g, 1] + est[g + 1, 1])
+                nt += 1
+    d1 = 0.0
+    if nt:
+        d = _distance_over(tp[:nt], samp, lim, 64)
+        d1 = d[0]
+        for t in range(1, nt):  # (np.max: NaN wins)
+            if not d[t] <= d1 and d1 == d1:
+                d1 = d[t]
+    out[0] = d1
+    if d1 > limit:
+        return False
+    poly = np.empty((n, 2))
+    for g in range(f, e + 1):
+        src = est if valid[g] else W
+        poly[g - f, 0] = src[g, 0]
+        poly[g - f, 1] = src[g, 1]
+    d = _distance_over(samp, poly, lim, _NEAR_SEGMENTS)
+    d2 = d[0]
+    for t in range(1, m):
+        if not d[t] <= d2 and d2 == d2:
+            d2 = d[t]
+    out[1] = d2
+    return True
+
+
+@njit(cache=True, nogil=True)
+def _distance_over(samp, poly, lim, k):  # pragma: no cover (compiled)
+    """:func:`_polyline_distance_over` compiled (a one-point polyline: the distance to it,
+    libm's hypot, as :func:`point_polyline_distance`)."""
+    n = poly.shape[0]
+    ms = samp.shape[0]
+    d = np.empty(ms)
+    if n == 1:
+        for t in range(ms):
+            d[t] = math.hypot(samp[t, 0] - poly[0, 0], samp[t, 1] - poly[0, 1])
+        return d
+    if n <= 2 * k + 2:
+        _brute_kernel(samp, poly, d)
+        return d
+    fl = np.empty(max(n, ms), dtype=np.bool_)
+    dx = np.empty(max(n, ms))
+    dy = np.empty(max(n, ms))
+    pstep = np.empty(n - 1)
+    for t in range(n - 1):
+        dx[t] = poly[t + 1, 0] - poly[t, 0]
+        dy[t] = poly[t + 1, 1] - poly[t, 1]
+    hypot_into(dx, dy, n - 1, pstep, fl)
+    sstep = np.empty(max(ms - 1, 0))
+    for t in range(ms - 1):
+        dx[t] = samp[t + 1, 0] - samp[t, 0]
+        dy[t] = samp[t + 1, 1] - samp[t, 1]
+    hypot_into(dx, dy, ms - 1, sstep, fl)
+    if ms:
+        _over_kernel(samp, sstep, poly, pstep, lim, k, d)
+    return d
 
 
 def _estimates_off(points, is_cubic, tail, gfirst, glast, sr, est, valid):
@@ -4658,6 +5033,15 @@ _LONE_SINE = 0.9
 #: ... and moves it by at least this many half quanta (less is within the estimate's
 #: own error: the input point stays)
 _LONE_MIN_MOVE = 0.2
+#: a corner turning by more than 120 degrees (the cosine of its turn below this) is a tip: an
+#: error d in either side's estimated offset moves the tangents' crossing by d / sin(interior
+#: angle) along the tip's axis, more than the rounding ...
+_TIP_COS = -0.5
+#: ... so a crossing that cuts the tip (moves the corner inward along its axis) by more than
+#: this many quanta moves across the axis only (serif "g" at em 400: the crossing cut the
+#: tip by 0.55 quanta, the fit 1.055 from the design; a tip's rounded point is within
+#: q/sqrt(2) of the design's outline, and smaller cuts and moves outward hold)
+_TIP_CUT = 0.45
 
 
 def _lone_sides(W, K, smooth, v, w, quant, p, t, ok, ok_other, after=False) -> np.ndarray:
@@ -4704,22 +5088,23 @@ def _collinear(W, a, b, p, t, quant) -> np.ndarray:
 
 
 def _corners_on_the_design(W, K, Q, arc, smooth, rnd, first, last, quant, eps) -> None:
-    """Rounded input: the corners (thinned vertices that are not smooth; a closed path's
-    seam too) move inside their rounding squares onto an estimate of the design's corner.
-    Per side, the input points of the thinned segment on that side give a position and a
-    tangent at the corner: their least-squares line where the segment is a line (its
-    other end a corner too), else a least-squares quadratic (over at least
-    ``_CORNER_POINTS`` input points of the path). The corner is the
-    intersection of the two tangent lines where they cross at an angle, else the mean of
-    the two positions. A side that is a line over two input points only (no least-squares
-    line) beside a curve side is the line through its two rounded ends
-    (:func:`_lone_sides`), intersected with the curve's tangent where they cross at
-    ``_LONE_SINE`` or more; at a middling angle (``_CORNER_SINE`` to ``_LONE_SINE``: an
-    error in the line's offset would move the intersection far) the corner stays. A corner
-    stays where a line from it to a neighbouring thinned point would miss its input points
-    by more than ``eps`` (per thinned point), so the lines keep their bound (the curve side
-    of a corner with a two-point side is not held to that: the fitter tests its cubics
-    against the bound, and a line there is made valid by :func:`_valid_lines`). In place
+    """Rounded input: the corners (thinned vertices that are not smooth; a closed path's seam too)
+    move inside their rounding squares onto an estimate of the design's corner. Per side, the
+    input points of the thinned segment on that side give a position and a tangent at the
+    corner: their least-squares line where the segment is a line (its other end a corner too),
+    else a least-squares quadratic (over at least ``_CORNER_POINTS`` input points of the path).
+    The corner is the intersection of the two tangent lines where they cross at an angle, else
+    the mean of the two positions; at a tip (a turn of more than 120 degrees, ``_TIP_COS``) a
+    crossing that cuts the tip by more than ``_TIP_CUT`` quanta keeps only its move across
+    the tip's axis.
+    A side that is a line over two input points only (no least-squares line) beside a curve side
+    is the line through its two rounded ends (:func:`_lone_sides`), intersected with the curve's
+    tangent where they cross at ``_LONE_SINE`` or more; at a middling angle (``_CORNER_SINE`` to
+    ``_LONE_SINE``: an error in the line's offset would move the intersection far) the corner
+    stays. A corner stays where a line from it to a neighbouring thinned point would miss its
+    input points by more than ``eps`` (per thinned point), so the lines keep their bound (the
+    curve side of a corner with a two-point side is not held to that: the fitter tests its
+    cubics against the bound, and a line there is made valid by :func:`_valid_lines`). In place
     on ``Q``."""
     n = len(Q)
     is_first = np.zeros(n, dtype=bool)
@@ -4774,6 +5159,7 @@ def _corners_on_the_design(W, K, Q, arc, smooth, rnd, first, last, quant, eps) -
     lone = lone_in | lone_out
     # a side of two points meeting a curve at a middling angle: neither estimate is good
     both &= ~lone | (np.abs(cr) >= _LONE_SINE) | (np.abs(cr) < _CORNER_SINE)
+    tip = both & ((t_in * t_out).sum(axis=1) < _TIP_COS)
     sharp = both & (np.abs(cr) >= _CORNER_SINE)
     # a shallow corner between a curve and a least-squares line whose points are collinear:
     # on that line (the mean would tilt the whole line by the curve's error at its end)
@@ -4790,6 +5176,14 @@ def _corners_on_the_design(W, K, Q, arc, smooth, rnd, first, last, quant, eps) -
         ti, to = t_in[sharp], t_out[sharp]
         s = (d[:, 0] * to[:, 1] - d[:, 1] * to[:, 0]) / cr[sharp]
         est[sharp] = p_in[sharp] + s[:, None] * ti
+    if tip.any():
+        # a tip cut by more than _TIP_CUT quanta: only the move across the tip's axis kept
+        ax = t_in[tip] - t_out[tip]
+        ax /= np.hypot(*ax.T)[:, None]
+        mv = est[tip] - W[K[vo[tip]]]
+        al = (mv * ax).sum(axis=1)
+        cut = al < -_TIP_CUT * quant[vo[tip]]
+        est[tip] -= np.where(cut, al, 0.0)[:, None] * ax
     vi, vo, est = vi[both], vo[both], est[both]
     lone_in, lone_out = lone_in[both], lone_out[both]
     wk = W[K[vo]]

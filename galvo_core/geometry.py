@@ -153,9 +153,42 @@ def nearest_on_cubic(
     """
     c = _ctrl(ctrl)
     p = np.asarray(pts, dtype=np.float64).reshape(-1, 2)
+    if len(p):  # (one cubic: nearest_on_cubic_each's steps without its grouping)
+        cc = np.ascontiguousarray(c[None])
+        ns = int(_seed_counts(cc, seeds)[0])
+        best_u = np.empty(len(p))
+        best_d2 = np.empty(len(p))
+        if _nearest_one_kernel(cc, np.linspace(0.0, 1.0, ns + 1), np.ascontiguousarray(p),
+                               iters, min(_NEAREST_CANDIDATES, ns + 1), best_u, best_d2):
+            return best_u, np.sqrt(best_d2)
     return nearest_on_cubic_each(
         c[None], np.zeros(len(p), dtype=np.intp), p, seeds=seeds, iters=iters
     )
+
+
+@njit(cache=True, nogil=True)
+def _nearest_one_kernel(cc, su, p, iters, nc, best_u, best_d2):  # type: ignore[no-untyped-def]
+    """:func:`nearest_on_cubic_each` for the one cubic cc[0] (its numbers: the samples at
+    ``su`` and candidates of :func:`_candidates_kernel`, the refinement of
+    :func:`_refine_kernel`); False (nothing decided) where two sampled minima tie (the
+    caller then takes nearest_on_cubic_each, which selects those by numpy)."""
+    k = p.shape[0]
+    ns = su.shape[0] - 1
+    spx = np.empty((1, ns + 1))
+    spy = np.empty((1, ns + 1))
+    u0 = np.zeros((_NEAREST_CANDIDATES, k))
+    lo = np.zeros((_NEAREST_CANDIDATES, k))
+    hi = np.ones((_NEAREST_CANDIDATES, k))
+    ok = np.zeros((_NEAREST_CANDIDATES, k), dtype=np.bool_)
+    tie = np.zeros(k, dtype=np.bool_)
+    pid = np.zeros(k, dtype=np.int64)
+    out = np.arange(k)
+    _candidates_kernel(cc, su, pid, p, out, spx, spy, best_u, best_d2, u0, lo, hi, ok, nc,
+                       tie)
+    if tie.any():
+        return False
+    _refine_kernel(cc, pid, p, u0, lo, hi, ok, iters, best_u, best_d2)
+    return True
 
 
 def _seed_counts(c: np.ndarray, seeds: int) -> np.ndarray:
@@ -265,21 +298,8 @@ def _refine_kernel(c, pid, p, u0, lo, hi, ok, iters, best_u,
                     dy = cb[5, j]
                     lo_k = lo[m, k]
                     hi_k = hi[m, k]
-                    uk = ub[j]
-                    rx = ((ax * uk + bx) * uk + dx) * uk - cb[6, j]  # B(u) - p
-                    ry = ((ay * uk + by) * uk + dy) * uk - cb[7, j]
-                    d1x = (3.0 * ax * uk + 2.0 * bx) * uk + dx  # B'(u)
-                    d1y = (3.0 * ay * uk + 2.0 * by) * uk + dy
-                    f = d1x * rx + d1y * ry  # f = B'·(B - p)
-                    fp = (6.0 * ax * uk + 2.0 * bx) * rx + (6.0 * ay * uk + 2.0 * by) * ry
-                    fp += d1x * d1x  # f' = B''·(B - p) + |B'|^2
-                    fp += d1y * d1y
-                    if fp <= 0.0:  # not convex here: halve the way downhill
-                        end = hi_k if f < 0.0 else lo_k
-                        uk = 0.5 * (uk + end)
-                    else:
-                        uk -= f / fp
-                    ub[j] = min(max(uk, lo_k), hi_k)
+                    ub[j] = newton_param_in(ax, ay, bx, by, dx, dy, cb[6, j], cb[7, j], ub[j],
+                                            lo_k, hi_k, True)
             for j in range(n):
                 k = c0 + j
                 if not ok[m, k]:
@@ -696,35 +716,21 @@ def _newton_kernel(cf, p, u, d2, iters, lo, hi, downhill):  # type: ignore[no-un
 
 
 @njit(cache=True, nogil=True, inline="always")
+def _cubic_point(cf, c, p, k):  # type: ignore[no-untyped-def]
+    """:func:`_newton_kernel`'s cubic ``c`` (power coefficients a, b, d) and point ``k``
+    relative to its start: (ax, ay, bx, by, dx, dy, qx, qy)."""
+    return (cf[0, 0, c], cf[0, 1, c], cf[1, 0, c], cf[1, 1, c], cf[2, 0, c], cf[2, 1, c],
+            p[0, k] - cf[3, 0, c], p[1, k] - cf[3, 1, c])
+
+
+@njit(cache=True, nogil=True, inline="always")
 def _newton_step(cf, p, u, c0, c1, lo, hi, one_lo, one_hi, downhill):  # type: ignore[no-untyped-def]
     """One Newton step of :func:`_newton_kernel` for the points c0 .. c1 - 1."""
     for k in range(c0, c1):
-        ax = cf[0, 0, k]
-        ay = cf[0, 1, k]
-        bx = cf[1, 0, k]
-        by = cf[1, 1, k]
-        dx = cf[2, 0, k]
-        dy = cf[2, 1, k]
-        qx = p[0, k] - cf[3, 0, k]
-        qy = p[1, k] - cf[3, 1, k]
+        ax, ay, bx, by, dx, dy, qx, qy = _cubic_point(cf, k, p, k)
         lo_k = lo[0] if one_lo else lo[k]
         hi_k = hi[0] if one_hi else hi[k]
-        uk = u[k]
-        rx = ((ax * uk + bx) * uk + dx) * uk - qx  # B(u) - p
-        ry = ((ay * uk + by) * uk + dy) * uk - qy
-        d1x = (3.0 * ax * uk + 2.0 * bx) * uk + dx  # B'(u)
-        d1y = (3.0 * ay * uk + 2.0 * by) * uk + dy
-        f = d1x * rx + d1y * ry  # f = B'·(B - p)
-        fp = (6.0 * ax * uk + 2.0 * bx) * rx + (6.0 * ay * uk + 2.0 * by) * ry
-        fp += d1x * d1x  # f' = B''·(B - p) + |B'|^2
-        fp += d1y * d1y
-        if fp <= 0.0:  # not convex here: no step, or halve the way downhill
-            if downhill:
-                end = hi_k if f < 0.0 else lo_k
-                uk = 0.5 * (uk + end)
-        else:
-            uk -= f / fp
-        u[k] = min(max(uk, lo_k), hi_k)
+        u[k] = newton_param_in(ax, ay, bx, by, dx, dy, qx, qy, u[k], lo_k, hi_k, downhill)
 
 
 #: :func:`hypot_into`'s common range (both in it: libm's hypot is this arithmetic)
@@ -779,6 +785,15 @@ def newton_param(ax, ay, bx, by, dx, dy, qx, qy, uk):  # type: ignore[no-untyped
     its start at the origin) towards the point of it nearest (qx, qy) (relative to the start
     too), clamped to [0, 1]; no step where the squared distance is not convex (the compiled
     fitting kernels' reparametrisation; inlined, so their arithmetic is unchanged)."""
+    return newton_param_in(ax, ay, bx, by, dx, dy, qx, qy, uk, 0.0, 1.0, False)
+
+
+@njit(cache=True, nogil=True, inline="always")
+def newton_param_in(ax, ay, bx, by, dx, dy, qx, qy, uk, lo, hi,
+                    downhill):  # type: ignore[no-untyped-def]
+    """:func:`newton_param` clamped to [lo, hi] instead, and with ``downhill`` halving the
+    way towards the end downhill where the squared distance is not convex (instead of no
+    step): :func:`_newton_kernel`'s step. Inlined: the callers' arithmetic is unchanged."""
     rx = ((ax * uk + bx) * uk + dx) * uk - qx  # B(u) - p
     ry = ((ay * uk + by) * uk + dy) * uk - qy
     d1x = (3.0 * ax * uk + 2.0 * bx) * uk + dx  # B'(u)
@@ -787,9 +802,12 @@ def newton_param(ax, ay, bx, by, dx, dy, qx, qy, uk):  # type: ignore[no-untyped
     fp = (6.0 * ax * uk + 2.0 * bx) * rx + (6.0 * ay * uk + 2.0 * by) * ry
     fp += d1x * d1x  # f' = B''·(B - p) + |B'|^2
     fp += d1y * d1y
-    if not fp <= 0.0:
+    if fp <= 0.0:  # not convex here: no step, or halve the way downhill
+        if downhill:
+            uk = 0.5 * (uk + (hi if f < 0.0 else lo))
+    else:
         uk -= f / fp
-    return min(max(uk, 0.0), 1.0)
+    return min(max(uk, lo), hi)
 
 
 @njit(cache=True, nogil=True)
@@ -802,39 +820,12 @@ def _newton_one_cubic(cf, p, u, d2, iters, lo, hi, downhill):  # type: ignore[no
     one_hi = hi.shape[0] == 1
     for k in range(k_n):
         c = 0 if one_c else k
-        ax = cf[0, 0, c]
-        ay = cf[0, 1, c]
-        bx = cf[1, 0, c]
-        by = cf[1, 1, c]
-        dx = cf[2, 0, c]
-        dy = cf[2, 1, c]
-        qx = p[0, k] - cf[3, 0, c]
-        qy = p[1, k] - cf[3, 1, c]
-        a3x = 3.0 * ax
-        a3y = 3.0 * ay
-        b2x = 2.0 * bx
-        b2y = 2.0 * by
-        a6x = 6.0 * ax
-        a6y = 6.0 * ay
+        ax, ay, bx, by, dx, dy, qx, qy = _cubic_point(cf, c, p, k)
         lo_k = lo[0] if one_lo else lo[k]
         hi_k = hi[0] if one_hi else hi[k]
         uk = u[k]
         for _ in range(iters):
-            rx = ((ax * uk + bx) * uk + dx) * uk - qx  # B(u) - p
-            ry = ((ay * uk + by) * uk + dy) * uk - qy
-            d1x = (a3x * uk + b2x) * uk + dx  # B'(u)
-            d1y = (a3y * uk + b2y) * uk + dy
-            f = d1x * rx + d1y * ry  # f = B'·(B - p)
-            fp = (a6x * uk + b2x) * rx + (a6y * uk + b2y) * ry  # f' = B''·(B - p) + |B'|^2
-            fp += d1x * d1x
-            fp += d1y * d1y
-            if fp <= 0.0:  # not convex here: no step, or halve the way downhill
-                if downhill:
-                    end = hi_k if f < 0.0 else lo_k
-                    uk = 0.5 * (uk + end)
-            else:
-                uk -= f / fp
-            uk = min(max(uk, lo_k), hi_k)
+            uk = newton_param_in(ax, ay, bx, by, dx, dy, qx, qy, uk, lo_k, hi_k, downhill)
         rx = ((ax * uk + bx) * uk + dx) * uk - qx
         ry = ((ay * uk + by) * uk + dy) * uk - qy
         u[k] = uk

@@ -45,9 +45,10 @@ def _pieces(seed: int, n_pieces: int = 60, *, rounded: bool):
     return ctrl, np.array(i0), np.array(i1), work_a, arc
 
 
-def _reference(ctrl, i0, i1, work, arc, e2, qa):
+def _reference(ctrl, i0, i1, work, arc, e2, qa, coarse):
     """The plain definition: Newton (6 steps from arc length) per point, the ends at the
-    curve's ends, then the exact bound of every pair against e2 (plus the rounding slack)."""
+    curve's ends, then the exact bound of every pair against e2 (plus the rounding slack
+    the curve may not use beside a long segment, unless ``coarse`` marks it a chord)."""
     m = len(ctrl)
     cnt = i1 - i0 + 1
     pid = np.repeat(np.arange(m), cnt)
@@ -68,6 +69,7 @@ def _reference(ctrl, i0, i1, work, arc, e2, qa):
         ln = np.hypot(*(work[idx[j] + 1] - work[idx[j]]).T)
         with np.errstate(divide="ignore", invalid="ignore"):
             f = np.clip(fitmod._LONG_SEGMENT * q / ln, fitmod._LONG_FLOOR, 1.0)
+        f = np.where(coarse[idx[j]], 1.0, f)
         bnd = bnd + q * fitmod._HALF_DIAGONAL * (1.0 - np.where(q > 0.0, f, 1.0))
     worst = np.zeros(m)
     np.maximum.at(worst, pid[j], bnd)
@@ -80,7 +82,9 @@ def test_compiled_accept_matches_the_definition(seed: int, rounded: bool) -> Non
     ctrl, i0, i1, work, arc = _pieces(seed, rounded=rounded)
     m = len(ctrl)
     qa = np.full(m, 1.0) if rounded else fitmod._NO_QUANTA
-    u_ref, d_ref, worst = _reference(ctrl, i0, i1, work, arc, np.ones(m), qa)
+    # (rounded: some segments marked chords of a coarse curve, full slack beside them)
+    coarse = np.random.default_rng(seed).random(len(work)) < (0.3 if rounded else 0.0)
+    u_ref, d_ref, worst = _reference(ctrl, i0, i1, work, arc, np.ones(m), qa, coarse)
     cnt = i1 - i0 + 1
     starts = np.cumsum(cnt) - cnt
     cm = power_coeffs_many(ctrl)
@@ -97,9 +101,9 @@ def test_compiled_accept_matches_the_definition(seed: int, rounded: bool) -> Non
         assert np.array_equal(dist, d_ref)
         assert np.array_equal(emax0, np.maximum.reduceat(d_ref, starts))
         ok = np.ones(m, dtype=bool)
-        fitmod._accept_pairs(cm, i0, i1, starts, work, u, e2, qa, ok)
+        fitmod._accept_pairs(cm, i0, i1, starts, work, u, e2, qa, coarse, ok)
         assert np.array_equal(ok, worst <= e2), scale
     # (both verdicts occur)
     ok = np.ones(m, dtype=bool)
-    fitmod._accept_pairs(cm, i0, i1, starts, work, u, worst * 0.999999, qa, ok)
+    fitmod._accept_pairs(cm, i0, i1, starts, work, u, worst * 0.999999, qa, coarse, ok)
     assert not ok[worst > 0].any()

@@ -131,3 +131,37 @@ def test_corner_hidden_inside_a_thinned_line_is_kept():
                        else np.asarray(s.points) for s in fp.segments])
     design_corner = np.array([[-41.5, 70.0]])
     assert point_polyline_distance(design_corner, dense)[0] < 0.6
+
+
+# 90 whole-unit points of DejaVu Serif "g" at em 400 (its ear): a vertical stem whose top
+# turns back by 152 degrees into a curve; the design's tip is at (706.445, 32.422)
+_TIP = [
+    [703, -29], [703, -28], [703, -27], [703, -26], [704, -25], [704, -24], [704, -23], [704, -22],
+    [704, -21], [705, -20], [705, -19], [705, -18], [705, -17], [705, -15], [705, -14], [706, -13],
+    [706, -12], [706, -11], [706, -10], [706, -8], [706, -7], [706, -6], [706, -5], [706, -3],
+    [706, -2], [706, -1], [706, 1], [706, 2], [706, 3], [706, 4], [706, 32], [706, 31],
+    [705, 30], [705, 29], [704, 29], [704, 28], [703, 27], [702, 26], [702, 25], [701, 24],
+    [701, 23], [700, 22], [699, 21], [698, 20], [697, 19], [697, 18], [696, 17], [695, 17],
+    [695, 16], [694, 15], [693, 14], [692, 13], [691, 12], [690, 11], [689, 10], [688, 10],
+    [688, 9], [687, 8], [686, 8], [685, 7], [684, 7], [684, 6], [683, 6], [682, 5],
+    [681, 5], [680, 4], [679, 3], [678, 3], [677, 2], [676, 2], [675, 1], [674, 1],
+    [673, 1], [673, 0], [672, 0], [671, -1], [670, -1], [669, -1], [668, -2], [667, -2],
+    [666, -2], [665, -2], [664, -3], [663, -3], [662, -3], [661, -3], [660, -4], [659, -4],
+    [658, -4], [657, -4],
+]
+
+
+def test_an_acute_tip_is_not_cut():
+    """Where the outline turns back by more than 120 degrees, the crossing of the two sides'
+    estimated tangents moves along the tip's axis by an offset error over the sine of the
+    narrow angle: here it cut the tip by 0.55 units, the fit 1.055 from the design's tip.
+    Such a cut is dropped (the move across the axis kept), and the fitted tip is no farther
+    from the design's than the rounded input point is (0.613)."""
+    w = np.array(_TIP, dtype=float)
+    fp = fit_paths([w], [False])[0]
+    assert not check_fit(w, fp, 0.02, 0.02, report=True)["violation"]
+    dense = np.vstack([flatten_cubic(s.points, 0.002) if s.kind == "cubic"
+                       else np.asarray(s.points) for s in fp.segments])
+    tip = np.array([[706.4453125, 32.421875]])
+    rounded = np.hypot(*(tip[0] - w[30]))
+    assert point_polyline_distance(tip, dense)[0] <= rounded + 0.01
