@@ -157,7 +157,7 @@ _GN_FREE = True
 _GN_TURN = math.radians(5.0)
 #: rounded input: a free Gauss-Newton cubic that fails is refined towards the least worst
 #: error (galvo_core.minimax; False: off, for measurements)
-_MINIMAX = True
+_MINIMAX = False
 #: ... only where every sampled input point of the start is within this many times the
 #: bound (the near misses: the refinement rarely brings a farther start under it)
 _MINIMAX_NEAR = 1.3
@@ -165,6 +165,12 @@ _MINIMAX_NEAR = 1.3
 #: on cubic typefaces, but there the long refined cubics moved fitted joints and corners off
 #: the design (bench/RESULTS.md, "CFF counts, seventh session")
 _MINIMAX_GREEDY = True
+#: rounded input: after the fit, rounds of merging two adjacent cubics at a smooth vertex
+#: by the refinement (:meth:`_BatchFitter._minimax_merge_round`; 0: off)
+_MINIMAX_MERGE = 2
+#: ... a merged cubic kept only where it stays within this many quanta of the two it
+#: replaces (both ways, sampled): the refinement corrects near misses by little
+_MERGE_DEV = 0.35
 #: rounded input: the greedy refit also from each chain's end (False: off, for measurements)
 _GREEDY_BACK = False
 _RESPLIT_CANDIDATES = 3
@@ -1042,6 +1048,31 @@ def _halves(a: np.ndarray, b: np.ndarray, k: np.ndarray) -> np.ndarray:
     return np.stack([np.stack([a, k], axis=1), np.stack([k, b], axis=1)], axis=1).reshape(-1, 2)
 
 
+_DEV_T = np.linspace(0.0, 1.0, 33)
+_DEV_B = np.stack([(1 - _DEV_T) ** 3, 3 * (1 - _DEV_T) ** 2 * _DEV_T,
+                   3 * (1 - _DEV_T) * _DEV_T ** 2, _DEV_T ** 3], axis=1)
+
+
+def _pair_deviation(c, ca, cb) -> np.ndarray:
+    """Per row: the largest distance (both ways, on samples) between the cubic ``c`` and
+    the two cubics ``ca``, ``cb`` it replaces (one polyline of 33 samples against one of
+    65)."""
+    new = np.einsum("tk,mkc->mtc", _DEV_B, c)
+    old = np.concatenate([np.einsum("tk,mkc->mtc", _DEV_B, ca),
+                          np.einsum("tk,mkc->mtc", _DEV_B[1:], cb)], axis=1)
+
+    def one_way(p, poly):  # (m, P, 2) points to (m, Q, 2) polylines
+        a = poly[:, None, :-1]
+        d = poly[:, None, 1:] - a
+        w = p[:, :, None] - a
+        dd = (d * d).sum(-1)
+        t = np.clip((w * d).sum(-1) / np.where(dd > 0, dd, 1.0), 0.0, 1.0)
+        r = w - t[..., None] * d
+        return np.sqrt((r * r).sum(-1).min(axis=2)).max(axis=1)
+
+    return np.maximum(one_way(new, old), one_way(old, new))
+
+
 def _chain_phase(idx: np.ndarray, k: int) -> np.ndarray:
     """Per sorted index of a group of ``k`` consecutive segments (idx .. idx + k - 1) its
     offset mod ``k`` from the first index of its chain (indices less than ``k`` apart, so
@@ -1547,6 +1578,7 @@ class _BatchFitter:
         self._triples: tuple | None = None
         #: keys a (M + 1) + b of the ranges a..b that :meth:`_try` found no cubic for
         self._failed = np.zeros(0, dtype=np.int64)
+        self._refine = _MINIMAX  # (the minimax refinement in :meth:`_second_candidate`)
 
     # -- the one-parameter family ---------------------------------------------------------
     def _triangle(self, A: np.ndarray, B: np.ndarray):
@@ -1700,11 +1732,79 @@ class _BatchFitter:
         for _ in range(_RESPLIT_ROUNDS):
             if not (self._resplit_round(0) | self._resplit_round(1) | self._resplit_round(2)):
                 break
-        self._refine = _MINIMAX_GREEDY
+        self._refine = _MINIMAX and _MINIMAX_GREEDY
         self._greedy_round()
-        self._refine = True
+        self._refine = _MINIMAX
         if _GREEDY_BACK and self.quant is not None:
             self._greedy_back_round()
+        if _MINIMAX_MERGE and self.quant is not None:
+            for _ in range(_MINIMAX_MERGE):
+                if not (self._minimax_merge_round(0) | self._minimax_merge_round(1)):
+                    break
+
+    def _minimax_merge_round(self, parity: int) -> bool:
+        """Rounded input whose rounding is a fair share of the bound (:meth:`_exact`), after
+        the fit: two adjacent cubics at a vertex that barely turns (``_ABSORB_TURN``) are
+        replaced by one cubic over both where the refinement
+        (:func:`galvo_core.minimax.minimax_cubics`) brings a near miss within the bound,
+        under the same test (:meth:`_accept`). The start: the free Gauss-Newton cubic
+        (:meth:`_gauss_newton_free`) from the cubic the two would be pieces of (their outer
+        handles stretched by the shares of their lengths); refined only where its sampled
+        points are all within ``_MINIMAX_NEAR`` times the bound; kept only where it stays
+        within ``_MERGE_DEV`` quanta of the two cubics it replaces. One try per joint (the
+        refinement inside every candidate of the fit cost a tenth more time on sparse
+        outlines, :data:`_MINIMAX`): non-overlapping pairs from ``parity``; True when
+        something merged."""
+        A, B, C, E, isl = self._all_segments()
+        if len(A) < 2:
+            return False
+        assert self.quant is not None  # (called on rounded input only)
+        if self._barely_turns is None:  # per thinned point (as :meth:`_absorb_round`)
+            cosv = (self.t_in * self.t_out).sum(axis=1)
+            self._barely_turns = cosv > math.cos(_ABSORB_TURN)
+        adj = ~isl[:-1] & ~isl[1:] & (B[:-1] == A[1:]) & self._barely_turns[B[:-1]]
+        idx = np.flatnonzero(adj)
+        idx = idx[(self.quant[A[idx]] > 0.0) & self._exact(A[idx])]
+        if len(idx) == 0:
+            return False
+        pick = idx[_chain_phase(idx, 2) == parity]
+        if len(pick) == 0:
+            return False
+        ca, cb = C[pick], C[pick + 1]
+        la = np.hypot(*np.diff(ca, axis=1).transpose(2, 0, 1)).sum(axis=1)
+        lb = np.hypot(*np.diff(cb, axis=1).transpose(2, 0, 1)).sum(axis=1)
+        t = (la / np.maximum(la + lb, 1e-300))[:, None]
+        start = ca.copy()
+        start[:, 3] = cb[:, 3]
+        start[:, 1] = ca[:, 0] + (ca[:, 1] - ca[:, 0]) / np.maximum(t, 1e-9)
+        start[:, 2] = cb[:, 3] + (cb[:, 2] - cb[:, 3]) / np.maximum(1.0 - t, 1e-9)
+        a, b = A[pick], B[pick + 1]
+        i0, i1 = self.kept[a], self.kept[b]
+        cf_, okf = self._gauss_newton_free(a, b, i0, i1, start)
+        start = np.where(okf[:, None, None], cf_, start)
+        v = np.flatnonzero(self._sample_ok(start, i0, i1, _MINIMAX_NEAR * self.e_per[a]))
+        if len(v) == 0:
+            return False
+        cm, okm = minimax_cubics(self.work, self.arc, i0[v], i1[v], start[v],
+                                 self.e_per[a[v]])
+        okm &= _handles_in_order(cm)
+        v, cm = v[okm], cm[okm]
+        if len(v):
+            near = _pair_deviation(cm, ca[v], cb[v]) <= _MERGE_DEV * self.quant[a[v]]
+            v, cm = v[near], cm[near]
+        if len(v) == 0:
+            return False
+        g, e, _, _ = self._accept(cm, i0[v], i1[v], self.e_per[a[v]], a[v])
+        if not g.any():
+            return False
+        i = pick[v[g]]
+        B[i] = B[i + 1]
+        C[i] = cm[g]
+        E[i] = e[g]
+        keep = np.ones(len(A), dtype=bool)
+        keep[i + 1] = False
+        self._store(A[keep], B[keep], C[keep], E[keep], isl[keep])
+        return True
 
     def _greedy_back_round(self) -> bool:
         """Rounded input whose rounding is a fair share of the bound (:meth:`_exact`):
@@ -2401,7 +2501,7 @@ class _BatchFitter:
                     passed[v[g]] = True
                     ctrl_all[v[g]] = cf_[g]
                     em_all[v[g]] = e[g]
-                if _MINIMAX and len(free_v):
+                if self._refine and len(free_v):
                     self._minimax_candidate(free_v, free_c, A, i0, i1, passed, ctrl_all,
                                             em_all)
         return passed, ctrl_all, em_all
@@ -2412,7 +2512,7 @@ class _BatchFitter:
         bound (:func:`galvo_core.minimax.minimax_cubics`), under the same test; in place."""
         rest = ~passed[v]
         v, start = v[rest], start[rest]
-        if len(v) == 0 or not getattr(self, "_refine", True):
+        if len(v) == 0:
             return
         # near misses only: a start whose sampled points are all within _MINIMAX_NEAR of
         # the bound (a cheap necessary test; most pieces refined from farther fail anyway)
