@@ -1579,6 +1579,8 @@ class _BatchFitter:
         #: keys a (M + 1) + b of the ranges a..b that :meth:`_try` found no cubic for
         self._failed = np.zeros(0, dtype=np.int64)
         self._refine = _MINIMAX  # (the minimax refinement in :meth:`_second_candidate`)
+        #: keys (as ``_failed``) of the ranges :meth:`_minimax_merge_round` tried
+        self._merge_tried = np.zeros(0, dtype=np.int64)
 
     # -- the one-parameter family ---------------------------------------------------------
     def _triangle(self, A: np.ndarray, B: np.ndarray):
@@ -1751,7 +1753,7 @@ class _BatchFitter:
         (:meth:`_gauss_newton_free`) from the cubic the two would be pieces of (their outer
         handles stretched by the shares of their lengths); refined only where its sampled
         points are all within ``_MINIMAX_NEAR`` times the bound; kept only where it stays
-        within ``_MERGE_DEV`` quanta of the two cubics it replaces. One try per joint (the
+        within ``_MERGE_DEV`` quanta of the two cubics it replaces. One try per range (the
         refinement inside every candidate of the fit cost a tenth more time on sparse
         outlines, :data:`_MINIMAX`): non-overlapping pairs from ``parity``; True when
         something merged."""
@@ -1768,8 +1770,16 @@ class _BatchFitter:
         if len(idx) == 0:
             return False
         pick = idx[_chain_phase(idx, 2) == parity]
+        # a range tried before is not tried again (the next round's new pairs only)
+        key = A[pick].astype(np.int64) * (len(self.kept) + 1) + B[pick + 1]
+        tried = self._merge_tried
+        if len(tried):
+            pos = np.minimum(np.searchsorted(tried, key), len(tried) - 1)
+            fresh = tried[pos] != key
+            pick, key = pick[fresh], key[fresh]
         if len(pick) == 0:
             return False
+        self._merge_tried = np.union1d(tried, key)
         ca, cb = C[pick], C[pick + 1]
         la = np.hypot(*np.diff(ca, axis=1).transpose(2, 0, 1)).sum(axis=1)
         lb = np.hypot(*np.diff(cb, axis=1).transpose(2, 0, 1)).sum(axis=1)
