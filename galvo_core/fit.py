@@ -1048,29 +1048,63 @@ def _halves(a: np.ndarray, b: np.ndarray, k: np.ndarray) -> np.ndarray:
     return np.stack([np.stack([a, k], axis=1), np.stack([k, b], axis=1)], axis=1).reshape(-1, 2)
 
 
-_DEV_T = np.linspace(0.0, 1.0, 33)
-_DEV_B = np.stack([(1 - _DEV_T) ** 3, 3 * (1 - _DEV_T) ** 2 * _DEV_T,
-                   3 * (1 - _DEV_T) * _DEV_T ** 2, _DEV_T ** 3], axis=1)
+#: :func:`_pair_deviation`'s samples per cubic
+_DEV_SAMPLES = 33
 
 
 def _pair_deviation(c, ca, cb) -> np.ndarray:
     """Per row: the largest distance (both ways, on samples) between the cubic ``c`` and
-    the two cubics ``ca``, ``cb`` it replaces (one polyline of 33 samples against one of
-    65)."""
-    new = np.einsum("tk,mkc->mtc", _DEV_B, c)
-    old = np.concatenate([np.einsum("tk,mkc->mtc", _DEV_B, ca),
-                          np.einsum("tk,mkc->mtc", _DEV_B[1:], cb)], axis=1)
+    the two cubics ``ca``, ``cb`` it replaces (a polyline of ``_DEV_SAMPLES`` samples
+    against one of twice as many; compiled: :func:`_pair_dev_kernel`)."""
+    out = np.empty(len(c))
+    _pair_dev_kernel(np.ascontiguousarray(c, dtype=np.float64),
+                     np.ascontiguousarray(ca, dtype=np.float64),
+                     np.ascontiguousarray(cb, dtype=np.float64), _DEV_SAMPLES, out)
+    return out
 
-    def one_way(p, poly):  # (m, P, 2) points to (m, Q, 2) polylines
-        a = poly[:, None, :-1]
-        d = poly[:, None, 1:] - a
-        w = p[:, :, None] - a
-        dd = (d * d).sum(-1)
-        t = np.clip((w * d).sum(-1) / np.where(dd > 0, dd, 1.0), 0.0, 1.0)
-        r = w - t[..., None] * d
-        return np.sqrt((r * r).sum(-1).min(axis=2)).max(axis=1)
 
-    return np.maximum(one_way(new, old), one_way(old, new))
+@njit(cache=True, nogil=True)
+def _bez_samples(c, n, out, at):  # pragma: no cover (compiled)
+    """n samples of the cubic c (4, 2) at parameters k / (n - 1) into out[at:at + n]."""
+    for k in range(n):
+        t = k / (n - 1)
+        s = 1.0 - t
+        b0, b1, b2, b3 = s * s * s, 3.0 * s * s * t, 3.0 * s * t * t, t * t * t
+        for j in range(2):
+            out[at + k, j] = b0 * c[0, j] + b1 * c[1, j] + b2 * c[2, j] + b3 * c[3, j]
+
+
+@njit(cache=True, nogil=True)
+def _to_polyline(p, poly):  # pragma: no cover (compiled)
+    """The largest distance of the points p to the polyline poly."""
+    worst = 0.0
+    for i in range(len(p)):
+        best = math.inf
+        for j in range(len(poly) - 1):
+            ax, ay = poly[j, 0], poly[j, 1]
+            dx, dy = poly[j + 1, 0] - ax, poly[j + 1, 1] - ay
+            wx, wy = p[i, 0] - ax, p[i, 1] - ay
+            dd = dx * dx + dy * dy
+            t = (wx * dx + wy * dy) / dd if dd > 0.0 else 0.0
+            t = min(1.0, max(0.0, t))
+            rx, ry = wx - t * dx, wy - t * dy
+            r = rx * rx + ry * ry
+            if r < best:
+                best = r
+        if best > worst:
+            worst = best
+    return math.sqrt(worst)
+
+
+@njit(cache=True, nogil=True)
+def _pair_dev_kernel(c, ca, cb, n, out):  # pragma: no cover (compiled)
+    new = np.empty((n, 2))
+    old = np.empty((2 * n - 1, 2))
+    for r in range(len(c)):
+        _bez_samples(c[r], n, new, 0)
+        _bez_samples(ca[r], n, old, 0)
+        _bez_samples(cb[r], n, old, n - 1)
+        out[r] = max(_to_polyline(new, old), _to_polyline(old, new))
 
 
 def _chain_phase(idx: np.ndarray, k: int) -> np.ndarray:
