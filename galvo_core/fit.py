@@ -171,6 +171,9 @@ _MINIMAX_MERGE = 2
 #: ... a merged cubic kept only where it stays within this many quanta of the two it
 #: replaces (both ways, sampled): the refinement corrects near misses by little
 _MERGE_DEV = 0.35
+#: ... the start's Gauss-Newton rounds, and the near misses refined (as ``_MINIMAX_NEAR``)
+_MERGE_GN_ROUNDS = 4
+_MERGE_NEAR = 1.2
 #: rounded input: the greedy refit also from each chain's end (False: off, for measurements)
 _GREEDY_BACK = False
 _RESPLIT_CANDIDATES = 3
@@ -1824,9 +1827,9 @@ class _BatchFitter:
         start[:, 2] = cb[:, 3] + (cb[:, 2] - cb[:, 3]) / np.maximum(1.0 - t, 1e-9)
         a, b = A[pick], B[pick + 1]
         i0, i1 = self.kept[a], self.kept[b]
-        cf_, okf = self._gauss_newton_free(a, b, i0, i1, start)
+        cf_, okf = self._gauss_newton_free(a, b, i0, i1, start, _MERGE_GN_ROUNDS)
         start = np.where(okf[:, None, None], cf_, start)
-        v = np.flatnonzero(self._sample_ok(start, i0, i1, _MINIMAX_NEAR * self.e_per[a]))
+        v = np.flatnonzero(self._sample_ok(start, i0, i1, _MERGE_NEAR * self.e_per[a]))
         if len(v) == 0:
             return False
         cm, okm = minimax_cubics(self.work, self.arc, i0[v], i1[v], start[v],
