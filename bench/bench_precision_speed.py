@@ -1,9 +1,9 @@
 """Fit throughput with the precision detection (issue 16): 1 M input points of the speed
 curve (bench_thin.sines) as 10 paths, exact and rounded to whole units; CPU time
-(time.process_time; with ``--plt``/``--sparse`` also wall time, which the kernel threads
-of galvo_core.parallel shorten: ``GALVO_THREADS=1`` for one), best of N, fit_drawing with the defaults (quantum detected) against
-quantum_units=0 given (no detection, the rounding ignored: today's fit). ``--nesting``: the
-refit of the corpus's fabric nesting file (40,705 paths) at e_per 0.05 and 0.02.
+(time.process_time; also wall time, which the kernel threads of galvo_core.parallel
+shorten: ``GALVO_THREADS=1`` for one), best of N, fit_drawing with the defaults (quantum
+detected) against quantum_units=0 given (no detection, the rounding ignored: today's fit).
+``--nesting``: the refit of the corpus's fabric nesting file (40,705 paths) at e_per 0.05 and 0.02.
 
 ``--code DIR`` imports galvo_core from another checkout (e.g. ``git worktree add /tmp/wt-66c
 66c99cd``), to measure two versions side by side in the same minutes (alternate the runs).

@@ -108,6 +108,7 @@ from galvo_core.geometry import (
     seeded_nearest,
 )
 from galvo_core.job import gc_paused
+from galvo_core.minimax import minimax_cubics
 from galvo_core.parallel import run_chunks
 from galvo_core.precision import path_quanta
 from galvo_core.runs import segmented_cumsum, split_pieces_many
@@ -155,6 +156,27 @@ _GN_ROUNDS = 4
 #: rounded input: the candidate with free end tangents too, each turned at most this much
 _GN_FREE = True
 _GN_TURN = math.radians(5.0)
+#: rounded input: a free Gauss-Newton cubic that fails is refined towards the least worst
+#: error (galvo_core.minimax; False: off, for measurements)
+_MINIMAX = False
+#: ... only where every sampled input point of the start is within this many times the
+#: bound (the near misses: the refinement rarely brings a farther start under it)
+_MINIMAX_NEAR = 1.3
+#: ... also in the greedy chain refit (:meth:`_BatchFitter._greedy_round`): fewer segments
+#: on cubic typefaces, but there the long refined cubics moved fitted joints and corners off
+#: the design (bench/RESULTS.md, "CFF counts, seventh session")
+_MINIMAX_GREEDY = True
+#: rounded input: after the fit, rounds of merging two adjacent cubics at a smooth vertex
+#: by the refinement (:meth:`_BatchFitter._minimax_merge_round`; 0: off)
+_MINIMAX_MERGE = 2
+#: ... a merged cubic kept only where it stays within this many quanta of the two it
+#: replaces (both ways, sampled): the refinement corrects near misses by little
+_MERGE_DEV = 0.35
+#: ... the start's Gauss-Newton rounds, and the near misses refined (as ``_MINIMAX_NEAR``)
+_MERGE_GN_ROUNDS = 4
+_MERGE_NEAR = 1.2
+#: rounded input: the greedy refit also from each chain's end (False: off, for measurements)
+_GREEDY_BACK = False
 _RESPLIT_CANDIDATES = 3
 #: ... in this order (the middle one first)
 _RESPLIT_ORDER = (1, 0, 2)
@@ -1036,6 +1058,65 @@ def _halves(a: np.ndarray, b: np.ndarray, k: np.ndarray) -> np.ndarray:
     return np.stack([np.stack([a, k], axis=1), np.stack([k, b], axis=1)], axis=1).reshape(-1, 2)
 
 
+#: :func:`_pair_deviation`'s samples per cubic
+_DEV_SAMPLES = 33
+
+
+def _pair_deviation(c, ca, cb) -> np.ndarray:
+    """Per row: the largest distance (both ways, on samples) between the cubic ``c`` and
+    the two cubics ``ca``, ``cb`` it replaces (a polyline of ``_DEV_SAMPLES`` samples
+    against one of twice as many; compiled: :func:`_pair_dev_kernel`)."""
+    out = np.empty(len(c))
+    _pair_dev_kernel(np.ascontiguousarray(c, dtype=np.float64),
+                     np.ascontiguousarray(ca, dtype=np.float64),
+                     np.ascontiguousarray(cb, dtype=np.float64), _DEV_SAMPLES, out)
+    return out
+
+
+@njit(cache=True, nogil=True)
+def _bez_samples(c, n, out, at):  # pragma: no cover (compiled)
+    """n samples of the cubic c (4, 2) at parameters k / (n - 1) into out[at:at + n]."""
+    for k in range(n):
+        t = k / (n - 1)
+        s = 1.0 - t
+        b0, b1, b2, b3 = s * s * s, 3.0 * s * s * t, 3.0 * s * t * t, t * t * t
+        for j in range(2):
+            out[at + k, j] = b0 * c[0, j] + b1 * c[1, j] + b2 * c[2, j] + b3 * c[3, j]
+
+
+@njit(cache=True, nogil=True)
+def _to_polyline(p, poly):  # pragma: no cover (compiled)
+    """The largest distance of the points p to the polyline poly."""
+    worst = 0.0
+    for i in range(len(p)):
+        best = math.inf
+        for j in range(len(poly) - 1):
+            ax, ay = poly[j, 0], poly[j, 1]
+            dx, dy = poly[j + 1, 0] - ax, poly[j + 1, 1] - ay
+            wx, wy = p[i, 0] - ax, p[i, 1] - ay
+            dd = dx * dx + dy * dy
+            t = (wx * dx + wy * dy) / dd if dd > 0.0 else 0.0
+            t = min(1.0, max(0.0, t))
+            rx, ry = wx - t * dx, wy - t * dy
+            r = rx * rx + ry * ry
+            if r < best:
+                best = r
+        if best > worst:
+            worst = best
+    return math.sqrt(worst)
+
+
+@njit(cache=True, nogil=True)
+def _pair_dev_kernel(c, ca, cb, n, out):  # pragma: no cover (compiled)
+    new = np.empty((n, 2))
+    old = np.empty((2 * n - 1, 2))
+    for r in range(len(c)):
+        _bez_samples(c[r], n, new, 0)
+        _bez_samples(ca[r], n, old, 0)
+        _bez_samples(cb[r], n, old, n - 1)
+        out[r] = max(_to_polyline(new, old), _to_polyline(old, new))
+
+
 def _chain_phase(idx: np.ndarray, k: int) -> np.ndarray:
     """Per sorted index of a group of ``k`` consecutive segments (idx .. idx + k - 1) its
     offset mod ``k`` from the first index of its chain (indices less than ``k`` apart, so
@@ -1541,6 +1622,9 @@ class _BatchFitter:
         self._triples: tuple | None = None
         #: keys a (M + 1) + b of the ranges a..b that :meth:`_try` found no cubic for
         self._failed = np.zeros(0, dtype=np.int64)
+        self._refine = _MINIMAX  # (the minimax refinement in :meth:`_second_candidate`)
+        #: keys (as ``_failed``) of the ranges :meth:`_minimax_merge_round` tried
+        self._merge_tried = np.zeros(0, dtype=np.int64)
 
     # -- the one-parameter family ---------------------------------------------------------
     def _triangle(self, A: np.ndarray, B: np.ndarray):
@@ -1703,7 +1787,186 @@ class _BatchFitter:
         for _ in range(_RESPLIT_ROUNDS):
             if not (self._resplit_round(0) | self._resplit_round(1) | self._resplit_round(2)):
                 break
+        self._refine = _MINIMAX and _MINIMAX_GREEDY
         self._greedy_round()
+        self._refine = _MINIMAX
+        if _GREEDY_BACK and self.quant is not None:
+            self._greedy_back_round()
+        if _MINIMAX_MERGE and self.quant is not None:
+            for _ in range(_MINIMAX_MERGE):
+                if not (self._minimax_merge_round(0) | self._minimax_merge_round(1)):
+                    break
+
+    def _minimax_merge_round(self, parity: int) -> bool:
+        """Rounded input whose rounding is a fair share of the bound (:meth:`_exact`), after
+        the fit: two adjacent cubics at a vertex that barely turns (``_ABSORB_TURN``) are
+        replaced by one cubic over both where the refinement
+        (:func:`galvo_core.minimax.minimax_cubics`) brings a near miss within the bound,
+        under the same test (:meth:`_accept`). The start: the free Gauss-Newton cubic
+        (:meth:`_gauss_newton_free`) from the cubic the two would be pieces of (their outer
+        handles stretched by the shares of their lengths); refined only where its sampled
+        points are all within ``_MINIMAX_NEAR`` times the bound; kept only where it stays
+        within ``_MERGE_DEV`` quanta of the two cubics it replaces. One try per range (the
+        refinement inside every candidate of the fit cost a tenth more time on sparse
+        outlines, :data:`_MINIMAX`): non-overlapping pairs from ``parity``; True when
+        something merged."""
+        A, B, C, E, isl = self._all_segments()
+        if len(A) < 2:
+            return False
+        assert self.quant is not None  # (called on rounded input only)
+        if self._barely_turns is None:  # per thinned point (as :meth:`_absorb_round`)
+            cosv = (self.t_in * self.t_out).sum(axis=1)
+            self._barely_turns = cosv > math.cos(_ABSORB_TURN)
+        adj = ~isl[:-1] & ~isl[1:] & (B[:-1] == A[1:]) & self._barely_turns[B[:-1]]
+        idx = np.flatnonzero(adj)
+        idx = idx[(self.quant[A[idx]] > 0.0) & self._exact(A[idx])]
+        if len(idx) == 0:
+            return False
+        pick = idx[_chain_phase(idx, 2) == parity]
+        # a range tried before is not tried again (the next round's new pairs only)
+        key = A[pick].astype(np.int64) * (len(self.kept) + 1) + B[pick + 1]
+        tried = self._merge_tried
+        if len(tried):
+            pos = np.minimum(np.searchsorted(tried, key), len(tried) - 1)
+            fresh = tried[pos] != key
+            pick, key = pick[fresh], key[fresh]
+        if len(pick) == 0:
+            return False
+        self._merge_tried = np.union1d(tried, key)
+        ca, cb = C[pick], C[pick + 1]
+        la = np.hypot(*np.diff(ca, axis=1).transpose(2, 0, 1)).sum(axis=1)
+        lb = np.hypot(*np.diff(cb, axis=1).transpose(2, 0, 1)).sum(axis=1)
+        t = (la / np.maximum(la + lb, 1e-300))[:, None]
+        start = ca.copy()
+        start[:, 3] = cb[:, 3]
+        start[:, 1] = ca[:, 0] + (ca[:, 1] - ca[:, 0]) / np.maximum(t, 1e-9)
+        start[:, 2] = cb[:, 3] + (cb[:, 2] - cb[:, 3]) / np.maximum(1.0 - t, 1e-9)
+        a, b = A[pick], B[pick + 1]
+        i0, i1 = self.kept[a], self.kept[b]
+        cf_, okf = self._gauss_newton_free(a, b, i0, i1, start, _MERGE_GN_ROUNDS)
+        start = np.where(okf[:, None, None], cf_, start)
+        v = np.flatnonzero(self._sample_ok(start, i0, i1, _MERGE_NEAR * self.e_per[a]))
+        if len(v) == 0:
+            return False
+        cm, okm = minimax_cubics(self.work, self.arc, i0[v], i1[v], start[v],
+                                 self.e_per[a[v]])
+        okm &= _handles_in_order(cm)
+        v, cm = v[okm], cm[okm]
+        if len(v):
+            near = _pair_deviation(cm, ca[v], cb[v]) <= _MERGE_DEV * self.quant[a[v]]
+            v, cm = v[near], cm[near]
+        if len(v) == 0:
+            return False
+        g, e, _, _ = self._accept(cm, i0[v], i1[v], self.e_per[a[v]], a[v])
+        if not g.any():
+            return False
+        i = pick[v[g]]
+        B[i] = B[i + 1]
+        C[i] = cm[g]
+        E[i] = e[g]
+        keep = np.ones(len(A), dtype=bool)
+        keep[i + 1] = False
+        self._store(A[keep], B[keep], C[keep], E[keep], isl[keep])
+        return True
+
+    def _greedy_back_round(self) -> bool:
+        """Rounded input whose rounding is a fair share of the bound (:meth:`_exact`):
+        :meth:`_greedy_round` from each chain's end backwards (each cubic reaching back to
+        the earliest thinned point where one passes). On rounded input a cubic may reach a
+        little past a design joint within the bound, so the forward pass lags a little
+        more at every joint and can end with one cubic more than the design has (a closed
+        4-cubic oval in 5); from the other end the lags fall elsewhere. Replaced where it
+        takes fewer segments than the chain has now. True when something changed."""
+        A, B, C, E, isl = self._all_segments()
+        n = len(A)
+        if n < _GREEDY_MIN:
+            return False
+        cub = ~isl
+        smooth = (self.t_in[B[:-1]] == self.t_out[B[:-1]]).all(axis=1)
+        adj = cub[:-1] & cub[1:] & (B[:-1] == A[1:]) & smooth
+        head = np.r_[True, ~adj]
+        cid = np.cumsum(head) - 1
+        size = np.bincount(cid)
+        first = np.flatnonzero(head)
+        last = first + size - 1
+        pick = np.flatnonzero(size >= _GREEDY_MIN)
+        assert self.quant is not None  # (called on rounded input only)
+        pick = pick[(self.quant[A[first[pick]]] > 0.0) & self._exact(A[first[pick]])]
+        if len(pick) == 0:
+            return False
+        old = size[pick]
+        firstseg = first[pick]
+        # (negated thinned indices: the forward search's arithmetic, backwards)
+        cur = -B[last[pick]]
+        end = -A[firstseg]
+
+        def cap(c, i):  # the earliest start tried for the end -c: _GREEDY_SPAN old segments
+            cs = np.searchsorted(B, -c, side="left")
+            return -A[np.maximum(cs - _GREEDY_SPAN + 1, firstseg[i])]
+
+        bnd = cap(cur, np.arange(len(cur)))
+        lo = cur.copy()
+        hi = bnd + 1
+        made = np.zeros(len(pick), dtype=np.intp)
+        live = np.ones(len(pick), dtype=bool)
+        done = np.zeros(len(pick), dtype=bool)
+        best_c = np.zeros((len(pick), 4, 2))
+        best_e = np.zeros(len(pick))
+        out_k: list[np.ndarray] = []
+        out_a: list[np.ndarray] = []
+        out_b: list[np.ndarray] = []
+        out_c: list[np.ndarray] = []
+        out_e: list[np.ndarray] = []
+        while live.any():
+            w = np.flatnonzero(live)
+            mid = np.where(hi[w] > bnd[w], bnd[w], (lo[w] + hi[w]) // 2)
+            ok, ctrl, em = self._try(-mid, -cur[w])
+            g = w[ok]
+            lo[g] = mid[ok]
+            best_c[g] = ctrl[ok]
+            best_e[g] = em[ok]
+            hi[w[~ok]] = mid[~ok]
+            settled = w[(hi[w] - lo[w] <= 1) | (lo[w] == bnd[w])]
+            if len(settled) == 0:
+                continue
+            none = settled[lo[settled] == cur[settled]]
+            # no cubic to cur: the old segment ending there stays
+            os_ = np.searchsorted(B, -cur[none])
+            has = (os_ < n) & (B[np.minimum(os_, n - 1)] == -cur[none])
+            live[none[~has]] = False
+            none, os_ = none[has], os_[has]
+            lo[none] = -A[os_]
+            best_c[none] = C[os_]
+            best_e[none] = E[os_]
+            s = settled[lo[settled] > cur[settled]]
+            out_k.append(s)
+            out_a.append(-lo[s])
+            out_b.append(-cur[s])
+            out_c.append(best_c[s].copy())
+            out_e.append(best_e[s].copy())
+            made[s] += 1
+            fin = s[lo[s] == end[s]]
+            done[fin] = made[fin] < old[fin]
+            live[fin] = False
+            go = s[lo[s] < end[s]]
+            live[go[made[go] + 1 >= old[go]]] = False
+            go = go[live[go]]
+            cur[go] = lo[go]
+            bnd[go] = cap(cur[go], go)
+            hi[go] = bnd[go] + 1
+        if not done.any():
+            return False
+        k = np.concatenate(out_k)
+        keep_new = done[k]
+        drop = np.isin(cid, pick[done])
+        A2 = np.concatenate([A[~drop], np.concatenate(out_a)[keep_new]])
+        B2 = np.concatenate([B[~drop], np.concatenate(out_b)[keep_new]])
+        C2 = np.concatenate([C[~drop], np.concatenate(out_c)[keep_new]])
+        E2 = np.concatenate([E[~drop], np.concatenate(out_e)[keep_new]])
+        L2 = np.concatenate([isl[~drop], np.zeros(int(keep_new.sum()), dtype=bool)])
+        o = np.argsort(A2, kind="stable")
+        self._store(A2[o], B2[o], C2[o], E2[o], L2[o])
+        return True
 
     def _greedy_round(self) -> bool:
         """Chains of at least ``_GREEDY_MIN`` adjacent cubics meeting at smooth vertices
@@ -2243,7 +2506,6 @@ class _BatchFitter:
         """Rounded input: from ``ctrl`` (:meth:`_gauss_newton`), both inner control points
         free (the end tangents too: they are estimates from rounded points), Gauss-Newton on
         the normal distances; ok where each end tangent turned at most ``_GN_TURN``."""
-        m = len(A)
         i0 = np.ascontiguousarray(i0, dtype=np.intp)
         i1 = np.ascontiguousarray(i1, dtype=np.intp)
         L = i1 - i0 - 1
@@ -2308,6 +2570,8 @@ class _BatchFitter:
             if len(v):
                 cf_, okf = self._gauss_newton_free(A[v], B[v], i0[v], i1[v], cg[v])
                 okf &= _handles_in_order(cf_)
+                # (the minimax refinement's starts: the free cubic, else the other)
+                free_v, free_c = v, np.where(okf[:, None, None], cf_, cg[v])
                 v, cf_ = v[okf], cf_[okf]
                 if len(v):
                     sk = self._sample_ok(cf_, i0[v], i1[v], self.e_per[A[v]])
@@ -2317,7 +2581,34 @@ class _BatchFitter:
                     passed[v[g]] = True
                     ctrl_all[v[g]] = cf_[g]
                     em_all[v[g]] = e[g]
+                if self._refine and len(free_v):
+                    self._minimax_candidate(free_v, free_c, A, i0, i1, passed, ctrl_all,
+                                            em_all)
         return passed, ctrl_all, em_all
+
+    def _minimax_candidate(self, v, start, A, i0, i1, passed, ctrl_all, em_all) -> None:
+        """Rounded input: the pieces ``v`` whose free Gauss-Newton cubic (``start``)
+        failed, its inner control points moved to bring the worst input point under the
+        bound (:func:`galvo_core.minimax.minimax_cubics`), under the same test; in place."""
+        rest = ~passed[v]
+        v, start = v[rest], start[rest]
+        if len(v) == 0:
+            return
+        # near misses only: a start whose sampled points are all within _MINIMAX_NEAR of
+        # the bound (a cheap necessary test; most pieces refined from farther fail anyway)
+        near = self._sample_ok(start, i0[v], i1[v], _MINIMAX_NEAR * self.e_per[A[v]])
+        v, start = v[near], start[near]
+        if len(v) == 0:
+            return
+        cm, okm = minimax_cubics(self.work, self.arc, i0[v], i1[v], start, self.e_per[A[v]])
+        okm &= _handles_in_order(cm)
+        v, cm = v[okm], cm[okm]
+        if len(v) == 0:
+            return
+        g, e, _, _ = self._accept(cm, i0[v], i1[v], self.e_per[A[v]], A[v])
+        passed[v[g]] = True
+        ctrl_all[v[g]] = cm[g]
+        em_all[v[g]] = e[g]
 
     def _exact(self, A: np.ndarray) -> np.ndarray:
         """Per piece starting at thinned point A: True on exact input (no rounding) and on
