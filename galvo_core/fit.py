@@ -1653,15 +1653,15 @@ class _BatchFitter:
         crosses zero (Illinois false position inside the bracket [0, 1]); each piece on its
         own, compiled (:func:`_dichotomy_kernel`). Returns the pieces' cubics (m, 4, 2)."""
         t = np.empty(len(p0))
-        args = [np.ascontiguousarray(a, dtype=np.float64) for a in (p0, qq, p3, sig)]
-        args += [np.ascontiguousarray(a, dtype=np.intp) for a in (i0, i1)]
+        f0, fq, f3, fs = (np.ascontiguousarray(a, dtype=np.float64) for a in (p0, qq, p3, sig))
+        j0, j1 = (np.ascontiguousarray(a, dtype=np.intp) for a in (i0, i1))
         eps_s = self.eps_sum if eps_sum is None else eps_sum
 
         def chunk(lo: int, hi: int) -> None:
-            _dichotomy_kernel(*(a[lo:hi] for a in args), self.work, self.arc, sample,
-                              max_iter, eps_s, t[lo:hi])
+            _dichotomy_kernel(f0[lo:hi], fq[lo:hi], f3[lo:hi], fs[lo:hi], j0[lo:hi], j1[lo:hi],
+                              self.work, self.arc, sample, max_iter, eps_s, t[lo:hi])
 
-        run_chunks(chunk, _sampled_weights(args[4], args[5], sample) * max_iter)
+        run_chunks(chunk, _sampled_weights(j0, j1, sample) * max_iter)
         return self._ctrl(p0, qq, p3, t)
 
     def _accept(self, ctrl: np.ndarray, i0: np.ndarray, i1: np.ndarray, e2: np.ndarray,
@@ -2416,15 +2416,15 @@ class _BatchFitter:
         chord = np.hypot(*(p3 - p0).T)
         ctrl = np.empty((m, 4, 2))
         ok = np.empty(m, dtype=bool)
-        ii = [np.ascontiguousarray(a, dtype=np.intp) for a in (i0, i1)]
-        ff = [np.ascontiguousarray(a, dtype=np.float64)
-              for a in (p0, p3, self.t_out[A], self.t_in[B], chord)]
+        j0, j1 = (np.ascontiguousarray(a, dtype=np.intp) for a in (i0, i1))
+        f0, f3, g0, g3 = (np.ascontiguousarray(a, dtype=np.float64)
+                          for a in (p0, p3, self.t_out[A], self.t_in[B]))
 
         def chunk(lo: int, hi: int) -> None:
-            _ls_kernel(*(a[lo:hi] for a in ii), self.work, self.arc, _BISECT_SAMPLE,
-                       *(a[lo:hi] for a in ff), ctrl[lo:hi], ok[lo:hi])
+            _ls_kernel(j0[lo:hi], j1[lo:hi], self.work, self.arc, _BISECT_SAMPLE, f0[lo:hi],
+                       f3[lo:hi], g0[lo:hi], g3[lo:hi], chord[lo:hi], ctrl[lo:hi], ok[lo:hi])
 
-        run_chunks(chunk, _sampled_weights(ii[0], ii[1], _BISECT_SAMPLE) * 3)
+        run_chunks(chunk, _sampled_weights(j0, j1, _BISECT_SAMPLE) * 3)
         return ctrl, ok
 
     def _gauss_newton(self, A: np.ndarray, B: np.ndarray, i0: np.ndarray, i1: np.ndarray,
@@ -2443,15 +2443,16 @@ class _BatchFitter:
         chord = np.hypot(*(p3 - p0).T)
         ctrl = np.empty((m, 4, 2))
         ok = np.empty(m, dtype=bool)
-        ii = [np.ascontiguousarray(a, dtype=np.intp) for a in (i0, i1)]
-        ff = [np.ascontiguousarray(a, dtype=np.float64)
-              for a in (p0, p3, self.t_out[A], self.t_in[B], chord)]
+        j0, j1 = (np.ascontiguousarray(a, dtype=np.intp) for a in (i0, i1))
+        f0, f3, g0, g3 = (np.ascontiguousarray(a, dtype=np.float64)
+                          for a in (p0, p3, self.t_out[A], self.t_in[B]))
 
         def chunk(lo: int, hi: int) -> None:
-            _gn_kernel(*(a[lo:hi] for a in ii), self.work, self.arc, _BISECT_SAMPLE,
-                       *(a[lo:hi] for a in ff), rounds, ctrl[lo:hi], ok[lo:hi])
+            _gn_kernel(j0[lo:hi], j1[lo:hi], self.work, self.arc, _BISECT_SAMPLE, f0[lo:hi],
+                       f3[lo:hi], g0[lo:hi], g3[lo:hi], chord[lo:hi], rounds, ctrl[lo:hi],
+                       ok[lo:hi])
 
-        run_chunks(chunk, _sampled_weights(ii[0], ii[1], _BISECT_SAMPLE) * (rounds + 1))
+        run_chunks(chunk, _sampled_weights(j0, j1, _BISECT_SAMPLE) * (rounds + 1))
         return ctrl, ok
 
     def _bulging_segments(self, ab: np.ndarray, line: np.ndarray) -> np.ndarray:

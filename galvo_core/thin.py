@@ -45,6 +45,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
+from typing import cast
 
 import numpy as np
 from numba import njit
@@ -142,12 +143,9 @@ def thin_many(
                            _DP_RATIO, _DP_WINDOW, _SLACK)
 
     # (each path on its own: chunks of paths thin at once on the kernel threads)
-    parts = run_chunks(chunk, lens0)
-    if len(parts) == 1:
-        kept, cnt = parts[0]  # type: ignore[misc]
-    else:
-        kept = np.concatenate([k for k, _ in parts])  # type: ignore[misc]
-        cnt = np.concatenate([c for _, c in parts])  # type: ignore[misc]
+    parts = cast("list[tuple[np.ndarray, np.ndarray]]", run_chunks(chunk, lens0))
+    kept = np.concatenate([k for k, _ in parts]) if len(parts) > 1 else parts[0][0]
+    cnt = np.concatenate([c for _, c in parts]) if len(parts) > 1 else parts[0][1]
     if len(arrs) == 1:
         return [kept]
     cl = [0, *np.cumsum(cnt).tolist()]
