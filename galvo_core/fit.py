@@ -175,8 +175,6 @@ _MERGE_DEV = 0.35
 #: ... the start's Gauss-Newton rounds, and the near misses refined (as ``_MINIMAX_NEAR``)
 _MERGE_GN_ROUNDS = 4
 _MERGE_NEAR = 1.2
-#: rounded input: the greedy refit also from each chain's end (False: off, for measurements)
-_GREEDY_BACK = False
 _RESPLIT_CANDIDATES = 3
 #: ... in this order (the middle one first)
 _RESPLIT_ORDER = (1, 0, 2)
@@ -1790,8 +1788,6 @@ class _BatchFitter:
         self._refine = _MINIMAX and _MINIMAX_GREEDY
         self._greedy_round()
         self._refine = _MINIMAX
-        if _GREEDY_BACK and self.quant is not None:
-            self._greedy_back_round()
         if _MINIMAX_MERGE and self.quant is not None:
             for _ in range(_MINIMAX_MERGE):
                 if not (self._minimax_merge_round(0) | self._minimax_merge_round(1)):
@@ -1867,105 +1863,6 @@ class _BatchFitter:
         keep = np.ones(len(A), dtype=bool)
         keep[i + 1] = False
         self._store(A[keep], B[keep], C[keep], E[keep], isl[keep])
-        return True
-
-    def _greedy_back_round(self) -> bool:
-        """Rounded input whose rounding is a fair share of the bound (:meth:`_exact`):
-        :meth:`_greedy_round` from each chain's end backwards (each cubic reaching back to
-        the earliest thinned point where one passes). On rounded input a cubic may reach a
-        little past a design joint within the bound, so the forward pass lags a little
-        more at every joint and can end with one cubic more than the design has (a closed
-        4-cubic oval in 5); from the other end the lags fall elsewhere. Replaced where it
-        takes fewer segments than the chain has now. True when something changed."""
-        A, B, C, E, isl = self._all_segments()
-        n = len(A)
-        if n < _GREEDY_MIN:
-            return False
-        cub = ~isl
-        smooth = (self.t_in[B[:-1]] == self.t_out[B[:-1]]).all(axis=1)
-        adj = cub[:-1] & cub[1:] & (B[:-1] == A[1:]) & smooth
-        head = np.r_[True, ~adj]
-        cid = np.cumsum(head) - 1
-        size = np.bincount(cid)
-        first = np.flatnonzero(head)
-        last = first + size - 1
-        pick = np.flatnonzero(size >= _GREEDY_MIN)
-        assert self.quant is not None  # (called on rounded input only)
-        pick = pick[(self.quant[A[first[pick]]] > 0.0) & self._exact(A[first[pick]])]
-        if len(pick) == 0:
-            return False
-        old = size[pick]
-        firstseg = first[pick]
-        # (negated thinned indices: the forward search's arithmetic, backwards)
-        cur = -B[last[pick]]
-        end = -A[firstseg]
-
-        def cap(c, i):  # the earliest start tried for the end -c: _GREEDY_SPAN old segments
-            cs = np.searchsorted(B, -c, side="left")
-            return -A[np.maximum(cs - _GREEDY_SPAN + 1, firstseg[i])]
-
-        bnd = cap(cur, np.arange(len(cur)))
-        lo = cur.copy()
-        hi = bnd + 1
-        made = np.zeros(len(pick), dtype=np.intp)
-        live = np.ones(len(pick), dtype=bool)
-        done = np.zeros(len(pick), dtype=bool)
-        best_c = np.zeros((len(pick), 4, 2))
-        best_e = np.zeros(len(pick))
-        out_k: list[np.ndarray] = []
-        out_a: list[np.ndarray] = []
-        out_b: list[np.ndarray] = []
-        out_c: list[np.ndarray] = []
-        out_e: list[np.ndarray] = []
-        while live.any():
-            w = np.flatnonzero(live)
-            mid = np.where(hi[w] > bnd[w], bnd[w], (lo[w] + hi[w]) // 2)
-            ok, ctrl, em = self._try(-mid, -cur[w])
-            g = w[ok]
-            lo[g] = mid[ok]
-            best_c[g] = ctrl[ok]
-            best_e[g] = em[ok]
-            hi[w[~ok]] = mid[~ok]
-            settled = w[(hi[w] - lo[w] <= 1) | (lo[w] == bnd[w])]
-            if len(settled) == 0:
-                continue
-            none = settled[lo[settled] == cur[settled]]
-            # no cubic to cur: the old segment ending there stays
-            os_ = np.searchsorted(B, -cur[none])
-            has = (os_ < n) & (B[np.minimum(os_, n - 1)] == -cur[none])
-            live[none[~has]] = False
-            none, os_ = none[has], os_[has]
-            lo[none] = -A[os_]
-            best_c[none] = C[os_]
-            best_e[none] = E[os_]
-            s = settled[lo[settled] > cur[settled]]
-            out_k.append(s)
-            out_a.append(-lo[s])
-            out_b.append(-cur[s])
-            out_c.append(best_c[s].copy())
-            out_e.append(best_e[s].copy())
-            made[s] += 1
-            fin = s[lo[s] == end[s]]
-            done[fin] = made[fin] < old[fin]
-            live[fin] = False
-            go = s[lo[s] < end[s]]
-            live[go[made[go] + 1 >= old[go]]] = False
-            go = go[live[go]]
-            cur[go] = lo[go]
-            bnd[go] = cap(cur[go], go)
-            hi[go] = bnd[go] + 1
-        if not done.any():
-            return False
-        k = np.concatenate(out_k)
-        keep_new = done[k]
-        drop = np.isin(cid, pick[done])
-        A2 = np.concatenate([A[~drop], np.concatenate(out_a)[keep_new]])
-        B2 = np.concatenate([B[~drop], np.concatenate(out_b)[keep_new]])
-        C2 = np.concatenate([C[~drop], np.concatenate(out_c)[keep_new]])
-        E2 = np.concatenate([E[~drop], np.concatenate(out_e)[keep_new]])
-        L2 = np.concatenate([isl[~drop], np.zeros(int(keep_new.sum()), dtype=bool)])
-        o = np.argsort(A2, kind="stable")
-        self._store(A2[o], B2[o], C2[o], E2[o], L2[o])
         return True
 
     def _greedy_round(self) -> bool:

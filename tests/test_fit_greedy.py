@@ -49,7 +49,6 @@ def test_greedy_round_takes_fewer_segments_within_the_bound(monkeypatch, whole):
         with_greedy = fitmod.fit_paths([pts], [True])[0]
         with monkeypatch.context() as mp:
             mp.setattr(fitmod._BatchFitter, "_greedy_round", lambda self: False)
-            mp.setattr(fitmod._BatchFitter, "_greedy_back_round", lambda self: False)
             without = fitmod.fit_paths([pts], [True])[0]
         # never more segments than without the round, and the bound holds (independent
         # referee: true distances both ways)
