@@ -2937,6 +2937,10 @@ def _fit_concatenated(
 _GAP_OFF = 0.75
 #: ... and that is at least this many times as long as the input steps beside it
 _GAP_RATIO = 3.0
+#: ... and the rest of the segment at least this many input steps (a curve's dense end: a
+#: polyline's few short strokes beside a long one are lines of the design, and one thinned
+#: line within the bound serves them; vk2bea tektronix.hpgl: 761 -> 957 segments without)
+_GAP_REST = 5
 
 
 def _gap_ends_kept(W, K, tlen, quanta, eps, coarse):
@@ -2996,7 +3000,7 @@ def _gap_ends_kept(W, K, tlen, quanta, eps, coarse):
     r0 = np.where(at_end, a, v)
     r1 = np.where(at_end, v, b)
     err = _line_errors(W, np.stack([W[r0], W[r1]], axis=1), r0, r1)
-    keep = err <= eps_k[seg]
+    keep = (err <= eps_k[seg]) & (r1 - r0 >= _GAP_REST)
     add = np.setdiff1d(v[keep], K)
     if len(add) == 0:
         return K, tlen
