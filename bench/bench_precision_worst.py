@@ -231,20 +231,34 @@ EXCESS_TOL = 0.02
 ISSUE_BOUND = 0.6
 
 
+def fitted_contours(style: str, em: float, text: str, chord: float):
+    """The style's whole-unit glyph set fitted at the defaults: (fitted paths, the style's
+    name, and per contour
+    (index, design segments, true curve T, its labels, dense fit F, closed rounded input,
+    places T then F, their distances to the other curve))."""
+    gs = glyph_set(style, em=em, whole=True, text=text, chord=chord)
+    cs = contours(font_file(style), text, em)
+    fps = fitmod.fit_paths(gs.points, [True] * len(gs.points))
+
+    def each():
+        for ci, (segs, fp, pts) in enumerate(zip(cs, fps, gs.points, strict=True)):
+            T, lab = labelled_truth(segs)
+            F = fitted_dense(fp)
+            Rp = np.vstack([pts, pts[:1]]) if (pts[0] != pts[-1]).any() else pts
+            errs = np.concatenate([point_polyline_distance(T, F),
+                                   point_polyline_distance(F, T)])
+            yield ci, segs, T, lab, F, Rp, np.vstack([T, F]), errs
+
+    return fps, gs.style, each()
+
+
 def excess_places(style: str, em: float = 1000.0, text: str = TEXT, chord: float = 0.002):
     """Every place where the fit is farther than ISSUE_BOUND from the true curve (places at
     least R apart, worst first), with the local fit and rounded-polyline distances there and
     the excess ``fit - max(ISSUE_BOUND, poly)``. Returns (rows, segments)."""
-    gs = glyph_set(style, em=em, whole=True, text=text, chord=chord)
-    cs = contours(font_file(style), text, em)
-    fps = fitmod.fit_paths(gs.points, [True] * len(gs.points))
+    fps, name, per_contour = fitted_contours(style, em, text, chord)
     rows = []
-    for ci, (segs, fp, pts) in enumerate(zip(cs, fps, gs.points, strict=True)):
-        T, lab = labelled_truth(segs)
-        F = fitted_dense(fp)
-        Rp = np.vstack([pts, pts[:1]]) if (pts[0] != pts[-1]).any() else pts
-        locs = np.vstack([T, F])
-        errs = np.concatenate([point_polyline_distance(T, F), point_polyline_distance(F, T)])
+    for ci, segs, T, lab, F, Rp, locs, errs in per_contour:
         chosen: list[np.ndarray] = []
         for k in np.argsort(-errs):
             if errs[k] <= ISSUE_BOUND:
@@ -254,7 +268,7 @@ def excess_places(style: str, em: float = 1000.0, text: str = TEXT, chord: float
                 continue
             chosen.append(p)
             f, q = local_dist(p, F, T), local_dist(p, Rp, T)
-            rows.append({"style": gs.style, "em": em, "contour": ci, "x": float(p[0]),
+            rows.append({"style": name, "em": em, "contour": ci, "x": float(p[0]),
                          "y": float(p[1]), "fit": f, "poly": q,
                          "excess": f - max(ISSUE_BOUND, q), "segs": segs, "lab": lab, "T": T})
     for r in rows:  # the kind of the place (its design segment and the joints near it)
@@ -315,18 +329,9 @@ def excess_main(a, styles, text, ems) -> None:
 
 def worst_places(style: str, top: int, em: float = 1000.0, text: str = TEXT,
                  chord: float = 0.002):
-    gs = glyph_set(style, em=em, whole=True, text=text, chord=chord)
-    cs = contours(font_file(style), text, em)
-    fps = fitmod.fit_paths(gs.points, [True] * len(gs.points))
+    _, name, per_contour = fitted_contours(style, em, text, chord)
     cands = []
-    for ci, (segs, fp, pts) in enumerate(zip(cs, fps, gs.points, strict=True)):
-        T, lab = labelled_truth(segs)
-        F = fitted_dense(fp)
-        Rp = np.vstack([pts, pts[:1]]) if (pts[0] != pts[-1]).any() else pts
-        dT = point_polyline_distance(T, F)
-        dF = point_polyline_distance(F, T)
-        locs = np.vstack([T, F])
-        errs = np.concatenate([dT, dF])
+    for ci, segs, T, lab, F, Rp, locs, errs in per_contour:
         order = np.argsort(-errs)
         chosen = []
         for k in order[:4000]:
@@ -359,7 +364,7 @@ def worst_places(style: str, top: int, em: float = 1000.0, text: str = TEXT,
         used.append((ci, p))
         kind, orc = classify(segs, sgi, apos, seglens)
         rows.append({
-            "style": gs.style, "em": em, "contour": ci, "x": float(p[0]), "y": float(p[1]),
+            "style": name, "em": em, "contour": ci, "x": float(p[0]), "y": float(p[1]),
             "kind": kind,
             "fit": local_dist(p, F, T), "poly": local_dist(p, Rp, T),
             "oracle": oracle_vertex_moves(segs, orc) if orc else None,
