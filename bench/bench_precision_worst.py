@@ -231,6 +231,19 @@ EXCESS_TOL = 0.02
 ISSUE_BOUND = 0.6
 
 
+def design_position(p: np.ndarray, T: np.ndarray, lab: np.ndarray) -> tuple[int, float]:
+    """The nearest point of the true curve T (labels ``lab``) to p: its design segment and
+    its arc position along that segment."""
+    a, ab = T[:-1], np.diff(T, axis=0)
+    den = np.maximum((ab * ab).sum(axis=1), 1e-300)
+    t = np.clip(((p - a) * ab).sum(axis=1) / den, 0, 1)
+    it = int(np.argmin(np.hypot(*(a + t[:, None] * ab - p).T)))
+    sgi = int(lab[it + 1])
+    arc = np.r_[0, np.cumsum(np.hypot(*ab.T))]
+    s0 = int(np.flatnonzero(lab == sgi)[0]) - (1 if sgi else 0)
+    return sgi, float(arc[it] + t[it] * math.sqrt(den[it]) - arc[max(s0, 0)])
+
+
 def fitted_contours(style: str, em: float, text: str, chord: float):
     """The style's whole-unit glyph set fitted at the defaults: (fitted paths, the style's
     name, and per contour
@@ -273,15 +286,8 @@ def excess_places(style: str, em: float = 1000.0, text: str = TEXT, chord: float
                          "excess": f - max(ISSUE_BOUND, q), "segs": segs, "lab": lab, "T": T})
     for r in rows:  # the kind of the place (its design segment and the joints near it)
         T, lab, segs, p = r.pop("T"), r.pop("lab"), r.pop("segs"), np.array([r["x"], r["y"]])
-        a, ab = T[:-1], np.diff(T, axis=0)
-        den = np.maximum((ab * ab).sum(axis=1), 1e-300)
-        t = np.clip(((p - a) * ab).sum(axis=1) / den, 0, 1)
-        it = int(np.argmin(np.hypot(*(a + t[:, None] * ab - p).T)))
-        sgi = int(lab[it + 1])
-        arc = np.r_[0, np.cumsum(np.hypot(*ab.T))]
-        s0 = int(np.flatnonzero(lab == sgi)[0]) - (1 if sgi else 0)
-        apos = arc[it] + t[it] * math.sqrt(den[it]) - arc[max(s0, 0)]
-        r["kind"] = classify(segs, sgi, float(apos), [seg_len(s) for s in segs])[0]
+        sgi, apos = design_position(p, T, lab)
+        r["kind"] = classify(segs, sgi, apos, [seg_len(s) for s in segs])[0]
     rows.sort(key=lambda r: -r["excess"])
     return rows, sum(len(f.segments) for f in fps)
 
@@ -345,16 +351,8 @@ def worst_places(style: str, top: int, em: float = 1000.0, text: str = TEXT,
                 break
         seglens = [seg_len(s) for s in segs]
         for e, p in chosen:
-            # the nearest point of the true curve: its polyline segment and arc position
-            a, ab = T[:-1], np.diff(T, axis=0)
-            den = np.maximum((ab * ab).sum(axis=1), 1e-300)
-            t = np.clip(((p - a) * ab).sum(axis=1) / den, 0, 1)
-            it = int(np.argmin(np.hypot(*(a + t[:, None] * ab - p).T)))
-            sgi = int(lab[it + 1])
-            arc = np.r_[0, np.cumsum(np.hypot(*ab.T))]
-            s0 = int(np.flatnonzero(lab == sgi)[0]) - (1 if sgi else 0)
-            apos = arc[it] + t[it] * math.sqrt(den[it]) - arc[max(s0, 0)]
-            cands.append((float(e), ci, p, sgi, float(apos), segs, seglens, F, T, Rp))
+            sgi, apos = design_position(p, T, lab)
+            cands.append((float(e), ci, p, sgi, apos, segs, seglens, F, T, Rp))
     cands.sort(key=lambda c: -c[0])
     rows = []
     used = []
