@@ -12,20 +12,12 @@ from __future__ import annotations
 import math
 
 import numpy as np
+from _util import flattened_cubic as _cubic
 
 from galvo_core import fit as fitmod
 from galvo_core.fit import check_fit, fit_paths
 from galvo_core.geometry import flatten_cubic, point_polyline_distance
 from galvo_core.minimax import MINIMAX_MOVE, minimax_cubics
-
-
-def _cubic(p0, c1, c2, p3, chord: float = 0.002) -> np.ndarray:
-    p0, c1, c2, p3 = (np.asarray(v, dtype=float) for v in (p0, c1, c2, p3))
-    acc = 6.0 * max(np.hypot(*(p0 - 2 * c1 + c2)), np.hypot(*(c1 - 2 * c2 + p3)))
-    n = max(1, math.ceil(math.sqrt(acc / (8 * chord))))
-    t = np.linspace(0.0, 1.0, n + 1)[:, None]
-    s = 1.0 - t
-    return s**3 * p0 + 3 * s * s * t * c1 + 3 * s * t * t * c2 + t**3 * p3
 
 
 def _lens(x, y, length, height, f1, f2, g) -> list[tuple]:
