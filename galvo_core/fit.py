@@ -1072,35 +1072,24 @@ def _pair_deviation(c, ca, cb) -> np.ndarray:
 
 
 @njit(cache=True, nogil=True)
-def _bez_samples(c, n, out, at):  # pragma: no cover (compiled)
-    """n samples of the cubic c (4, 2) at parameters k / (n - 1) into out[at:at + n]."""
+def _bez_samples(c, r, n, out, at):  # pragma: no cover (compiled)
+    """n samples of the cubic c[r] ((M, 4, 2)) at parameters k / (n - 1) into
+    out[at:at + n] (the kernels' Bernstein arithmetic: geometry.bernstein_point)."""
     for k in range(n):
-        t = k / (n - 1)
-        s = 1.0 - t
-        b0, b1, b2, b3 = s * s * s, 3.0 * s * s * t, 3.0 * s * t * t, t * t * t
+        b0, b1, b2, b3 = bernstein_weights(k / (n - 1))
         for j in range(2):
-            out[at + k, j] = b0 * c[0, j] + b1 * c[1, j] + b2 * c[2, j] + b3 * c[3, j]
+            out[at + k, j] = bernstein_point(b0, b1, b2, b3, c, r, j)
 
 
 @njit(cache=True, nogil=True)
 def _to_polyline(p, poly):  # pragma: no cover (compiled)
-    """The largest distance of the points p to the polyline poly."""
+    """The largest distance of the points p to the polyline poly (:func:`_seg_d2`)."""
     worst = 0.0
     for i in range(len(p)):
         best = math.inf
         for j in range(len(poly) - 1):
-            ax, ay = poly[j, 0], poly[j, 1]
-            dx, dy = poly[j + 1, 0] - ax, poly[j + 1, 1] - ay
-            wx, wy = p[i, 0] - ax, p[i, 1] - ay
-            dd = dx * dx + dy * dy
-            t = (wx * dx + wy * dy) / dd if dd > 0.0 else 0.0
-            t = min(1.0, max(0.0, t))
-            rx, ry = wx - t * dx, wy - t * dy
-            r = rx * rx + ry * ry
-            if r < best:
-                best = r
-        if best > worst:
-            worst = best
+            best = min(best, _seg_d2(p[i, 0], p[i, 1], poly, j, False))
+        worst = max(worst, best)
     return math.sqrt(worst)
 
 
@@ -1109,9 +1098,9 @@ def _pair_dev_kernel(c, ca, cb, n, out):  # pragma: no cover (compiled)
     new = np.empty((n, 2))
     old = np.empty((2 * n - 1, 2))
     for r in range(len(c)):
-        _bez_samples(c[r], n, new, 0)
-        _bez_samples(ca[r], n, old, 0)
-        _bez_samples(cb[r], n, old, n - 1)
+        _bez_samples(c, r, n, new, 0)
+        _bez_samples(ca, r, n, old, 0)
+        _bez_samples(cb, r, n, old, n - 1)
         out[r] = max(_to_polyline(new, old), _to_polyline(old, new))
 
 
