@@ -21,16 +21,25 @@ For each place (a point of the plane where our fit is far from the true design c
   (the moved segments, sampled every 0.01 unit). Elsewhere "–" (curves: the dense points
   pin the design down to well under the rounding, no simple bound).
 
+Worst excess (``--excess``, eighth session): per row, every place where our fit is farther
+than 0.6 unit from the true curve, with its excess: fit minus max(0.6, rounded polyline) at
+that place (the places where the fit is farther from the design than the rounded input it
+was given, and farther than the issue's 0.6); per row the worst excess, the number of places
+over 0.02, and the worst places (``--top``).
+
 Usage: python bench/bench_precision_worst.py [--styles sans,...] [--top 10] [--json F]
-       [--chord H]   (the curves flattened to chord height H before rounding, as in
-                      bench_precision.py; default 0.002)
        python bench/bench_precision_worst.py --set heldout [--em 700] [--text T] [--font F.otf]
-(the font options as in bench_precision.py; see fonts.py)
+       python bench/bench_precision_worst.py --excess [--set heldout | --em 400 | --font F]
+                                              [--chord H] [--code DIR]
+(the font options as in bench_precision.py; see fonts.py; ``--chord H``: the curves flattened
+at chord height H before rounding, as bench_precision.py; ``--code DIR``: import galvo_core
+from another checkout, e.g. /work/main, to compare)
 """
 
 from __future__ import annotations
 
 import argparse
+import importlib
 import itertools
 import json
 import math
@@ -39,9 +48,12 @@ import sys
 
 import numpy as np
 
-sys.path.insert(0, os.path.join(os.path.dirname(__file__), ".."))
+_CODE = next((sys.argv[i + 1] for i, v in enumerate(sys.argv[:-1]) if v == "--code"), None)
+sys.path.insert(0, os.path.abspath(_CODE) if _CODE else os.path.join(os.path.dirname(__file__),
+                                                                     ".."))
 sys.path.insert(0, os.path.dirname(__file__))
-
+# (imported first: bench_precision puts this checkout first on sys.path, --code must win)
+importlib.import_module("galvo_core.fit")
 from bench_precision import add_chord_option, chord_label, fitted_dense  # noqa: E402
 from fonts import (  # noqa: E402
     TEXT,
@@ -213,20 +225,117 @@ def classify(segs, lab_seg, arc_pos, seglens):
     return "inside a curve", []
 
 
-def worst_places(style: str, top: int, em: float = 1000.0, text: str = TEXT, *,
-                 chord: float = 0.002):
+#: a place's excess counts when over this (the target: no place over it)
+EXCESS_TOL = 0.02
+#: the issue's distance bound: a place closer than this is no excess whatever the input
+ISSUE_BOUND = 0.6
+
+
+def design_position(p: np.ndarray, T: np.ndarray, lab: np.ndarray) -> tuple[int, float]:
+    """The nearest point of the true curve T (labels ``lab``) to p: its design segment and
+    its arc position along that segment."""
+    a, ab = T[:-1], np.diff(T, axis=0)
+    den = np.maximum((ab * ab).sum(axis=1), 1e-300)
+    t = np.clip(((p - a) * ab).sum(axis=1) / den, 0, 1)
+    it = int(np.argmin(np.hypot(*(a + t[:, None] * ab - p).T)))
+    sgi = int(lab[it + 1])
+    arc = np.r_[0, np.cumsum(np.hypot(*ab.T))]
+    s0 = int(np.flatnonzero(lab == sgi)[0]) - (1 if sgi else 0)
+    return sgi, float(arc[it] + t[it] * math.sqrt(den[it]) - arc[max(s0, 0)])
+
+
+def fitted_contours(style: str, em: float, text: str, chord: float):
+    """The style's whole-unit glyph set fitted at the defaults: (fitted paths, the style's
+    name, and per contour
+    (index, design segments, true curve T, its labels, dense fit F, closed rounded input,
+    places T then F, their distances to the other curve))."""
     gs = glyph_set(style, em=em, whole=True, text=text, chord=chord)
     cs = contours(font_file(style), text, em)
     fps = fitmod.fit_paths(gs.points, [True] * len(gs.points))
+
+    def each():
+        for ci, (segs, fp, pts) in enumerate(zip(cs, fps, gs.points, strict=True)):
+            T, lab = labelled_truth(segs)
+            F = fitted_dense(fp)
+            Rp = np.vstack([pts, pts[:1]]) if (pts[0] != pts[-1]).any() else pts
+            errs = np.concatenate([point_polyline_distance(T, F),
+                                   point_polyline_distance(F, T)])
+            yield ci, segs, T, lab, F, Rp, np.vstack([T, F]), errs
+
+    return fps, gs.style, each()
+
+
+def excess_places(style: str, em: float = 1000.0, text: str = TEXT, chord: float = 0.002):
+    """Every place where the fit is farther than ISSUE_BOUND from the true curve (places at
+    least R apart, worst first), with the local fit and rounded-polyline distances there and
+    the excess ``fit - max(ISSUE_BOUND, poly)``. Returns (rows, segments)."""
+    fps, name, per_contour = fitted_contours(style, em, text, chord)
+    rows = []
+    for ci, segs, T, lab, F, Rp, locs, errs in per_contour:
+        chosen: list[np.ndarray] = []
+        for k in np.argsort(-errs):
+            if errs[k] <= ISSUE_BOUND:
+                break
+            p = locs[k]
+            if any(math.hypot(*(p - c)) < R for c in chosen):
+                continue
+            chosen.append(p)
+            f, q = local_dist(p, F, T), local_dist(p, Rp, T)
+            rows.append({"style": name, "em": em, "contour": ci, "x": float(p[0]),
+                         "y": float(p[1]), "fit": f, "poly": q,
+                         "excess": f - max(ISSUE_BOUND, q), "segs": segs, "lab": lab, "T": T})
+    for r in rows:  # the kind of the place (its design segment and the joints near it)
+        T, lab, segs, p = r.pop("T"), r.pop("lab"), r.pop("segs"), np.array([r["x"], r["y"]])
+        sgi, apos = design_position(p, T, lab)
+        r["kind"] = classify(segs, sgi, apos, [seg_len(s) for s in segs])[0]
+    rows.sort(key=lambda r: -r["excess"])
+    return rows, sum(len(f.segments) for f in fps)
+
+
+def excess_main(a, styles, text, ems) -> None:
+    label = chord_label(run_label(text, ems), a.chord)
+    if a.code:
+        label = (label + "; " if label else "") + f"code {a.code}"
+    if label:
+        print(label)
+    allrows, summary = [], []
+    for em, st in itertools.product(ems, styles):
+        with font_errors(st):
+            rows, nseg = excess_places(st, em, text, a.chord)
+        name = style_name(st) + (f" em {em:g}" if len(ems) > 1 else "")
+        for r in rows:
+            r["glyph"] = glyph_of(r["x"], st, em, text)
+            r["row"] = name
+        worst = max([0.0] + [r["excess"] for r in rows])
+        over = sum(r["excess"] > EXCESS_TOL for r in rows)
+        summary.append((name, nseg, len(rows), over, worst))
+        allrows += rows
+        print(f"{name}: segments {nseg}, places over {ISSUE_BOUND} {len(rows)}, "
+              f"excess > {EXCESS_TOL} {over}, worst excess {worst:.3f}", file=sys.stderr,
+              flush=True)
+    print(f"| row | segments | places over {ISSUE_BOUND} | places with excess > {EXCESS_TOL} "
+          "| worst excess |")
+    print("| --- | ---: | ---: | ---: | ---: |")
+    for name, nseg, n, over, worst in summary:
+        print(f"| {name} | {nseg} | {n} | {over} | {worst:.3f} |")
+    bad = sorted((r for r in allrows if r["excess"] > EXCESS_TOL), key=lambda r: -r["excess"])
+    if bad:
+        print()
+        print("| row | glyph | at (x, y) | kind | fit | rounded polyline | excess |")
+        print("| --- | --- | --- | --- | ---: | ---: | ---: |")
+        for r in bad[: a.top * max(1, len(summary))]:
+            print(f"| {r['row']} | {r['glyph']} | {r['x']:.1f}, {r['y']:.1f} | {r['kind']} | "
+                  f"{r['fit']:.3f} | {r['poly']:.3f} | {r['excess']:.3f} |")
+    if a.json:
+        with open(a.json, "w") as f:
+            json.dump(allrows, f, indent=1)
+
+
+def worst_places(style: str, top: int, em: float = 1000.0, text: str = TEXT,
+                 chord: float = 0.002):
+    _, name, per_contour = fitted_contours(style, em, text, chord)
     cands = []
-    for ci, (segs, fp, pts) in enumerate(zip(cs, fps, gs.points, strict=True)):
-        T, lab = labelled_truth(segs)
-        F = fitted_dense(fp)
-        Rp = np.vstack([pts, pts[:1]]) if (pts[0] != pts[-1]).any() else pts
-        dT = point_polyline_distance(T, F)
-        dF = point_polyline_distance(F, T)
-        locs = np.vstack([T, F])
-        errs = np.concatenate([dT, dF])
+    for ci, segs, T, lab, F, Rp, locs, errs in per_contour:
         order = np.argsort(-errs)
         chosen = []
         for k in order[:4000]:
@@ -240,16 +349,8 @@ def worst_places(style: str, top: int, em: float = 1000.0, text: str = TEXT, *,
                 break
         seglens = [seg_len(s) for s in segs]
         for e, p in chosen:
-            # the nearest point of the true curve: its polyline segment and arc position
-            a, ab = T[:-1], np.diff(T, axis=0)
-            den = np.maximum((ab * ab).sum(axis=1), 1e-300)
-            t = np.clip(((p - a) * ab).sum(axis=1) / den, 0, 1)
-            it = int(np.argmin(np.hypot(*(a + t[:, None] * ab - p).T)))
-            sgi = int(lab[it + 1])
-            arc = np.r_[0, np.cumsum(np.hypot(*ab.T))]
-            s0 = int(np.flatnonzero(lab == sgi)[0]) - (1 if sgi else 0)
-            apos = arc[it] + t[it] * math.sqrt(den[it]) - arc[max(s0, 0)]
-            cands.append((float(e), ci, p, sgi, float(apos), segs, seglens, F, T, Rp))
+            sgi, apos = design_position(p, T, lab)
+            cands.append((float(e), ci, p, sgi, apos, segs, seglens, F, T, Rp))
     cands.sort(key=lambda c: -c[0])
     rows = []
     used = []
@@ -259,7 +360,7 @@ def worst_places(style: str, top: int, em: float = 1000.0, text: str = TEXT, *,
         used.append((ci, p))
         kind, orc = classify(segs, sgi, apos, seglens)
         rows.append({
-            "style": gs.style, "em": em, "contour": ci, "x": float(p[0]), "y": float(p[1]),
+            "style": name, "em": em, "contour": ci, "x": float(p[0]), "y": float(p[1]),
             "kind": kind,
             "fit": local_dist(p, F, T), "poly": local_dist(p, Rp, T),
             "oracle": oracle_vertex_moves(segs, orc) if orc else None,
@@ -291,9 +392,15 @@ def main() -> None:
     ap.add_argument("--top", type=int, default=10)
     ap.add_argument("--json")
     add_chord_option(ap)
+    ap.add_argument("--excess", action="store_true",
+                    help="per row the worst excess over max(0.6, rounded polyline)")
+    ap.add_argument("--code", help="import galvo_core from this checkout")
     a = ap.parse_args()
     styles, text, ems = font_options(a)
     fitmod.warm_up()
+    if a.excess:
+        excess_main(a, styles, text, ems)
+        return
     allrows = []
     label = chord_label(run_label(text, ems), a.chord)
     if label:
@@ -302,7 +409,7 @@ def main() -> None:
     print("| --- | --- | --- | --- | ---: | ---: | ---: |")
     for em, st in itertools.product(ems, styles):
         with font_errors(st):
-            rows = worst_places(st, a.top, em, text, chord=a.chord)
+            rows = worst_places(st, a.top, em, text, a.chord)
         name = style_name(st) + (f" em {em:g}" if len(ems) > 1 else "")
         for r in rows:
             r["glyph"] = glyph_of(r["x"], st, em, text)

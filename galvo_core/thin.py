@@ -45,11 +45,13 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
+from typing import cast
 
 import numpy as np
 from numba import njit
 
 from galvo_core.errors import ParamError
+from galvo_core.parallel import run_chunks
 
 __all__ = ["thin", "thin_many", "dedup_indices", "check_positive"]
 
@@ -132,15 +134,18 @@ def thin_many(
     o0 = np.zeros(len(arrs) + 1, dtype=np.int64)
     np.cumsum(lens0, out=o0[1:])
     pts = np.concatenate(arrs) if len(arrs) > 1 else arrs[0]
-    kept, cnt = _thin_paths(
-        np.ascontiguousarray(pts[:, 0]),
-        np.ascontiguousarray(pts[:, 1]),
-        o0,
-        eps_arr,
-        _DP_RATIO,
-        _DP_WINDOW,
-        _SLACK,
-    )
+    x0 = np.ascontiguousarray(pts[:, 0])
+    y0 = np.ascontiguousarray(pts[:, 1])
+
+    def chunk(lo: int, hi: int) -> tuple[np.ndarray, np.ndarray]:
+        a, b = o0[lo], o0[hi]
+        return _thin_paths(x0[a:b], y0[a:b], o0[lo:hi + 1] - a, eps_arr[lo:hi],
+                           _DP_RATIO, _DP_WINDOW, _SLACK)
+
+    # (each path on its own: chunks of paths thin at once on the kernel threads)
+    parts = cast("list[tuple[np.ndarray, np.ndarray]]", run_chunks(chunk, lens0))
+    kept = np.concatenate([k for k, _ in parts]) if len(parts) > 1 else parts[0][0]
+    cnt = np.concatenate([c for _, c in parts]) if len(parts) > 1 else parts[0][1]
     if len(arrs) == 1:
         return [kept]
     cl = [0, *np.cumsum(cnt).tolist()]

@@ -76,3 +76,18 @@ def whole_units(points, *, closed: bool = True):
     w = np.round(np.asarray(points, dtype=np.float64))
     w = w[np.r_[True, (w[1:] != w[:-1]).any(axis=1)]]
     return w[:-1] if closed and len(w) > 1 and (w[-1] == w[0]).all() else w
+
+
+def flattened_cubic(p0, c1, c2, p3, chord: float = 0.002):
+    """The cubic p0 c1 c2 p3 flattened to chord height ``chord`` (equal parameter steps,
+    as many as its second difference needs), float points from p0 to p3."""
+    import math
+
+    import numpy as np
+
+    p0, c1, c2, p3 = (np.asarray(v, dtype=float) for v in (p0, c1, c2, p3))
+    acc = 6.0 * max(np.hypot(*(p0 - 2 * c1 + c2)), np.hypot(*(c1 - 2 * c2 + p3)))
+    n = max(1, math.ceil(math.sqrt(acc / (8 * chord))))
+    t = np.linspace(0.0, 1.0, n + 1)[:, None]
+    s = 1.0 - t
+    return s**3 * p0 + 3 * s * s * t * c1 + 3 * s * t * t * c2 + t**3 * p3

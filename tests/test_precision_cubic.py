@@ -8,18 +8,10 @@ from __future__ import annotations
 import math
 
 import numpy as np
+from _util import flattened_cubic as _cubic
 
 from galvo_core.fit import check_fit, fit_paths
 from galvo_core.runs import split_pieces_many
-
-
-def _cubic(p0, c1, c2, p3, chord: float = 0.002) -> np.ndarray:
-    p0, c1, c2, p3 = (np.asarray(v, dtype=float) for v in (p0, c1, c2, p3))
-    acc = 6.0 * max(np.hypot(*(p0 - 2 * c1 + c2)), np.hypot(*(c1 - 2 * c2 + p3)))
-    n = max(1, math.ceil(math.sqrt(acc / (8 * chord))))
-    t = np.linspace(0.0, 1.0, n + 1)[:, None]
-    s = 1.0 - t
-    return s**3 * p0 + 3 * s * s * t * c1 + 3 * s * t * t * c2 + t**3 * p3
 
 
 def _whole_units(segs) -> np.ndarray:
