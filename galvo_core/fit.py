@@ -5214,14 +5214,14 @@ def _on_the_design(W, K, Q, arc, t_in, t_out, smooth, quant, tlen, eps) -> None:
     # (and within _CORNER_ARC quanta of arc, as the corners' sides)
     co = np.flatnonzero(~smooth & rnd & ~is_last)
     if len(co):
-        hi = np.maximum(K[co + 1], _window_hi(arc, K[co], np.minimum(
-            K[co] + _SIDE_POINTS - 1, k_last[co]), _CORNER_ARC * quant[co]))
+        hi = np.maximum(K[co + 1], _window_hi(W, arc, K[co], np.minimum(
+            K[co] + _SIDE_POINTS - 1, k_last[co]), quant[co]))
         _, tan, ok = _local_fits(W, arc, K[co], hi, K[co])
         t_out[co[ok]] = tan[ok]
     ci = np.flatnonzero(~smooth & rnd & ~is_first)
     if len(ci):
-        lo = np.minimum(K[ci - 1], _window_lo(arc, K[ci], np.maximum(
-            K[ci] - _SIDE_POINTS + 1, k_first[ci]), _CORNER_ARC * quant[ci]))
+        lo = np.minimum(K[ci - 1], _window_lo(W, arc, K[ci], np.maximum(
+            K[ci] - _SIDE_POINTS + 1, k_first[ci]), quant[ci]))
         _, tan, ok = _local_fits(W, arc, lo, K[ci], K[ci])
         t_in[ci[ok]] = tan[ok]
     _corners_on_the_design(W, K, Q, arc, smooth, rnd, first, last, quant, eps)
@@ -5248,23 +5248,48 @@ _CORNER_ARC = 60.0
 _WINDOW_MIN = 6
 
 
-def _window_lo(arc, k, lo, reach):
-    """The first input point index >= ``lo`` (at most ``_CORNER_POINTS`` - 1 before ``k``,
-    in k's path; global indices, ``arc`` per path) of the window ending at ``k`` whose arc
-    length is within ``reach`` of k's, keeping at least ``_WINDOW_MIN`` points (not before
-    ``lo``)."""
-    idx = k[:, None] - np.arange(_CORNER_POINTS)[None, :]
-    inside = (idx >= lo[:, None]) & (
-        arc[k][:, None] - arc[np.maximum(idx, 0)] <= reach[:, None])
-    return np.maximum(lo, np.minimum(k - inside.sum(axis=1) + 1, k - (_WINDOW_MIN - 1)))
+#: ... where the input is coarse only: the window's input points lie more than this many
+#: quanta off the chord between its ends (20 points of a curve flattened at chord height h
+#: bend about 361 h off their chord whatever the curve's radius: 0.7 quanta for h = 0.002
+#: quanta, dense input, whose windows then stay as they are; 3.6 for h = 0.01)
+_COARSE_BEND = 2.0
 
 
-def _window_hi(arc, k, hi, reach):
-    """:func:`_window_lo` forwards: the last index <= ``hi`` within ``reach`` of k's arc."""
-    idx = k[:, None] + np.arange(_CORNER_POINTS)[None, :]
-    inside = (idx <= hi[:, None]) & (
-        arc[np.minimum(idx, len(arc) - 1)] - arc[k][:, None] <= reach[:, None])
-    return np.minimum(hi, np.maximum(k + inside.sum(axis=1) - 1, k + (_WINDOW_MIN - 1)))
+def _arc_window(W, arc, k, end, quant, step):
+    """The window of input points from ``k`` to ``end`` (global indices, ``end`` at most
+    ``_CORNER_POINTS`` - 1 before k (``step`` -1) or after it (+1), in k's path; ``arc`` per
+    path) cut to those within ``_CORNER_ARC`` quanta of arc of k, keeping at least
+    ``_WINDOW_MIN`` points (not past ``end``), where the input is coarse (its points bend
+    more than ``_COARSE_BEND`` quanta off the window's chord); elsewhere ``end``. Returns
+    the window's far end."""
+    idx = k[:, None] + step * np.arange(_CORNER_POINTS)[None, :]
+    inw = (idx - end[:, None]) * step <= 0
+    idx = np.clip(idx, 0, len(arc) - 1)
+    reach = _CORNER_ARC * quant
+    near = inw & (np.abs(arc[idx] - arc[k][:, None]) <= reach[:, None])
+    cut = k + step * np.maximum(near.sum(axis=1) - 1, _WINDOW_MIN - 1)
+    cut = np.where((cut - end) * step < 0, cut, end)
+    c = np.flatnonzero(cut != end)
+    if len(c):
+        # (the bend of the whole window: its points' largest distance to its chord)
+        a = W[k[c]]
+        ch = W[end[c]] - a
+        rel = W[idx[c]] - a[:, None, :]
+        off = np.abs(rel[..., 0] * ch[:, None, 1] - rel[..., 1] * ch[:, None, 0])
+        off = np.where(inw[c], off, 0.0).max(axis=1)
+        flat = off <= _COARSE_BEND * quant[c] * np.hypot(ch[:, 0], ch[:, 1])
+        cut[c[flat]] = end[c[flat]]
+    return cut
+
+
+def _window_lo(W, arc, k, lo, quant):
+    """:func:`_arc_window` backwards from ``k``: the window's first index (>= ``lo``)."""
+    return _arc_window(W, arc, k, lo, quant, -1)
+
+
+def _window_hi(W, arc, k, hi, quant):
+    """:func:`_arc_window` forwards from ``k``: the window's last index (<= ``hi``)."""
+    return _arc_window(W, arc, k, hi, quant, 1)
 
 #: ... and give no estimate where one of its input points lies this many quanta or more off
 #: its quadratic (the window spans another corner: sans-light "J" at em 400, a 16-unit side
@@ -5374,11 +5399,10 @@ def _corners_on_the_design(W, K, Q, arc, smooth, rnd, first, last, quant, eps) -
     pid_i = np.searchsorted(last, vi)
     pid_o = np.searchsorted(last, vo)
     # (and within _CORNER_ARC quanta of arc: coarser input, the same stretch of the design)
-    reach = _CORNER_ARC * quant[vo]
-    lo_i = np.minimum(K[vi - 1], _window_lo(arc, K[vi], np.maximum(
-        K[vi] - _CORNER_POINTS + 1, K[first[pid_i]]), reach))
-    hi_o = np.maximum(K[vo + 1], _window_hi(arc, k, np.minimum(
-        k + _CORNER_POINTS - 1, K[last[pid_o]]), reach))
+    lo_i = np.minimum(K[vi - 1], _window_lo(W, arc, K[vi], np.maximum(
+        K[vi] - _CORNER_POINTS + 1, K[first[pid_i]]), quant[vo]))
+    hi_o = np.maximum(K[vo + 1], _window_hi(W, arc, k, np.minimum(
+        k + _CORNER_POINTS - 1, K[last[pid_o]]), quant[vo]))
     # ... but not past the corner at the run's other end (a short run of lines that barely
     # turn: a window across other corners estimates nothing)
     idx = np.arange(n)
