@@ -5248,37 +5248,44 @@ _CORNER_ARC = 60.0
 _WINDOW_MIN = 6
 
 
-#: ... where the input is coarse only: the window's input points lie more than this many
-#: quanta off the chord between its ends (20 points of a curve flattened at chord height h
-#: bend about 361 h off their chord whatever the curve's radius: 0.7 quanta for h = 0.002
-#: quanta, dense input, whose windows then stay as they are; 3.6 for h = 0.01)
+#: ... where the input is coarse only: the window is a curve flattened in even steps (none
+#: longer than ``_EVEN_STEP`` times their mean: not a corner's window running on along a
+#: line, which dense input has too) whose points lie more than ``_COARSE_BEND`` quanta off
+#: the chord between its ends (20 points of a curve flattened at chord height h bend about
+#: 361 h off their chord whatever the curve's radius: 0.7 quanta for h = 0.002 quanta,
+#: dense input, whose windows then stay as they are; 3.6 for h = 0.01)
 _COARSE_BEND = 2.0
+_EVEN_STEP = 2.0
 
 
 def _arc_window(W, arc, k, end, quant, step):
     """The window of input points from ``k`` to ``end`` (global indices, ``end`` at most
     ``_CORNER_POINTS`` - 1 before k (``step`` -1) or after it (+1), in k's path; ``arc`` per
     path) cut to those within ``_CORNER_ARC`` quanta of arc of k, keeping at least
-    ``_WINDOW_MIN`` points (not past ``end``), where the input is coarse (its points bend
-    more than ``_COARSE_BEND`` quanta off the window's chord); elsewhere ``end``. Returns
-    the window's far end."""
+    ``_WINDOW_MIN`` points (not past ``end``), where the input is coarse (a curve in even
+    steps bending more than ``_COARSE_BEND`` quanta off the window's chord); elsewhere
+    ``end``. Returns the window's far end."""
     idx = k[:, None] + step * np.arange(_CORNER_POINTS)[None, :]
     inw = (idx - end[:, None]) * step <= 0
     idx = np.clip(idx, 0, len(arc) - 1)
-    reach = _CORNER_ARC * quant
-    near = inw & (np.abs(arc[idx] - arc[k][:, None]) <= reach[:, None])
+    span = np.abs(arc[idx] - arc[k][:, None])
+    near = inw & (span <= _CORNER_ARC * quant[:, None])
     cut = k + step * np.maximum(near.sum(axis=1) - 1, _WINDOW_MIN - 1)
     cut = np.where((cut - end) * step < 0, cut, end)
     c = np.flatnonzero(cut != end)
     if len(c):
+        # (even steps: the longest within _EVEN_STEP times the mean)
+        sc = np.where(inw[c], span[c], 0.0)
+        longest = np.diff(sc, axis=1).max(axis=1)
+        even = longest <= _EVEN_STEP * sc.max(axis=1) / np.abs(end[c] - k[c])
         # (the bend of the whole window: its points' largest distance to its chord)
         a = W[k[c]]
         ch = W[end[c]] - a
         rel = W[idx[c]] - a[:, None, :]
         off = np.abs(rel[..., 0] * ch[:, None, 1] - rel[..., 1] * ch[:, None, 0])
         off = np.where(inw[c], off, 0.0).max(axis=1)
-        flat = off <= _COARSE_BEND * quant[c] * np.hypot(ch[:, 0], ch[:, 1])
-        cut[c[flat]] = end[c[flat]]
+        keep = ~even | (off <= _COARSE_BEND * quant[c] * np.hypot(ch[:, 0], ch[:, 1]))
+        cut[c[keep]] = end[c[keep]]
     return cut
 
 
