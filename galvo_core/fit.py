@@ -5256,6 +5256,7 @@ _WINDOW_MIN = 6
 #: dense input, whose windows then stay as they are; 3.6 for h = 0.01)
 _COARSE_BEND = 2.0
 _EVEN_STEP = 2.0
+_CURVE_POINTS = 15
 
 
 def _arc_window(W, arc, k, end, quant, step):
@@ -5274,17 +5275,27 @@ def _arc_window(W, arc, k, end, quant, step):
     cut = np.where((cut - end) * step < 0, cut, end)
     c = np.flatnonzero(cut != end)
     if len(c):
-        # (even steps: the longest within _EVEN_STEP times the mean)
-        sc = np.where(inw[c], span[c], 0.0)
-        longest = np.diff(sc, axis=1).max(axis=1)
-        even = longest <= _EVEN_STEP * sc.max(axis=1) / np.abs(end[c] - k[c])
-        # (the bend of the whole window: its points' largest distance to its chord)
-        a = W[k[c]]
+        # (the curve part of the window: its points past its last long step, one over
+        # _EVEN_STEP times the mean step of the steps after it)
+        sc = span[c]
+        st = np.where(inw[c, 1:], np.diff(sc, axis=1), 0.0)
+        cnt = np.abs(end[c] - k[c])
+        rest = (sc[np.arange(len(c)), cnt][:, None] - sc[:, 1:]).clip(0)
+        after = cnt[:, None] - np.arange(1, _CORNER_POINTS)[None, :]
+        long = (st > _EVEN_STEP * rest / np.maximum(after, 1)) & (after >= 1)
+        start = np.where(long.any(axis=1), _CORNER_POINTS - 1 - np.argmax(long[:, ::-1], axis=1),
+                         0)
+        n_c = cnt - start + 1
+        # (its bend: the largest distance of its points to its chord)
+        a = W[idx[c, start]]
         ch = W[end[c]] - a
         rel = W[idx[c]] - a[:, None, :]
         off = np.abs(rel[..., 0] * ch[:, None, 1] - rel[..., 1] * ch[:, None, 0])
-        off = np.where(inw[c], off, 0.0).max(axis=1)
-        keep = ~even | (off <= _COARSE_BEND * quant[c] * np.hypot(ch[:, 0], ch[:, 1]))
+        part = inw[c] & (np.arange(_CORNER_POINTS)[None, :] >= start[:, None])
+        off = np.where(part, off, 0.0).max(axis=1)
+        # (coarse: 20 points of it would bend more than _COARSE_BEND quanta)
+        lim = _COARSE_BEND * quant[c] * ((n_c - 1) / (_CORNER_POINTS - 1)) ** 2
+        keep = (n_c < _CURVE_POINTS) | (off <= lim * np.hypot(ch[:, 0], ch[:, 1]))
         cut[c[keep]] = end[c[keep]]
     return cut
 
