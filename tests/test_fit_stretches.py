@@ -204,3 +204,45 @@ def test_a_sparse_tip_is_estimated_over_the_design_near_it():
     far = max(point_polyline_distance(near_d, dense).max(),
               point_polyline_distance(near_f, design).max())
     assert far <= 0.55
+
+
+#: DejaVu Sans "e" at em 1000, the end of its bar (a quadratic runs into a 38-unit line, a
+#: square corner, an 83-unit line up, a line and a quadratic back) flattened at chord height
+#: 0.01 unit before rounding: the curves 3-5 units between points
+_SPARSE_BAR_END = [
+    [7165, -185], [7161, -186], [7158, -187], [7154, -188], [7151, -189], [7147, -190],
+    [7143, -191], [7140, -192], [7136, -193], [7132, -194], [7128, -195], [7124, -196],
+    [7120, -196], [7116, -197], [7112, -197], [7108, -198], [7103, -198], [7099, -199],
+    [7095, -199], [7090, -200], [7086, -200], [7081, -200], [7077, -200], [7072, -200],
+    [7067, -200], [7030, -200], [7030, -117], [7061, -117], [7064, -117], [7068, -117],
+    [7071, -117], [7074, -117], [7078, -117], [7081, -116], [7084, -116], [7087, -115],
+    [7090, -115], [7093, -115], [7096, -114], [7099, -113], [7102, -113], [7105, -112],
+    [7107, -111], [7110, -110], [7113, -109], [7115, -109], [7118, -108], [7120, -106],
+    [7122, -105], [7125, -104],
+]
+#: ... and the design at its square corner: the two lines
+_BAR_CORNER = [(7067.3828125, -200.1953125), (7029.78515625, -200.1953125),
+               (7029.78515625, -117.1875)]
+
+
+def test_a_corner_beside_a_sparse_curve_keeps_to_its_rounding():
+    """A corner's window that runs along a short line into a coarsely flattened curve spans
+    20 of the curve's points (80 units and more) only where that curve is dense: here it
+    stops within the arc length dense input has, and the square corner stays as near the
+    design as its rounded point (0.29; 0.66 with the 20-point windows)."""
+    w = np.array(_SPARSE_BAR_END, dtype=float)
+    fp = fit_paths([w], [False])[0]
+    assert not check_fit(w, fp, 0.02, 0.02, report=True)["violation"]
+    dense = np.vstack([flatten_cubic(s.points, 0.002) if s.kind == "cubic"
+                       else np.asarray(s.points) for s in fp.segments])
+    design = np.array(_BAR_CORNER)
+    corner = design[1]
+    design_near = np.vstack([design[:1] + t * (design[1:2] - design[:1])
+                             for t in np.linspace(0.0, 1.0, 400)]
+                            + [design[1:2] + t * (design[2:] - design[1:2])
+                               for t in np.linspace(0.0, 1.0, 800)])
+    near_d = design_near[np.hypot(*(design_near - corner).T) < 6.0]
+    near_f = dense[np.hypot(*(dense - corner).T) < 6.0]
+    far = max(point_polyline_distance(near_d, dense).max(),
+              point_polyline_distance(near_f, design).max())
+    assert far <= 0.4
