@@ -5266,6 +5266,12 @@ def _arc_window(W, arc, k, end, quant, step):
     ``_WINDOW_MIN`` points (not past ``end``), where the input is coarse (a curve in even
     steps bending more than ``_COARSE_BEND`` quanta off the window's chord); elsewhere
     ``end``. Returns the window's far end."""
+    out = end.copy()
+    # (only windows reaching farther than _CORNER_ARC quanta can be cut: few on dense input)
+    sub = np.flatnonzero(np.abs(arc[end] - arc[k]) > _CORNER_ARC * quant)
+    if len(sub) == 0:
+        return out
+    k, end, quant = k[sub], end[sub], quant[sub]
     idx = k[:, None] + step * np.arange(_CORNER_POINTS)[None, :]
     inw = (idx - end[:, None]) * step <= 0
     idx = np.clip(idx, 0, len(arc) - 1)
@@ -5297,7 +5303,8 @@ def _arc_window(W, arc, k, end, quant, step):
         lim = _COARSE_BEND * quant[c] * ((n_c - 1) / (_CORNER_POINTS - 1)) ** 2
         keep = (n_c < _CURVE_POINTS) | (off <= lim * np.hypot(ch[:, 0], ch[:, 1]))
         cut[c[keep]] = end[c[keep]]
-    return cut
+    out[sub] = cut
+    return out
 
 
 def _window_lo(W, arc, k, lo, quant):
