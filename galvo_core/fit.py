@@ -5248,14 +5248,19 @@ _CORNER_ARC = 60.0
 _WINDOW_MIN = 6
 
 
-#: ... where the input is coarse only: the window is a curve flattened in even steps (none
-#: longer than ``_EVEN_STEP`` times their mean: not a corner's window running on along a
-#: line, which dense input has too) whose points lie more than ``_COARSE_BEND`` quanta off
-#: the chord between its ends (20 points of a curve flattened at chord height h bend about
-#: 361 h off their chord whatever the curve's radius: 0.7 quanta for h = 0.002 quanta,
-#: dense input, whose windows then stay as they are; 3.6 for h = 0.01)
+#: ... where the input is coarse only: the window's curve part (its points past its last
+#: long step: a corner's window may run along a line first, in dense input too) has at least
+#: ``_CURVE_POINTS`` points and bends off the chord between its ends by more than this many
+#: quanta, scaled to 20 points by ((n - 1) / 19)^2 (20 points of a curve flattened at chord
+#: height h bend about 361 h off their chord whatever the curve's radius: 0.7 quanta for
+#: h = 0.002 quanta, dense input, whose windows then stay as they are (bench_fit_hash.py
+#: bit-identical); 3.6 for h = 0.01; the step length alone does not tell them apart: dense
+#: DejaVu Sans Bold has 3-4 unit steps on its flatter curves)
 _COARSE_BEND = 2.0
+#: a long step: over this many times the mean of the window's steps after it
 _EVEN_STEP = 2.0
+#: fewer points of a curve part than this bend too little to tell its flattening from the
+#: rounding: the window stays
 _CURVE_POINTS = 15
 
 
@@ -5263,8 +5268,8 @@ def _arc_window(W, arc, k, end, quant, step):
     """The window of input points from ``k`` to ``end`` (global indices, ``end`` at most
     ``_CORNER_POINTS`` - 1 before k (``step`` -1) or after it (+1), in k's path; ``arc`` per
     path) cut to those within ``_CORNER_ARC`` quanta of arc of k, keeping at least
-    ``_WINDOW_MIN`` points (not past ``end``), where the input is coarse (a curve in even
-    steps bending more than ``_COARSE_BEND`` quanta off the window's chord); elsewhere
+    ``_WINDOW_MIN`` points (not past ``end``), where the input is coarse (the window's curve
+    part bends more than ``_COARSE_BEND`` quanta off its chord, scaled to 20 points); elsewhere
     ``end``. Returns the window's far end."""
     out = end.copy()
     # (only windows reaching farther than _CORNER_ARC quanta can be cut: few on dense input)
