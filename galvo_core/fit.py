@@ -156,22 +156,28 @@ _GN_ROUNDS = 4
 #: rounded input: the candidate with free end tangents too, each turned at most this much
 _GN_FREE = True
 _GN_TURN = math.radians(5.0)
-#: rounded input: a free Gauss-Newton cubic that fails is refined towards the least worst
-#: error (galvo_core.minimax; False: off, for measurements)
-_MINIMAX = False
-#: ... only where every sampled input point of the start is within this many times the
-#: bound (the near misses: the refinement rarely brings a farther start under it)
+#: rounded input: a failing candidate is refined towards the least worst error
+#: (galvo_core.minimax) only where every sampled input point of its start is within this many
+#: times the bound (the near misses: the refinement rarely brings a farther start under it)
 _MINIMAX_NEAR = 1.3
-#: ... also in the greedy chain refit (:meth:`_BatchFitter._greedy_round`): fewer segments
-#: on cubic typefaces, but there the long refined cubics moved fitted joints and corners off
-#: the design (bench/RESULTS.md, "CFF counts, seventh session")
-_MINIMAX_GREEDY = True
 #: rounded input: after the fit, rounds of merging two adjacent cubics at a smooth vertex
 #: by the refinement (:meth:`_BatchFitter._minimax_merge_round`; 0: off)
 _MINIMAX_MERGE = 2
 #: ... a merged cubic kept only where it stays within this many quanta of the two it
-#: replaces (both ways, sampled): the refinement corrects near misses by little
-_MERGE_DEV = 0.35
+#: replaces (both ways, sampled): the refinement corrects near misses by little. (0.35 until
+#: the joints' moves were made order-free, :func:`_joint_rounds`: one merge then flipped the
+#: order of two joint moves 670 units away; at 1.0 no training, held-out, CFF or em 400
+#: distance is worse and the CFF counts drop, bench/RESULTS.md "CFF counts, ninth session")
+_MERGE_DEV = 1.0
+#: rounded input, after the merge pass: the greedy chain refit and the three-into-two
+#: resplit once more, where the ranges they tried before come back at no cost (a pass keeps
+#: its cubic, a failure is tried only by the refinement of its cached start,
+#: :meth:`_BatchFitter._refined_rounds`)
+_REFINED_ROUNDS = True
+#: ... and new ranges fitted in full (with the refinement) in the chains and triples a
+#: refined cubic opened: a few segments fewer on cubic typefaces, but over a tenth more CPU
+#: on sparse outlines (off)
+_REFINED_NEW = False
 #: ... the start's Gauss-Newton rounds, and the near misses refined (as ``_MINIMAX_NEAR``)
 _MERGE_GN_ROUNDS = 4
 _MERGE_NEAR = 1.2
@@ -1609,9 +1615,22 @@ class _BatchFitter:
         self._triples: tuple | None = None
         #: keys a (M + 1) + b of the ranges a..b that :meth:`_try` found no cubic for
         self._failed = np.zeros(0, dtype=np.int64)
-        self._refine = _MINIMAX  # (the minimax refinement in :meth:`_second_candidate`)
+        self._refine = False  # (the minimax refinement in :meth:`_second_candidate`)
         #: keys (as ``_failed``) of the ranges :meth:`_minimax_merge_round` tried
         self._merge_tried = np.zeros(0, dtype=np.int64)
+        #: rounded input: the refinement's starts of the failed ranges (keys as ``_failed``,
+        #: free Gauss-Newton cubics), gathered by :meth:`_second_candidate`
+        self._start_keys: list[np.ndarray] = []
+        self._start_ctrl: list[np.ndarray] = []
+        #: during the refined rounds: (sorted keys, their starts, refined yet)
+        self._starts: tuple | None = None
+        #: rounded input: the ranges :meth:`_try` passed (keys, cubics, bounds), and during
+        #: the refined rounds the same sorted
+        self._pass_keys: list[np.ndarray] = []
+        self._pass_ctrl: list[np.ndarray] = []
+        self._pass_em: list[np.ndarray] = []
+        self._passes: tuple = ()
+        self._refined_now = _EMPTY_BOOL
 
     # -- the one-parameter family ---------------------------------------------------------
     def _triangle(self, A: np.ndarray, B: np.ndarray):
@@ -1774,13 +1793,42 @@ class _BatchFitter:
         for _ in range(_RESPLIT_ROUNDS):
             if not (self._resplit_round(0) | self._resplit_round(1) | self._resplit_round(2)):
                 break
-        self._refine = _MINIMAX and _MINIMAX_GREEDY
         self._greedy_round()
-        self._refine = _MINIMAX
         if _MINIMAX_MERGE and self.quant is not None:
             for _ in range(_MINIMAX_MERGE):
                 if not (self._minimax_merge_round(0) | self._minimax_merge_round(1)):
                     break
+            if _REFINED_ROUNDS:
+                self._refined_rounds()
+
+    def _refined_rounds(self) -> None:
+        """Rounded input, after the merge pass: :meth:`_greedy_round` and
+        :meth:`_resplit_round` once more, their :meth:`_try` answering the ranges tried
+        before from what it found then (a pass: its cubic; a failure: only the refinement
+        of the free Gauss-Newton start :meth:`_second_candidate` cached for it, where that
+        start is a near miss, :meth:`_refine_cached`). New ranges fail, except with
+        ``_REFINED_NEW`` in a chain or triple that a refined cubic opened (then fitted in
+        full, the refinement in their candidates). The merge pass changed the segments:
+        chains and triples the first rounds could not shorten may shorten now, and a near
+        miss of theirs may now pass."""
+        def cat(parts, empty):
+            return np.concatenate(parts) if parts else empty
+
+        ks = cat(self._start_keys, np.zeros(0, dtype=np.int64))
+        cs = cat(self._start_ctrl, np.zeros((0, 4, 2)))
+        ks, first = np.unique(ks, return_index=True)
+        self._starts = (ks, cs[first], np.zeros(len(ks), dtype=bool))
+        pk = cat(self._pass_keys, np.zeros(0, dtype=np.int64))
+        pc = cat(self._pass_ctrl, np.zeros((0, 4, 2)))
+        pe = cat(self._pass_em, np.zeros(0))
+        pk, first = np.unique(pk, return_index=True)
+        self._passes = (pk, pc[first], pe[first])
+        self._refine = _REFINED_NEW
+        self._greedy_round()
+        self._resplit_round(0) | self._resplit_round(1) | self._resplit_round(2)
+        self._refine = False
+        self._starts = None
+        self._passes = ()
 
     def _minimax_merge_round(self, parity: int) -> bool:
         """Rounded input whose rounding is a fair share of the bound (:meth:`_exact`), after
@@ -1793,7 +1841,7 @@ class _BatchFitter:
         points are all within ``_MINIMAX_NEAR`` times the bound; kept only where it stays
         within ``_MERGE_DEV`` quanta of the two cubics it replaces. One try per range (the
         refinement inside every candidate of the fit cost a tenth more time on sparse
-        outlines, :data:`_MINIMAX`): non-overlapping pairs from ``parity``; True when
+        outlines): non-overlapping pairs from ``parity``; True when
         something merged."""
         A, B, C, E, isl = self._all_segments()
         if len(A) < 2:
@@ -1898,6 +1946,7 @@ class _BatchFitter:
         done = np.zeros(len(pick), dtype=bool)
         best_c = np.zeros((len(pick), 4, 2))
         best_e = np.zeros(len(pick))
+        hot = np.zeros(len(pick), dtype=bool)
         out_k: list[np.ndarray] = []
         out_a: list[np.ndarray] = []
         out_b: list[np.ndarray] = []
@@ -1907,7 +1956,11 @@ class _BatchFitter:
             w = np.flatnonzero(live)
             # the first try of a cubic is its farthest end; then halve the bracket
             mid = np.where(hi[w] > bnd[w], bnd[w], (lo[w] + hi[w]) // 2)
-            ok, ctrl, em = self._try(cur[w], mid)
+            if self._starts is None:
+                ok, ctrl, em = self._try(cur[w], mid)
+            else:  # (refined: new ranges only in chains the refinement opened)
+                ok, ctrl, em = self._try(cur[w], mid, hot[w])
+                hot[w[self._refined_now]] = True
             g = w[ok]
             lo[g] = mid[ok]
             best_c[g] = ctrl[ok]
@@ -2004,10 +2057,11 @@ class _BatchFitter:
             if len(g) == 0:
                 continue
             ok1, c1, e1 = self._try(a0[g], v)
+            rn = self._refined_now
             h = np.flatnonzero(ok1)
             if len(h) == 0:
                 continue
-            ok2, c2, e2 = self._try(v[h], d0[g[h]])
+            ok2, c2, e2 = self._try(v[h], d0[g[h]], None if self._starts is None else rn[h])
             h = h[ok2]
             gh = g[h]
             found[gh] = True
@@ -2138,7 +2192,49 @@ class _BatchFitter:
         self._store(A[keep], B[keep], C[keep], E[keep], isl[keep], fixed[keep])
         return True
 
-    def _try(self, A: np.ndarray, B: np.ndarray):
+    def _try(self, A: np.ndarray, B: np.ndarray, allow: np.ndarray | None = None):
+        """One cubic per piece A..B (no split): (passed, ctrl, bound) (:meth:`_try_full`).
+        In the refined rounds (:meth:`_refined_rounds`) the ranges tried before are not
+        fitted again: one that passed has its cubic back, one that failed is tried only by
+        the refinement of its cached start (:meth:`_refine_cached`; those that pass so are
+        ``self._refined_now``); a new range is fitted (with the refinement) only where
+        ``allow``, else it fails."""
+        if self._starts is None:
+            out = self._try_full(A, B)
+            if _REFINED_ROUNDS and self.quant is not None and out[0].any():
+                p = out[0]
+                self._pass_keys.append(A[p].astype(np.int64) * (len(self.kept) + 1) + B[p])
+                self._pass_ctrl.append(out[1][p])
+                self._pass_em.append(out[2][p])
+            return out
+        m = len(A)
+        passed = np.zeros(m, dtype=bool)
+        ctrl_all = np.zeros((m, 4, 2))
+        em_all = np.zeros(m)
+        key = A.astype(np.int64) * (len(self.kept) + 1) + B
+        fresh = ~self._failed_before(key)
+        if not fresh.all():
+            self._refine_cached(A, key, fresh, passed, ctrl_all, em_all)
+        self._refined_now = passed.copy()
+        pk, pc, pe = self._passes
+        f = np.flatnonzero(fresh)
+        if len(pk) and len(f):
+            pos = np.minimum(np.searchsorted(pk, key[f]), len(pk) - 1)
+            hit = pk[pos] == key[f]
+            passed[f[hit]] = True
+            ctrl_all[f[hit]] = pc[pos[hit]]
+            em_all[f[hit]] = pe[pos[hit]]
+            f = f[~hit]
+        if allow is not None and _REFINED_NEW and len(f):
+            f = f[allow[f]]
+            if len(f):
+                g, c, e = self._try_full(A[f], B[f])
+                passed[f] = g
+                ctrl_all[f] = c
+                em_all[f] = e
+        return passed, ctrl_all, em_all
+
+    def _try_full(self, A: np.ndarray, B: np.ndarray):
         """One cubic per piece A..B (no split): (passed, ctrl, bound) for the pieces whose
         end tangents meet (the others fail)."""
         m = len(A)
@@ -2195,6 +2291,51 @@ class _BatchFitter:
         self._remember_failed(key[fresh & ~passed])
         return passed, ctrl_all, em_all
 
+    def _cached_starts(self, key: np.ndarray) -> np.ndarray:
+        """Per key: the index of its cached refinement start not refined yet, else -1."""
+        assert self._starts is not None
+        ks, _, used = self._starts
+        out = np.full(len(key), -1, dtype=np.intp)
+        if len(ks) == 0:
+            return out
+        pos = np.minimum(np.searchsorted(ks, key), len(ks) - 1)
+        hit = (ks[pos] == key) & ~used[pos]
+        out[hit] = pos[hit]
+        return out
+
+    def _refine_cached(self, A, key, fresh, passed, ctrl_all, em_all) -> None:
+        """The refined rounds: a range that failed before (its candidates fail again) is
+        tried once more only by the refinement of its cached start, where that start is a
+        near miss; in place."""
+        assert self._starts is not None
+        r = np.flatnonzero(~fresh)
+        at = self._cached_starts(key[r])
+        has = at >= 0
+        r, at = r[has], at[has]
+        if len(r) == 0:
+            return
+        _, sc, used = self._starts
+        used[at] = True
+        start = sc[at]
+        a = A[r]
+        i0, i1 = self.kept[a], self.kept[self._key_end(key[r])]
+        near = self._sample_ok(start, i0, i1, _MINIMAX_NEAR * self.e_per[a])
+        r, start, a, i0, i1 = r[near], start[near], a[near], i0[near], i1[near]
+        if len(r) == 0:
+            return
+        cm, okm = minimax_cubics(self.work, self.arc, i0, i1, start, self.e_per[a])
+        okm &= _handles_in_order(cm)
+        r, cm, a, i0, i1 = r[okm], cm[okm], a[okm], i0[okm], i1[okm]
+        if len(r) == 0:
+            return
+        g, e, _, _ = self._accept(cm, i0, i1, self.e_per[a], a)
+        passed[r[g]] = True
+        ctrl_all[r[g]] = cm[g]
+        em_all[r[g]] = e[g]
+
+    def _key_end(self, key: np.ndarray) -> np.ndarray:
+        return (key % (len(self.kept) + 1)).astype(np.intp)
+
     def _second_try(self, A, B, fresh, ok, passed, ctrl_all, em_all) -> None:
         """:meth:`_try`'s exact pieces whose triangle cubic failed (no triangle, or at the
         screening or the test): the second candidate, in place."""
@@ -2210,6 +2351,8 @@ class _BatchFitter:
         triangle does not exist, the range failed before, or the coarse screening cubic
         misses by over ``_SCREEN_SLACK`` times the bound); True otherwise."""
         key = A.astype(np.int64) * (len(self.kept) + 1) + B
+        if self._starts is not None:  # (the refined rounds: :meth:`_try` decides cheaply)
+            return np.ones(len(A), dtype=bool)
         hope = ~self._failed_before(key)
         ok, p0, qq, p3, sig = self._triangle(A, B)
         hope &= ok
@@ -2471,6 +2614,12 @@ class _BatchFitter:
                 if self._refine and len(free_v):
                     self._minimax_candidate(free_v, free_c, A, i0, i1, passed, ctrl_all,
                                             em_all)
+                elif _REFINED_ROUNDS and len(free_v):
+                    rest = ~passed[free_v]
+                    fv = free_v[rest]
+                    self._start_keys.append(A[fv].astype(np.int64) * (len(self.kept) + 1)
+                                            + B[fv])
+                    self._start_ctrl.append(free_c[rest])
         return passed, ctrl_all, em_all
 
     def _minimax_candidate(self, v, start, A, i0, i1, passed, ctrl_all, em_all) -> None:
@@ -3264,10 +3413,32 @@ def _joints_on_the_design(W, arc, points, is_cubic, tail, step, gfirst, glast, s
         return changed
     wstep = np.hypot(*np.diff(W, axis=0).T)
     bj = np.asarray(bound, dtype=np.float64)[own]
-    for parity in (0, 1):
-        _try_joints(W, wstep, points, is_cubic, tail, gfirst, glast,
-                    np.flatnonzero(j % 2 == parity), j, v, bj, q, changed)
+    for sel in _joint_rounds(j, mv[keep]):
+        _try_joints(W, wstep, points, is_cubic, tail, gfirst, glast, sel, j, v, bj, q,
+                    changed)
     return changed
+
+
+def _joint_rounds(j: np.ndarray, mv: np.ndarray) -> list[np.ndarray]:
+    """The joints ``j`` (sorted segment indices) in rounds of which no two share a segment
+    (adjacent indices), in an order that depends on each joint's neighbourhood only: each
+    round takes the joints whose move ``mv`` is the largest among their remaining
+    neighbours (of equal moves the earlier), so a change of the segment count elsewhere
+    on the path leaves the order here as it was (an even/odd split of the segment index
+    flipped it: bench/RESULTS.md, "CFF counts, eighth session")."""
+    left = np.ones(len(j), dtype=bool)
+    prev = np.r_[False, j[1:] == j[:-1] + 1]  # joint i - 1 shares segment j[i] - 1
+    nxt = np.r_[prev[1:], False]
+    out = []
+    while left.any():
+        lp = prev & np.r_[False, left[:-1]]
+        ln = nxt & np.r_[left[1:], False]
+        mp = np.r_[-np.inf, mv[:-1]]
+        mn = np.r_[mv[1:], -np.inf]
+        top = left & (~lp | (mv > mp)) & (~ln | (mv >= mn))
+        out.append(np.flatnonzero(top))
+        left &= ~top
+    return out
 
 
 def _try_joints(W, wstep, points, is_cubic, tail, gfirst, glast, sel, j, v, bj, q, changed):

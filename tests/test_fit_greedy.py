@@ -40,9 +40,6 @@ def _quad_chain(scale: float, *, whole: bool, seed: int) -> tuple[np.ndarray, in
 
 @pytest.mark.parametrize("whole", [False, True])
 def test_greedy_round_takes_fewer_segments_within_the_bound(monkeypatch, whole):
-    # (the minimax candidate, galvo_core.minimax, already fits these whole-unit chains with
-    # their fewest cubics: the greedy rounds are measured on their own)
-    monkeypatch.setattr(fitmod, "_MINIMAX", False)
     fewer = 0
     for seed in range(3):
         pts, own = _quad_chain(1000.0, whole=whole, seed=seed)

@@ -1,0 +1,64 @@
+"""Rounded input, issue 16 (ninth session): the refined rounds after the merge pass, and the
+joints' moves in an order-free sequence.
+
+After the minimax merge pass (:meth:`_BatchFitter._minimax_merge_round`) the greedy chain
+refit and the three-into-two resplit run once more (:meth:`_BatchFitter._refined_rounds`):
+the ranges they tried before come back from a cache, and a range that failed is tried
+only by the refinement (galvo_core.minimax) of the start cached for it. Whole-unit outlines
+of three design cubics take fewer segments, within the bound and near the design."""
+
+from __future__ import annotations
+
+import numpy as np
+from test_precision_minimax import _dense, _lens, _whole
+
+from galvo_core import fit as fitmod
+from galvo_core.fit import check_fit, fit_paths
+from galvo_core.geometry import flatten_cubic, point_polyline_distance
+
+#: lens outlines (three design cubics) where the first rounds and the merge pass leave a
+#: segment or two more than the refined rounds
+LENSES = [
+    (2312.981, 0.049, 1499.176, 460.948, 0.394, 0.53, 47.419),
+    (15261.495, 0.553, 606.262, 545.75, 0.411, 0.534, -44.274),
+    (12727.085, 0.741, 1213.328, 275.926, 0.433, 0.528, -11.371),
+    (22249.289, 0.251, 693.416, 329.538, 0.337, 0.681, -13.487),
+]
+
+
+def test_the_refined_rounds_take_fewer_cubics_within_the_bound(monkeypatch):
+    fewer = 0
+    for args in LENSES:
+        true = _dense(_lens(*args))
+        p = _whole(true)
+        fp = fit_paths([p], [True])[0]
+        with monkeypatch.context() as mp:
+            mp.setattr(fitmod, "_REFINED_ROUNDS", False)
+            without = fit_paths([p], [True])[0]
+        assert fp.n_segments <= without.n_segments, args
+        fewer += fp.n_segments < without.n_segments
+        rep = check_fit(p, fp, 0.02, 0.02, report=True)
+        assert not rep["violation"], args
+        fitted = np.vstack([flatten_cubic(s.points, 0.002) if s.kind == "cubic"
+                            else np.asarray(s.points) for s in fp.segments])
+        both = max(point_polyline_distance(fitted, true).max(),
+                   point_polyline_distance(true, fitted).max())
+        assert both < 0.6, (args, both)  # the issue's distance to the true curve
+    assert fewer >= 3
+
+
+def test_the_joint_rounds_never_share_a_segment_and_do_not_depend_on_the_index():
+    j = np.array([3, 4, 5, 10, 11, 20])
+    mv = np.array([0.2, 0.5, 0.3, 0.25, 0.4, 0.1])
+    rounds = fitmod._joint_rounds(j, mv)
+    seen = np.concatenate(rounds)
+    assert sorted(seen.tolist()) == list(range(len(j)))  # every joint once
+    for r in rounds:
+        assert not np.any(np.diff(j[r]) == 1)  # no two in a round share a segment
+    # the larger move of two neighbours goes first: (4 before 3 and 5, 11 before 10)
+    first = set(j[rounds[0]].tolist())
+    assert {4, 11, 20} <= first and not first & {3, 5, 10}
+    # one segment fewer before them (every index after it one lower): the same order (an
+    # even/odd split of the index flipped it)
+    shifted = fitmod._joint_rounds(j - np.r_[0, 0, 0, 1, 1, 1], mv)
+    assert [r.tolist() for r in shifted] == [r.tolist() for r in rounds]
