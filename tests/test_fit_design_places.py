@@ -314,3 +314,29 @@ def test_a_swallowed_design_line_comes_out_when_the_rest_takes_two_segments():
     rounded, fit = _line_gap((1257.0312, 135.5469), (1213.4766, 135.5469),
                              np.vstack([w, w[:1]]), _fit_dense(fp))
     assert fit <= max(0.6, rounded + 0.02)
+
+
+#: Cantarell "a" at em 1500 (s9-pl; a piece of its outline, open): the bowl's cubic ends
+#: vertical at (535.5, 469.5) and a 48-unit vertical design line follows, written as its two
+#: rounded ends (x = 536); the thinning keeps the curve's last 12 points and the line in one
+#: segment, and a line over those 12 points alone misses one by more than the bound
+_CANTARELL_A = [
+    ("cubic", (120.0, 580.5), (195.0, 613.5), (270.0, 630.0), (340.5, 630.0)),
+    ("cubic", (340.5, 630.0), (469.5, 630.0), (535.5, 576.0), (535.5, 469.5)),
+    ("line", (535.5, 469.5), (535.5, 421.5)),
+    ("cubic", (535.5, 421.5), (211.5, 418.5), (70.5, 351.0), (70.5, 196.5)),
+    ("cubic", (70.5, 196.5), (70.5, 67.5), (166.5, -15.0), (315.0, -15.0)),
+]
+
+
+def test_a_gap_end_is_kept_where_the_curve_before_it_bends_from_the_chord():
+    """The gap's end was kept only where the rest of the thinned segment (the curve's end) is
+    a line within the bound; here it is not, the curve run took the line along and its cubic
+    bulged 0.25 over the line's rounded chord, 0.75 from the design where the rounded input
+    is 0.5. The rest is split where it bends (each piece a line within the bound) and the
+    gap's end kept: the line is a line again."""
+    w = _rounded(_CANTARELL_A)
+    fp = fit_paths([w], [False])[0]
+    assert not check_fit(w, fp, 0.02, 0.02, report=True)["violation"]
+    rounded, fit = _line_gap((535.5, 469.5), (535.5, 421.5), w, _fit_dense(fp))
+    assert fit <= max(0.6, rounded + 0.02)
