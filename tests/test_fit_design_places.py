@@ -340,3 +340,30 @@ def test_a_gap_end_is_kept_where_the_curve_before_it_bends_from_the_chord():
     assert not check_fit(w, fp, 0.02, 0.02, report=True)["violation"]
     rounded, fit = _line_gap((535.5, 469.5), (535.5, 421.5), w, _fit_dense(fp))
     assert fit <= max(0.6, rounded + 0.02)
+
+
+#: DejaVu Serif Bold Italic "Q" at em 400 (s9-pl; a piece of its outline, open): the tail's
+#: bottom, a 30-unit horizontal design line written as its two rounded ends, right after a
+#: 49-unit slanted one (also two points), then the tail's curve
+_SERIF_BOLDITALIC_Q = _as_cubics([
+    ("quad", (956.0546875, -3.125), (963.4765625, -14.2578125), (975.9765625, -19.140625)),
+    ("quad", (975.9765625, -19.140625), (1004.8828125, -30.46875), (1028.7109375, -30.46875)),
+    ("line", (1028.7109375, -30.46875), (1062.5, -30.46875)),
+    ("line", (1062.5, -30.46875), (1054.1015625, -78.515625)),
+    ("line", (1054.1015625, -78.515625), (1024.0234375, -78.515625)),
+    ("quad", (1024.0234375, -78.515625), (979.6875, -78.515625), (952.34375, -56.0546875)),
+    ("quad", (952.34375, -56.0546875), (932.8125, -40.0390625), (924.4140625, -5.6640625)),
+])
+
+
+def test_a_gap_end_is_kept_where_another_design_line_comes_before_the_gap():
+    """The gap's end was kept only where the gap is 3x the input steps on both of its sides;
+    here the step before it is the other design line (longer still), the curve run took the
+    30-unit line along and its cubic was 0.66 from the design where the rounded input is 0.48.
+    The step that matters is the one inside the thinned segment (the curve's dense end)."""
+    w = _rounded(_SERIF_BOLDITALIC_Q)
+    fp = fit_paths([w], [False])[0]
+    assert not check_fit(w, fp, 0.02, 0.02, report=True)["violation"]
+    rounded, fit = _line_gap((1054.1015625, -78.515625), (1024.0234375, -78.515625), w,
+                             _fit_dense(fp))
+    assert fit <= max(0.6, rounded + 0.02)
