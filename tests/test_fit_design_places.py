@@ -367,3 +367,51 @@ def test_a_gap_end_is_kept_where_another_design_line_comes_before_the_gap():
     rounded, fit = _line_gap((1054.1015625, -78.515625), (1024.0234375, -78.515625), w,
                              _fit_dense(fp))
     assert fit <= max(0.6, rounded + 0.02)
+
+
+#: Cantarell "&" at em 1500 (s9-pl; a piece of its outline, open): two curves meet at an
+#: 85-degree corner (5815.5, 484.5); the thinning keeps the input points on either side of
+#: its rounded point (5816, 484) and a 3-unit line between them
+_CANTARELL_AMP = [
+    ("cubic", (5910.0, 85.5), (5785.5, 85.5), (5695.5, 171.0), (5695.5, 291.0)),
+    ("cubic", (5695.5, 291.0), (5695.5, 381.0), (5746.5, 439.5), (5815.5, 484.5)),
+    ("cubic", (5815.5, 484.5), (5883.0, 399.0), (5983.5, 300.0), (6127.5, 174.0)),
+    ("cubic", (6127.5, 174.0), (6057.0, 115.5), (5985.0, 85.5), (5910.0, 85.5)),
+]
+
+#: Cantarell Thin "8" at em 2048 (s9-pl; a piece of its outline, open): a 2.9-unit design line
+#: between two curves, each of its ends a 158-degree turn (not one corner split in two)
+_CANTARELL_THIN_8 = [
+    ("cubic", (11550.72, 14.336), (11302.912, 14.336), (11132.928, 145.408),
+     (11132.928, 339.968)),
+    ("cubic", (11132.928, 339.968), (11132.928, 520.192), (11280.384, 665.6),
+     (11503.616, 722.944)),
+    ("line", (11503.616, 722.944), (11501.568, 724.992)),
+    ("cubic", (11501.568, 724.992), (11716.608, 634.88), (11950.08, 567.296),
+     (11950.08, 329.728)),
+    ("cubic", (11950.08, 329.728), (11950.08, 137.216), (11792.384, 14.336),
+     (11550.72, 14.336)),
+]
+
+
+def test_a_corner_split_over_two_thinned_points_is_one_corner():
+    """Each of the two thinned points took the short line between them as a side: the corner
+    was cut, 0.84 from the design where the rounded input is 0.5. Both move toward the
+    crossing of the two curves' sides (the design's corner)."""
+    w = _rounded(_CANTARELL_AMP)
+    fp = fit_paths([w], [False])[0]
+    assert not check_fit(w, fp, 0.02, 0.02, report=True)["violation"]
+    assert _local_distance(_CANTARELL_AMP, fp, np.array([5815.5, 484.5]), 2.0) <= 0.6
+
+
+def test_a_short_line_between_two_tips_is_not_one_corner():
+    """The two curves' sides cross, but the short line between them runs back across both:
+    two tips, not one corner split in two (taken as one, both ends moved to the crossing,
+    1.05 from the design where the rounded input is 0.43)."""
+    w = _rounded(_CANTARELL_THIN_8)
+    fp = fit_paths([w], [False])[0]
+    assert not check_fit(w, fp, 0.02, 0.02, report=True)["violation"]
+    place = np.array([11501.568, 724.992])
+    rounded = point_polyline_distance(_dense(_CANTARELL_THIN_8, 0.001)[
+        np.hypot(*(_dense(_CANTARELL_THIN_8, 0.001) - place).T) <= 2.0], w).max()
+    assert _local_distance(_CANTARELL_THIN_8, fp, place, 2.0) <= max(0.6, rounded + 0.02)
