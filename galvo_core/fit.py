@@ -5307,6 +5307,10 @@ _TIP_COS = -0.5
 #: tip by 0.55 quanta, the fit 1.055 from the design; a tip's rounded point is within
 #: q/sqrt(2) of the design's outline, and smaller cuts and moves outward hold)
 _TIP_CUT = 0.45
+#: ... and one that stretches the tip (moves the corner outward along its axis) by more than
+#: this many quanta too (sans-light "g" at em 400, a 160-degree tip: the crossing 1.0 beyond
+#: the input point, the fit 0.73 from the design where the rounded input is 0.36)
+_TIP_OUT = 0.45
 
 
 def _lone_sides(W, K, smooth, v, w, quant, p, t, ok, ok_other, after=False) -> np.ndarray:
@@ -5532,6 +5536,8 @@ def _corners_on_the_design(W, K, Q, arc, smooth, rnd, first, last, quant, eps) -
         mv = est[tip] - W[K[vo[tip]]]
         al = (mv * ax).sum(axis=1)
         cut = al < -_TIP_CUT * quant[vo[tip]]
+        # ... and so is one that stretches it by more than _TIP_OUT quanta
+        cut |= al > _TIP_OUT * quant[vo[tip]]
         est[tip] -= np.where(cut, al, 0.0)[:, None] * ax
     _split_corners(W, K, vi, vo, quant, p_in, t_in, ok_in & ~lone_in, p_out, t_out,
                    ok_out & ~lone_out, est, both)

@@ -415,3 +415,27 @@ def test_a_short_line_between_two_tips_is_not_one_corner():
     rounded = point_polyline_distance(_dense(_CANTARELL_THIN_8, 0.001)[
         np.hypot(*(_dense(_CANTARELL_THIN_8, 0.001) - place).T) <= 2.0], w).max()
     assert _local_distance(_CANTARELL_THIN_8, fp, place, 2.0) <= max(0.6, rounded + 0.02)
+
+
+#: DejaVu Sans ExtraLight "g" at em 400 (s9-pl; a piece of its outline, open): the stem's
+#: right side, a 34-unit vertical design line, turns by 160 degrees at (697.66, 54.88) into
+#: the curve of the bowl's top
+_SANS_LIGHT_G = _as_cubics([
+    ("quad", (618.1640625, -67.96875), (650.78125, -67.96875), (674.21875, -54.1015625)),
+    ("quad", (674.21875, -54.1015625), (697.65625, -40.234375), (697.65625, 20.703125)),
+    ("line", (697.65625, 20.703125), (697.65625, 54.8828125)),
+    ("quad", (697.65625, 54.8828125), (689.6484375, 32.421875), (675.5859375, 19.53125)),
+    ("quad", (675.5859375, 19.53125), (654.1015625, -0.1953125), (627.34375, 0.0)),
+    ("quad", (627.34375, 0.0), (585.7421875, 0.0), (562.5, 29.39453125)),
+])
+
+
+def test_a_tip_is_not_stretched_far_past_its_input_point():
+    """The two sides' crossing at a narrow tip lies 1.0 beyond the input point (an error in a
+    side's offset moves it by that error over the sine of the 20-degree interior angle); the
+    corner moved half a unit outward, 0.73 from the design where the rounded input is 0.36.
+    A stretch of more than _TIP_OUT quanta keeps only the move across the tip's axis."""
+    w = _rounded(_SANS_LIGHT_G)
+    fp = fit_paths([w], [False])[0]
+    assert not check_fit(w, fp, 0.02, 0.02, report=True)["violation"]
+    assert _local_distance(_SANS_LIGHT_G, fp, np.array([697.65625, 54.8828125]), 2.0) <= 0.6
