@@ -439,3 +439,30 @@ def test_a_tip_is_not_stretched_far_past_its_input_point():
     fp = fit_paths([w], [False])[0]
     assert not check_fit(w, fp, 0.02, 0.02, report=True)["violation"]
     assert _local_distance(_SANS_LIGHT_G, fp, np.array([697.65625, 54.8828125]), 2.0) <= 0.6
+
+
+#: DejaVu Sans Bold "@" at em 400 (s9-pl; a piece of its outline, open): the bowl's curve runs
+#: tangentially into a 7.6-unit horizontal design line, which meets a 30-unit vertical one at
+#: (2388.48, 16.41); both lines written as their two rounded ends, the first in a curve run
+_SANS_BOLD_AT = _as_cubics([
+    ("quad", (2510.25390625, 174.90234375), (2517.7734375, 152.5390625),
+     (2517.7734375, 127.9296875)),
+    ("quad", (2517.7734375, 127.9296875), (2517.7734375, 75.0), (2485.9375, 45.703125)),
+    ("quad", (2485.9375, 45.703125), (2454.1015625, 16.40625), (2396.09375, 16.40625)),
+    ("line", (2396.09375, 16.40625), (2388.4765625, 16.40625)),
+    ("line", (2388.4765625, 16.40625), (2388.4765625, 46.484375)),
+    ("quad", (2388.4765625, 46.484375), (2382.6171875, 32.6171875), (2369.62890625, 24.90234375)),
+])
+
+
+def test_a_corner_between_two_long_input_steps_stays():
+    """Both input steps at the corner are design lines written as their two rounded ends: the
+    input point is all the input says of the corner. The side in the curve run was estimated
+    by a quadratic across the line into the curve, which moved the corner 0.2 off the line's
+    row, 0.77 from the design where the rounded input is 0.63."""
+    w = _rounded(_SANS_BOLD_AT)
+    fp = fit_paths([w], [False])[0]
+    assert not check_fit(w, fp, 0.02, 0.02, report=True)["violation"]
+    place = np.array([2388.4765625, 16.40625])
+    rounded = float(np.hypot(*(np.round(place) - place)))
+    assert _local_distance(_SANS_BOLD_AT, fp, place, 2.0) <= max(0.6, rounded + 0.02)
