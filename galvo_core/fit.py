@@ -2941,11 +2941,13 @@ def _gap_ends_kept(W, K, tlen, quanta, eps, coarse):
     (``_LONE_LENGTH``; not a chord of a coarse curve, ``coarse``) added where the thinning
     left one of them inside a thinned segment (the gap at its other end) that also holds
     points off the gap's line (``_GAP_OFF``), the gap at least ``_GAP_RATIO`` times the input
-    steps beside it, and the rest of the segment within ``eps`` (per path, the line bound)
-    of its chord: the thinning keeps a curve's end and the design line after it in one
-    segment where they are nearly collinear, and the curve piece then swallows the line (a
-    cubic through its two rounded ends may bulge over it by the rounding; Cantarell "a" at
-    em 1500: 0.75 from the design where the rounded input is 0.5). Returns (K, tlen)."""
+    step beside it inside the segment, and the rest of the segment within ``eps`` (per path,
+    the line bound) of its chord, or of the chords of its pieces where it is split at its
+    farthest input points (``_GAP_SPLITS``; those points are kept too): the thinning keeps a
+    curve's end and the design line after it in one segment where they are nearly collinear,
+    and the curve piece then swallows the line (a cubic through its two rounded ends may bulge
+    over it by the rounding; Cantarell "a" at em 1500: 0.75 from the design where the rounded
+    input is 0.5). Returns (K, tlen)."""
     q_k = np.repeat(quanta, tlen)
     eps_k = np.repeat(eps, tlen)
     if len(K) < 2 or not (q_k > 0.0).any():
@@ -5431,7 +5433,10 @@ def _corners_on_the_design(W, K, Q, arc, smooth, rnd, first, last, quant, eps) -
     The corner is the intersection of the two tangent lines where they cross at an angle, else
     the mean of the two positions; at a tip (a turn of more than 120 degrees, ``_TIP_COS``) a
     crossing that cuts the tip by more than ``_TIP_CUT`` quanta keeps only its move across
-    the tip's axis.
+    the tip's axis, and so does one that stretches it by more than ``_TIP_OUT`` quanta. A
+    corner between two long input steps (two design lines written as their rounded ends)
+    stays; two corners with a short segment between them are one corner the thinning split
+    (:func:`_split_corners`).
     A side that is a line over two input points only (no least-squares line) beside a curve side
     is the line through its two rounded ends (:func:`_lone_sides`), intersected with the curve's
     tangent where they cross at ``_LONE_SINE`` or more; at a middling angle (``_CORNER_SINE`` to
