@@ -3079,6 +3079,9 @@ _GAP_RATIO = 3.0
 #: polyline's few short strokes beside a long one are lines of the design, and one thinned
 #: line within the bound serves them; vk2bea tektronix.hpgl: 761 -> 957 segments without)
 _GAP_REST = 5
+#: ... and where that rest is no line within the bound, it is split at its farthest input
+#: point up to this many times (each piece a line within the bound) or the gap's end is not kept
+_GAP_SPLITS = 2
 
 
 def _gap_ends_kept(W, K, tlen, quanta, eps, coarse):
@@ -3087,11 +3090,13 @@ def _gap_ends_kept(W, K, tlen, quanta, eps, coarse):
     (``_LONE_LENGTH``; not a chord of a coarse curve, ``coarse``) added where the thinning
     left one of them inside a thinned segment (the gap at its other end) that also holds
     points off the gap's line (``_GAP_OFF``), the gap at least ``_GAP_RATIO`` times the input
-    steps beside it, and the rest of the segment within ``eps`` (per path, the line bound)
-    of its chord: the thinning keeps a curve's end and the design line after it in one
-    segment where they are nearly collinear, and the curve piece then swallows the line (a
-    cubic through its two rounded ends may bulge over it by the rounding; Cantarell "a" at
-    em 1500: 0.75 from the design where the rounded input is 0.5). Returns (K, tlen)."""
+    step beside it inside the segment, and the rest of the segment within ``eps`` (per path,
+    the line bound) of its chord, or of the chords of its pieces where it is split at its
+    farthest input points (``_GAP_SPLITS``; those points are kept too): the thinning keeps a
+    curve's end and the design line after it in one segment where they are nearly collinear,
+    and the curve piece then swallows the line (a cubic through its two rounded ends may bulge
+    over it by the rounding; Cantarell "a" at em 1500: 0.75 from the design where the rounded
+    input is 0.5). Returns (K, tlen)."""
     q_k = np.repeat(quanta, tlen)
     eps_k = np.repeat(eps, tlen)
     if len(K) < 2 or not (q_k > 0.0).any():
@@ -3112,10 +3117,13 @@ def _gap_ends_kept(W, K, tlen, quanta, eps, coarse):
     ok &= (K[seg] == g) | (K[seg + 1] == g + 1)  # at one end of it (the other is added)
     q = q_k[seg]
     ok &= (q > 0.0) & (np.hypot(*(W[g + 1] - W[g]).T) >= _LONE_LENGTH * q)
-    # ... a design line among dense points: at least _GAP_RATIO times the input step before
-    # and after it (a walk of long steps, each like the next, has no such gap)
-    nb = np.maximum(np.hypot(*(W[np.maximum(g - 1, 0)] - W[g]).T),
-                    np.hypot(*(W[np.minimum(g + 2, len(W) - 1)] - W[g + 1]).T))
+    # ... a design line beside dense points: at least _GAP_RATIO times the input step beside
+    # it inside the thinned segment (a walk of long steps, each like the next, has no such
+    # gap; the step on its other side may be another design line: serif-bolditalic "Q" at em
+    # 400, a 30-unit line after a 49-unit one, its cubic 0.66 from the design where the
+    # rounded input is 0.48)
+    nb = np.where(K[seg] == g, np.hypot(*(W[np.minimum(g + 2, len(W) - 1)] - W[g + 1]).T),
+                  np.hypot(*(W[np.maximum(g - 1, 0)] - W[g]).T))
     ok &= np.hypot(*(W[g + 1] - W[g]).T) >= _GAP_RATIO * nb
     g, seg, q = g[ok], seg[ok], q[ok]
     if len(g) == 0:
@@ -3137,9 +3145,53 @@ def _gap_ends_kept(W, K, tlen, quanta, eps, coarse):
     v = np.where(at_end, g, g + 1)
     r0 = np.where(at_end, a, v)
     r1 = np.where(at_end, v, b)
+    keep = r1 - r0 >= _GAP_REST
+    v, r0, r1, seg = v[keep], r0[keep], r1[keep], seg[keep]
+    if len(v) == 0:
+        return K, tlen
     err = _line_errors(W, np.stack([W[r0], W[r1]], axis=1), r0, r1)
-    keep = (err <= eps_k[seg]) & (r1 - r0 >= _GAP_REST)
-    add = np.setdiff1d(v[keep], K)
+    held = err <= eps_k[seg]
+    # ... or, where it does not (the curve's end bends away from the chord), the rest split
+    # at its farthest input point, up to _GAP_SPLITS times (Douglas-Peucker): each piece then
+    # holds the bound (Cantarell "a" at em 1500: a curve's last 12 points beside a 48-unit
+    # design line; its cubic bulged 0.25 over the line's rounded chord, 0.75 from the design)
+    extra: list[np.ndarray] = []
+    todo = np.flatnonzero(~held)
+    pa, pb, own = r0[todo], r1[todo], todo
+    for _ in range(_GAP_SPLITS if len(todo) else 0):
+        cnt = pb - pa - 1
+        has = cnt > 0
+        pa, pb, own, cnt = pa[has], pb[has], own[has], cnt[has]
+        if len(pa) == 0:
+            break
+        o2, off = _ragged(np.arange(len(pa)), cnt)
+        idx = pa[o2] + 1 + off
+        d = point_segment_distance(W[idx], W[pa][o2], W[pb][o2])
+        st = np.cumsum(cnt) - cnt
+        dm = np.maximum.reduceat(d, st)
+        bad = dm > eps_k[seg[own]]
+        if not bad.any():
+            break
+        # the farthest point (the first of equal ones) of each failing piece
+        at = np.flatnonzero(d >= dm[o2])
+        at = at[np.r_[True, o2[at][1:] != o2[at][:-1]]]
+        m = idx[at][bad[o2[at]]]
+        pa, pb, own = pa[bad], pb[bad], own[bad]
+        extra.append(np.stack([own, m], axis=1))
+        pa, pb, own = np.concatenate([pa, m]), np.concatenate([m, pb]), np.concatenate([own, own])
+    if len(pa):
+        # pieces still over the bound after the last split: that gap's end is not kept
+        cnt = pb - pa - 1
+        e2 = _line_errors(W, np.stack([W[pa], W[pb]], axis=1), pa, pb)
+        fail = np.unique(own[(cnt > 0) & (e2 > eps_k[seg[own]])])
+    else:
+        fail = np.zeros(0, dtype=np.intp)
+    ok2 = np.zeros(len(v), dtype=bool)
+    ok2[todo] = True
+    ok2[fail] = False
+    keep = held | ok2
+    more = [e[ok2[e[:, 0]], 1] for e in extra]
+    add = np.setdiff1d(np.concatenate([v[keep]] + more), K)
     if len(add) == 0:
         return K, tlen
     path = np.searchsorted(last, np.searchsorted(K, add) - 1)  # (the segment's start's path)
@@ -5516,6 +5568,10 @@ _TIP_COS = -0.5
 #: tip by 0.55 quanta, the fit 1.055 from the design; a tip's rounded point is within
 #: q/sqrt(2) of the design's outline, and smaller cuts and moves outward hold)
 _TIP_CUT = 0.45
+#: ... and one that stretches the tip (moves the corner outward along its axis) by more than
+#: this many quanta too (sans-light "g" at em 400, a 160-degree tip: the crossing 1.0 beyond
+#: the input point, the fit 0.73 from the design where the rounded input is 0.36)
+_TIP_OUT = 0.45
 
 
 def _lone_sides(W, K, smooth, v, w, quant, p, t, ok, ok_other, after=False) -> np.ndarray:
@@ -5561,6 +5617,72 @@ def _collinear(W, a, b, p, t, quant) -> np.ndarray:
     return err <= _STRAIGHT_SLACK * quant
 
 
+#: rounded input: two corners with a thinned segment of at most this many input steps ...
+_SPLIT_STEPS = 3
+#: ... and at most this many quanta between them are one design corner that the thinning
+#: split (the corner's rounded point between them, or on one of them)
+_SPLIT_LENGTH = 4.0
+#: ... where their sides' crossing is within this many quanta of an input point between them
+_SPLIT_NEAR = 1.5
+
+
+def _split_corners(W, K, vi, vo, quant, p_in, t_in, ok_in, p_out, t_out, ok_out, est,
+                   both) -> None:
+    """:func:`_corners_on_the_design`'s estimates (``est``, ``both``, in place; per corner
+    as the end ``vi`` and start ``vo`` of its segments, their sides' estimates) at two
+    corners that the thinning split out of one (``_SPLIT_STEPS``, ``_SPLIT_LENGTH``): each
+    estimated alone takes the short segment between them as a side and cuts the design's
+    corner (Cantarell "&" at em 1500, an 85-degree corner between two curves: 0.84 from the
+    design where the rounded input is 0.5). Both move toward the one corner where the side
+    before the first and the side after the second cross, at an angle (``_CORNER_SINE``, not
+    a tip), near the input points between them (``_SPLIT_NEAR``)."""
+    n = int(max(vi.max(), vo.max())) + 2
+    at = np.full(n, -1, dtype=np.intp)
+    at[vi] = np.arange(len(vi))
+    b = at[vo + 1]
+    a = np.flatnonzero(b >= 0)
+    if len(a) == 0:
+        return
+    b = b[a]
+    v = vo[a]
+    ka, kb = K[v], K[v + 1]
+    q = quant[v]
+    pair = (kb - ka <= _SPLIT_STEPS) & (np.hypot(*(W[kb] - W[ka]).T) <= _SPLIT_LENGTH * q)
+    # (not a chain of three or more such corners)
+    chain = np.zeros(len(vo), dtype=bool)
+    chain[a[pair]] = True
+    pair &= ~chain[b]
+    chain_b = np.zeros(len(vo), dtype=bool)
+    chain_b[b[pair]] = True
+    pair &= ~chain_b[a]
+    pair &= ok_in[a] & ok_out[b]
+    if not pair.any():
+        return
+    a, b, ka, kb, q = a[pair], b[pair], ka[pair], kb[pair], q[pair]
+    ti, to = t_in[a], t_out[b]
+    cr = ti[:, 0] * to[:, 1] - ti[:, 1] * to[:, 0]
+    good = (np.abs(cr) >= _CORNER_SINE) & ((ti * to).sum(axis=1) >= _TIP_COS)
+    # ... and the short segment's direction between the two sides' (one turn split in two;
+    # not a short design line between two tips: Cantarell Thin "8" at em 2048, 2.9 units)
+    m = W[kb] - W[ka]
+    c1 = ti[:, 0] * m[:, 1] - ti[:, 1] * m[:, 0]
+    c2 = m[:, 0] * to[:, 1] - m[:, 1] * to[:, 0]
+    good &= (c1 * cr >= 0.0) & (c2 * cr >= 0.0) & ((ti * m).sum(axis=1) > 0.0)
+    good &= (m * to).sum(axis=1) > 0.0
+    d = p_out[b] - p_in[a]
+    s = (d[:, 0] * to[:, 1] - d[:, 1] * to[:, 0]) / np.where(good, cr, 1.0)
+    c = p_in[a] + s[:, None] * ti
+    # ... near the input points of the short segment (the corner is among them)
+    own, off = _ragged(np.arange(len(a)), kb - ka + 1)
+    dd = np.hypot(*(W[ka[own] + off] - c[own]).T)
+    near = np.minimum.reduceat(dd, np.cumsum(kb - ka + 1) - (kb - ka + 1)) <= _SPLIT_NEAR * q
+    good &= near
+    est[a[good]] = c[good]
+    est[b[good]] = c[good]
+    both[a[good]] = True
+    both[b[good]] = True
+
+
 def _corners_on_the_design(W, K, Q, arc, smooth, rnd, first, last, quant, eps) -> None:
     """Rounded input: the corners (thinned vertices that are not smooth; a closed path's seam too)
     move inside their rounding squares onto an estimate of the design's corner. Per side, the
@@ -5570,7 +5692,10 @@ def _corners_on_the_design(W, K, Q, arc, smooth, rnd, first, last, quant, eps) -
     The corner is the intersection of the two tangent lines where they cross at an angle, else
     the mean of the two positions; at a tip (a turn of more than 120 degrees, ``_TIP_COS``) a
     crossing that cuts the tip by more than ``_TIP_CUT`` quanta keeps only its move across
-    the tip's axis.
+    the tip's axis, and so does one that stretches it by more than ``_TIP_OUT`` quanta. A
+    corner between two long input steps (two design lines written as their rounded ends)
+    stays; two corners with a short segment between them are one corner the thinning split
+    (:func:`_split_corners`).
     A side that is a line over two input points only (no least-squares line) beside a curve side
     is the line through its two rounded ends (:func:`_lone_sides`), intersected with the curve's
     tangent where they cross at ``_LONE_SINE`` or more; at a middling angle (``_CORNER_SINE`` to
@@ -5654,6 +5779,14 @@ def _corners_on_the_design(W, K, Q, arc, smooth, rnd, first, last, quant, eps) -
     gap_out = ((K[vo + 1] - K[vo]) == 1) & (
         np.hypot(*(W[K[vo + 1]] - W[K[vo]]).T) >= _LONE_LENGTH * quant[vo])
     both &= ~(tip & ((gap_in & ~lone_in) | (gap_out & ~lone_out)))
+    # a corner between two long input steps (two design lines, each written as its two rounded
+    # ends: the input point is all the input says of the corner) stays, also where the
+    # curve-run rules put one of those lines in a curve run and the side's quadratic, fitted
+    # across the line into the curve, would move it (serif-bolditalic "3" at em 400: 0.67 from
+    # the design where the rounded input is 0.53; sans-bold "@": 0.77 against 0.63)
+    long_in = np.hypot(*(W[K[vi]] - W[K[vi] - 1]).T) >= _LONE_LENGTH * quant[vi]
+    long_out = np.hypot(*(W[K[vo] + 1] - W[K[vo]]).T) >= _LONE_LENGTH * quant[vo]
+    both &= ~(long_in & long_out)
     tip &= both
     sharp = both & (np.abs(cr) >= _CORNER_SINE)
     # a shallow corner between a curve and a least-squares line whose points are collinear:
@@ -5678,7 +5811,11 @@ def _corners_on_the_design(W, K, Q, arc, smooth, rnd, first, last, quant, eps) -
         mv = est[tip] - W[K[vo[tip]]]
         al = (mv * ax).sum(axis=1)
         cut = al < -_TIP_CUT * quant[vo[tip]]
+        # ... and so is one that stretches it by more than _TIP_OUT quanta
+        cut |= al > _TIP_OUT * quant[vo[tip]]
         est[tip] -= np.where(cut, al, 0.0)[:, None] * ax
+    _split_corners(W, K, vi, vo, quant, p_in, t_in, ok_in & ~lone_in, p_out, t_out,
+                   ok_out & ~lone_out, est, both)
     vi, vo, est = vi[both], vo[both], est[both]
     lone_in, lone_out = lone_in[both], lone_out[both]
     wk = W[K[vo]]

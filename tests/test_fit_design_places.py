@@ -314,3 +314,155 @@ def test_a_swallowed_design_line_comes_out_when_the_rest_takes_two_segments():
     rounded, fit = _line_gap((1257.0312, 135.5469), (1213.4766, 135.5469),
                              np.vstack([w, w[:1]]), _fit_dense(fp))
     assert fit <= max(0.6, rounded + 0.02)
+
+
+#: Cantarell "a" at em 1500 (s9-pl; a piece of its outline, open): the bowl's cubic ends
+#: vertical at (535.5, 469.5) and a 48-unit vertical design line follows, written as its two
+#: rounded ends (x = 536); the thinning keeps the curve's last 12 points and the line in one
+#: segment, and a line over those 12 points alone misses one by more than the bound
+_CANTARELL_A = [
+    ("cubic", (120.0, 580.5), (195.0, 613.5), (270.0, 630.0), (340.5, 630.0)),
+    ("cubic", (340.5, 630.0), (469.5, 630.0), (535.5, 576.0), (535.5, 469.5)),
+    ("line", (535.5, 469.5), (535.5, 421.5)),
+    ("cubic", (535.5, 421.5), (211.5, 418.5), (70.5, 351.0), (70.5, 196.5)),
+    ("cubic", (70.5, 196.5), (70.5, 67.5), (166.5, -15.0), (315.0, -15.0)),
+]
+
+
+def test_a_gap_end_is_kept_where_the_curve_before_it_bends_from_the_chord():
+    """The gap's end was kept only where the rest of the thinned segment (the curve's end) is
+    a line within the bound; here it is not, the curve run took the line along and its cubic
+    bulged 0.25 over the line's rounded chord, 0.75 from the design where the rounded input
+    is 0.5. The rest is split where it bends (each piece a line within the bound) and the
+    gap's end kept: the line is a line again."""
+    w = _rounded(_CANTARELL_A)
+    fp = fit_paths([w], [False])[0]
+    assert not check_fit(w, fp, 0.02, 0.02, report=True)["violation"]
+    rounded, fit = _line_gap((535.5, 469.5), (535.5, 421.5), w, _fit_dense(fp))
+    assert fit <= max(0.6, rounded + 0.02)
+
+
+#: DejaVu Serif Bold Italic "Q" at em 400 (s9-pl; a piece of its outline, open): the tail's
+#: bottom, a 30-unit horizontal design line written as its two rounded ends, right after a
+#: 49-unit slanted one (also two points), then the tail's curve
+_SERIF_BOLDITALIC_Q = _as_cubics([
+    ("quad", (956.0546875, -3.125), (963.4765625, -14.2578125), (975.9765625, -19.140625)),
+    ("quad", (975.9765625, -19.140625), (1004.8828125, -30.46875), (1028.7109375, -30.46875)),
+    ("line", (1028.7109375, -30.46875), (1062.5, -30.46875)),
+    ("line", (1062.5, -30.46875), (1054.1015625, -78.515625)),
+    ("line", (1054.1015625, -78.515625), (1024.0234375, -78.515625)),
+    ("quad", (1024.0234375, -78.515625), (979.6875, -78.515625), (952.34375, -56.0546875)),
+    ("quad", (952.34375, -56.0546875), (932.8125, -40.0390625), (924.4140625, -5.6640625)),
+])
+
+
+def test_a_gap_end_is_kept_where_another_design_line_comes_before_the_gap():
+    """The gap's end was kept only where the gap is 3x the input steps on both of its sides;
+    here the step before it is the other design line (longer still), the curve run took the
+    30-unit line along and its cubic was 0.66 from the design where the rounded input is 0.48.
+    The step that matters is the one inside the thinned segment (the curve's dense end)."""
+    w = _rounded(_SERIF_BOLDITALIC_Q)
+    fp = fit_paths([w], [False])[0]
+    assert not check_fit(w, fp, 0.02, 0.02, report=True)["violation"]
+    rounded, fit = _line_gap((1054.1015625, -78.515625), (1024.0234375, -78.515625), w,
+                             _fit_dense(fp))
+    assert fit <= max(0.6, rounded + 0.02)
+
+
+#: Cantarell "&" at em 1500 (s9-pl; a piece of its outline, open): two curves meet at an
+#: 85-degree corner (5815.5, 484.5); the thinning keeps the input points on either side of
+#: its rounded point (5816, 484) and a 3-unit line between them
+_CANTARELL_AMP = [
+    ("cubic", (5910.0, 85.5), (5785.5, 85.5), (5695.5, 171.0), (5695.5, 291.0)),
+    ("cubic", (5695.5, 291.0), (5695.5, 381.0), (5746.5, 439.5), (5815.5, 484.5)),
+    ("cubic", (5815.5, 484.5), (5883.0, 399.0), (5983.5, 300.0), (6127.5, 174.0)),
+    ("cubic", (6127.5, 174.0), (6057.0, 115.5), (5985.0, 85.5), (5910.0, 85.5)),
+]
+
+#: Cantarell Thin "8" at em 2048 (s9-pl; a piece of its outline, open): a 2.9-unit design line
+#: between two curves, each of its ends a 158-degree turn (not one corner split in two)
+_CANTARELL_THIN_8 = [
+    ("cubic", (11550.72, 14.336), (11302.912, 14.336), (11132.928, 145.408),
+     (11132.928, 339.968)),
+    ("cubic", (11132.928, 339.968), (11132.928, 520.192), (11280.384, 665.6),
+     (11503.616, 722.944)),
+    ("line", (11503.616, 722.944), (11501.568, 724.992)),
+    ("cubic", (11501.568, 724.992), (11716.608, 634.88), (11950.08, 567.296),
+     (11950.08, 329.728)),
+    ("cubic", (11950.08, 329.728), (11950.08, 137.216), (11792.384, 14.336),
+     (11550.72, 14.336)),
+]
+
+
+def test_a_corner_split_over_two_thinned_points_is_one_corner():
+    """Each of the two thinned points took the short line between them as a side: the corner
+    was cut, 0.84 from the design where the rounded input is 0.5. Both move toward the
+    crossing of the two curves' sides (the design's corner)."""
+    w = _rounded(_CANTARELL_AMP)
+    fp = fit_paths([w], [False])[0]
+    assert not check_fit(w, fp, 0.02, 0.02, report=True)["violation"]
+    assert _local_distance(_CANTARELL_AMP, fp, np.array([5815.5, 484.5]), 2.0) <= 0.6
+
+
+def test_a_short_line_between_two_tips_is_not_one_corner():
+    """The two curves' sides cross, but the short line between them runs back across both:
+    two tips, not one corner split in two (taken as one, both ends moved to the crossing,
+    1.05 from the design where the rounded input is 0.43)."""
+    w = _rounded(_CANTARELL_THIN_8)
+    fp = fit_paths([w], [False])[0]
+    assert not check_fit(w, fp, 0.02, 0.02, report=True)["violation"]
+    place = np.array([11501.568, 724.992])
+    rounded = point_polyline_distance(_dense(_CANTARELL_THIN_8, 0.001)[
+        np.hypot(*(_dense(_CANTARELL_THIN_8, 0.001) - place).T) <= 2.0], w).max()
+    assert _local_distance(_CANTARELL_THIN_8, fp, place, 2.0) <= max(0.6, rounded + 0.02)
+
+
+#: DejaVu Sans ExtraLight "g" at em 400 (s9-pl; a piece of its outline, open): the stem's
+#: right side, a 34-unit vertical design line, turns by 160 degrees at (697.66, 54.88) into
+#: the curve of the bowl's top
+_SANS_LIGHT_G = _as_cubics([
+    ("quad", (618.1640625, -67.96875), (650.78125, -67.96875), (674.21875, -54.1015625)),
+    ("quad", (674.21875, -54.1015625), (697.65625, -40.234375), (697.65625, 20.703125)),
+    ("line", (697.65625, 20.703125), (697.65625, 54.8828125)),
+    ("quad", (697.65625, 54.8828125), (689.6484375, 32.421875), (675.5859375, 19.53125)),
+    ("quad", (675.5859375, 19.53125), (654.1015625, -0.1953125), (627.34375, 0.0)),
+    ("quad", (627.34375, 0.0), (585.7421875, 0.0), (562.5, 29.39453125)),
+])
+
+
+def test_a_tip_is_not_stretched_far_past_its_input_point():
+    """The two sides' crossing at a narrow tip lies 1.0 beyond the input point (an error in a
+    side's offset moves it by that error over the sine of the 20-degree interior angle); the
+    corner moved half a unit outward, 0.73 from the design where the rounded input is 0.36.
+    A stretch of more than _TIP_OUT quanta keeps only the move across the tip's axis."""
+    w = _rounded(_SANS_LIGHT_G)
+    fp = fit_paths([w], [False])[0]
+    assert not check_fit(w, fp, 0.02, 0.02, report=True)["violation"]
+    assert _local_distance(_SANS_LIGHT_G, fp, np.array([697.65625, 54.8828125]), 2.0) <= 0.6
+
+
+#: DejaVu Sans Bold "@" at em 400 (s9-pl; a piece of its outline, open): the bowl's curve runs
+#: tangentially into a 7.6-unit horizontal design line, which meets a 30-unit vertical one at
+#: (2388.48, 16.41); both lines written as their two rounded ends, the first in a curve run
+_SANS_BOLD_AT = _as_cubics([
+    ("quad", (2510.25390625, 174.90234375), (2517.7734375, 152.5390625),
+     (2517.7734375, 127.9296875)),
+    ("quad", (2517.7734375, 127.9296875), (2517.7734375, 75.0), (2485.9375, 45.703125)),
+    ("quad", (2485.9375, 45.703125), (2454.1015625, 16.40625), (2396.09375, 16.40625)),
+    ("line", (2396.09375, 16.40625), (2388.4765625, 16.40625)),
+    ("line", (2388.4765625, 16.40625), (2388.4765625, 46.484375)),
+    ("quad", (2388.4765625, 46.484375), (2382.6171875, 32.6171875), (2369.62890625, 24.90234375)),
+])
+
+
+def test_a_corner_between_two_long_input_steps_stays():
+    """Both input steps at the corner are design lines written as their two rounded ends: the
+    input point is all the input says of the corner. The side in the curve run was estimated
+    by a quadratic across the line into the curve, which moved the corner 0.2 off the line's
+    row, 0.77 from the design where the rounded input is 0.63."""
+    w = _rounded(_SANS_BOLD_AT)
+    fp = fit_paths([w], [False])[0]
+    assert not check_fit(w, fp, 0.02, 0.02, report=True)["violation"]
+    place = np.array([2388.4765625, 16.40625])
+    rounded = float(np.hypot(*(np.round(place) - place)))
+    assert _local_distance(_SANS_BOLD_AT, fp, place, 2.0) <= max(0.6, rounded + 0.02)
