@@ -2207,11 +2207,7 @@ class _BatchFitter:
                 self._pass_ctrl.append(out[1][p])
                 self._pass_em.append(out[2][p])
             return out
-        m = len(A)
-        passed = np.zeros(m, dtype=bool)
-        ctrl_all = np.zeros((m, 4, 2))
-        em_all = np.zeros(m)
-        key = A.astype(np.int64) * (len(self.kept) + 1) + B
+        passed, ctrl_all, em_all, key = self._try_arrays(A, B)
         fresh = ~self._failed_before(key)
         if not fresh.all():
             self._refine_cached(A, key, fresh, passed, ctrl_all, em_all)
@@ -2234,15 +2230,18 @@ class _BatchFitter:
                 em_all[f] = e
         return passed, ctrl_all, em_all
 
+    def _try_arrays(self, A: np.ndarray, B: np.ndarray):
+        """:meth:`_try`'s empty answers for the pieces A..B (passed, control points, bound)
+        and each range's cache key."""
+        m = len(A)
+        key = A.astype(np.int64) * (len(self.kept) + 1) + B
+        return np.zeros(m, dtype=bool), np.zeros((m, 4, 2)), np.zeros(m), key
+
     def _try_full(self, A: np.ndarray, B: np.ndarray):
         """One cubic per piece A..B (no split): (passed, ctrl, bound) for the pieces whose
         end tangents meet (the others fail)."""
-        m = len(A)
-        passed = np.zeros(m, dtype=bool)
-        ctrl_all = np.zeros((m, 4, 2))
-        em_all = np.zeros(m)
+        passed, ctrl_all, em_all, key = self._try_arrays(A, B)
         # a range that failed before fails again (same ends, tangents and points): skipped
-        key = A.astype(np.int64) * (len(self.kept) + 1) + B
         fresh = ~self._failed_before(key)
         ok, p0, qq, p3, sig = self._triangle(A, B)
         ok &= fresh

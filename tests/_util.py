@@ -91,3 +91,16 @@ def flattened_cubic(p0, c1, c2, p3, chord: float = 0.002):
     t = np.linspace(0.0, 1.0, n + 1)[:, None]
     s = 1.0 - t
     return s**3 * p0 + 3 * s * s * t * c1 + 3 * s * t * t * c2 + t**3 * p3
+
+
+def design_distance(fp, true) -> float:
+    """Both-ways distance between a fitted path (its cubics flattened at 0.002 unit chords,
+    its lines as they are) and the true design polyline ``true``: the issue's measure."""
+    import numpy as np
+
+    from galvo_core.geometry import flatten_cubic, point_polyline_distance
+
+    fitted = np.vstack([flatten_cubic(s.points, 0.002) if s.kind == "cubic"
+                        else np.asarray(s.points) for s in fp.segments])
+    return max(float(point_polyline_distance(fitted, true).max()),
+               float(point_polyline_distance(true, fitted).max()))

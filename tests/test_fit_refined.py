@@ -10,11 +10,11 @@ of three design cubics take fewer segments, within the bound and near the design
 from __future__ import annotations
 
 import numpy as np
+from _util import design_distance
 from test_precision_minimax import _dense, _lens, _whole
 
 from galvo_core import fit as fitmod
 from galvo_core.fit import check_fit, fit_paths
-from galvo_core.geometry import flatten_cubic, point_polyline_distance
 
 #: lens outlines (three design cubics) where the first rounds and the merge pass leave a
 #: segment or two more than the refined rounds
@@ -39,10 +39,7 @@ def test_the_refined_rounds_take_fewer_cubics_within_the_bound(monkeypatch):
         fewer += fp.n_segments < without.n_segments
         rep = check_fit(p, fp, 0.02, 0.02, report=True)
         assert not rep["violation"], args
-        fitted = np.vstack([flatten_cubic(s.points, 0.002) if s.kind == "cubic"
-                            else np.asarray(s.points) for s in fp.segments])
-        both = max(point_polyline_distance(fitted, true).max(),
-                   point_polyline_distance(true, fitted).max())
+        both = design_distance(fp, true)
         assert both < 0.6, (args, both)  # the distance to the true curve
     assert fewer >= 3
 

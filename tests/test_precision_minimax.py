@@ -12,6 +12,7 @@ from __future__ import annotations
 import math
 
 import numpy as np
+from _util import design_distance
 from _util import flattened_cubic as _cubic
 
 from galvo_core import fit as fitmod
@@ -67,10 +68,7 @@ def test_long_design_cubics_take_fewer_cubics_after_the_merge_pass(monkeypatch):
         assert fp.n_segments <= len(segs) + 1, args
         rep = check_fit(p, fp, 0.02, 0.02, report=True)
         assert not rep["violation"], args
-        fitted = np.vstack([flatten_cubic(s.points, 0.002) if s.kind == "cubic"
-                            else np.asarray(s.points) for s in fp.segments])
-        both = max(point_polyline_distance(fitted, true).max(),
-                   point_polyline_distance(true, fitted).max())
+        both = design_distance(fp, true)
         assert both < 0.6, (args, both)  # the distance to the true curve
     assert fewer >= 2
 
