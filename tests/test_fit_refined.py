@@ -10,11 +10,9 @@ of three design cubics take fewer segments, within the bound and near the design
 from __future__ import annotations
 
 import numpy as np
-from _util import design_distance
-from test_precision_minimax import _dense, _lens, _whole
+from test_precision_minimax import fewer_than_without
 
 from galvo_core import fit as fitmod
-from galvo_core.fit import check_fit, fit_paths
 
 #: lens outlines (three design cubics) where the first rounds and the merge pass leave a
 #: segment or two more than the refined rounds
@@ -27,21 +25,7 @@ LENSES = [
 
 
 def test_the_refined_rounds_take_fewer_cubics_within_the_bound(monkeypatch):
-    fewer = 0
-    for args in LENSES:
-        true = _dense(_lens(*args))
-        p = _whole(true)
-        fp = fit_paths([p], [True])[0]
-        with monkeypatch.context() as mp:
-            mp.setattr(fitmod, "_REFINED_ROUNDS", False)
-            without = fit_paths([p], [True])[0]
-        assert fp.n_segments <= without.n_segments, args
-        fewer += fp.n_segments < without.n_segments
-        rep = check_fit(p, fp, 0.02, 0.02, report=True)
-        assert not rep["violation"], args
-        both = design_distance(fp, true)
-        assert both < 0.6, (args, both)  # the distance to the true curve
-    assert fewer >= 3
+    assert fewer_than_without(monkeypatch, "_REFINED_ROUNDS", False, LENSES) >= 3
 
 
 def test_the_joint_rounds_never_share_a_segment_and_do_not_depend_on_the_index():
