@@ -25,11 +25,13 @@ acceptance test decides, as for every other.
 from __future__ import annotations
 
 import math
+from typing import cast
 
 import numpy as np
 from numba import njit
 
 from galvo_core.geometry import newton_param
+from galvo_core.parallel import MIN_WORK, run_chunks
 
 __all__ = ["minimax_cubics"]
 
@@ -328,10 +330,20 @@ def minimax_cubics(work: np.ndarray, arc: np.ndarray, i0: np.ndarray, i1: np.nda
     ok = np.zeros(m, dtype=np.bool_)
     if m == 0:
         return out, ok
-    _minimax_kernel(work, arc, np.ascontiguousarray(i0, dtype=np.intp),
-                    np.ascontiguousarray(i1, dtype=np.intp),
-                    np.ascontiguousarray(ctrl, dtype=np.float64),
-                    np.ascontiguousarray(MINIMAX_TARGET * np.asarray(bound, dtype=np.float64)),
-                    MINIMAX_ROUNDS, MINIMAX_LAWSON, MINIMAX_RADIUS, MINIMAX_START, out, ok,
-                    COUNTS, _ACTIVE, _WATCH, _SAMPLE, MINIMAX_MOVE)
+    a = np.ascontiguousarray(i0, dtype=np.intp)
+    b = np.ascontiguousarray(i1, dtype=np.intp)
+    start = np.ascontiguousarray(ctrl, dtype=np.float64).reshape(m, 4, 2)
+    target = np.ascontiguousarray(MINIMAX_TARGET * np.asarray(bound, dtype=np.float64))
+
+    def chunk(lo: int, hi: int) -> np.ndarray:
+        # each piece is refined on its own: chunks of pieces on the pool give the same cubics
+        cnt = np.zeros_like(COUNTS)
+        _minimax_kernel(work, arc, a[lo:hi], b[lo:hi], start[lo:hi], target[lo:hi],
+                        MINIMAX_ROUNDS, MINIMAX_LAWSON, MINIMAX_RADIUS, MINIMAX_START,
+                        out[lo:hi], ok[lo:hi], cnt, _ACTIVE, _WATCH, _SAMPLE, MINIMAX_MOVE)
+        return cnt
+
+    # (a refinement costs tens of passes over its points: worth the pool from fewer points)
+    for cnt in run_chunks(chunk, (b - a + 1).astype(np.float64), min_work=MIN_WORK / 8):
+        COUNTS[:] = COUNTS + cast(np.ndarray, cnt)
     return out, ok
