@@ -30,8 +30,8 @@ from typing import cast
 import numpy as np
 from numba import njit
 
+from galvo_core import parallel
 from galvo_core.geometry import newton_param
-from galvo_core.parallel import MIN_WORK, run_chunks
 
 __all__ = ["minimax_cubics"]
 
@@ -344,6 +344,7 @@ def minimax_cubics(work: np.ndarray, arc: np.ndarray, i0: np.ndarray, i1: np.nda
         return cnt
 
     # (a refinement costs tens of passes over its points: worth the pool from fewer points)
-    for cnt in run_chunks(chunk, (b - a + 1).astype(np.float64), min_work=MIN_WORK / 8):
+    for cnt in parallel.run_chunks(chunk, (b - a + 1).astype(np.float64),
+                                   min_work=parallel.MIN_WORK / 8):
         COUNTS[:] = COUNTS + cast(np.ndarray, cnt)
     return out, ok

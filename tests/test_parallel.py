@@ -92,3 +92,37 @@ def test_threaded_thinning_is_the_one_thread_thinning(monkeypatch: pytest.Monkey
     four = thin_many(paths, 0.6)
     assert seen
     assert all(np.array_equal(a, b) for a, b in zip(one, four, strict=True))
+
+
+def test_threaded_minimax_is_the_one_thread_minimax(monkeypatch: pytest.MonkeyPatch) -> None:
+    """The refinement of the fit's near misses (galvo_core.minimax) gives each piece the same
+    cubic whether its pieces run in one call or in chunks on the pool."""
+    from _util import flattened_cubic
+
+    from galvo_core.minimax import minimax_cubics
+
+    rng = np.random.default_rng(7)
+    work, i0, i1, ctrl = [], [], [], []
+    n = 0
+    for _ in range(12):
+        c = np.cumsum(rng.uniform(20.0, 120.0, size=(4, 2)), axis=0)
+        p = np.round(flattened_cubic(*c, chord=0.01))
+        p = p[np.r_[True, (p[1:] != p[:-1]).any(axis=1)]]
+        work.append(p)
+        i0.append(n)
+        i1.append(n + len(p) - 1)
+        n += len(p)
+        start = c.copy()
+        start[[0, 3]] = p[[0, -1]]
+        start[1:3] += rng.uniform(-1.5, 1.5, size=(2, 2))  # a near miss to refine
+        ctrl.append(start)
+    W = np.vstack(work)
+    arc = np.r_[0.0, np.cumsum(np.hypot(*np.diff(W, axis=0).T))]
+    args = (W, arc, np.array(i0), np.array(i1), np.array(ctrl), np.full(len(i0), 0.727))
+    monkeypatch.setattr(parallel, "THREADS", 1)
+    one, ok1 = minimax_cubics(*args)
+    seen = _threads(monkeypatch, 3)
+    three, ok3 = minimax_cubics(*args)
+    assert any(name.startswith("galvo-kernel") for name in seen)  # chunks ran on the pool
+    assert ok1.any()  # some pieces were refined within the bound
+    assert np.array_equal(ok1, ok3) and np.array_equal(one, three)
