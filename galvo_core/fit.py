@@ -1566,6 +1566,13 @@ def _triangle_kernel(A, B, q, t_out, t_in, ok, p0, qq, p3,
             sig[r] = det  # (NaN, as np.sign)
 
 
+def _sorted_find(sorted_keys: np.ndarray, keys: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Per key: (a position in the non-empty sorted array ``sorted_keys``, whether the key is
+    there), by binary search."""
+    pos = np.minimum(np.searchsorted(sorted_keys, keys), len(sorted_keys) - 1)
+    return pos, sorted_keys[pos] == keys
+
+
 class _BatchFitter:
     """Fits curve pieces together (of one path, or of many concatenated paths: ``work`` the
     input points, ``kept`` the thinned indices into it, ``arc`` the cumulative arc length
@@ -1857,11 +1864,10 @@ class _BatchFitter:
             return False
         pick = idx[_chain_phase(idx, 2) == parity]
         # a range tried before is not tried again (the next round's new pairs only)
-        key = A[pick].astype(np.int64) * (len(self.kept) + 1) + B[pick + 1]
+        key = self._range_keys(A[pick], B[pick + 1])
         tried = self._merge_tried
         if len(tried):
-            pos = np.minimum(np.searchsorted(tried, key), len(tried) - 1)
-            fresh = tried[pos] != key
+            fresh = ~_sorted_find(tried, key)[1]
             pick, key = pick[fresh], key[fresh]
         if len(pick) == 0:
             return False
@@ -2203,7 +2209,7 @@ class _BatchFitter:
             out = self._try_full(A, B)
             if _REFINED_ROUNDS and self.quant is not None and out[0].any():
                 p = out[0]
-                self._pass_keys.append(A[p].astype(np.int64) * (len(self.kept) + 1) + B[p])
+                self._pass_keys.append(self._range_keys(A[p], B[p]))
                 self._pass_ctrl.append(out[1][p])
                 self._pass_em.append(out[2][p])
             return out
@@ -2215,8 +2221,7 @@ class _BatchFitter:
         pk, pc, pe = self._passes
         f = np.flatnonzero(fresh)
         if len(pk) and len(f):
-            pos = np.minimum(np.searchsorted(pk, key[f]), len(pk) - 1)
-            hit = pk[pos] == key[f]
+            pos, hit = _sorted_find(pk, key[f])
             passed[f[hit]] = True
             ctrl_all[f[hit]] = pc[pos[hit]]
             em_all[f[hit]] = pe[pos[hit]]
@@ -2234,7 +2239,7 @@ class _BatchFitter:
         """:meth:`_try`'s empty answers for the pieces A..B (passed, control points, bound)
         and each range's cache key."""
         m = len(A)
-        key = A.astype(np.int64) * (len(self.kept) + 1) + B
+        key = self._range_keys(A, B)
         return np.zeros(m, dtype=bool), np.zeros((m, 4, 2)), np.zeros(m), key
 
     def _try_full(self, A: np.ndarray, B: np.ndarray):
@@ -2297,8 +2302,8 @@ class _BatchFitter:
         out = np.full(len(key), -1, dtype=np.intp)
         if len(ks) == 0:
             return out
-        pos = np.minimum(np.searchsorted(ks, key), len(ks) - 1)
-        hit = (ks[pos] == key) & ~used[pos]
+        pos, hit = _sorted_find(ks, key)
+        hit &= ~used[pos]
         out[hit] = pos[hit]
         return out
 
@@ -2332,7 +2337,12 @@ class _BatchFitter:
         ctrl_all[r[g]] = cm[g]
         em_all[r[g]] = e[g]
 
+    def _range_keys(self, A: np.ndarray, B: np.ndarray) -> np.ndarray:
+        """One int64 key per range A..B of thinned points (the caches' keys)."""
+        return A.astype(np.int64) * (len(self.kept) + 1) + B
+
     def _key_end(self, key: np.ndarray) -> np.ndarray:
+        """The range end B of keys from :meth:`_range_keys`."""
         return (key % (len(self.kept) + 1)).astype(np.intp)
 
     def _second_try(self, A, B, fresh, ok, passed, ctrl_all, em_all) -> None:
@@ -2349,7 +2359,7 @@ class _BatchFitter:
         """Per piece A..B: False where :meth:`_try` will not be tried in earnest (the
         triangle does not exist, the range failed before, or the coarse screening cubic
         misses by over ``_SCREEN_SLACK`` times the bound); True otherwise."""
-        key = A.astype(np.int64) * (len(self.kept) + 1) + B
+        key = self._range_keys(A, B)
         if self._starts is not None:  # (the refined rounds: :meth:`_try` decides cheaply)
             return np.ones(len(A), dtype=bool)
         hope = ~self._failed_before(key)
@@ -2371,8 +2381,7 @@ class _BatchFitter:
         f = self._failed
         if len(f) == 0:
             return np.zeros(len(keys), dtype=bool)
-        pos = np.minimum(np.searchsorted(f, keys), len(f) - 1)
-        return f[pos] == keys
+        return _sorted_find(f, keys)[1]
 
     def _remember_failed(self, keys: np.ndarray) -> None:
         if len(keys):
@@ -2616,8 +2625,7 @@ class _BatchFitter:
                 elif _REFINED_ROUNDS and len(free_v):
                     rest = ~passed[free_v]
                     fv = free_v[rest]
-                    self._start_keys.append(A[fv].astype(np.int64) * (len(self.kept) + 1)
-                                            + B[fv])
+                    self._start_keys.append(self._range_keys(A[fv], B[fv]))
                     self._start_ctrl.append(free_c[rest])
         return passed, ctrl_all, em_all
 
