@@ -2963,23 +2963,35 @@ def _fit_concatenated(
     if rounding is not None and (rounding[:, 1] > 0.0).any():
         coarse = _coarse_chords(W, woff[todo], wlen[todo], rounding[:, 1])
         K, tlen = _gap_ends_kept(W, K, tlen, rounding[:, 1], rounding[:, 0], coarse)
-    kend = np.cumsum(tlen) - 1  # each path's last thinned point
-    Q = W[K]
-    is_kend = np.zeros(len(Q), dtype=bool)
-    is_kend[kend] = True
-    pa, pb, curve, t_in, t_out, smooth = split_pieces_many(
-        Q, tlen, np.asarray(closed)[todo], rounding=rounding, return_smooth=True
-    )
     arc = _arc_per_path(W, wlen)
     move_q = None
     if rounding is not None:
         # the vertices move onto the design where the rounding is a fair share of the bound
         slack = rounding[:, 1] * _HALF_DIAGONAL
         move_q = np.where(slack >= _MOVE_SHARE * (e_per - slack), rounding[:, 1], 0.0)
-        if (move_q > 0.0).any():
-            Q = Q.copy()
-            _on_the_design(W, K, Q, arc, t_in, t_out, smooth, np.repeat(move_q, tlen), tlen,
-                           np.repeat(rounding[:, 0], tlen))
+    closed_t = np.asarray(closed)[todo]
+    Q = W[K]
+    pa, pb, curve, t_in, t_out, smooth = split_pieces_many(
+        Q, tlen, closed_t, rounding=rounding, return_smooth=True
+    )
+    if move_q is not None and (move_q > 0.0).any():
+        assert rounding is not None  # (move_q comes from it)
+        Q = Q.copy()
+        found: list[tuple[np.ndarray, np.ndarray, np.ndarray]] = []
+        _on_the_design(W, K, Q, arc, t_in, t_out, smooth, np.repeat(move_q, tlen), tlen,
+                       np.repeat(rounding[:, 0], tlen), found, coarse)
+        if found and len(found[0][0]):
+            # corners the thinning kept beside the design's: their input points kept instead
+            # (or too), and those paths' pieces split again
+            K2, tlen2, touched = _corners_kept_right(W, K, tlen, *found[0],
+                                                     np.repeat(rounding[:, 0], tlen))
+            if touched.any():
+                K, tlen, Q, pa, pb, curve, t_in, t_out, smooth = _split_again(
+                    W, arc, K, tlen, K2, tlen2, touched, Q, pa, pb, t_in, t_out, smooth,
+                    closed_t, rounding, move_q, coarse)
+    kend = np.cumsum(tlen) - 1  # each path's last thinned point
+    is_kend = np.zeros(len(Q), dtype=bool)
+    is_kend[kend] = True
     fitter = _BatchFitter(W, K, t_in, t_out, np.repeat(e_per, tlen), eps_sum, arc, q=Q)
     if rounding is not None and (rounding[:, 1] > 0.0).any():
         fitter.quant = np.repeat(rounding[:, 1], tlen)
@@ -3204,6 +3216,113 @@ def _gap_ends_kept(W, K, tlen, quanta, eps, coarse):
     path = np.searchsorted(last, np.searchsorted(K, add) - 1)  # (the segment's start's path)
     K2 = np.sort(np.concatenate([K, add]))
     return K2, tlen + np.bincount(path, minlength=len(tlen))
+
+
+def _corners_kept_right(W, K, tlen, v, j, both, eps):
+    """Rounded input: ``K`` (the thinned points, global indices; ``tlen`` per path) with the
+    input point ``j`` kept for the corner at thinned index ``v`` (:func:`_misplaced_corners`:
+    the design's corner lies at ``j``, beside ``K[v]``, inside one of the two thinned segments
+    at ``v``), while every thinned segment stays a line within ``eps`` (per thinned point) of
+    its input points (the thinning's promise): ``K[v]`` is replaced by ``j`` where the
+    segment from the neighbour across ``K[v]`` to ``j`` holds that bound; else that segment
+    is split at its farthest input point (not next to ``j``) where both parts hold it; else
+    ``K[v]`` is kept too where ``both`` (per pair) allows it. Nothing changes where the
+    segment from ``j`` to the neighbour on its
+    own side misses the bound. Returns (K, tlen, the paths changed (bool per path))."""
+    n = len(K)
+    last = np.cumsum(tlen) - 1
+    path = np.searchsorted(last, np.arange(n))
+    drop, add = [], []  # (thinned points dropped, input points added)
+    done = np.zeros(n + 1, dtype=bool)
+
+    def valid(a: int, b: int, e: float) -> bool:
+        return bool(_line_errors(W, W[[a, b]][None], np.array([a]), np.array([b]))[0] <= e)
+
+    for vv, jj, bb in zip(v.tolist(), j.tolist(), both.tolist(), strict=True):
+        if done[vv] or done[vv - 1] or done[vv + 1]:
+            continue  # (a neighbour's segments already changed)
+        k = int(K[vv])
+        e = float(eps[vv])
+        # the neighbour across k (its segment then spans k) and the one on j's side
+        across, own = (int(K[vv - 1]), int(K[vv + 1])) if jj > k else (int(K[vv + 1]),
+                                                                        int(K[vv - 1]))
+        lo, hi = min(jj, own), max(jj, own)
+        if not valid(lo, hi, e):
+            continue
+        lo, hi = min(across, jj), max(across, jj)
+        if valid(lo, hi, e):
+            drop.append(k)
+            add.append(jj)
+        else:
+            # (split near its middle, away from both ends: a corner's neighbours are short
+            # segments the curve-run rules take for rounding)
+            mid = (lo + hi) // 2
+            ms = [m for m in (mid, mid + 1, mid - 1, mid + 2, mid - 2)
+                  if min(m - lo, hi - m) > _MISPLACED_STEPS]
+            m = next((m for m in ms if valid(lo, m, e) and valid(m, hi, e)), -1)
+            if m >= 0:
+                drop.append(k)
+                add += [jj, m]
+            elif bb and valid(min(k, jj), max(k, jj), e):
+                add.append(jj)
+            else:
+                continue
+        done[vv] = True
+    touched = np.zeros(len(tlen), dtype=bool)
+    if not add:
+        return K, tlen, touched
+    touched[path[np.flatnonzero(done[:n])]] = True
+    keep = ~np.isin(K, np.array(drop, dtype=K.dtype))
+    Kd = K[keep]
+    pd = path[keep]
+    a = np.array(add, dtype=K.dtype)
+    # (each added point's path: that of the thinned segment it lies in)
+    pa = pd[np.clip(np.searchsorted(Kd, a) - 1, 0, len(Kd) - 1)]
+    order = np.argsort(np.concatenate([Kd, a]), kind="stable")
+    K2 = np.concatenate([Kd, a])[order]
+    cnt = np.bincount(np.concatenate([pd, pa]), minlength=len(tlen))
+    return K2, cnt.astype(tlen.dtype), touched
+
+
+def _split_again(W, arc, K, tlen, K2, tlen2, touched, Q, pa, pb, t_in, t_out, smooth,
+                 closed, rounding, move_q, coarse):
+    """The pieces, tangents, smooth flags and moved vertices (:func:`_on_the_design`) of the
+    thinned points ``K2`` (``tlen2`` per path), where only the paths ``touched`` differ from
+    ``K`` (``tlen``), whose results ``Q``, ``pa``, ``pb``, ``t_in``, ``t_out``, ``smooth`` are
+    kept for the other paths (each path's are its own: the same numbers as all paths again).
+    Returns (K2, tlen2, Q, pa, pb, curve, t_in, t_out, smooth)."""
+    P = np.flatnonzero(touched)
+    sel = np.repeat(touched, tlen2)
+    Ks = K2[sel]
+    ts = tlen2[P]
+    Qs = W[Ks]
+    sa, sb, _, si, so, ss = split_pieces_many(Qs, ts, closed[P], rounding=rounding[P],
+                                              return_smooth=True)
+    Qs = Qs.copy()
+    _on_the_design(W, Ks, Qs, arc, si, so, ss, np.repeat(move_q[P], ts), ts,
+                   np.repeat(rounding[P, 0], ts), None, coarse)
+    # per thinned point: the old rows of the other paths, the new rows of the touched ones
+    src = np.empty(len(K2), dtype=np.intp)
+    src[~sel] = np.flatnonzero(~np.repeat(touched, tlen))
+    src[sel] = len(K) + np.arange(len(Ks))
+    Q2 = np.concatenate([Q, Qs])[src]
+    ti2 = np.concatenate([t_in, si])[src]
+    to2 = np.concatenate([t_out, so])[src]
+    sm2 = np.concatenate([smooth, ss])[src]
+    # the pieces (thinned index ranges), moved to the new numbering, in order
+    o_old = np.cumsum(tlen) - tlen
+    o_new = np.cumsum(tlen2) - tlen2
+    o_sub = np.cumsum(ts) - ts
+    pp = np.searchsorted(np.cumsum(tlen) - 1, pa)
+    kp = ~touched[pp]
+    sh = (o_new - o_old)[pp[kp]]
+    ps = np.searchsorted(np.cumsum(ts) - 1, sa)
+    shs = o_new[P[ps]] - o_sub[ps]
+    a = np.concatenate([pa[kp] + sh, sa + shs])
+    b = np.concatenate([pb[kp] + sh, sb + shs])
+    order = np.argsort(a, kind="stable")
+    a, b = a[order], b[order]
+    return K2, tlen2, Q2, a, b, b - a >= 2, ti2, to2, sm2
 
 
 #: rounded input: a cubic's end segment (thinned) with a gap between two of its input
@@ -5402,7 +5521,8 @@ _SMOOTH_HALF = 6
 _SMOOTH_SHORT = 4.0
 
 
-def _on_the_design(W, K, Q, arc, t_in, t_out, smooth, quant, tlen, eps) -> None:
+def _on_the_design(W, K, Q, arc, t_in, t_out, smooth, quant, tlen, eps, found=None,
+                   coarse=None) -> None:
     """Rounded input (per thinned point its path's quantum ``quant``): the smooth thinned
     vertices (inside curve runs) moved onto a least-squares estimate of the design curve
     (a quadratic in arc length through the input points between the middles of the two
@@ -5454,7 +5574,7 @@ def _on_the_design(W, K, Q, arc, t_in, t_out, smooth, quant, tlen, eps) -> None:
             K[ci] - _SIDE_POINTS + 1, k_first[ci]), quant[ci]))
         _, tan, ok = _local_fits(W, arc, lo, K[ci], K[ci])
         t_in[ci[ok]] = tan[ok]
-    _corners_on_the_design(W, K, Q, arc, smooth, rnd, first, last, quant, eps)
+    _corners_on_the_design(W, K, Q, arc, smooth, rnd, first, last, quant, eps, found, coarse)
 
 
 #: one-sided tangents of rounded input are fitted over at least this many input points
@@ -5690,7 +5810,158 @@ def _split_corners(W, K, vi, vo, quant, p_in, t_in, ok_in, p_out, t_out, ok_out,
     both[b[good]] = True
 
 
-def _corners_on_the_design(W, K, Q, arc, smooth, rnd, first, last, quant, eps) -> None:
+#: rounded input: a corner whose design estimate lies more than this many quanta outside its
+#: input point's rounding square may be kept on the wrong input point (the thinning kept a
+#: point beside the design's corner) ...
+_MISPLACED_OFF = 0.25
+#: ... its sides are then fitted again without this many input points on each side of it
+#: (they may belong to the other side), and the design's corner looked for among the input
+#: points this many steps around it
+_MISPLACED_STEPS = 3
+#: ... the input point whose rounding square is nearest the sides' crossing (within this many
+#: quanta outside it) and nearer it than the kept one's by at least this many quanta
+_MISPLACED_NEAR = 0.5
+_MISPLACED_GAIN = 0.5
+#: ... where the crossing lies at least this many quanta outside the kept point's square (a
+#: tight smooth bend that the curve-run rules split also gives its sides a crossing, 1.0
+#: quanta outside: serif-italic "R" at em 400, two more segments and 0.05 farther from the
+#: design; the corners moved here lay 1.6 (Cantarell "8" at em 2048) and 2.7 quanta out)
+_MISPLACED_FAR = 1.25
+
+
+def _misplaced_corners(W, K, arc, vi, vo, lo_i, hi_o, line_in, line_out, est, cand, quant):
+    """:func:`_corners_on_the_design`'s corners (``vi``, ``vo``; their windows ``lo_i``,
+    ``hi_o``; ``line_in``/``line_out``: that side is a line) kept on an input point beside the
+    design's corner: where the estimate ``est`` (``cand``: a crossing of two sides) lies over
+    ``_MISPLACED_OFF`` quanta outside the thinned point's rounding square, the sides are fitted
+    again without the ``_MISPLACED_STEPS`` input points next to the thinned point, and where
+    their crossing lies in (within ``_MISPLACED_NEAR`` quanta of) the rounding square of
+    another input point up to ``_MISPLACED_STEPS`` steps away inside the two thinned segments,
+    nearer by ``_MISPLACED_GAIN`` quanta than the kept one's, and at least ``_MISPLACED_FAR``
+    quanta outside the kept one's, that point is the corner.
+    Returns (thinned index of the corner, global index of the input point)."""
+    none = (np.zeros(0, dtype=np.intp), np.zeros(0, dtype=np.intp))
+    k = K[vo]
+    q = quant[vo]
+    off = np.abs(est - W[k]).max(axis=1) - 0.5 * q
+    sel = cand & (vi == vo) & (off > _MISPLACED_OFF * q)
+    if not sel.any():
+        return none
+    c = np.flatnonzero(sel)
+    v, k, q = vo[c], k[c], q[c]
+    S = _MISPLACED_STEPS
+    lo, hi = lo_i[c], k - S
+    lo2, hi2 = k + S, hi_o[c]
+    li, lo_ = line_in[c], line_out[c]
+    ok = (hi - lo + 1 >= np.where(li, 3, _WINDOW_MIN)) & (hi2 - lo2 + 1 >= np.where(lo_, 3,
+                                                                                    _WINDOW_MIN))
+    if not ok.any():
+        return none
+    v, k, q, lo, hi, lo2, hi2, li, lo_ = (x[ok] for x in (v, k, q, lo, hi, lo2, hi2, li, lo_))
+    p1, t1, g1 = _local_fits(W, arc, lo, hi, k)
+    p2, t2, g2 = _local_fits(W, arc, lo2, hi2, k)
+    if li.any():
+        p1[li], t1[li], g1[li] = _local_lines(W, lo[li], hi[li], k[li])
+    if lo_.any():
+        p2[lo_], t2[lo_], g2[lo_] = _local_lines(W, lo2[lo_], hi2[lo_], k[lo_])
+    cr = t1[:, 0] * t2[:, 1] - t1[:, 1] * t2[:, 0]
+    good = g1 & g2 & (np.abs(cr) >= _CORNER_SINE)
+    d = p2 - p1
+    s = (d[:, 0] * t2[:, 1] - d[:, 1] * t2[:, 0]) / np.where(good, cr, 1.0)
+    x = p1 + s[:, None] * t1
+    # the candidates: the input points k - S .. k + S strictly inside the two segments
+    cands = k[:, None] + np.arange(-S, S + 1)[None, :]
+    inside = (cands > K[v - 1][:, None]) & (cands < K[v + 1][:, None])
+    cands = np.clip(cands, 0, len(W) - 1)
+    dist = np.abs(W[cands] - x[:, None, :]).max(axis=2) - 0.5 * q[:, None]
+    dist = np.where(inside, dist, np.inf)
+    best = np.argmin(dist, axis=1)
+    db = dist[np.arange(len(v)), best]
+    d0 = dist[:, S]
+    good &= (best != S) & (db <= _MISPLACED_NEAR * q) & (d0 - db >= _MISPLACED_GAIN * q)
+    good &= d0 >= _MISPLACED_FAR * q
+    return v[good], cands[np.flatnonzero(good), best[good]]
+
+
+#: ... (:func:`_corners_beside_gaps`) where the input steps between the thinned corner and the
+#: line's end are at most this many quanta each (a curve's steps; a longer one is a short
+#: design line of its own, whose ends are both corners: Cantarell Thin "g" at em 1500, a
+#: 6-unit line between a long one and the curve)
+_GAP_STEP = 4.0
+
+
+#: ... and the thinned corner is kept beside the line's end only where the line from its far
+#: end to the thinned corner misses the line's end by this many quanta or more (else that
+#: line serves the design nearly as well, and a second vertex only adds a segment: Cantarell
+#: "@" at em 1500, 0.13)
+_GAP_MISS = 0.5
+
+
+def _corners_beside_gaps(W, K, vo, smooth, quant, coarse, t_in, ok_in, t_out, ok_out):
+    """Rounded input: the corners ``vo`` (thinned indices) between a curve and a design line
+    written as its two rounded ends (a step of at least ``_LONE_LENGTH`` quanta, not a chord of
+    a coarse curve, ``coarse``) that the thinning kept up to ``_MISPLACED_STEPS`` short input
+    steps (each under 1 / ``_GAP_RATIO`` of the line and ``_GAP_STEP`` quanta) into the curve
+    past the line's end: the
+    line's end is the design's corner (sans "Q" at em 400: kept one step into the curve, the
+    fit 0.78 from the design where the rounded input is 0.42; serif-italic "a", two steps,
+    0.81 against 0.44), where the curve's tangent there (``t_out`` after the line, ``t_in``
+    before it, where ``ok_out`` / ``ok_in``) turns from the line by ``_CORNER_SINE`` or more
+    (a curve running tangentially into the line is no corner: serif-italic "R" at em 1000,
+    its corner estimate at the line's end then left the line's row, 0.67 from the design
+    where the rounded input is 0.45). Returns (thinned index of the corner, global index of
+    the line's end, whether both may be kept: ``_GAP_MISS``)."""
+    out_v, out_j, out_m = [], [], []
+    if len(vo) == 0:
+        return (np.zeros(0, dtype=np.intp), np.zeros(0, dtype=np.intp),
+                np.zeros(0, dtype=bool))
+    k = K[vo]
+    q = quant[vo]
+    n = len(W)
+    for side in (-1, 1):
+        # the line's end j = k + side * s, the line from j to j + side
+        # (the other side a curve: a curve run, or a thinned segment of at least _GAP_REST
+        # input steps; not a polyline's few short strokes)
+        other = smooth[vo + 1] if side < 0 else smooth[vo - 1]
+        other |= (K[vo + 1] - k if side < 0 else k - K[vo - 1]) >= _GAP_REST
+        nb = K[vo - 1] if side < 0 else K[vo + 1]  # the thinned neighbour on this side
+        found = np.zeros(len(vo), dtype=bool)
+        for s in range(1, _MISPLACED_STEPS + 1):
+            j = k + side * s
+            f = j + side  # the line's far end
+            ok = other & ~found & ((f - nb) * side <= 0)
+            jj = np.clip(j, 0, n - 1)
+            ff = np.clip(f, 0, n - 1)
+            ln = np.hypot(*(W[ff] - W[jj]).T)
+            ok &= ln >= _LONE_LENGTH * q
+            ok &= ~coarse[np.minimum(jj, ff)]
+            # (a corner: the curve's tangent turns from the line)
+            tc, okc = (t_out, ok_out) if side < 0 else (t_in, ok_in)
+            u = (W[jj] - W[ff]) * -side  # the line's direction along the path
+            cr = (u[:, 0] * tc[:, 1] - u[:, 1] * tc[:, 0]) / np.maximum(ln, 1e-300)
+            dt = (u * tc).sum(axis=1)
+            ok &= okc & ((np.abs(cr) >= _CORNER_SINE) | (dt < 0.0))
+            # (the steps from k to j short beside the line, and a curve's: at most
+            # _GAP_STEP quanta)
+            for t in range(s):
+                a = np.clip(k + side * t, 0, n - 1)
+                b = np.clip(k + side * (t + 1), 0, n - 1)
+                st = np.hypot(*(W[b] - W[a]).T)
+                ok &= (st * _GAP_RATIO <= ln) & (st <= _GAP_STEP * q)
+            found |= ok
+            out_v.append(vo[ok])
+            out_j.append(j[ok])
+            # (how far the line from its far end to the kept point misses the line's end)
+            d = W[k] - W[ff]
+            r = W[jj] - W[ff]
+            miss = np.abs(d[:, 0] * r[:, 1] - d[:, 1] * r[:, 0]) / np.maximum(
+                np.hypot(d[:, 0], d[:, 1]), 1e-300)
+            out_m.append((miss >= _GAP_MISS * q)[ok])
+    return np.concatenate(out_v), np.concatenate(out_j), np.concatenate(out_m)
+
+
+def _corners_on_the_design(W, K, Q, arc, smooth, rnd, first, last, quant, eps,
+                           found=None, coarse=None) -> None:
     """Rounded input: the corners (thinned vertices that are not smooth; a closed path's seam too)
     move inside their rounding squares onto an estimate of the design's corner. Per side, the
     input points of the thinned segment on that side give a position and a tangent at the
@@ -5823,6 +6094,16 @@ def _corners_on_the_design(W, K, Q, arc, smooth, rnd, first, last, quant, eps) -
         est[tip] -= np.where(cut, al, 0.0)[:, None] * ax
     _split_corners(W, K, vi, vo, quant, p_in, t_in, ok_in & ~lone_in, p_out, t_out,
                    ok_out & ~lone_out, est, both)
+    if found is not None:
+        one = vi == vo  # (not a closed path's seam)
+        gv, gj, gm = _corners_beside_gaps(W, K, vo[one], smooth, quant, coarse, t_in[one],
+                                      ok_in[one] & ~lone_in[one], t_out[one],
+                                      ok_out[one] & ~lone_out[one])
+        mv, mj = _misplaced_corners(W, K, arc, vi, vo, lo_i, hi_o, ~smooth[vi - 1],
+                                    ~smooth[vo + 1], est, sharp & ~lone, quant)
+        keep = ~np.isin(mv, gv)
+        found.append((np.concatenate([gv, mv[keep]]), np.concatenate([gj, mj[keep]]),
+                      np.concatenate([gm, np.ones(int(keep.sum()), dtype=bool)])))
     vi, vo, est = vi[both], vo[both], est[both]
     lone_in, lone_out = lone_in[both], lone_out[both]
     wk = W[K[vo]]
