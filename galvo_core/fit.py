@@ -5581,9 +5581,6 @@ _LONE_SINE = 0.9
 #: ... and moves it by at least this many half quanta (less is within the estimate's
 #: own error: the input point stays)
 _LONE_MIN_MOVE = 0.2
-#: a line side of a corner (its least-squares line) at most ``_SMOOTH_SHORT`` quanta long gives
-#: no estimate (s10-bias; False: off, for measurements)
-_SHORT_LINE_SIDES = True
 #: a corner whose move makes a line beside it miss its input points goes back half its move
 #: at a time, this many times, before it goes back to its input point
 _CORNER_HALVINGS = 2
@@ -5723,8 +5720,7 @@ def _corners_on_the_design(W, K, Q, arc, smooth, rnd, first, last, quant, eps) -
     the tip's axis, and so does one that stretches it by more than ``_TIP_OUT`` quanta. A
     corner between two long input steps (two design lines written as their rounded ends)
     stays; two corners with a short segment between them are one corner the thinning split
-    (:func:`_split_corners`); a line side of at most ``_SMOOTH_SHORT`` quanta (a step or two
-    of the rounding) gives no estimate.
+    (:func:`_split_corners`).
     A side that is a line over two input points only (no least-squares line) beside a curve side
     is the line through its two rounded ends (:func:`_lone_sides`), intersected with the curve's
     tangent where they cross at ``_LONE_SINE`` or more; at a middling angle (``_CORNER_SINE`` to
@@ -5784,16 +5780,6 @@ def _corners_on_the_design(W, K, Q, arc, smooth, rnd, first, last, quant, eps) -
     if lin_out.any():
         p, t, ok = _local_lines(W, k[lin_out], K[vo + 1][lin_out], k[lin_out])
         p_out[lin_out], t_out[lin_out], ok_out[lin_out] = p, t, ok
-    if _SHORT_LINE_SIDES:
-        # a line side of at most _SMOOTH_SHORT quanta is rounding (a step or two between
-        # two thinned corners): its least-squares direction is the rounding's, no estimate
-        # (Cantarell Light "B" at em 1000: a 1.4-unit L of three input points taken as a
-        # side moved the corner 0.83 from the design where the input point is 0.42)
-        short_in = lin_in & (np.hypot(*(W[K[vi]] - W[K[vi - 1]]).T)
-                             <= _SMOOTH_SHORT * quant[vi])
-        short_out = lin_out & (np.hypot(*(W[K[vo + 1]] - W[k]).T) <= _SMOOTH_SHORT * quant[vo])
-        ok_in &= ~short_in
-        ok_out &= ~short_out
     # a side that is a line written as its two ends only (no least-squares line) beside a
     # curve side: the line through those two rounded ends, long enough to give a direction
     # (the curve side of such a corner is not checked as a line below: the fitter checks
