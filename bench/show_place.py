@@ -13,7 +13,6 @@ from __future__ import annotations
 import argparse
 import importlib
 import inspect
-import math
 import os
 import sys
 
@@ -114,7 +113,7 @@ def main() -> None:
             far = point_polyline_distance(samp, T).max()
             print(f"  {s.kind} {s.first}..{s.last} {ctl} ends {de[0]:.3f} {de[1]:.3f}, "
                   f"farthest {far:.3f}")
-    print(f"(local R=2 window; place {a.x}, {a.y}; {math.hypot(0, 0):.0f})")
+    print(f"(local distances within 2 units of the place {a.x}, {a.y})")
 
 
 if __name__ == "__main__":
