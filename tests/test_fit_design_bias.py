@@ -1,9 +1,8 @@
 """Issue 16 (s10-bias): places of real typeface outlines where the fit on whole-unit input was
 farther from the true design curve than the rounded input: a smooth vertex's tangent from a
 window of two or three input points, a corner estimate given up whole where part of its move
-keeps the lines' bound. The outlines are
-built as in test_fit_design_places.py (the design flattened to 0.002 unit chords, rounded to
-whole units, repeats dropped)."""
+keeps the lines' bound. The outlines are built as in test_fit_design_places.py (the design
+flattened to 0.002 unit chords, rounded to whole units, repeats dropped)."""
 
 from __future__ import annotations
 
