@@ -5519,6 +5519,12 @@ def _local_lines(
 _SMOOTH_HALF = 6
 #: ... on a side whose thinned segment is at most this many quanta long
 _SMOOTH_SHORT = 4.0
+#: ... and elsewhere, on a side whose half window (from the vertex to the middle of its
+#: thinned segment) has fewer than this many input points, where at least _SMOOTH_HALF are
+#: there up to the thinned point beyond (s10-bias; ``_SMOOTH_ALWAYS`` False: off, for
+#: measurements)
+_SMOOTH_FEW = 3
+_SMOOTH_ALWAYS = True
 
 
 def _on_the_design(W, K, Q, arc, t_in, t_out, smooth, quant, tlen, eps, found=None,
@@ -5526,7 +5532,9 @@ def _on_the_design(W, K, Q, arc, t_in, t_out, smooth, quant, tlen, eps, found=No
     """Rounded input (per thinned point its path's quantum ``quant``): the smooth thinned
     vertices (inside curve runs) moved onto a least-squares estimate of the design curve
     (a quadratic in arc length through the input points between the middles of the two
-    thinned segments around it), kept inside the point's rounding square, with the fit's
+    thinned segments around it, at least ``_SMOOTH_HALF`` points on a side beside a short
+    segment or where that half has fewer than ``_SMOOTH_FEW``), kept inside the point's
+    rounding square, with the fit's
     tangent as both of its tangents; the ends of curve runs keep their place and get
     one-sided fitted tangents. In place on ``Q``, ``t_in``, ``t_out``."""
     n = len(Q)
@@ -5547,10 +5555,17 @@ def _on_the_design(W, K, Q, arc, t_in, t_out, smooth, quant, tlen, eps, found=No
         short = _SMOOTH_SHORT * quant[sm]
         lo_min = np.where(smooth[sm - 1], K[np.maximum(sm - 2, 0)], K[sm - 1])
         hi_max = np.where(smooth[sm + 1], K[np.minimum(sm + 2, n - 1)], K[sm + 1])
-        lo = np.where(ln[sm - 1] <= short,
-                      np.maximum(lo_min, np.minimum(lo, K[sm] - _SMOOTH_HALF)), lo)
-        hi = np.where(ln[sm] <= short,
-                      np.minimum(hi_max, np.maximum(hi, K[sm] + _SMOOTH_HALF)), hi)
+        lo_w = np.maximum(lo_min, np.minimum(lo, K[sm] - _SMOOTH_HALF))
+        hi_w = np.minimum(hi_max, np.maximum(hi, K[sm] + _SMOOTH_HALF))
+        # (elsewhere too where that reaches _SMOOTH_HALF points: a window of a few points
+        # of a curve flattened into long steps, near a lattice slope, gives a tangent several
+        # degrees off)
+        wide_lo = (ln[sm - 1] <= short) | (_SMOOTH_ALWAYS & (K[sm] - lo_w >= _SMOOTH_HALF)
+                                           & (K[sm] - lo < _SMOOTH_FEW))
+        wide_hi = (ln[sm] <= short) | (_SMOOTH_ALWAYS & (hi_w - K[sm] >= _SMOOTH_HALF)
+                                       & (hi - K[sm] < _SMOOTH_FEW))
+        lo = np.where(wide_lo, lo_w, lo)
+        hi = np.where(wide_hi, hi_w, hi)
         pos, tan, ok = _local_fits(W, arc, np.minimum(lo, K[sm]), np.maximum(hi, K[sm]), K[sm])
         k = sm[ok]
         h = 0.5 * quant[k][:, None]
@@ -5686,6 +5701,9 @@ _LONE_SINE = 0.9
 #: ... and moves it by at least this many half quanta (less is within the estimate's
 #: own error: the input point stays)
 _LONE_MIN_MOVE = 0.2
+#: a corner whose move makes a line beside it miss its input points goes back half its move
+#: at a time, this many times, before it goes back to its input point
+_CORNER_HALVINGS = 2
 #: a corner turning by more than 120 degrees (the cosine of its turn below this) is a tip: an
 #: error d in either side's estimated offset moves the tangents' crossing by d / sin(interior
 #: angle) along the tip's axis, more than the rounding ...
@@ -5978,8 +5996,9 @@ def _corners_on_the_design(W, K, Q, arc, smooth, rnd, first, last, quant, eps,
     is the line through its two rounded ends (:func:`_lone_sides`), intersected with the curve's
     tangent where they cross at ``_LONE_SINE`` or more; at a middling angle (``_CORNER_SINE`` to
     ``_LONE_SINE``: an error in the line's offset would move the intersection far) the corner
-    stays. A corner stays where a line from it to a neighbouring thinned point would miss its
-    input points by more than ``eps`` (per thinned point), so the lines keep their bound (the
+    stays. A corner goes back toward its input point (half its move at a time, then all of
+    it) where a line from it to a neighbouring thinned point would miss its input points by
+    more than ``eps`` (per thinned point), so the lines keep their bound (the
     curve side of a corner with a two-point side is not held to that: the fitter tests its
     cubics against the bound, and a line there is made valid by :func:`_valid_lines`). In place
     on ``Q``."""
@@ -6120,7 +6139,12 @@ def _corners_on_the_design(W, K, Q, arc, smooth, rnd, first, last, quant, eps,
     moved = np.zeros(n, dtype=bool)
     moved[vo] = True
     moved[vi] = True
-    for _ in range(3):
+    # a corner whose line misses its points goes back toward its input point, half its move
+    # at a time (_CORNER_HALVINGS times), then to the input point (each round moves at
+    # least one corner back: at most _CORNER_HALVINGS + 1 rounds per corner)
+    mv = new - old
+    frac = np.ones(len(vo))
+    while True:
         # the thinned segments next to a moved corner, as lines: within eps of their points?
         seg = np.unique(np.concatenate([vi[~lone_out] - 1, vo[~lone_in]]))
         seg = seg[moved[seg] | moved[seg + 1]]
@@ -6136,12 +6160,16 @@ def _corners_on_the_design(W, K, Q, arc, smooth, rnd, first, last, quant, eps,
         back = (hit[vi] | hit[vo]) & moved[vo]
         if not back.any():
             break
-        Q[vo[back]] = old[back]
-        Q[vi[back]] = old[back]
-        moved[vo[back]] = False
-        moved[vi[back]] = False
-        keep = ~back
-        vi, vo, old = vi[keep], vo[keep], old[keep]
+        frac[back] *= 0.5
+        frac[back & (frac < 0.5 ** _CORNER_HALVINGS)] = 0.0
+        part = old[back] + frac[back, None] * mv[back]
+        Q[vo[back]] = part
+        Q[vi[back]] = part
+        gone = back & (frac == 0.0)
+        moved[vo[gone]] = False
+        moved[vi[gone]] = False
+        keep = ~gone
+        vi, vo, old, mv, frac = vi[keep], vo[keep], old[keep], mv[keep], frac[keep]
         lone_in, lone_out = lone_in[keep], lone_out[keep]
 
 
