@@ -169,6 +169,8 @@ _MINIMAX_MERGE = 2
 #: order of two joint moves 670 units away; at 1.0 no training, held-out, CFF or em 400
 #: distance is worse and the CFF counts drop, bench/RESULTS.md "CFF counts, ninth session")
 _MERGE_DEV = 1.0
+#: ... lines (not the design's, :meth:`_BatchFitter._fixed_lines`) merged so too
+_MINIMAX_LINES = True
 #: rounded input, after the merge pass: the greedy chain refit and the three-into-two
 #: resplit once more, where the ranges they tried before come back at no cost (a pass keeps
 #: its cubic, a failure is tried only by the refinement of its cached start,
@@ -1857,7 +1859,17 @@ class _BatchFitter:
         if self._barely_turns is None:  # per thinned point (as :meth:`_absorb_round`)
             cosv = (self.t_in * self.t_out).sum(axis=1)
             self._barely_turns = cosv > math.cos(_ABSORB_TURN)
-        adj = ~isl[:-1] & ~isl[1:] & (B[:-1] == A[1:]) & self._barely_turns[B[:-1]]
+        if _MINIMAX_LINES:
+            # a line that is no design line (:meth:`_fixed_lines`) may take part too, as the
+            # cubic with its handles at its thirds
+            fixed = self._fixed_lines(A, B, isl)
+            adj = ~fixed[:-1] & ~fixed[1:] & (B[:-1] == A[1:]) & self._barely_turns[B[:-1]]
+            C = C.copy()
+            li = np.flatnonzero(isl)
+            p0, p3 = self.q[A[li]], self.q[B[li]]
+            C[li] = np.stack([p0, (2.0 * p0 + p3) / 3.0, (p0 + 2.0 * p3) / 3.0, p3], axis=1)
+        else:
+            adj = ~isl[:-1] & ~isl[1:] & (B[:-1] == A[1:]) & self._barely_turns[B[:-1]]
         idx = np.flatnonzero(adj)
         idx = idx[(self.quant[A[idx]] > 0.0) & self._exact(A[idx])]
         if len(idx) == 0:
@@ -1900,6 +1912,10 @@ class _BatchFitter:
         if not g.any():
             return False
         i = pick[v[g]]
+        if _MINIMAX_LINES:
+            C[isl] = 0.0  # (a line's C is zeros)
+            isl = isl.copy()
+            isl[i] = False
         B[i] = B[i + 1]
         C[i] = cm[g]
         E[i] = e[g]

@@ -53,3 +53,37 @@ def test_connector_taken_out_where_the_joint_can_move(monkeypatch):
     assert not check_fit(w, fp, 0.02, 0.02, report=True)["violation"]
     truth = _dense(_SERIF_B, 0.001)
     assert design_distance(fp, truth) <= design_distance(without, truth) + 0.02
+
+
+#: DejaVu Sans "B" (the inner contour of its lower bowl) in the training text at em 1000:
+#: three design lines and four quadratics
+_SANS_B = [
+    ("line", (809.5703125, 348.14453125), (809.5703125, 81.0546875)),
+    ("line", (809.5703125, 81.0546875), (967.7734375, 81.0546875)),
+    _cubic_of_quad((967.7734375, 81.0546875), (1047.36328125, 81.0546875),
+                   (1085.693359375, 114.013671875)),
+    _cubic_of_quad((1085.693359375, 114.013671875), (1124.0234375, 146.97265625),
+                   (1124.0234375, 214.84375)),
+    _cubic_of_quad((1124.0234375, 214.84375), (1124.0234375, 283.203125),
+                   (1085.693359375, 315.673828125)),
+    _cubic_of_quad((1085.693359375, 315.673828125), (1047.36328125, 348.14453125),
+                   (967.7734375, 348.14453125)),
+    ("line", (967.7734375, 348.14453125), (809.5703125, 348.14453125)),
+]
+
+
+def test_refinement_merges_a_line_that_is_no_design_line(monkeypatch):
+    """A thinned line inside a smooth stretch (not a design line: it has input points between
+    its ends) is merged with its neighbour by the refinement (``fit._MINIMAX_LINES``), as two
+    cubics are: fewer segments, the bound held, no farther from the design."""
+    w = _rounded(_SANS_B)
+    fp = fit_paths([w], [True])[0]
+    monkeypatch.setattr(fitmod, "_MINIMAX_LINES", False)
+    without = fit_paths([w], [True])[0]
+    assert len(fp.first) < len(without.first)
+    assert not check_fit(w, fp, 0.02, 0.02, report=True)["violation"]
+    truth = _dense(_SANS_B, 0.001)
+    assert design_distance(fp, truth) <= design_distance(without, truth) + 0.02
+    # the design's long lines stay lines
+    lines = [s for s in fp.segments if s.kind == "line"]
+    assert sum(np.hypot(*(s.points[1] - s.points[0])) > 100.0 for s in lines) == 3
