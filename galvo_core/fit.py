@@ -4840,11 +4840,11 @@ def _smooth_stretches(W, arc, points, is_cubic, tail, step, gfirst, glast, seg_o
 #: of its neighbours: the first of these shares of the way from the input point to the
 #: moved vertex that keeps both within the bound (1: the line beside it takes the moved
 #: vertex; 0: the other segment's end goes back to the input point)
-_CONNECTOR_SHARES = (1.0, 0.5, 0.0)
+_CONNECTOR_SHARES = (1.0, 0.75, 0.5, 0.25, 0.0)
 #: ... the segments' curve-to-polyline checks sampled at most this far apart (units of q;
 #: the check keeps half of it spare: coarser than the joints' moves, ``_JOINT_STEP``, for a
-#: tenth of the time, at the cost of a few connectors kept)
-_CONNECTOR_STEP = 0.15
+#: fraction of the time, at the cost of a few connectors kept)
+_CONNECTOR_STEP = 0.1
 
 
 def _connectors_out(W, points, is_cubic, tail, step, gfirst, glast, seg_owner, quant, bound,
