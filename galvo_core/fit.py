@@ -169,6 +169,8 @@ _MINIMAX_MERGE = 2
 #: order of two joint moves 670 units away; at 1.0 no training, held-out, CFF or em 400
 #: distance is worse and the CFF counts drop, bench/RESULTS.md "CFF counts, ninth session")
 _MERGE_DEV = 1.0
+#: ... lines (not the design's, :meth:`_BatchFitter._fixed_lines`) merged so too
+_MINIMAX_LINES = True
 #: rounded input, after the merge pass: the greedy chain refit and the three-into-two
 #: resplit once more, where the ranges they tried before come back at no cost (a pass keeps
 #: its cubic, a failure is tried only by the refinement of its cached start,
@@ -1857,7 +1859,17 @@ class _BatchFitter:
         if self._barely_turns is None:  # per thinned point (as :meth:`_absorb_round`)
             cosv = (self.t_in * self.t_out).sum(axis=1)
             self._barely_turns = cosv > math.cos(_ABSORB_TURN)
-        adj = ~isl[:-1] & ~isl[1:] & (B[:-1] == A[1:]) & self._barely_turns[B[:-1]]
+        if _MINIMAX_LINES:
+            # a line that is no design line (:meth:`_fixed_lines`) may take part too, as the
+            # cubic with its handles at its thirds
+            fixed = self._fixed_lines(A, B, isl)
+            adj = ~fixed[:-1] & ~fixed[1:] & (B[:-1] == A[1:]) & self._barely_turns[B[:-1]]
+            C = C.copy()
+            li = np.flatnonzero(isl)
+            p0, p3 = self.q[A[li]], self.q[B[li]]
+            C[li] = np.stack([p0, (2.0 * p0 + p3) / 3.0, (p0 + 2.0 * p3) / 3.0, p3], axis=1)
+        else:
+            adj = ~isl[:-1] & ~isl[1:] & (B[:-1] == A[1:]) & self._barely_turns[B[:-1]]
         idx = np.flatnonzero(adj)
         idx = idx[(self.quant[A[idx]] > 0.0) & self._exact(A[idx])]
         if len(idx) == 0:
@@ -1900,6 +1912,10 @@ class _BatchFitter:
         if not g.any():
             return False
         i = pick[v[g]]
+        if _MINIMAX_LINES:
+            C[isl] = 0.0  # (a line's C is zeros)
+            isl = isl.copy()
+            isl[i] = False
         B[i] = B[i + 1]
         C[i] = cm[g]
         E[i] = e[g]
@@ -3073,6 +3089,8 @@ def _fit_concatenated(
                                         seg_owner, move_q, bound)
         is_cubic, points, tail, step, gf, gl, seg_owner, changed = _smooth_stretches(
             W, arc, points, is_cubic, tail, step, gf, gl, seg_owner, move_q, bound, changed)
+        is_cubic, points, tail, step, gf, gl, seg_owner, changed = _connectors_out(
+            W, points, is_cubic, tail, step, gf, gl, seg_owner, move_q, bound, changed)
         if changed.any():
             worst = _changed_errors(W, points, is_cubic, tail, gf, gl, seg_owner, changed,
                                     worst)
@@ -4931,6 +4949,106 @@ def _smooth_stretches(W, arc, points, is_cubic, tail, step, gfirst, glast, seg_o
             rep[a] = [(ra[1], fa, ea)]
             rep[b] = [(rb[1], fb, eb)]
             done[a] = done[b] = True
+    if not rep:
+        return unchanged
+    return _rebuilt(points, is_cubic, tail, step, gfirst, glast, seg_owner, changed, rep)
+
+
+#: rounded input: a connector (a line over no input step, from a moved vertex to its input
+#: point, :func:`_valid_lines`) is taken out where the vertex can sit at one place for both
+#: of its neighbours: the first of these shares of the way from the input point to the
+#: moved vertex that keeps both within the bound (1: the line beside it takes the moved
+#: vertex; 0: the other segment's end goes back to the input point)
+_CONNECTOR_SHARES = (1.0, 0.75, 0.5, 0.25, 0.0)
+#: ... the segments' curve-to-polyline checks sampled at most this far apart (units of q;
+#: the check keeps half of it spare: coarser than the joints' moves, ``_JOINT_STEP``, for a
+#: fraction of the time, at the cost of a few connectors kept)
+_CONNECTOR_STEP = 0.1
+
+
+def _connectors_out(W, points, is_cubic, tail, step, gfirst, glast, seg_owner, quant, bound,
+                    changed):
+    """Rounded input: the connectors :func:`_valid_lines` left (a line over no input step
+    between a moved vertex and its input point: a segment of its own, 35 of them on
+    FreeSerif Italic at em 2048) taken out where the joint can sit at one point for both
+    segments beside it (``_CONNECTOR_SHARES`` of the way from the input point to the moved
+    vertex), both then within ``bound`` (per path) of their input points and polyline
+    (:func:`_seg_fits_many`, as the joints' moves). A connector at a path's first or last
+    segment stays. Returns the segments (is_cubic, points, tail, step, gfirst, glast,
+    seg_owner, changed) rebuilt, or the inputs when none changed."""
+    ns = len(is_cubic)
+    unchanged = (is_cubic, points, tail, step, gfirst, glast, seg_owner, changed)
+    if ns < 3:
+        return unchanged
+    c = np.flatnonzero(~is_cubic & (gfirst == glast))
+    c = c[(c > 0) & (c < ns - 1)]
+    c = c[(seg_owner[c - 1] == seg_owner[c]) & (seg_owner[c + 1] == seg_owner[c])]
+    c = c[quant[seg_owner[c]] > 0.0]
+    # (no two connectors share a neighbour: every other one of a run of them)
+    c = c[np.r_[True, c[1:] > c[:-1] + 2]] if len(c) else c
+    if len(c) == 0:
+        return unchanged
+    p0 = points[tail[c] - 1]
+    p1 = points[tail[c]]
+    g = gfirst[c]
+    # the input point end X and the moved vertex end Y; ``lin`` the segment at X (the
+    # thinned line), ``oth`` the one at Y
+    x_first = (p0 == W[g]).all(axis=1)
+    x_last = (p1 == W[g]).all(axis=1)
+    ok = x_first ^ x_last
+    c, p0, p1, g, x_first = c[ok], p0[ok], p1[ok], g[ok], x_first[ok]
+    if len(c) == 0:
+        return unchanged
+    X = np.where(x_first[:, None], p0, p1)
+    Y = np.where(x_first[:, None], p1, p0)
+    lin = np.where(x_first, c - 1, c + 1)
+    oth = np.where(x_first, c + 1, c - 1)
+    wstep = np.hypot(*np.diff(W, axis=0).T)
+    bj = np.asarray(bound, dtype=np.float64)[seg_owner[c]]
+    h = _CONNECTOR_STEP * quant[seg_owner[c]]
+    rep: dict[int, list] = {}
+    rem = np.arange(len(c))
+    for share in _CONNECTOR_SHARES:
+        if len(rem) == 0:
+            break
+        # per connector its two segments with the joint at the new place; only those that
+        # change are checked (at share 1 the segment at the moved vertex stays as it is, at
+        # share 0 the thinned line)
+        ctrls, segs, who, moved = [], [], [], []
+        for t, i in enumerate(rem.tolist()):
+            v = X[i] + share * (Y[i] - X[i])
+            for s, at in ((int(lin[i]), X[i]), (int(oth[i]), Y[i])):
+                cc = _seg_ctrl(points, is_cubic, tail, s)
+                dv = v - at
+                if s > c[i]:  # the segment after the connector starts at the joint
+                    cc[0] += dv
+                    if len(cc) == 4:
+                        cc[1] += dv
+                else:
+                    cc[-1] += dv
+                    if len(cc) == 4:
+                        cc[2] += dv
+                ctrls.append(cc)
+                segs.append(s)
+                who.append(t)
+                moved.append(bool((dv != 0.0).any()))
+        segs_a = np.asarray(segs, dtype=np.intp)
+        who_a = np.asarray(who, dtype=np.intp)
+        chk = np.flatnonzero(moved)
+        fits = np.ones(len(segs), dtype=bool)
+        if len(chk):
+            fits[chk] = _seg_fits_many(W, wstep, [ctrls[k] for k in chk.tolist()],
+                                       gfirst[segs_a[chk]], glast[segs_a[chk]],
+                                       bj[rem][who_a[chk]], h[rem][who_a[chk]])
+        both = fits[0::2] & fits[1::2]
+        for t in np.flatnonzero(both).tolist():
+            i = int(rem[t])
+            ci = int(c[i])
+            rep[ci] = []
+            for k in (0, 1):
+                s = segs[2 * t + k]
+                rep[s] = [(ctrls[2 * t + k], int(gfirst[s]), int(glast[s]))]
+        rem = rem[~both]
     if not rep:
         return unchanged
     return _rebuilt(points, is_cubic, tail, step, gfirst, glast, seg_owner, changed, rep)
