@@ -149,6 +149,9 @@ _SCREEN_SLACK = 2.0
 #: rounds of absorbing lines into cubics on rounded input, and the largest turn (radians)
 #: between the one-sided tangents at the vertex where that may happen
 _ABSORB_ROUNDS = 3
+#: rounded input: rounds of replacing a short line and its two neighbours by one cubic
+#: (:meth:`_BatchFitter._bridge_round`)
+_BRIDGE_ROUNDS = 2
 #: rounds of replacing three adjacent cubics by two, and the split points tried per triple
 _RESPLIT_ROUNDS = 1
 #: Gauss-Newton rounds of the second candidate cubic (:meth:`_BatchFitter._gauss_newton`)
@@ -174,12 +177,11 @@ _MINIMAX_LINES = True
 #: rounded input, after the merge pass: the greedy chain refit and the three-into-two
 #: resplit once more, where the ranges they tried before come back at no cost (a pass keeps
 #: its cubic, a failure is tried only by the refinement of its cached start,
-#: :meth:`_BatchFitter._refined_rounds`)
+#: :meth:`_BatchFitter._refined_rounds`; new ranges fail: fitting them in full, with the
+#: refinement, in the chains a refined cubic opened took a few segments fewer on cubic
+#: typefaces for over a tenth more CPU on sparse outlines, bench/RESULTS.md "CFF counts,
+#: ninth session")
 _REFINED_ROUNDS = True
-#: ... and new ranges fitted in full (with the refinement) in the chains and triples a
-#: refined cubic opened: a few segments fewer on cubic typefaces, but over a tenth more CPU
-#: on sparse outlines (off)
-_REFINED_NEW = False
 #: ... the start's Gauss-Newton rounds, and the near misses refined (as ``_MINIMAX_NEAR``)
 _MERGE_GN_ROUNDS = 4
 _MERGE_NEAR = 1.2
@@ -1624,7 +1626,6 @@ class _BatchFitter:
         self._triples: tuple | None = None
         #: keys a (M + 1) + b of the ranges a..b that :meth:`_try` found no cubic for
         self._failed = np.zeros(0, dtype=np.int64)
-        self._refine = False  # (the minimax refinement in :meth:`_second_candidate`)
         #: keys (as ``_failed``) of the ranges :meth:`_minimax_merge_round` tried
         self._merge_tried = np.zeros(0, dtype=np.int64)
         #: rounded input: the refinement's starts of the failed ranges (keys as ``_failed``,
@@ -1639,7 +1640,6 @@ class _BatchFitter:
         self._pass_ctrl: list[np.ndarray] = []
         self._pass_em: list[np.ndarray] = []
         self._passes: tuple = ()
-        self._refined_now = _EMPTY_BOOL
 
     # -- the one-parameter family ---------------------------------------------------------
     def _triangle(self, A: np.ndarray, B: np.ndarray):
@@ -1799,6 +1799,10 @@ class _BatchFitter:
             for _ in range(_ABSORB_ROUNDS):
                 if not (self._absorb_round(0) | self._absorb_round(1)):
                     break
+        if self.quant is not None:
+            for _ in range(_BRIDGE_ROUNDS):
+                if not self._bridge_round():
+                    break
         for _ in range(_RESPLIT_ROUNDS):
             if not (self._resplit_round(0) | self._resplit_round(1) | self._resplit_round(2)):
                 break
@@ -1815,9 +1819,8 @@ class _BatchFitter:
         :meth:`_resplit_round` once more, their :meth:`_try` answering the ranges tried
         before from what it found then (a pass: its cubic; a failure: only the refinement
         of the free Gauss-Newton start :meth:`_second_candidate` cached for it, where that
-        start is a near miss, :meth:`_refine_cached`). New ranges fail, except with
-        ``_REFINED_NEW`` in a chain or triple that a refined cubic opened (then fitted in
-        full, the refinement in their candidates). The merge pass changed the segments:
+        start is a near miss, :meth:`_refine_cached`). New ranges fail. The merge pass
+        changed the segments:
         chains and triples the first rounds could not shorten may shorten now, and a near
         miss of theirs may now pass."""
         def cat(parts, empty):
@@ -1832,10 +1835,8 @@ class _BatchFitter:
         pe = cat(self._pass_em, np.zeros(0))
         pk, first = np.unique(pk, return_index=True)
         self._passes = (pk, pc[first], pe[first])
-        self._refine = _REFINED_NEW
         self._greedy_round()
         self._resplit_round(0) | self._resplit_round(1) | self._resplit_round(2)
-        self._refine = False
         self._starts = None
         self._passes = ()
 
@@ -1924,6 +1925,51 @@ class _BatchFitter:
         self._store(A[keep], B[keep], C[keep], E[keep], isl[keep])
         return True
 
+    def _bridge_round(self) -> bool:
+        """Rounded input: a line that is no line of the design (:meth:`_fixed_lines`) between
+        two segments, at vertices that barely turn (``_ABSORB_TURN``), is replaced with both
+        neighbours by one cubic where one passes the same test (the rounding leaves short
+        lines in curves, their thinned tangents off the design's: no cubic may end at them,
+        so neither the pairs of :meth:`_absorb_round` nor the chains of
+        :meth:`_greedy_round` get past them). Every such triple is tried; those that pass are
+        taken from the first on, none overlapping one taken. True when something changed."""
+        A, B, C, E, isl = self._all_segments()
+        if len(A) < 3:
+            return False
+        assert self.quant is not None  # (called on rounded input only)
+        if self._barely_turns is None:  # per thinned point (as :meth:`_absorb_round`)
+            cosv = (self.t_in * self.t_out).sum(axis=1)
+            self._barely_turns = cosv > math.cos(_ABSORB_TURN)
+        fixed = self._fixed_lines(A, B, isl)
+        i = np.arange(1, len(A) - 1)
+        tri = (isl[i] & ~fixed[i - 1] & ~fixed[i] & ~fixed[i + 1]
+               & (B[i - 1] == A[i]) & (B[i] == A[i + 1])
+               & self._barely_turns[A[i]] & self._barely_turns[B[i]]
+               & (self.quant[A[i]] > 0.0))
+        i = i[tri]
+        if len(i) == 0:
+            return False
+        ok, ctrl, em = self._try(A[i - 1], B[i + 1])
+        i, ctrl, em = i[ok], ctrl[ok], em[ok]
+        if len(i) == 0:
+            return False
+        take = np.zeros(len(i), dtype=bool)
+        last = -10
+        for k in range(len(i)):  # (sorted by position: the first of overlapping triples)
+            if i[k] - 1 > last:
+                take[k] = True
+                last = i[k] + 1
+        i, ctrl, em = i[take], ctrl[take], em[take]
+        B[i - 1] = B[i + 1]
+        C[i - 1] = ctrl
+        E[i - 1] = em
+        isl[i - 1] = False
+        keep = np.ones(len(A), dtype=bool)
+        keep[i] = False
+        keep[i + 1] = False
+        self._store(A[keep], B[keep], C[keep], E[keep], isl[keep], fixed[keep])
+        return True
+
     def _greedy_round(self) -> bool:
         """Chains of at least ``_GREEDY_MIN`` adjacent cubics meeting at smooth vertices
         (one tangent at the joint: no corner between them) are fitted again from the
@@ -1968,7 +2014,6 @@ class _BatchFitter:
         done = np.zeros(len(pick), dtype=bool)
         best_c = np.zeros((len(pick), 4, 2))
         best_e = np.zeros(len(pick))
-        hot = np.zeros(len(pick), dtype=bool)
         out_k: list[np.ndarray] = []
         out_a: list[np.ndarray] = []
         out_b: list[np.ndarray] = []
@@ -1978,11 +2023,7 @@ class _BatchFitter:
             w = np.flatnonzero(live)
             # the first try of a cubic is its farthest end; then halve the bracket
             mid = np.where(hi[w] > bnd[w], bnd[w], (lo[w] + hi[w]) // 2)
-            if self._starts is None:
-                ok, ctrl, em = self._try(cur[w], mid)
-            else:  # (refined: new ranges only in chains the refinement opened)
-                ok, ctrl, em = self._try(cur[w], mid, hot[w])
-                hot[w[self._refined_now]] = True
+            ok, ctrl, em = self._try(cur[w], mid)
             g = w[ok]
             lo[g] = mid[ok]
             best_c[g] = ctrl[ok]
@@ -2079,11 +2120,10 @@ class _BatchFitter:
             if len(g) == 0:
                 continue
             ok1, c1, e1 = self._try(a0[g], v)
-            rn = self._refined_now
             h = np.flatnonzero(ok1)
             if len(h) == 0:
                 continue
-            ok2, c2, e2 = self._try(v[h], d0[g[h]], None if self._starts is None else rn[h])
+            ok2, c2, e2 = self._try(v[h], d0[g[h]])
             h = h[ok2]
             gh = g[h]
             found[gh] = True
@@ -2214,13 +2254,11 @@ class _BatchFitter:
         self._store(A[keep], B[keep], C[keep], E[keep], isl[keep], fixed[keep])
         return True
 
-    def _try(self, A: np.ndarray, B: np.ndarray, allow: np.ndarray | None = None):
+    def _try(self, A: np.ndarray, B: np.ndarray):
         """One cubic per piece A..B (no split): (passed, ctrl, bound) (:meth:`_try_full`).
         In the refined rounds (:meth:`_refined_rounds`) the ranges tried before are not
         fitted again: one that passed has its cubic back, one that failed is tried only by
-        the refinement of its cached start (:meth:`_refine_cached`; those that pass so are
-        ``self._refined_now``); a new range is fitted (with the refinement) only where
-        ``allow``, else it fails."""
+        the refinement of its cached start (:meth:`_refine_cached`); a new range fails."""
         if self._starts is None:
             out = self._try_full(A, B)
             if _REFINED_ROUNDS and self.quant is not None and out[0].any():
@@ -2233,7 +2271,6 @@ class _BatchFitter:
         fresh = ~self._failed_before(key)
         if not fresh.all():
             self._refine_cached(A, key, fresh, passed, ctrl_all, em_all)
-        self._refined_now = passed.copy()
         pk, pc, pe = self._passes
         f = np.flatnonzero(fresh)
         if len(pk) and len(f):
@@ -2241,14 +2278,6 @@ class _BatchFitter:
             passed[f[hit]] = True
             ctrl_all[f[hit]] = pc[pos[hit]]
             em_all[f[hit]] = pe[pos[hit]]
-            f = f[~hit]
-        if allow is not None and _REFINED_NEW and len(f):
-            f = f[allow[f]]
-            if len(f):
-                g, c, e = self._try_full(A[f], B[f])
-                passed[f] = g
-                ctrl_all[f] = c
-                em_all[f] = e
         return passed, ctrl_all, em_all
 
     def _try_arrays(self, A: np.ndarray, B: np.ndarray):
@@ -2635,39 +2664,12 @@ class _BatchFitter:
                     passed[v[g]] = True
                     ctrl_all[v[g]] = cf_[g]
                     em_all[v[g]] = e[g]
-                if self._refine and len(free_v):
-                    self._minimax_candidate(free_v, free_c, A, i0, i1, passed, ctrl_all,
-                                            em_all)
-                elif _REFINED_ROUNDS and len(free_v):
+                if _REFINED_ROUNDS and len(free_v):
                     rest = ~passed[free_v]
                     fv = free_v[rest]
                     self._start_keys.append(self._range_keys(A[fv], B[fv]))
                     self._start_ctrl.append(free_c[rest])
         return passed, ctrl_all, em_all
-
-    def _minimax_candidate(self, v, start, A, i0, i1, passed, ctrl_all, em_all) -> None:
-        """Rounded input: the pieces ``v`` whose free Gauss-Newton cubic (``start``)
-        failed, its inner control points moved to bring the worst input point under the
-        bound (:func:`galvo_core.minimax.minimax_cubics`), under the same test; in place."""
-        rest = ~passed[v]
-        v, start = v[rest], start[rest]
-        if len(v) == 0:
-            return
-        # near misses only: a start whose sampled points are all within _MINIMAX_NEAR of
-        # the bound (a cheap necessary test; most pieces refined from farther fail anyway)
-        near = self._sample_ok(start, i0[v], i1[v], _MINIMAX_NEAR * self.e_per[A[v]])
-        v, start = v[near], start[near]
-        if len(v) == 0:
-            return
-        cm, okm = minimax_cubics(self.work, self.arc, i0[v], i1[v], start, self.e_per[A[v]])
-        okm &= _handles_in_order(cm)
-        v, cm = v[okm], cm[okm]
-        if len(v) == 0:
-            return
-        g, e, _, _ = self._accept(cm, i0[v], i1[v], self.e_per[A[v]], A[v])
-        passed[v[g]] = True
-        ctrl_all[v[g]] = cm[g]
-        em_all[v[g]] = e[g]
 
     def _exact(self, A: np.ndarray) -> np.ndarray:
         """Per piece starting at thinned point A: True on exact input (no rounding) and on
