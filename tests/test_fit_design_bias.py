@@ -9,6 +9,7 @@ from __future__ import annotations
 import numpy as np
 from test_fit_design_places import _as_cubics, _dense, _local_distance, _rounded
 
+from galvo_core import fit as fitmod
 from galvo_core.fit import check_fit, fit_paths
 from galvo_core.geometry import point_polyline_distance
 
@@ -82,12 +83,19 @@ _SERIF_ITALIC_A = _as_cubics([
 ])
 
 
-def test_a_corner_keeps_the_part_of_its_move_that_keeps_the_lines():
+def test_a_corner_keeps_the_part_of_its_move_that_keeps_the_lines(monkeypatch):
     """The corner's estimate, 0.21 across the design line from its input point, made the
     thinned line before it miss its input points by more than the bound, so the whole move
     was given up (0.81 from the design where the rounded input is 0.44). Half of it keeps the
-    line within the bound: the corner moves that far (0.70)."""
+    line within the bound: the corner moves that far (0.70). (With the corner put on the
+    input point nearer the design's, ``fit._corners_kept_right``, the fit there is nearer
+    still; the partial move is checked with the corner left where the thinning kept it.)"""
     w = _rounded(_SERIF_ITALIC_A)
+    fp = fit_paths([w], [True])[0]
+    assert not check_fit(w, fp, 0.02, 0.02, report=True)["violation"]
+    assert _local_distance(_SERIF_ITALIC_A, fp, np.array([175.4, 187.7]), 2.0) <= 0.75
+    monkeypatch.setattr(fitmod, "_corners_kept_right",
+                        lambda W, K, tlen, *rest: (K, tlen, np.zeros(len(tlen), dtype=bool)))
     fp = fit_paths([w], [True])[0]
     assert not check_fit(w, fp, 0.02, 0.02, report=True)["violation"]
     ends = np.array([s.points[-1] for s in fp.segments])
