@@ -1840,6 +1840,14 @@ class _BatchFitter:
         self._starts = None
         self._passes = ()
 
+    def _barely_turning(self) -> np.ndarray:
+        """Per thinned point: its two tangents differ by less than ``_ABSORB_TURN`` (cached:
+        the tangents stay as they are after the fit's first pass)."""
+        if self._barely_turns is None:
+            cosv = (self.t_in * self.t_out).sum(axis=1)
+            self._barely_turns = cosv > math.cos(_ABSORB_TURN)
+        return self._barely_turns
+
     def _minimax_merge_round(self, parity: int) -> bool:
         """Rounded input whose rounding is a fair share of the bound (:meth:`_exact`), after
         the fit: two adjacent cubics at a vertex that barely turns (``_ABSORB_TURN``) are
@@ -1857,20 +1865,18 @@ class _BatchFitter:
         if len(A) < 2:
             return False
         assert self.quant is not None  # (called on rounded input only)
-        if self._barely_turns is None:  # per thinned point (as :meth:`_absorb_round`)
-            cosv = (self.t_in * self.t_out).sum(axis=1)
-            self._barely_turns = cosv > math.cos(_ABSORB_TURN)
+        barely = self._barely_turning()
         if _MINIMAX_LINES:
             # a line that is no design line (:meth:`_fixed_lines`) may take part too, as the
             # cubic with its handles at its thirds
             fixed = self._fixed_lines(A, B, isl)
-            adj = ~fixed[:-1] & ~fixed[1:] & (B[:-1] == A[1:]) & self._barely_turns[B[:-1]]
+            adj = ~fixed[:-1] & ~fixed[1:] & (B[:-1] == A[1:]) & barely[B[:-1]]
             C = C.copy()
             li = np.flatnonzero(isl)
             p0, p3 = self.q[A[li]], self.q[B[li]]
             C[li] = np.stack([p0, (2.0 * p0 + p3) / 3.0, (p0 + 2.0 * p3) / 3.0, p3], axis=1)
         else:
-            adj = ~isl[:-1] & ~isl[1:] & (B[:-1] == A[1:]) & self._barely_turns[B[:-1]]
+            adj = ~isl[:-1] & ~isl[1:] & (B[:-1] == A[1:]) & barely[B[:-1]]
         idx = np.flatnonzero(adj)
         idx = idx[(self.quant[A[idx]] > 0.0) & self._exact(A[idx])]
         if len(idx) == 0:
@@ -1937,14 +1943,12 @@ class _BatchFitter:
         if len(A) < 3:
             return False
         assert self.quant is not None  # (called on rounded input only)
-        if self._barely_turns is None:  # per thinned point (as :meth:`_absorb_round`)
-            cosv = (self.t_in * self.t_out).sum(axis=1)
-            self._barely_turns = cosv > math.cos(_ABSORB_TURN)
+        barely = self._barely_turning()
         fixed = self._fixed_lines(A, B, isl)
         i = np.arange(1, len(A) - 1)
         tri = (isl[i] & ~fixed[i - 1] & ~fixed[i] & ~fixed[i + 1]
                & (B[i - 1] == A[i]) & (B[i] == A[i + 1])
-               & self._barely_turns[A[i]] & self._barely_turns[B[i]]
+               & barely[A[i]] & barely[B[i]]
                & (self.quant[A[i]] > 0.0))
         i = i[tri]
         if len(i) == 0:
@@ -2223,15 +2227,13 @@ class _BatchFitter:
         A, B, C, E, isl = self._all_segments()
         if len(A) < 2:
             return False
-        if self._barely_turns is None:  # per thinned point (the tangents stay as they are)
-            cosv = (self.t_in * self.t_out).sum(axis=1)
-            self._barely_turns = cosv > math.cos(_ABSORB_TURN)
+        barely = self._barely_turning()
         fixed = self._fixed_lines(A, B, isl)
         if self._pairs is not None and self._pairs[0] is A:  # (both parities of one state)
             idx, pos = self._pairs[1], self._pairs[2]
         else:
             adj = ((B[:-1] == A[1:]) & ~fixed[:-1] & ~fixed[1:]
-                   & self._barely_turns[B[:-1]])
+                   & barely[B[:-1]])
             idx = np.flatnonzero(adj)
             pos = _chain_phase(idx, 2)
             self._pairs = (A, idx, pos)
