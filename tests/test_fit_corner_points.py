@@ -19,8 +19,9 @@ from galvo_core.fit import (
     check_fit,
     fit_paths,
 )
-from galvo_core.geometry import flatten_cubic, point_polyline_distance
+from galvo_core.geometry import point_polyline_distance
 from galvo_core.thin import thin
+from tests.test_fit_design_places import _local_distance
 
 sys.path.insert(0, os.path.join(os.path.dirname(__file__), "..", "bench"))
 import fonts  # noqa: E402
@@ -47,15 +48,9 @@ def _distances(segs, fp, w, place, r: float = 2.0) -> tuple[float, float]:
     """Both-ways distance of the fit and the design within ``r`` of ``place``, and the design's
     distance there to the rounded input polyline ``w``."""
     truth = _dense(segs, 0.001)
-    fit = np.vstack([flatten_cubic(s.points, 0.002) if s.kind == "cubic"
-                     else np.asarray(s.points) for s in fp.segments])
-    out = 0.0
-    for a, b in ((truth, fit), (fit, truth)):
-        near = a[np.hypot(*(a - place).T) <= r]
-        if len(near):
-            out = max(out, float(point_polyline_distance(near, b).max()))
     near = truth[np.hypot(*(truth - place).T) <= r]
-    return out, float(point_polyline_distance(near, w).max())
+    return (_local_distance(segs, fp, place, r, truth),
+            float(point_polyline_distance(near, w).max()))
 
 
 def _check(raw, closed: bool, place) -> tuple[float, float]:

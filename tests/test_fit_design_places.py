@@ -37,9 +37,11 @@ def _rounded(segs) -> np.ndarray:
     return w[np.r_[True, (w[1:] != w[:-1]).any(axis=1)]]
 
 
-def _local_distance(segs, fp, place, r: float) -> float:
-    """Both-ways distance of the fit and the design within ``r`` of ``place``."""
-    truth = _dense(segs, 0.001)
+def _local_distance(segs, fp, place, r: float, truth=None) -> float:
+    """Both-ways distance of the fit and the design within ``r`` of ``place`` (``truth``: the
+    design's dense points, by default ``segs`` flattened here)."""
+    if truth is None:
+        truth = _dense(segs, 0.001)
     fit = np.vstack([flatten_cubic(s.points, 0.002) if s.kind == "cubic"
                      else np.asarray(s.points) for s in fp.segments])
     out = 0.0
