@@ -2983,7 +2983,8 @@ def _fit_concatenated(
     if rounding is not None and (rounding[:, 1] > 0.0).any():
         coarse = _coarse_chords(W, woff[todo], wlen[todo], rounding[:, 1])
         K, tlen = _gap_ends_kept(W, K, tlen, rounding[:, 1], rounding[:, 0], coarse)
-    arc = _arc_per_path(W, wlen)
+    wstep = _step_lengths(W)  # (once: the passes below all read it)
+    arc = _arc_per_path(W, wlen, wstep)
     move_q = None
     if rounding is not None:
         # the vertices move onto the design where the rounding is a fair share of the bound
@@ -3025,7 +3026,7 @@ def _fit_concatenated(
         ca, cb, ctrl, bound, fla = _lone_lines_out(
             W, K, Q, arc, t_in, t_out, np.repeat(e_per, tlen), eps_sum,
             np.repeat(move_q, tlen), np.repeat(rounding[:, 0], tlen), ca, cb, ctrl, bound, fla,
-            coarse=fitter.coarse)
+            coarse=fitter.coarse, wstep=wstep)
     la = fla
     lb = la + 1
     owner = np.repeat(np.arange(len(todo)), tlen)  # thinned index -> position in todo
@@ -3090,11 +3091,11 @@ def _fit_concatenated(
         assert rounding is not None  # move_q is set with rounding
         bound = np.minimum(e_per, rounding[:, 0])
         changed = _joints_on_the_design(W, arc, points, is_cubic, tail, step, gf, gl,
-                                        seg_owner, move_q, bound)
+                                        seg_owner, move_q, bound, wstep)
         is_cubic, points, tail, step, gf, gl, seg_owner, changed = _smooth_stretches(
             W, arc, points, is_cubic, tail, step, gf, gl, seg_owner, move_q, bound, changed)
         is_cubic, points, tail, step, gf, gl, seg_owner, changed = _connectors_out(
-            W, points, is_cubic, tail, step, gf, gl, seg_owner, move_q, bound, changed)
+            W, points, is_cubic, tail, step, gf, gl, seg_owner, move_q, bound, changed, wstep)
         if changed.any():
             worst = _changed_errors(W, points, is_cubic, tail, gf, gl, seg_owner, changed,
                                     worst)
@@ -3365,7 +3366,7 @@ _LONE_BASIS = seed_basis(_LONE_SAMPLES - 1)[1]
 
 
 def _lone_lines_out(W, K, Q, arc, t_in, t_out, e_per, eps_sum, quant, eps, ca, cb, ctrl,
-                    bound, la, coarse=None):
+                    bound, la, coarse=None, wstep=None):
     """Rounded input (``quant`` per thinned point, 0: not moved): the cubics that swallow a
     design line at one of their ends (``_LONE_SHARE``, ``_LONE_BULGE``) are re-fitted over
     their other segments, that end segment made a line. Returns (ca, cb, ctrl, bound, la)
@@ -3377,7 +3378,7 @@ def _lone_lines_out(W, K, Q, arc, t_in, t_out, e_per, eps_sum, quant, eps, ca, c
     cand = (q > 0.0) & (cb - ca >= 2)
     if not cand.any():
         return ca, cb, ctrl, bound, la
-    step = np.r_[np.hypot(*np.diff(W, axis=0).T), 0.0]
+    step = np.r_[_step_lengths(W) if wstep is None else wstep, 0.0]
     # the gaps long enough for any path (few: a design line's two rounded ends), not the
     # chords of a coarsely flattened curve (no design lines)
     long_ = step >= _LONE_LENGTH * float(q[cand].min())
@@ -3565,7 +3566,7 @@ def _joint_estimates(W, arc, g, ps, pe, k, side=4):
 
 
 def _joints_on_the_design(W, arc, points, is_cubic, tail, step, gfirst, glast, seg_owner,
-                          quant, bound):
+                          quant, bound, wstep=None):
     """Rounded input: the joints between two segments of a path that still sit on their
     input point inside a smooth stretch (the points around lie within ``_JOINT_SMOOTH``
     quanta of their least-squares quadratic) move onto that design estimate (inside the
@@ -3611,7 +3612,8 @@ def _joints_on_the_design(W, arc, points, is_cubic, tail, step, gfirst, glast, s
     j, g, v, q, own = j[keep], g[keep], v[keep], q[keep], own[keep]
     if len(j) == 0:
         return changed
-    wstep = np.hypot(*np.diff(W, axis=0).T)
+    if wstep is None:
+        wstep = _step_lengths(W)
     bj = np.asarray(bound, dtype=np.float64)[own]
     for sel in _joint_rounds(j, mv[keep]):
         _try_joints(W, wstep, points, is_cubic, tail, gfirst, glast, sel, j, v, bj, q,
@@ -4971,7 +4973,7 @@ _CONNECTOR_STEP = 0.1
 
 
 def _connectors_out(W, points, is_cubic, tail, step, gfirst, glast, seg_owner, quant, bound,
-                    changed):
+                    changed, wstep=None):
     """Rounded input: the connectors :func:`_valid_lines` left (a line over no input step
     between a moved vertex and its input point: a segment of its own, 35 of them on
     FreeSerif Italic at em 2048) taken out where the joint can sit at one point for both
@@ -5007,7 +5009,8 @@ def _connectors_out(W, points, is_cubic, tail, step, gfirst, glast, seg_owner, q
     Y = np.where(x_first[:, None], p1, p0)
     lin = np.where(x_first, c - 1, c + 1)
     oth = np.where(x_first, c + 1, c - 1)
-    wstep = np.hypot(*np.diff(W, axis=0).T)
+    if wstep is None:
+        wstep = _step_lengths(W)
     bj = np.asarray(bound, dtype=np.float64)[seg_owner[c]]
     h = _CONNECTOR_STEP * quant[seg_owner[c]]
     rep: dict[int, list] = {}
@@ -6266,14 +6269,20 @@ def _corners_on_the_design(W, K, Q, arc, smooth, rnd, first, last, quant, eps,
     # least one corner back: at most _CORNER_HALVINGS + 1 rounds per corner)
     mv = new - old
     frac = np.ones(len(vo))
+    # each segment's error as last measured (``known``: its ends have not moved since)
+    errs = np.empty(n)
+    known = np.zeros(n, dtype=bool)
     while True:
         # the thinned segments next to a moved corner, as lines: within eps of their points?
         seg = np.unique(np.concatenate([vi[~lone_out] - 1, vo[~lone_in]]))
         seg = seg[moved[seg] | moved[seg + 1]]
         if len(seg) == 0:
             break
-        err = _line_errors(W, np.stack([Q[seg], Q[seg + 1]], axis=1), K[seg], K[seg + 1])
-        bad = seg[err > eps[seg]]
+        new_s = seg[~known[seg]]
+        errs[new_s] = _line_errors(W, np.stack([Q[new_s], Q[new_s + 1]], axis=1), K[new_s],
+                                   K[new_s + 1])
+        known[new_s] = True
+        bad = seg[errs[seg] > eps[seg]]
         if len(bad) == 0:
             break
         hit = np.zeros(n, dtype=bool)
@@ -6287,6 +6296,9 @@ def _corners_on_the_design(W, K, Q, arc, smooth, rnd, first, last, quant, eps,
         part = old[back] + frac[back, None] * mv[back]
         Q[vo[back]] = part
         Q[vi[back]] = part
+        for v in (vo[back], vi[back]):  # (the segments at those points measured again)
+            known[v] = False
+            known[v[v > 0] - 1] = False
         gone = back & (frac == 0.0)
         moved[vo[gone]] = False
         moved[vi[gone]] = False
@@ -6295,13 +6307,21 @@ def _corners_on_the_design(W, K, Q, arc, smooth, rnd, first, last, quant, eps,
         lone_in, lone_out = lone_in[keep], lone_out[keep]
 
 
-def _arc_per_path(W: np.ndarray, wlen: np.ndarray) -> np.ndarray:
+def _step_lengths(W: np.ndarray) -> np.ndarray:
+    """The lengths of the steps W[i]..W[i + 1] of the concatenated input (libm's hypot)."""
+    return np.hypot(*np.diff(W, axis=0).T)
+
+
+def _arc_per_path(W: np.ndarray, wlen: np.ndarray,
+                  seg: np.ndarray | None = None) -> np.ndarray:
     """Cumulative arc length along the concatenated paths, restarted at 0 at every path's
-    first point (the same numbers as ``cumsum`` on each path alone)."""
+    first point (the same numbers as ``cumsum`` on each path alone). ``seg``: the step
+    lengths (:func:`_step_lengths`) when known."""
     arc = np.zeros(len(W))
     if len(W) < 2:
         return arc
-    seg = np.hypot(*np.diff(W, axis=0).T)
+    if seg is None:
+        seg = _step_lengths(W)
     inside = np.ones(len(seg), dtype=bool)
     starts = np.cumsum(wlen) - wlen
     inside[starts[(starts > 0) & (wlen > 0)] - 1] = False  # from one path to the next

@@ -99,7 +99,7 @@ def test_the_swallowed_line_refit_leaves_no_hole(monkeypatch):
     init = fm._BatchFitter.__init__
     calls = []
 
-    def every_chord(*args, coarse=None):
+    def every_chord(*args, coarse=None, **kw):
         calls.append(len(args[10]))
 
         def with_chords(self, *a, **kw):  # (the re-fit still knows the chords)
@@ -109,7 +109,7 @@ def test_the_swallowed_line_refit_leaves_no_hole(monkeypatch):
 
         monkeypatch.setattr(fm._BatchFitter, "__init__", with_chords)
         try:
-            return real(*args, coarse=None)
+            return real(*args, coarse=None, **kw)
         finally:
             monkeypatch.setattr(fm._BatchFitter, "__init__", init)
 
