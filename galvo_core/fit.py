@@ -3676,8 +3676,18 @@ def _try_joints(W, wstep, points, is_cubic, tail, gfirst, glast, sel, j, v, bj, 
         jr = j[rem]
         segs = np.r_[jr - 1, jr]
         h = np.tile(_JOINT_STEP * q[rem], 2)
-        fits = _seg_fits_many(W, wstep, ctrls, gfirst[segs], glast[segs],
-                              np.tile(bj[rem], 2), h)
+        bs = np.tile(bj[rem], 2)
+        # a pair's line first where it has one (cheap), its other segment only where that
+        # one fits (the pair moves only when both do)
+        lead = np.where(is_cubic[jr - 1] & ~is_cubic[jr], r, 0) + np.arange(r)
+        partner = (lead + r) % (2 * r)
+        fits = np.zeros(2 * r, dtype=bool)
+        x = lead
+        for _ in range(2):
+            if len(x):
+                fits[x] = _seg_fits_many(W, wstep, [ctrls[k] for k in x.tolist()],
+                                         gfirst[segs[x]], glast[segs[x]], bs[x], h[x])
+            x = partner[fits[lead]]
         both = fits[:r] & fits[r:]
         for t in np.flatnonzero(both).tolist():
             a, b = int(jr[t]) - 1, int(jr[t])
@@ -3694,18 +3704,30 @@ def _seg_fits_many(W, wstep, ctrls, first, last, bound, h):
     input's steps W[i]..W[i + 1]): the same arithmetic, so the same decisions, batched (the
     nearest points of all cubics in one call, the polyline checks in one compiled loop)."""
     n = len(ctrls)
+    if n == 0:
+        return np.ones(n, dtype=bool)
+    cub = np.array([len(c) == 4 for c in ctrls], dtype=bool)
+    C4 = np.zeros((n, 4, 2))
+    for r, c in enumerate(ctrls):
+        C4[r, :len(c)] = c
+    return _seg_fits_arrays(W, wstep, C4, cub, first, last, bound, h)
+
+
+def _seg_fits_arrays(W, wstep, C4, cub, first, last, bound, h):
+    """:func:`_seg_fits_many` on arrays: ``C4`` (n, 4, 2) the control points (a line's in
+    its first two rows, the others zeros), ``cub`` which are cubics."""
+    n = len(C4)
     ok = np.ones(n, dtype=bool)
     if n == 0:
         return ok
     first = np.asarray(first, dtype=np.int64)
     last = np.asarray(last, dtype=np.int64)
-    cub = np.array([len(c) == 4 for c in ctrls], dtype=bool)
     cnt = last - first + 1
     m = np.empty(n, dtype=np.int64)
     li = np.flatnonzero(~cub)
     ci = np.flatnonzero(cub)
     if len(li):
-        L = np.stack([ctrls[i] for i in li.tolist()])
+        L = C4[li, :2]
         lc = cnt[li]
         st = np.cumsum(lc) - lc
         pid = np.repeat(np.arange(len(li)), lc)
@@ -3715,7 +3737,7 @@ def _seg_fits_many(W, wstep, ctrls, first, last, bound, h):
         length = np.hypot(*(L[:, 1] - L[:, 0]).T)
         m[li] = np.maximum(2, np.ceil(length / h[li]).astype(np.int64) + 1)
     if len(ci):
-        C = np.stack([ctrls[i] for i in ci.tolist()])
+        C = C4[ci]
         cc = cnt[ci]
         st = np.cumsum(cc) - cc
         pid = np.repeat(np.arange(len(ci)), cc)
@@ -3734,10 +3756,7 @@ def _seg_fits_many(W, wstep, ctrls, first, last, bound, h):
     go = np.flatnonzero(ok)
     if len(go) == 0:
         return ok
-    C4 = np.zeros((len(go), 4, 2))
-    for r, i in enumerate(go.tolist()):
-        c = ctrls[i]
-        C4[r, :len(c)] = c
+    C4 = C4[go]
     lim = bound[go] - 0.5 * h[go]
     res = np.empty(len(go), dtype=np.bool_)
     cg, mg, fg, lg = cub[go], m[go], first[go], last[go]
@@ -5015,46 +5034,64 @@ def _connectors_out(W, points, is_cubic, tail, step, gfirst, glast, seg_owner, q
     h = _CONNECTOR_STEP * quant[seg_owner[c]]
     rep: dict[int, list] = {}
     rem = np.arange(len(c))
+    # per connector its two segments: 0 the one at X (``lin``), 1 the one at Y (``oth``);
+    # the one checked first is a line where one is (lines are cheap and mostly fail), the
+    # other only where that one fits (a pair passes only when both do)
+    segs2 = np.stack([lin, oth])
+    at2 = np.stack([X, Y])
+    after2 = segs2 > c
+    cub2 = is_cubic[segs2]
+    first_k = (cub2[0] & ~cub2[1]).astype(np.intp)
     for share in _CONNECTOR_SHARES:
         if len(rem) == 0:
             break
-        # per connector its two segments with the joint at the new place; only those that
-        # change are checked (at share 1 the segment at the moved vertex stays as it is, at
-        # share 0 the thinned line)
-        ctrls, segs, who, moved = [], [], [], []
-        for t, i in enumerate(rem.tolist()):
-            v = X[i] + share * (Y[i] - X[i])
-            for s, at in ((int(lin[i]), X[i]), (int(oth[i]), Y[i])):
-                cc = _seg_ctrl(points, is_cubic, tail, s)
-                dv = v - at
-                if s > c[i]:  # the segment after the connector starts at the joint
-                    cc[0] += dv
-                    if len(cc) == 4:
-                        cc[1] += dv
-                else:
-                    cc[-1] += dv
-                    if len(cc) == 4:
-                        cc[2] += dv
-                ctrls.append(cc)
-                segs.append(s)
-                who.append(t)
-                moved.append(bool((dv != 0.0).any()))
-        segs_a = np.asarray(segs, dtype=np.intp)
-        who_a = np.asarray(who, dtype=np.intp)
-        chk = np.flatnonzero(moved)
-        fits = np.ones(len(segs), dtype=bool)
-        if len(chk):
-            fits[chk] = _seg_fits_many(W, wstep, [ctrls[k] for k in chk.tolist()],
-                                       gfirst[segs_a[chk]], glast[segs_a[chk]],
-                                       bj[rem][who_a[chk]], h[rem][who_a[chk]])
-        both = fits[0::2] & fits[1::2]
+        # the two segments with the joint at the new place; only those that change are
+        # checked (at share 1 the segment at the moved vertex stays as it is, at share 0
+        # the thinned line)
+        v = X[rem] + share * (Y[rem] - X[rem])
+        C4 = np.zeros((2, len(rem), 4, 2))
+        moved = np.empty((2, len(rem)), dtype=bool)
+        for k in (0, 1):
+            sg = segs2[k, rem]
+            dv = v - at2[k, rem]
+            moved[k] = (dv != 0.0).any(axis=1)
+            cb = cub2[k, rem]
+            af = after2[k, rem]
+            r0 = tail[sg] - 1
+            cc = C4[k]
+            cc[:, :2] = points[r0[:, None] + np.arange(2)]
+            cc[cb, 2:] = points[r0[cb, None] + np.arange(2, 4)]
+            # the segment after the connector starts at the joint (a cubic's first handle
+            # along), the one before ends there (its last handle along)
+            cc[af, 0] += dv[af]
+            cc[af & cb, 1] += dv[af & cb]
+            e = ~af & ~cb
+            cc[e, 1] += dv[e]
+            e = ~af & cb
+            cc[e, 3] += dv[e]
+            cc[e, 2] += dv[e]
+        fits = np.ones((2, len(rem)), dtype=bool)
+        fk = first_k[rem]
+        todo = np.arange(len(rem))
+        for stage in (0, 1):
+            kk = fk[todo] if stage == 0 else 1 - fk[todo]
+            sel = moved[kk, todo]
+            t_, k_ = todo[sel], kk[sel]
+            if len(t_):
+                sg = segs2[k_, rem[t_]]
+                fits[k_, t_] = _seg_fits_arrays(W, wstep, C4[k_, t_], cub2[k_, rem[t_]],
+                                                gfirst[sg], glast[sg], bj[rem[t_]],
+                                                h[rem[t_]])
+            todo = todo[fits[kk, todo]]
+        both = fits[0] & fits[1]
         for t in np.flatnonzero(both).tolist():
             i = int(rem[t])
             ci = int(c[i])
             rep[ci] = []
             for k in (0, 1):
-                s = segs[2 * t + k]
-                rep[s] = [(ctrls[2 * t + k], int(gfirst[s]), int(glast[s]))]
+                x = int(segs2[k, i])
+                rep[x] = [(C4[k, t] if cub2[k, i] else C4[k, t, :2], int(gfirst[x]),
+                           int(glast[x]))]
         rem = rem[~both]
     if not rep:
         return unchanged
