@@ -238,8 +238,7 @@ def nearest_on_cubic_each(
     lo = np.zeros((_NEAREST_CANDIDATES, k))
     hi = np.ones((_NEAREST_CANDIDATES, k))
     ok = np.zeros((_NEAREST_CANDIDATES, k), dtype=bool)
-    for ns in np.unique(nsp).tolist():
-        sel = np.flatnonzero(nsp == ns)
+    for ns, sel in _groups(nsp):
         _sampled_candidates(c, pid[sel], p[sel], ns, sel, best_u, best_d2, (u0, lo, hi, ok))
     # Newton from every candidate (the arithmetic of _power_coeffs and cubic_eval), compiled
     _refine_kernel(np.ascontiguousarray(c), pid, p, u0, lo, hi, ok, iters, best_u, best_d2)
@@ -317,6 +316,36 @@ def _refine_kernel(c, pid, p, u0, lo, hi, ok, iters, best_u,
                     best_d2[k] = dn
 
 
+def _groups(keys: np.ndarray) -> list[tuple[int, np.ndarray]]:
+    """Per distinct value of ``keys`` (ascending): (value, the ascending indices holding it)
+    (``np.flatnonzero(keys == value)`` for each of ``np.unique(keys)``, by one stable
+    sort)."""
+    if len(keys) == 0:
+        return []
+    if (keys[1:] == keys[0]).all():  # (mostly one sample count)
+        return [(int(keys[0]), np.arange(len(keys)))]
+    order = np.argsort(keys, kind="stable")
+    sk = keys[order]
+    cut = np.flatnonzero(sk[1:] != sk[:-1]) + 1
+    lo = np.r_[0, cut]
+    hi = np.r_[cut, len(sk)]
+    return [(int(sk[a]), order[a:b]) for a, b in zip(lo.tolist(), hi.tolist(), strict=True)]
+
+
+def _unique_inverse(x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """``np.unique(x, return_inverse=True)`` for 1-d integers, without its sort where ``x``
+    is sorted already (the points of a cubic together, the cubics in order)."""
+    if len(x) and (x[1:] >= x[:-1]).all():
+        new = np.r_[True, x[1:] != x[:-1]]
+        return x[new], np.cumsum(new) - 1
+    if len(x) and x.min() >= 0 and x.max() <= 4 * len(x):  # (a table of the values)
+        seen = np.zeros(int(x.max()) + 1, dtype=bool)
+        seen[x] = True
+        rank = np.cumsum(seen) - 1
+        return np.flatnonzero(seen).astype(x.dtype, copy=False), rank[x]
+    return np.unique(x, return_inverse=True)
+
+
 def sampled_upper_d2(ctrl: object, pid: object, pts: object, *, seeds: int = 48) -> np.ndarray:
     """Per point the smallest squared distance to the samples of its cubic ``ctrl[pid[k]]``
     that :func:`nearest_on_cubic_each` (same ``seeds``) starts from, with their arithmetic:
@@ -331,8 +360,7 @@ def sampled_upper_d2(ctrl: object, pid: object, pts: object, *, seeds: int = 48)
     nsp = _seed_counts(c, seeds)
     per = nsp[pid]
     cc = np.ascontiguousarray(c)
-    for ns in np.unique(per).tolist():
-        sel = np.flatnonzero(per == ns)
+    for ns, sel in _groups(per):
         o = np.empty(len(sel))
         _upper_kernel(cc, pid[sel], p[sel], np.linspace(0.0, 1.0, ns + 1), o)
         out[sel] = o
@@ -384,7 +412,7 @@ def _sampled_candidates(
     of a sample slightly farther than the best one), its start, bracket and validity
     (``cands`` = u0, lo, hi, ok, each (candidates, K))."""
     u0, lo, hi, ok = cands
-    cubs, ci = np.unique(pid, return_inverse=True)
+    cubs, ci = _unique_inverse(pid)
     cc = np.ascontiguousarray(c[cubs])
     su = np.linspace(0.0, 1.0, ns + 1)
     spx = np.empty((len(cc), ns + 1))  # the samples, the arithmetic of cubic_eval
