@@ -3852,6 +3852,14 @@ def _over_kernel(samp, sstep, poly, pstep, lim, k, out):  # pragma: no cover (co
     by its share of the length (np.searchsorted of the scaled cumulated lengths), the
     distance to the 2k + 1 segments there, where over ``lim`` to 32k + 1 (on polylines of
     over 16k + 2 points), where still over to all of them."""
+    _over_kernel_upto(samp, sstep, poly, pstep, lim, k, out, np.inf)
+
+
+@njit(cache=True, nogil=True)
+def _over_kernel_upto(samp, sstep, poly, pstep, lim, k, out,
+                      stop):  # pragma: no cover (compiled)
+    """:func:`_over_kernel` up to the first sample farther than ``stop`` (each sample's
+    distance is its own: the same numbers); returns how many samples it measured."""
     n = poly.shape[0]
     ms = samp.shape[0]
     cum = np.empty(n)
@@ -3883,6 +3891,9 @@ def _over_kernel(samp, sstep, poly, pstep, lim, k, out):  # pragma: no cover (co
         if d > lim:
             d = _full_d(px, py, poly, 0, n, at, cum, d)
         out[t] = d
+        if d > stop:
+            return t + 1
+    return ms
 
 
 @njit(cache=True, nogil=True)
@@ -4506,7 +4517,12 @@ def _design_off_kernel(W, est, valid, ctrl, f, e, h, limit, out):  # pragma: no 
                 nt += 1
     d1 = 0.0
     if nt:
-        d = _distance_over(tp[:nt], samp, lim, 64)
+        # (finite, moderate coordinates give no NaN distance: the first target over
+        # ``limit`` decides, the others need not be measured)
+        stop = limit if _moderate(tp, nt) and _moderate(samp, m) else np.inf
+        d, cnt = _distance_over_upto(tp[:nt], samp, lim, 64, stop)
+        if cnt < nt:
+            return False
         d1 = d[0]
         for t in range(1, nt):  # (np.max: NaN wins)
             if not d[t] <= d1 and d1 == d1:
@@ -4528,20 +4544,42 @@ def _design_off_kernel(W, est, valid, ctrl, f, e, h, limit, out):  # pragma: no 
     return True
 
 
+@njit(cache=True, nogil=True, inline="always")
+def _moderate(a, n):  # pragma: no cover (compiled)
+    """Every coordinate of a[:n] finite and under 1e100 in size (squares and sums of them
+    stay finite: no NaN from these points' distances)."""
+    for i in range(n):
+        if not (abs(a[i, 0]) < 1e100 and abs(a[i, 1]) < 1e100):
+            return False
+    return True
+
+
 @njit(cache=True, nogil=True)
 def _distance_over(samp, poly, lim, k):  # pragma: no cover (compiled)
     """:func:`_polyline_distance_over` compiled (a one-point polyline: the distance to it,
     libm's hypot, as :func:`point_polyline_distance`)."""
+    return _distance_over_upto(samp, poly, lim, k, np.inf)[0]
+
+
+@njit(cache=True, nogil=True)
+def _distance_over_upto(samp, poly, lim, k, stop):  # pragma: no cover (compiled)
+    """:func:`_distance_over` up to the first sample farther than ``stop`` (the same
+    numbers): (the distances, how many were measured)."""
     n = poly.shape[0]
     ms = samp.shape[0]
     d = np.empty(ms)
     if n == 1:
         for t in range(ms):
             d[t] = math.hypot(samp[t, 0] - poly[0, 0], samp[t, 1] - poly[0, 1])
-        return d
+            if d[t] > stop:
+                return d, t + 1
+        return d, ms
     if n <= 2 * k + 2:
-        _brute_kernel(samp, poly, d)
-        return d
+        for t in range(ms):
+            d[t] = _brute_d(samp[t, 0], samp[t, 1], poly, 0, n)
+            if d[t] > stop:
+                return d, t + 1
+        return d, ms
     fl = np.empty(max(n, ms), dtype=np.bool_)
     dx = np.empty(max(n, ms))
     dy = np.empty(max(n, ms))
@@ -4555,9 +4593,10 @@ def _distance_over(samp, poly, lim, k):  # pragma: no cover (compiled)
         dx[t] = samp[t + 1, 0] - samp[t, 0]
         dy[t] = samp[t + 1, 1] - samp[t, 1]
     hypot_into(dx, dy, ms - 1, sstep, fl)
+    cnt = 0
     if ms:
-        _over_kernel(samp, sstep, poly, pstep, lim, k, d)
-    return d
+        cnt = _over_kernel_upto(samp, sstep, poly, pstep, lim, k, d, stop)
+    return d, cnt
 
 
 def _estimates_off(points, is_cubic, tail, gfirst, glast, sr, est, valid):
