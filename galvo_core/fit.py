@@ -4486,8 +4486,9 @@ def _samples_within(ctrl, h, W, first, last, lim):  # pragma: no cover (compiled
     (:func:`_seg_samples`) all lie within ``lim`` of the polyline W[first..last]
     (:func:`_polyline_distance_over`'s numbers; NaN fails)."""
     samp = _seg_samples(ctrl, h)
-    d = _distance_over(samp, W[first:last + 1], lim, _NEAR_SEGMENTS)
-    for t in range(d.shape[0]):
+    # (up to the first sample over ``lim``: the answer is False then anyway)
+    d, cnt = _distance_over_upto(samp, W[first:last + 1], lim, _NEAR_SEGMENTS, lim)
+    for t in range(cnt):
         if not d[t] <= lim:
             return False
     return True
