@@ -3506,13 +3506,14 @@ def _moved_ends_error(W, points, is_cubic, tail, step, gfirst, glast, seg_owner,
         ctrl = np.stack([points[tail[s] - 1 + j] for j in range(4)], axis=1)
         _, d[~ln] = nearest_on_cubic_each(ctrl, np.arange(len(s)), W[idx[~ln]], seeds=128,
                                           iters=10)
-    near = np.full(len(W), np.inf)
-    np.minimum.at(near, idx, d)
+    # (per distinct point: its nearest distance and its path; no arrays over all of W)
+    u, inv = np.unique(idx, return_inverse=True)
+    near = np.full(len(u), np.inf)
+    np.minimum.at(near, inv, d)
     out = np.asarray(worst, dtype=np.float64).copy()
-    u = np.unique(idx)
-    own = np.zeros(len(W), dtype=np.intp)
-    own[idx] = seg_owner[seg]
-    np.fmax.at(out, own[u], near[u])
+    own = np.zeros(len(u), dtype=np.intp)
+    own[inv] = seg_owner[seg]
+    np.fmax.at(out, own, near)
     return out
 
 
