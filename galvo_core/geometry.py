@@ -21,6 +21,8 @@ import math
 import numpy as np
 from numba import njit
 
+from galvo_core.parallel import run_chunks
+
 __all__ = [
     "cubic_eval",
     "cubic_derivative",
@@ -231,9 +233,22 @@ def nearest_on_cubic_each(
     if k == 0:
         return np.zeros(0), np.zeros(0)
     nsp = _seed_counts(c, seeds)[pid]
-    # per point: best sample, and the bracketed start of each candidate's Newton run
     best_u = np.empty(k)
     best_d2 = np.empty(k)
+    cc = np.ascontiguousarray(c)
+
+    def chunk(a: int, b: int) -> None:  # (each point on its own: the same numbers)
+        _nearest_each_part(cc, pid[a:b], p[a:b], nsp[a:b], iters, best_u[a:b], best_d2[a:b])
+
+    run_chunks(chunk, nsp)
+    return best_u, np.sqrt(best_d2)
+
+
+def _nearest_each_part(c, pid, p, nsp, iters, best_u, best_d2) -> None:
+    """:func:`nearest_on_cubic_each` for the points ``p`` (their cubics c[pid], sample
+    counts ``nsp``) into ``best_u``, ``best_d2`` (squared)."""
+    k = len(p)
+    # per point: best sample, and the bracketed start of each candidate's Newton run
     u0 = np.zeros((_NEAREST_CANDIDATES, k))
     lo = np.zeros((_NEAREST_CANDIDATES, k))
     hi = np.ones((_NEAREST_CANDIDATES, k))
@@ -241,8 +256,7 @@ def nearest_on_cubic_each(
     for ns, sel in _groups(nsp):
         _sampled_candidates(c, pid[sel], p[sel], ns, sel, best_u, best_d2, (u0, lo, hi, ok))
     # Newton from every candidate (the arithmetic of _power_coeffs and cubic_eval), compiled
-    _refine_kernel(np.ascontiguousarray(c), pid, p, u0, lo, hi, ok, iters, best_u, best_d2)
-    return best_u, np.sqrt(best_d2)
+    _refine_kernel(c, pid, p, u0, lo, hi, ok, iters, best_u, best_d2)
 
 
 #: points per chunk of :func:`_refine_kernel` (its Newton steps run over a chunk at a time)
