@@ -631,11 +631,35 @@ def _polyline_distance_rtree(p: np.ndarray, q: np.ndarray) -> np.ndarray:
 
 
 def power_coeffs_many(ctrl: np.ndarray) -> np.ndarray:
-    """Power-basis coefficients of M cubics: ``ctrl`` (M, 4, 2) -> (M, 4, 2) = [a, b, d, e]."""
-    c = np.asarray(ctrl, dtype=np.float64)
+    """Power-basis coefficients of M cubics: ``ctrl`` (M, 4, 2) -> (M, 4, 2) = [a, b, d, e]
+    (:func:`power_coeffs_into`'s arithmetic, compiled: :func:`_power_kernel`)."""
+    c = np.ascontiguousarray(ctrl, dtype=np.float64)
     out = np.empty(c.shape)
-    power_coeffs_into(out.swapaxes(0, 1), c[:, 0], c[:, 1], c[:, 2], c[:, 3])
+    if not (c.ndim == 3 and c.shape[1:] == (4, 2) and _power_kernel(c, out)):
+        power_coeffs_into(out.swapaxes(0, 1), c[:, 0], c[:, 1], c[:, 2], c[:, 3])
     return out
+
+
+@njit(cache=True, nogil=True)
+def _power_kernel(c, out):  # type: ignore[no-untyped-def]
+    """:func:`power_coeffs_many` per cubic: a = (-p0 + 3 (p1 - p2)) + p3, b = 3 (p0 + p2)
+    - 6 p1, d = 3 (p1 - p0), e = p0 (:func:`power_coeffs_into`'s operations, in its
+    order: the same numbers); False (the caller then takes numpy's) where a control point
+    is not finite (a NaN's sign bit may come out otherwise)."""
+    for m in range(c.shape[0]):
+        for j in range(2):
+            p0 = c[m, 0, j]
+            p1 = c[m, 1, j]
+            p2 = c[m, 2, j]
+            p3 = c[m, 3, j]
+            if not (abs(p0) < np.inf and abs(p1) < np.inf and abs(p2) < np.inf
+                    and abs(p3) < np.inf):
+                return False
+            out[m, 0, j] = (-p0 + 3.0 * (p1 - p2)) + p3
+            out[m, 1, j] = 3.0 * (p0 + p2) - 6.0 * p1
+            out[m, 2, j] = 3.0 * (p1 - p0)
+            out[m, 3, j] = p0
+    return True
 
 
 def power_coeffs_into(
