@@ -1711,13 +1711,29 @@ class _BatchFitter:
         emax = np.empty(m)
         ctrl = np.ascontiguousarray(ctrl, dtype=np.float64)
         if full:
+            # (chunks of pieces on the kernel threads: each piece's numbers are its own; a
+            # chunk lists its far points in its own part of ``far``, in order)
             far = np.empty(total, dtype=np.intp)
-            nfar = _accept_points(cm, i0, i1, starts, self.work, self.arc, e2, u, dist, emax,
-                                  far)
+
+            def points(lo: int, hi: int) -> tuple[int, int]:
+                f0 = int(starts[lo]) if lo < m else 0
+                nf = _accept_points(cm[lo:hi], i0[lo:hi], i1[lo:hi], starts[lo:hi], self.work,
+                                    self.arc, e2[lo:hi], u, dist, emax[lo:hi], far[f0:])
+                return f0, nf
+
+            parts = run_chunks(points, cnt)
+            far = np.concatenate([far[f0:f0 + nf] for f0, nf in parts])
             ok = emax <= e2
-            if nfar:
-                _accept_far(ctrl, cm, i0, i1, starts, self.work, e2, far[:nfar], _SEED_U,
-                            _SEED_BASIS, u, dist, emax, ok)
+            if len(far):
+                def far_chunk(lo: int, hi: int) -> None:
+                    a = np.searchsorted(far, starts[lo])
+                    b = np.searchsorted(far, starts[hi - 1] + cnt[hi - 1])
+                    if b > a:
+                        _accept_far(ctrl[lo:hi], cm[lo:hi], i0[lo:hi], i1[lo:hi],
+                                    starts[lo:hi], self.work, e2[lo:hi], far[a:b], _SEED_U,
+                                    _SEED_BASIS, u, dist, emax[lo:hi], ok[lo:hi])
+
+                run_chunks(far_chunk, cnt)
         else:
             ok = np.empty(m, dtype=bool)
         qa, coarse = _NO_QUANTA, _NO_COARSE
