@@ -84,6 +84,7 @@ import math
 import time
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
+from typing import cast
 
 import numpy as np
 from numba import njit
@@ -1721,7 +1722,7 @@ class _BatchFitter:
                                     self.arc, e2[lo:hi], u, dist, emax[lo:hi], far[f0:])
                 return f0, nf
 
-            parts = run_chunks(points, cnt)
+            parts = cast("list[tuple[int, int]]", run_chunks(points, cnt))
             far = np.concatenate([far[f0:f0 + nf] for f0, nf in parts])
             ok = emax <= e2
             if len(far):

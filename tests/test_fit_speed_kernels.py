@@ -256,3 +256,106 @@ def test_compiled_least_squares_are_the_numpy_ones() -> None:
     assert np.array_equal(got, ref)
     assert np.array_equal(gok, ok)
     assert ok.any() and (~ok).any()
+
+
+def test_compiled_power_coeffs_are_numpys_bit_for_bit() -> None:
+    """power_coeffs_many (compiled, s11) gives power_coeffs_into's numbers bit for bit, also
+    where they overflow, and takes numpy's own path for non-finite control points."""
+    rng = np.random.default_rng(11)
+    for m in (0, 1, 9, 500):
+        scale = rng.choice([1e-300, 1e-5, 1.0, 1e3, 1e300, 1e308], size=(m, 4, 2))
+        with np.errstate(over="ignore"):
+            c = rng.normal(size=(m, 4, 2)) * scale
+        if m > 1:
+            c[m // 2, 1, 0] = np.nan if m % 2 else -np.inf
+        want = np.empty(c.shape)
+        with np.errstate(all="ignore"):
+            geo.power_coeffs_into(want.swapaxes(0, 1), c[:, 0], c[:, 1], c[:, 2], c[:, 3])
+            got = power_coeffs_many(c)
+        assert got.tobytes() == want.tobytes()
+
+
+def test_unique_and_groups_without_sorting_are_numpys() -> None:
+    """geometry's grouping of points by sample count and np.unique(..., return_inverse)
+    shortcuts (s11) give numpy's arrays, sorted or not, dense or sparse values."""
+    rng = np.random.default_rng(5)
+    for n in (1, 2, 7, 3000):
+        for hi in (1, 4, 60, 10 ** 7):
+            x = rng.integers(0, hi, n).astype(np.intp)
+            for y in (x, np.sort(x)):
+                u, inv = np.unique(y, return_inverse=True)
+                u2, inv2 = geo._unique_inverse(y)
+                assert u2.dtype == u.dtype and np.array_equal(u2, u)
+                assert np.array_equal(inv2, inv)
+                groups = geo._groups(y)
+                assert [v for v, _ in groups] == np.unique(y).tolist()
+                for v, sel in groups:
+                    assert np.array_equal(sel, np.flatnonzero(y == v))
+
+
+def test_distances_up_to_a_stop_are_the_full_ones() -> None:
+    """_distance_over_upto (s11: the smooth-stretch pass stops at the first target over its
+    limit) measures the same numbers as _distance_over, in order, up to the first over
+    ``stop`` (all of them with stop inf), on short (brute force), one-point and long
+    polylines."""
+    rng = np.random.default_rng(21)
+    for n in (1, 2, 40, 600):
+        poly = np.round(np.cumsum(rng.normal(0.0, 2.0, (n, 2)), axis=0))
+        samp = poly[rng.integers(0, n, 300)] + rng.normal(0.0, 1.5, (300, 2))
+        full = fitmod._distance_over(samp, poly, 0.5, 64)
+        d, cnt = fitmod._distance_over_upto(samp, poly, 0.5, 64, np.inf)
+        assert cnt == len(samp) and np.array_equal(d, full)
+        for stop in (0.2, 1.0, 3.0, 100.0):
+            d, cnt = fitmod._distance_over_upto(samp, poly, 0.5, 64, stop)
+            assert np.array_equal(d[:cnt], full[:cnt])
+            assert (full[:cnt - 1] <= stop).all()
+            if cnt < len(samp):
+                assert full[cnt - 1] > stop
+            else:
+                assert (full[:-1] <= stop).all()
+
+
+def test_design_off_with_a_limit_is_none_exactly_when_over_it() -> None:
+    """_design_off with a limit (s11: it stops at the first target over it) answers None
+    exactly where the unlimited measure's first distance is over the limit, else that
+    measure's numbers."""
+    rng = np.random.default_rng(4)
+    t = np.linspace(0.0, 3.0, 400)
+    W = np.round(np.stack([200.0 * np.cos(t), 150.0 * np.sin(t)], axis=1))
+    est = W + rng.normal(0.0, 0.3, W.shape)
+    valid = rng.uniform(size=len(W)) > 0.2
+    for _ in range(60):
+        f = int(rng.integers(0, 300))
+        e = f + int(rng.integers(5, 99))
+        p0, p3 = W[f], W[e]
+        if rng.uniform() < 0.5:
+            ctrl = np.stack([p0, p3]).astype(np.float64)
+        else:
+            mid = W[(f + e) // 2] + rng.normal(0.0, 2.0, 2)
+            ctrl = np.stack([p0, p0 + 0.6 * (mid - p0), p3 + 0.6 * (mid - p3), p3])
+        free = fitmod._design_off(W, est, valid, ctrl, f, e, 0.25)
+        assert free is not None
+        for limit in (0.1, 0.5, 1.0, 2.0, 10.0):
+            got = fitmod._design_off(W, est, valid, ctrl, f, e, 0.25, limit)
+            if free[0] > limit:
+                assert got is None
+            else:
+                assert got == free
+
+
+def test_chunked_nearest_points_are_the_one_call_ones(monkeypatch: pytest.MonkeyPatch) -> None:
+    """nearest_on_cubic_each over chunks of its points on the kernel threads (s11) gives
+    the one-thread numbers."""
+    from galvo_core import parallel
+
+    rng = np.random.default_rng(9)
+    ctrl = rng.uniform(-30.0, 30.0, (50, 4, 2))
+    pid = rng.integers(0, len(ctrl), 5000)
+    pts = geo._bernstein_each(ctrl[pid], rng.uniform(0, 1, len(pid))) + rng.normal(
+        0.0, 3.0, (len(pid), 2))
+    monkeypatch.setattr(parallel, "THREADS", 1)
+    one = nearest_on_cubic_each(ctrl, pid, pts, seeds=16, iters=4)
+    monkeypatch.setattr(parallel, "THREADS", 3)
+    monkeypatch.setattr(parallel, "MIN_WORK", 0)
+    three = nearest_on_cubic_each(ctrl, pid, pts, seeds=16, iters=4)
+    assert np.array_equal(one[0], three[0]) and np.array_equal(one[1], three[1])
