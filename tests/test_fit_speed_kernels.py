@@ -359,3 +359,19 @@ def test_chunked_nearest_points_are_the_one_call_ones(monkeypatch: pytest.Monkey
     monkeypatch.setattr(parallel, "MIN_WORK", 0)
     three = nearest_on_cubic_each(ctrl, pid, pts, seeds=16, iters=4)
     assert np.array_equal(one[0], three[0]) and np.array_equal(one[1], three[1])
+
+
+def test_compiled_handle_order_is_numpys() -> None:
+    """_handles_in_order compiled (s11) answers as numpy's sum of the products did, also
+    on overflowing and non-finite control points."""
+    rng = np.random.default_rng(2)
+    for m in (0, 1, 100, 3000):
+        scale = rng.choice([1e-300, 1.0, 1e200, 1e308], size=(m, 4, 2))
+        with np.errstate(all="ignore"):
+            c = rng.normal(size=(m, 4, 2)) * scale
+            if m > 3:
+                c[1, 2, 0] = np.nan
+                c[2, 3, 1] = np.inf
+            want = ((c[:, 2] - c[:, 1]) * (c[:, 3] - c[:, 0])).sum(axis=1) > 0.0
+            got = fitmod._handles_in_order(c)
+        assert np.array_equal(got, want)
