@@ -3669,17 +3669,10 @@ def _try_joints(W, wstep, points, is_cubic, tail, gfirst, glast, sel, j, v, bj, 
         ctrls = []
         cand_b = []
         for i in rem.tolist():
-            a, b = int(j[i]) - 1, int(j[i])
             c0a, c0b = ca0[i], cb0[i]
             dv = share * (v[i] - c0b[0])
-            ca = c0a.copy()
-            cb = c0b.copy()
-            ca[-1] += dv
-            cb[0] += dv
-            if is_cubic[a]:
-                ca[2] += dv
-            if is_cubic[b]:
-                cb[1] += dv
+            ca = _end_moved(c0a, False, dv)
+            cb = _end_moved(c0b, True, dv)
             ctrls.append(ca)
             cand_b.append(cb)
         ctrls.extend(cand_b)
@@ -3785,6 +3778,21 @@ def _changed_errors(W, points, is_cubic, tail, gfirst, glast, seg_owner, changed
 def _seg_ctrl(points, is_cubic, tail, s):
     r = tail[s] - 1
     return points[r:r + (4 if is_cubic[s] else 2)].copy()
+
+
+def _end_moved(ctrl, start, dv):
+    """A segment's control points ``ctrl`` (2 or 4) with its start (``start``) or its end
+    moved by ``dv``, a cubic's inner control point there moved along (a copy)."""
+    c = ctrl.copy()
+    if start:
+        c[0] += dv
+        if len(c) == 4:
+            c[1] += dv
+    else:
+        c[-1] += dv
+        if len(c) == 4:
+            c[2] += dv
+    return c
 
 
 def _seg_fits(W, ctrl, first, last, bound, h) -> bool:
@@ -5035,16 +5043,9 @@ def _connectors_out(W, points, is_cubic, tail, step, gfirst, glast, seg_owner, q
         for t, i in enumerate(rem.tolist()):
             v = X[i] + share * (Y[i] - X[i])
             for s, at in ((int(lin[i]), X[i]), (int(oth[i]), Y[i])):
-                cc = _seg_ctrl(points, is_cubic, tail, s)
                 dv = v - at
-                if s > c[i]:  # the segment after the connector starts at the joint
-                    cc[0] += dv
-                    if len(cc) == 4:
-                        cc[1] += dv
-                else:
-                    cc[-1] += dv
-                    if len(cc) == 4:
-                        cc[2] += dv
+                # (the segment after the connector starts at the joint)
+                cc = _end_moved(_seg_ctrl(points, is_cubic, tail, s), s > c[i], dv)
                 ctrls.append(cc)
                 segs.append(s)
                 who.append(t)
