@@ -1871,10 +1871,6 @@ class _BatchFitter:
             # cubic with its handles at its thirds
             fixed = self._fixed_lines(A, B, isl)
             adj = ~fixed[:-1] & ~fixed[1:] & (B[:-1] == A[1:]) & barely[B[:-1]]
-            C = C.copy()
-            li = np.flatnonzero(isl)
-            p0, p3 = self.q[A[li]], self.q[B[li]]
-            C[li] = np.stack([p0, (2.0 * p0 + p3) / 3.0, (p0 + 2.0 * p3) / 3.0, p3], axis=1)
         else:
             adj = ~isl[:-1] & ~isl[1:] & (B[:-1] == A[1:]) & barely[B[:-1]]
         idx = np.flatnonzero(adj)
@@ -1891,7 +1887,8 @@ class _BatchFitter:
         if len(pick) == 0:
             return False
         self._merge_tried = np.union1d(tried, key)
-        ca, cb = C[pick], C[pick + 1]
+        ca = self._as_cubics(A, B, C, isl, pick)
+        cb = self._as_cubics(A, B, C, isl, pick + 1)
         la = np.hypot(*np.diff(ca, axis=1).transpose(2, 0, 1)).sum(axis=1)
         lb = np.hypot(*np.diff(cb, axis=1).transpose(2, 0, 1)).sum(axis=1)
         t = (la / np.maximum(la + lb, 1e-300))[:, None]
@@ -1919,10 +1916,8 @@ class _BatchFitter:
         if not g.any():
             return False
         i = pick[v[g]]
-        if _MINIMAX_LINES:
-            C[isl] = 0.0  # (a line's C is zeros)
-            isl = isl.copy()
-            isl[i] = False
+        isl = isl.copy()
+        isl[i] = False  # (a line merged: the cubic's)
         B[i] = B[i + 1]
         C[i] = cm[g]
         E[i] = e[g]
@@ -1930,6 +1925,15 @@ class _BatchFitter:
         keep[i + 1] = False
         self._store(A[keep], B[keep], C[keep], E[keep], isl[keep])
         return True
+
+    def _as_cubics(self, A, B, C, isl, s):
+        """The control points of the segments ``s`` (rows of ``A``, ``B``, ``C``, ``isl``), a
+        line's as the cubic with its handles at its thirds (a copy)."""
+        c = C[s].copy()
+        li = np.flatnonzero(isl[s])
+        p0, p3 = self.q[A[s[li]]], self.q[B[s[li]]]
+        c[li] = np.stack([p0, (2.0 * p0 + p3) / 3.0, (p0 + 2.0 * p3) / 3.0, p3], axis=1)
+        return c
 
     def _bridge_round(self) -> bool:
         """Rounded input: a line that is no line of the design (:meth:`_fixed_lines`) between
