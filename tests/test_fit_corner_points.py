@@ -148,6 +148,50 @@ def test_a_corner_kept_two_steps_past_a_two_point_line_moves_to_the_line_end():
     assert fit <= max(0.6, rounded + 0.02)
 
 
+
+#: FreeSerif Italic "n" at em 2048, placed as in the precision bench's unseen-font text (the
+#: outer contour, closed): a 7.4-unit design line, written as its two rounded ends, 7.2 units
+#: apart, meets a cubic at (45025.28, 903.17), whose rounded point is (45025, 903); the
+#: thinning kept the line to (45024, 903), one step into the curve
+_FREESERIF_ITALIC_N = [
+    ('cubic', (45537.28, 239.616), (45488.128, 180.224), (45406.208, 77.824), (45369.344, 77.824)),
+    ('cubic', (45369.344, 77.824), (45352.96, 77.824), (45336.576, 94.208), (45336.576, 110.592)),
+    ('cubic', (45336.576, 110.592), (45336.576, 124.928), (45336.576, 124.928),
+     (45365.248, 239.616)),
+    ('line', (45365.248, 239.616), (45481.984, 661.504)),
+    ('cubic', (45481.984, 661.504), (45494.272, 704.512), (45500.416, 749.568),
+     (45500.416, 778.24)),
+    ('cubic', (45500.416, 778.24), (45500.416, 851.968), (45445.12, 903.168), (45365.248, 903.168)),
+    ('cubic', (45365.248, 903.168), (45234.176, 903.168), (45105.152, 780.288),
+     (44894.208, 452.608)),
+    ('line', (44894.208, 452.608), (45031.424, 899.072)),
+    ('line', (45031.424, 899.072), (45025.28, 903.168)),
+    ('cubic', (45025.28, 903.168), (44914.688, 880.64), (44871.68, 872.448), (44693.504, 839.68)),
+    ('line', (44693.504, 839.68), (44693.504, 806.912)),
+    ('cubic', (44693.504, 806.912), (44797.952, 804.864), (44824.576, 792.576),
+     (44824.576, 751.616)),
+    ('cubic', (44824.576, 751.616), (44824.576, 739.328), (44822.528, 727.04), (44820.48, 716.8)),
+    ('line', (44820.48, 716.8), (44623.872, 0.0)),
+    ('line', (44623.872, 0.0), (44777.472, 0.0)),
+    ('cubic', (44777.472, 0.0), (44873.728, 323.584), (44892.16, 368.64), (44982.272, 507.904)),
+    ('cubic', (44982.272, 507.904), (45105.152, 696.32), (45209.6, 798.72), (45285.376, 798.72)),
+    ('cubic', (45285.376, 798.72), (45316.096, 798.72), (45334.528, 776.192), (45334.528, 739.328)),
+    ('cubic', (45334.528, 739.328), (45334.528, 714.752), (45322.24, 647.168), (45305.856, 583.68)),
+    ('line', (45305.856, 583.68), (45215.744, 245.76)),
+    ('cubic', (45215.744, 245.76), (45187.072, 141.312), (45182.976, 112.64), (45182.976, 92.16)),
+    ('cubic', (45182.976, 92.16), (45182.976, 14.336), (45211.648, -18.432), (45279.232, -18.432)),
+    ('cubic', (45279.232, -18.432), (45371.392, -18.432), (45424.64, 24.576), (45565.952, 212.992)),
+    ('line', (45565.952, 212.992), (45537.28, 239.616)),
+]
+
+
+def test_a_corner_kept_past_a_short_two_point_line_moves_to_the_line_end():
+    """0.738 from the design where the rounded input is 0.295: the line is under 8 quanta long
+    (``fit._LONE_LENGTH``), but at 7 times the curve's steps beside it it is a design line
+    all the same (``fit._BESIDE_LENGTH``), and its rounded end is the corner's point."""
+    fit, rounded = _check(_FREESERIF_ITALIC_N, True, (45025.28, 903.168))
+    assert fit <= max(0.6, rounded + 0.02)
+
 def test_kept_corner_points_keep_every_thinned_segment_a_line_within_the_tolerance():
     """The corner's point replaces the thinned point where the segment across it stays a line
     within the tolerance; else that segment is split near its middle; else the old point is
