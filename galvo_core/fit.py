@@ -5729,6 +5729,9 @@ _SMOOTH_SHORT = 4.0
 #: measurements)
 _SMOOTH_FEW = 3
 _SMOOTH_ALWAYS = True
+#: a smooth vertex beside a design line written as its two rounded ends (one input step of
+#: at least ``_JOINT_LINE`` quanta) moves only along that line
+_SMOOTH_ALONG = True
 
 
 def _on_the_design(W, K, Q, arc, t_in, t_out, smooth, quant, tlen, eps, found=None,
@@ -5773,7 +5776,25 @@ def _on_the_design(W, K, Q, arc, t_in, t_out, smooth, quant, tlen, eps, found=No
         pos, tan, ok = _local_fits(W, arc, np.minimum(lo, K[sm]), np.maximum(hi, K[sm]), K[sm])
         k = sm[ok]
         h = 0.5 * quant[k][:, None]
-        Q[k] = np.clip(pos[ok], W[K[k]] - h, W[K[k]] + h)
+        est = pos[ok]
+        if _SMOOTH_ALONG:
+            # beside a design line written as its two rounded ends (one input step of at
+            # least _JOINT_LINE quanta: the thinned segment), only the move along that line
+            # (a move across tilts the line, its far end fixed, off the design line its ends
+            # were rounded from: sans "B" at em 400, a 63-unit line into a tangent curve,
+            # 0.63 from the design where the rounded input is 0.44)
+            wk = W[K[k]]
+            gi = (K[k] - K[k - 1] == 1) & (np.hypot(*(wk - W[K[k - 1]]).T)
+                                           >= _JOINT_LINE * quant[k])
+            go = (K[k + 1] - K[k] == 1) & (np.hypot(*(W[K[k + 1]] - wk).T)
+                                           >= _JOINT_LINE * quant[k])
+            one = gi ^ go
+            if one.any():
+                d = np.where(gi[:, None], wk - W[K[k - 1]], W[K[k + 1]] - wk)[one]
+                d = d / np.hypot(d[:, 0], d[:, 1])[:, None]
+                est[one] = wk[one] + ((est[one] - wk[one]) * d).sum(axis=1)[:, None] * d
+            est[gi & go] = wk[gi & go]
+        Q[k] = np.clip(est, W[K[k]] - h, W[K[k]] + h)
         t_in[k] = tan[ok]
         t_out[k] = tan[ok]
     # one-sided tangents at the other vertices (corners, ends of runs)
@@ -5894,6 +5915,12 @@ def _window_hi(W, arc, k, hi, quant):
 #: its quadratic (the window spans another corner: sans-light "J" at em 400, a 16-unit side
 #: fitted across its far corner moved the corner 0.5 away from the design's, 0.90 from it)
 _CORNER_RES = 1.0
+#: ... and a curve side beside a side of two input points (:func:`_lone_sides`) gives no
+#: crossing where one of its input points lies this many quanta or more off its quadratic:
+#: the crossing slides along the line by the curve's error there (Inconsolata "5" at em 700,
+#: a quadratic over a short S-shaped cubic's inflection, 0.84 quanta off: the corner 0.67
+#: from the design where the rounded input is 0.49); the corner stays
+_LONE_RES = 0.75
 
 
 #: a side written as its two rounded ends only gives the corner a direction where it is at
@@ -5908,6 +5935,12 @@ _LONE_MIN_MOVE = 0.2
 #: a corner whose move makes a line beside it miss its input points goes back half its move
 #: at a time, this many times, before it goes back to its input point
 _CORNER_HALVINGS = 2
+#: ... but a corner that turns (sharp, no tip) does not go back for the thinned segment on a
+#: side that is a curve run (its neighbour smooth): the fitter tests its cubics against the
+#: bound, and a line there is made valid by :func:`_valid_lines` (Cantarell Thin "&" at em
+#: 1500: a 90-degree corner of two cubics whose input point is 0.71 from the design's, its
+#: estimate 0.34, taken back because the 3-unit thinned segment beside it would miss a point)
+_CURVE_SIDES_FREE = True
 #: a corner turning by more than 120 degrees (the cosine of its turn below this) is a tip: an
 #: error d in either side's estimated offset moves the tangents' crossing by d / sin(interior
 #: angle) along the tip's axis, more than the rounding ...
@@ -6268,6 +6301,10 @@ def _corners_on_the_design(W, K, Q, arc, smooth, rnd, first, last, quant, eps,
     lone = lone_in | lone_out
     # a side of two points meeting a curve at a middling angle: neither estimate is good
     both &= ~lone | (np.abs(cr) >= _LONE_SINE) | (np.abs(cr) < _CORNER_SINE)
+    # ... nor a curve side beside a side of two points whose points miss its quadratic by
+    # _LONE_RES quanta or more (the crossing slides along the line by the curve's error)
+    both &= ~(lone_out & (r_in >= _LONE_RES * quant[vi]))
+    both &= ~(lone_in & (r_out >= _LONE_RES * quant[vo]))
     tip = both & ((t_in * t_out).sum(axis=1) < _TIP_COS)
     # a tip beside a design line written as its two rounded ends (one long input step) that
     # the curve-run rules put in a curve run: the quadratic over that side spans the line's
@@ -6327,6 +6364,9 @@ def _corners_on_the_design(W, K, Q, arc, smooth, rnd, first, last, quant, eps,
         keep = ~np.isin(mv, gv)
         found.append((np.concatenate([gv, mv[keep]]), np.concatenate([gj, mj[keep]]),
                       np.concatenate([gm, np.ones(int(keep.sum()), dtype=bool)])))
+    # (a corner that turns (sharp, not a tip) with a curve run on a side: the thinned
+    # segment there is not held to the line bound (the fitter tests its cubics))
+    free = (sharp & ~tip)[both] if _CURVE_SIDES_FREE else np.zeros(int(both.sum()), dtype=bool)
     vi, vo, est = vi[both], vo[both], est[both]
     lone_in, lone_out = lone_in[both], lone_out[both]
     wk = W[K[vo]]
@@ -6350,7 +6390,8 @@ def _corners_on_the_design(W, K, Q, arc, smooth, rnd, first, last, quant, eps,
     frac = np.ones(len(vo))
     while True:
         # the thinned segments next to a moved corner, as lines: within eps of their points?
-        seg = np.unique(np.concatenate([vi[~lone_out] - 1, vo[~lone_in]]))
+        seg = np.unique(np.concatenate([vi[~lone_out & ~(free & smooth[vi - 1])] - 1,
+                                        vo[~lone_in & ~(free & smooth[vo + 1])]]))
         seg = seg[moved[seg] | moved[seg + 1]]
         if len(seg) == 0:
             break
@@ -6374,7 +6415,7 @@ def _corners_on_the_design(W, K, Q, arc, smooth, rnd, first, last, quant, eps,
         moved[vi[gone]] = False
         keep = ~gone
         vi, vo, old, mv, frac = vi[keep], vo[keep], old[keep], mv[keep], frac[keep]
-        lone_in, lone_out = lone_in[keep], lone_out[keep]
+        lone_in, lone_out, free = lone_in[keep], lone_out[keep], free[keep]
 
 
 def _arc_per_path(W: np.ndarray, wlen: np.ndarray) -> np.ndarray:
