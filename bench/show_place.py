@@ -50,8 +50,8 @@ def main() -> None:
     cap = {}
     orig = fitmod._on_the_design
 
-    def spy(W, K, Q, arc, t_in, t_out, smooth, quant, tlen, eps):
-        orig(W, K, Q, arc, t_in, t_out, smooth, quant, tlen, eps)
+    def spy(W, K, Q, arc, t_in, t_out, smooth, quant, tlen, eps, *rest):
+        orig(W, K, Q, arc, t_in, t_out, smooth, quant, tlen, eps, *rest)
         cap.update(W=W.copy(), K=K.copy(), Q=Q.copy(), smooth=smooth.copy(),
                    t_in=t_in.copy(), t_out=t_out.copy())
 

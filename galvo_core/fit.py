@@ -3082,6 +3082,13 @@ def _fit_concatenated(
                 np.repeat(rounding[:, 0], tlen))
             if not more:
                 break
+        if _GAP_JOINTS and fitter.coarse is not None:
+            for _ in range(_GAP_SPLITS):
+                la, lpts, lfirst, llast, lerr, lkey, more = _split_gap_joints(
+                    W, la, lpts, lfirst, llast, lerr, lkey, np.repeat(rounding[:, 1], tlen),
+                    np.repeat(rounding[:, 0], tlen), fitter.coarse)
+                if not more:
+                    break
     lpts.setflags(write=False)
     worst = np.zeros(len(todo))
     np.fmax.at(worst, owner[la], lerr)  # NaN (overflow) ignored, as max() did
@@ -5343,6 +5350,81 @@ def _split_bulging_lines(W, arc, la, lpts, lfirst, llast, lerr, lkey, quant, eps
     return la2, pts2, f2, l2, e2, key2, True
 
 
+#: rounded input: a fitted line over an input point that joins two long input steps (at least
+#: ``_LONE_LENGTH`` quanta each, neither a chord of a coarse curve: two design lines, each
+#: written as its two rounded ends, meeting at a vertex of the design that turns a few
+#: degrees) is split at that point where it passes this many quanta or more from it (the
+#: design's vertex lies anywhere in the point's rounding square: the line may miss it by the
+#: rounding and this offset together, where the rounded polyline misses it by the rounding)
+_GAP_JOINT_OFF = 0.25
+_GAP_JOINTS = True
+
+
+def _split_gap_joints(W, la, lpts, lfirst, llast, lerr, lkey, quant, eps, coarse):
+    """Rounded input (``quant`` per thinned point, 0: exact): each line (start thinned index
+    ``la``, points ``lpts``, input points ``lfirst``..``llast``) split at its input point
+    farthest from it among those between two long input steps (``_LONE_LENGTH`` quanta each,
+    not ``coarse`` chords) that lie ``_GAP_JOINT_OFF`` quanta or more from it, into two lines
+    meeting at that input point, where both keep within ``eps`` (the line's bound) of their
+    input points. The thinning keeps two nearly collinear design lines in one segment, which
+    then misses their common vertex by up to the rounding's width beyond its offset
+    (Cantarell Thin "g" at em 2048: a 4-degree joint of a 152-unit and an 8-unit line, 0.77
+    from the design where the rounded input is 0.50). Returns the lines as
+    :func:`_split_bulging_lines` does."""
+    q = quant[la]
+    cand = np.flatnonzero((q > 0.0) & (llast - lfirst >= 2))
+    if len(cand) == 0:
+        return la, lpts, lfirst, llast, lerr, lkey, False
+    cnt = llast[cand] - lfirst[cand] - 1
+    own, off = _ragged(np.arange(len(cand)), cnt)
+    g = lfirst[cand][own] + 1 + off
+    qg = q[cand][own]
+    s0 = np.hypot(*(W[g] - W[g - 1]).T)
+    s1 = np.hypot(*(W[g + 1] - W[g]).T)
+    sel = (s0 >= _LONE_LENGTH * qg) & (s1 >= _LONE_LENGTH * qg) & ~coarse[g - 1] & ~coarse[g]
+    if not sel.any():
+        return la, lpts, lfirst, llast, lerr, lkey, False
+    own, g, qg = own[sel], g[sel], qg[sel]
+    c = cand[own]
+    t = point_segment_distance(W[g], lpts[c, 0], lpts[c, 1])
+    far = t >= _GAP_JOINT_OFF * qg
+    if not far.any():
+        return la, lpts, lfirst, llast, lerr, lkey, False
+    c, g, t = c[far], g[far], t[far]
+    # (per line its farthest such point)
+    order = np.lexsort((-t, c))
+    one = order[np.r_[True, c[order][1:] != c[order][:-1]]]
+    c, mc = c[one], g[one]
+    v = W[mc].astype(np.float64)
+    e = eps[la[c]] * (1.0 + 1e-9)
+    a_pts = np.stack([lpts[c, 0], v], axis=1)
+    b_pts = np.stack([v, lpts[c, 1]], axis=1)
+    ea = _line_errors(W, a_pts, lfirst[c], mc)
+    eb = _line_errors(W, b_pts, mc, llast[c])
+    fine = (ea <= e) & (eb <= e)
+    c, a_pts, b_pts, ea, eb, mc = c[fine], a_pts[fine], b_pts[fine], ea[fine], eb[fine], mc[fine]
+    if len(c) == 0:
+        return la, lpts, lfirst, llast, lerr, lkey, False
+    n = len(la)
+    rep = np.ones(n, dtype=np.intp)
+    rep[c] = 2
+    pos_new = np.cumsum(rep) - rep  # each old line's first row
+    la2 = np.repeat(la, rep)
+    key2 = np.repeat(lkey, rep)
+    pts2 = np.repeat(lpts, rep, axis=0)
+    f2 = np.repeat(lfirst, rep)
+    l2 = np.repeat(llast, rep)
+    e2 = np.repeat(lerr, rep)
+    r = pos_new[c]
+    pts2[r] = a_pts
+    pts2[r + 1] = b_pts
+    l2[r] = mc
+    f2[r + 1] = mc
+    e2[r] = ea
+    e2[r + 1] = eb
+    return la2, pts2, f2, l2, e2, key2, True
+
+
 def _valid_lines(W, K, Q, la, lb, lpts, lfirst, llast, lerr, eps):
     """Rounded input: a line between thinned vertices that :func:`_on_the_design` moved may
     miss its input points by more than the thinning's tolerance ``eps`` (per thinned
@@ -5782,6 +5864,9 @@ _SMOOTH_SHORT = 4.0
 #: measurements)
 _SMOOTH_FEW = 3
 _SMOOTH_ALWAYS = True
+#: a smooth vertex beside a design line written as its two rounded ends (one input step of
+#: at least ``_JOINT_LINE`` quanta) moves only along that line
+_SMOOTH_ALONG = True
 
 
 def _on_the_design(W, K, Q, arc, t_in, t_out, smooth, quant, tlen, eps, found=None,
@@ -5826,7 +5911,25 @@ def _on_the_design(W, K, Q, arc, t_in, t_out, smooth, quant, tlen, eps, found=No
         pos, tan, ok = _local_fits(W, arc, np.minimum(lo, K[sm]), np.maximum(hi, K[sm]), K[sm])
         k = sm[ok]
         h = 0.5 * quant[k][:, None]
-        Q[k] = np.clip(pos[ok], W[K[k]] - h, W[K[k]] + h)
+        est = pos[ok]
+        if _SMOOTH_ALONG:
+            # beside a design line written as its two rounded ends (one input step of at
+            # least _JOINT_LINE quanta: the thinned segment), only the move along that line
+            # (a move across tilts the line, its far end fixed, off the design line its ends
+            # were rounded from: sans "B" at em 400, a 63-unit line into a tangent curve,
+            # 0.63 from the design where the rounded input is 0.44)
+            wk = W[K[k]]
+            gi = (K[k] - K[k - 1] == 1) & (np.hypot(*(wk - W[K[k - 1]]).T)
+                                           >= _JOINT_LINE * quant[k])
+            go = (K[k + 1] - K[k] == 1) & (np.hypot(*(W[K[k + 1]] - wk).T)
+                                           >= _JOINT_LINE * quant[k])
+            one = gi ^ go
+            if one.any():
+                d = np.where(gi[:, None], wk - W[K[k - 1]], W[K[k + 1]] - wk)[one]
+                d = d / np.hypot(d[:, 0], d[:, 1])[:, None]
+                est[one] = wk[one] + ((est[one] - wk[one]) * d).sum(axis=1)[:, None] * d
+            est[gi & go] = wk[gi & go]
+        Q[k] = np.clip(est, W[K[k]] - h, W[K[k]] + h)
         t_in[k] = tan[ok]
         t_out[k] = tan[ok]
     # one-sided tangents at the other vertices (corners, ends of runs)
@@ -5947,6 +6050,12 @@ def _window_hi(W, arc, k, hi, quant):
 #: its quadratic (the window spans another corner: sans-light "J" at em 400, a 16-unit side
 #: fitted across its far corner moved the corner 0.5 away from the design's, 0.90 from it)
 _CORNER_RES = 1.0
+#: ... and a curve side beside a side of two input points (:func:`_lone_sides`) gives no
+#: crossing where one of its input points lies this many quanta or more off its quadratic:
+#: the crossing slides along the line by the curve's error there (Inconsolata "5" at em 700,
+#: a quadratic over a short S-shaped cubic's inflection, 0.84 quanta off: the corner 0.67
+#: from the design where the rounded input is 0.49); the corner stays
+_LONE_RES = 0.75
 
 
 #: a side written as its two rounded ends only gives the corner a direction where it is at
@@ -5961,6 +6070,12 @@ _LONE_MIN_MOVE = 0.2
 #: a corner whose move makes a line beside it miss its input points goes back half its move
 #: at a time, this many times, before it goes back to its input point
 _CORNER_HALVINGS = 2
+#: ... but a corner that turns (sharp, no tip) does not go back for the thinned segment on a
+#: side that is a curve run (its neighbour smooth): the fitter tests its cubics against the
+#: bound, and a line there is made valid by :func:`_valid_lines` (Cantarell Thin "&" at em
+#: 1500: a 90-degree corner of two cubics whose input point is 0.71 from the design's, its
+#: estimate 0.34, taken back because the 3-unit thinned segment beside it would miss a point)
+_CURVE_SIDES_FREE = True
 #: a corner turning by more than 120 degrees (the cosine of its turn below this) is a tip: an
 #: error d in either side's estimated offset moves the tangents' crossing by d / sin(interior
 #: angle) along the tip's axis, more than the rounding ...
@@ -6326,6 +6441,10 @@ def _corners_on_the_design(W, K, Q, arc, smooth, rnd, first, last, quant, eps,
     lone = lone_in | lone_out
     # a side of two points meeting a curve at a middling angle: neither estimate is good
     both &= ~lone | (np.abs(cr) >= _LONE_SINE) | (np.abs(cr) < _CORNER_SINE)
+    # ... nor a curve side beside a side of two points whose points miss its quadratic by
+    # _LONE_RES quanta or more (the crossing slides along the line by the curve's error)
+    both &= ~(lone_out & (r_in >= _LONE_RES * quant[vi]))
+    both &= ~(lone_in & (r_out >= _LONE_RES * quant[vo]))
     tip = both & ((t_in * t_out).sum(axis=1) < _TIP_COS)
     # a tip beside a design line written as its two rounded ends (one long input step) that
     # the curve-run rules put in a curve run: the quadratic over that side spans the line's
@@ -6385,6 +6504,9 @@ def _corners_on_the_design(W, K, Q, arc, smooth, rnd, first, last, quant, eps,
         keep = ~np.isin(mv, gv)
         found.append((np.concatenate([gv, mv[keep]]), np.concatenate([gj, mj[keep]]),
                       np.concatenate([gm, np.ones(int(keep.sum()), dtype=bool)])))
+    # (a corner that turns (sharp, not a tip) with a curve run on a side: the thinned
+    # segment there is not held to the line bound (the fitter tests its cubics))
+    free = (sharp & ~tip)[both] if _CURVE_SIDES_FREE else np.zeros(int(both.sum()), dtype=bool)
     vi, vo, est = vi[both], vo[both], est[both]
     lone_in, lone_out = lone_in[both], lone_out[both]
     wk = W[K[vo]]
@@ -6411,7 +6533,8 @@ def _corners_on_the_design(W, K, Q, arc, smooth, rnd, first, last, quant, eps,
     known = np.zeros(n, dtype=bool)
     while True:
         # the thinned segments next to a moved corner, as lines: within eps of their points?
-        seg = np.unique(np.concatenate([vi[~lone_out] - 1, vo[~lone_in]]))
+        seg = np.unique(np.concatenate([vi[~lone_out & ~(free & smooth[vi - 1])] - 1,
+                                        vo[~lone_in & ~(free & smooth[vo + 1])]]))
         seg = seg[moved[seg] | moved[seg + 1]]
         if len(seg) == 0:
             break
@@ -6441,7 +6564,7 @@ def _corners_on_the_design(W, K, Q, arc, smooth, rnd, first, last, quant, eps,
         moved[vi[gone]] = False
         keep = ~gone
         vi, vo, old, mv, frac = vi[keep], vo[keep], old[keep], mv[keep], frac[keep]
-        lone_in, lone_out = lone_in[keep], lone_out[keep]
+        lone_in, lone_out, free = lone_in[keep], lone_out[keep], free[keep]
 
 
 def _step_lengths(W: np.ndarray) -> np.ndarray:
