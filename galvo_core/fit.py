@@ -6070,12 +6070,6 @@ _LONE_MIN_MOVE = 0.2
 #: a corner whose move makes a line beside it miss its input points goes back half its move
 #: at a time, this many times, before it goes back to its input point
 _CORNER_HALVINGS = 2
-#: ... but a corner that turns (sharp, no tip) does not go back for the thinned segment on a
-#: side that is a curve run (its neighbour smooth): the fitter tests its cubics against the
-#: bound, and a line there is made valid by :func:`_valid_lines` (Cantarell Thin "&" at em
-#: 1500: a 90-degree corner of two cubics whose input point is 0.71 from the design's, its
-#: estimate 0.34, taken back because the 3-unit thinned segment beside it would miss a point)
-_CURVE_SIDES_FREE = True
 #: a corner turning by more than 120 degrees (the cosine of its turn below this) is a tip: an
 #: error d in either side's estimated offset moves the tangents' crossing by d / sin(interior
 #: angle) along the tip's axis, more than the rounding ...
@@ -6504,9 +6498,6 @@ def _corners_on_the_design(W, K, Q, arc, smooth, rnd, first, last, quant, eps,
         keep = ~np.isin(mv, gv)
         found.append((np.concatenate([gv, mv[keep]]), np.concatenate([gj, mj[keep]]),
                       np.concatenate([gm, np.ones(int(keep.sum()), dtype=bool)])))
-    # (a corner that turns (sharp, not a tip) with a curve run on a side: the thinned
-    # segment there is not held to the line bound (the fitter tests its cubics))
-    free = (sharp & ~tip)[both] if _CURVE_SIDES_FREE else np.zeros(int(both.sum()), dtype=bool)
     vi, vo, est = vi[both], vo[both], est[both]
     lone_in, lone_out = lone_in[both], lone_out[both]
     wk = W[K[vo]]
@@ -6533,8 +6524,7 @@ def _corners_on_the_design(W, K, Q, arc, smooth, rnd, first, last, quant, eps,
     known = np.zeros(n, dtype=bool)
     while True:
         # the thinned segments next to a moved corner, as lines: within eps of their points?
-        seg = np.unique(np.concatenate([vi[~lone_out & ~(free & smooth[vi - 1])] - 1,
-                                        vo[~lone_in & ~(free & smooth[vo + 1])]]))
+        seg = np.unique(np.concatenate([vi[~lone_out] - 1, vo[~lone_in]]))
         seg = seg[moved[seg] | moved[seg + 1]]
         if len(seg) == 0:
             break
@@ -6564,7 +6554,7 @@ def _corners_on_the_design(W, K, Q, arc, smooth, rnd, first, last, quant, eps,
         moved[vi[gone]] = False
         keep = ~gone
         vi, vo, old, mv, frac = vi[keep], vo[keep], old[keep], mv[keep], frac[keep]
-        lone_in, lone_out, free = lone_in[keep], lone_out[keep], free[keep]
+        lone_in, lone_out = lone_in[keep], lone_out[keep]
 
 
 def _step_lengths(W: np.ndarray) -> np.ndarray:

@@ -1,5 +1,5 @@
-"""Rounded input, issue 16 (eleventh session): corners whose estimate is held back by a side
-that is a curve, and corners beside a two-point line whose curve side is no good estimate.
+"""Rounded input, issue 16 (eleventh session): corners beside a two-point line whose curve
+side is no good estimate, and smooth vertices beside a design line written as its two ends.
 Each outline is a glyph contour as read from the font by bench/fonts.py (inline: a fresh
 machine has DejaVu fonts only), flattened and rounded as the precision bench does it."""
 
@@ -10,16 +10,6 @@ import numpy as np
 from galvo_core import fit as fitmod
 from galvo_core.fit import check_fit, fit_paths
 from tests.test_fit_design_places import _local_distance, _rounded
-
-#: Cantarell Thin at em 1500 in the precision bench's training text (bench/fonts.py): contour
-#: 14, the "&"'s inner loop; its corner at (6232.5, 139.5) turns 90 degrees between two cubics
-_AMP_LOOP = [
-    ('cubic', (5682.0, 279.0), (5682.0, 411.0), (5769.0, 480.0), (5871.0, 537.0)),
-    ('cubic', (5871.0, 537.0), (5943.0, 432.0), (6060.0, 306.0), (6232.5, 139.5)),
-    ('cubic', (6232.5, 139.5), (6150.0, 55.5), (6055.5, 9.0), (5959.5, 9.0)),
-    ('cubic', (5959.5, 9.0), (5811.0, 9.0), (5682.0, 118.5), (5682.0, 279.0)),
-]
-_AMP_CORNER = np.array([6232.5, 139.5])
 
 #: Inconsolata at em 700 in the held-out text: contour 6, the "5"; at (1838.2, 91.8) a short
 #: S-shaped cubic ends at a 44-unit design line written as its two rounded ends
@@ -70,20 +60,6 @@ def _input_distance(segs, place) -> float:
                     for i in range(len(poly) - 1)]
 
     return _local_distance(segs, _Poly, place, 2.0)
-
-
-def test_a_corner_between_two_curves_moves_though_a_thinned_segment_beside_it_would_miss(
-        monkeypatch):
-    # the corner's input point is 0.71 from the design's corner (a half-unit design point
-    # rounded to even); its estimate, 0.34 from it, was taken back because the thinned segment
-    # beside it, taken as a line, would miss its input points: a curve side is fitted by cubics
-    fp = _fit(_AMP_LOOP)
-    d = _local_distance(_AMP_LOOP, fp, _AMP_CORNER, 2.0)
-    assert d < 0.6 and d <= _input_distance(_AMP_LOOP, _AMP_CORNER) + 0.02, d
-    monkeypatch.setattr(fitmod, "_CURVE_SIDES_FREE", False)
-    fp0 = _fit(_AMP_LOOP)
-    assert _local_distance(_AMP_LOOP, fp0, _AMP_CORNER, 2.0) > 0.6
-    assert fp.n_segments <= fp0.n_segments
 
 
 def test_a_curve_side_that_misses_its_quadratic_gives_no_crossing_with_a_two_point_line(
