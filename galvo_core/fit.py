@@ -3189,18 +3189,29 @@ def _gap_ends_kept(W, K, tlen, quanta, eps, coarse):
     seg = np.clip(seg, 0, len(K) - 2)
     ok &= ~np.isin(seg, last)  # not across two paths
     ok &= (K[seg] != g) | (K[seg + 1] != g + 1)  # not a thinned segment already
-    ok &= (K[seg] == g) | (K[seg + 1] == g + 1)  # at one end of it (the other is added)
+    g, seg = g[ok], seg[ok]
+    # the gap's end kept: g + 1 where the gap starts the segment (its rest after the gap), g
+    # where it ends it (its rest before); a gap inside the segment (a design line between two
+    # curves' ends, all three nearly collinear) is tried at both of its ends, each with the
+    # rest on its side (NimbusRoman-Italic "U" at em 2048: a 104-unit line between two gently
+    # curved stretches, one 480-unit thinned line over all three, 0.97 from the design where
+    # the rounded input is 0.46)
+    inside = (K[seg] != g) & (K[seg + 1] != g + 1)
+    g = np.concatenate([g, g[inside]])
+    seg = np.concatenate([seg, seg[inside]])
+    after = np.concatenate([K[seg[:len(inside)]] == g[:len(inside)],
+                            np.ones(int(inside.sum()), dtype=bool)])
     q = q_k[seg]
-    ok &= (q > 0.0) & (np.hypot(*(W[g + 1] - W[g]).T) >= _LONE_LENGTH * q)
+    ok = (q > 0.0) & (np.hypot(*(W[g + 1] - W[g]).T) >= _LONE_LENGTH * q)
     # ... a design line beside dense points: at least _GAP_RATIO times the input step beside
     # it inside the thinned segment (a walk of long steps, each like the next, has no such
     # gap; the step on its other side may be another design line: serif-bolditalic "Q" at em
     # 400, a 30-unit line after a 49-unit one, its cubic 0.66 from the design where the
     # rounded input is 0.48)
-    nb = np.where(K[seg] == g, np.hypot(*(W[np.minimum(g + 2, len(W) - 1)] - W[g + 1]).T),
+    nb = np.where(after, np.hypot(*(W[np.minimum(g + 2, len(W) - 1)] - W[g + 1]).T),
                   np.hypot(*(W[np.maximum(g - 1, 0)] - W[g]).T))
     ok &= np.hypot(*(W[g + 1] - W[g]).T) >= _GAP_RATIO * nb
-    g, seg, q = g[ok], seg[ok], q[ok]
+    g, seg, q, after = g[ok], seg[ok], q[ok], after[ok]
     if len(g) == 0:
         return K, tlen
     a, b = K[seg], K[seg + 1]
@@ -3215,11 +3226,10 @@ def _gap_ends_kept(W, K, tlen, quanta, eps, coarse):
     # the point kept: the gap's end inside the segment; the rest of the segment, a line from
     # its other end to that point, must still hold its input points within eps (the thinning's
     # promise for the whole segment)
-    g, seg, a, b = g[far], seg[far], a[far], b[far]
-    at_end = b == g + 1
-    v = np.where(at_end, g, g + 1)
-    r0 = np.where(at_end, a, v)
-    r1 = np.where(at_end, v, b)
+    g, seg, a, b, after = g[far], seg[far], a[far], b[far], after[far]
+    v = np.where(after, g + 1, g)
+    r0 = np.where(after, v, a)
+    r1 = np.where(after, b, v)
     keep = r1 - r0 >= _GAP_REST
     v, r0, r1, seg = v[keep], r0[keep], r1[keep], seg[keep]
     if len(v) == 0:

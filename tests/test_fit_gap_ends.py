@@ -71,3 +71,48 @@ def test_a_gap_end_beside_a_curve_that_is_no_line_is_kept() -> None:
     assert _local_distance(_NIMBUS_ITALIC_L, fp, np.array([128.0, 99.0]), 2.0) <= 0.6
     # (the design's own count here is 16)
     assert len(fp.segments) <= 16
+
+
+#: NimbusRoman-Italic "U" (its design in font units, laid out at x 12626..13264 as in the
+#: benches' text), to be set at em 2048: the right stem's 49-unit design line (100 units at
+#: em 2048) between two gently curved cubics, all three nearly collinear
+_NIMBUS_ITALIC_U = [
+    ("line", (13264, 653), (13065, 653)),
+    ("line", (13065, 653), (13065, 637)),
+    ("cubic", (13065, 637), (13118, 632), (13136, 621), (13136, 591)),
+    ("cubic", (13136, 591), (13136, 575), (13110, 475), (13062, 304)),
+    ("line", (13062, 304), (13049, 255)),
+    ("cubic", (13049, 255), (13005, 91), (12941, 23), (12831, 23)),
+    ("cubic", (12831, 23), (12748, 23), (12691, 70), (12691, 141)),
+    ("cubic", (12691, 141), (12691, 176), (12719, 284), (12794, 546)),
+    ("cubic", (12794, 546), (12814, 615), (12830, 629), (12899, 637)),
+    ("line", (12899, 637), (12899, 653)),
+    ("line", (12899, 653), (12626, 653)),
+    ("line", (12626, 653), (12626, 637)),
+    ("cubic", (12626, 637), (12693, 631), (12704, 625), (12704, 596)),
+    ("cubic", (12704, 596), (12704, 584), (12701, 568), (12697, 551)),
+    ("line", (12697, 551), (12644, 359)),
+    ("cubic", (12644, 359), (12614, 250), (12601, 188), (12601, 146)),
+    ("cubic", (12601, 146), (12601, 51), (12692, -18), (12819, -18)),
+    ("cubic", (12819, -18), (12950, -18), (13033, 53), (13077, 203)),
+    ("line", (13077, 203), (13160, 488)),
+    ("cubic", (13160, 488), (13198, 618), (13202, 623), (13264, 637)),
+    ("line", (13264, 637), (13264, 653)),
+]
+
+
+def test_the_ends_of_a_design_line_between_two_curves_are_kept() -> None:
+    """The thinning kept one 480-unit line over the first cubic's straight tail, the design
+    line and the next cubic's start (all within the bound of that line's rounded points):
+    the design's line-curve joint bends 0.97 off it (the rounded input is 0.46 there). With
+    the design line's two ends kept, the fit follows the design: within 0.6 of it there, at
+    most 1.2 times the design's count (issue 16's bound)."""
+    segs = [(k, *[(x * 2.048, y * 2.048) for x, y in p]) for k, *p in _NIMBUS_ITALIC_U]
+    w = _rounded(segs)
+    fp = fitmod.fit_paths([w], [True])[0]
+    assert not fitmod.check_fit(w, fp, 0.02, 0.02, report=True)["violation"]
+    joint = np.array([13049.0, 255.0]) * 2.048  # (the design line's end, the cubic's start)
+    ends = np.array([s.points[-1] for s in fp.segments])
+    assert np.hypot(*(ends - joint).T).min() <= 0.71
+    assert _local_distance(segs, fp, joint + [-3.5, -12.8], 16.0) <= 0.6
+    assert len(fp.segments) <= 1.2 * len(segs)
