@@ -3129,6 +3129,8 @@ def _fit_concatenated(
             W, arc, points, is_cubic, tail, step, gf, gl, seg_owner, move_q, bound, changed)
         is_cubic, points, tail, step, gf, gl, seg_owner, changed = _connectors_out(
             W, points, is_cubic, tail, step, gf, gl, seg_owner, move_q, bound, changed, wstep)
+        is_cubic, points, tail, step, gf, gl, seg_owner, changed = _tips_joined(
+            W, points, is_cubic, tail, step, gf, gl, seg_owner, move_q, bound, changed, wstep)
         if changed.any():
             worst = _changed_errors(W, points, is_cubic, tail, gf, gl, seg_owner, changed,
                                     worst)
@@ -5203,6 +5205,116 @@ def _connectors_out(W, points, is_cubic, tail, step, gfirst, glast, seg_owner, q
     return _rebuilt(points, is_cubic, tail, step, gfirst, glast, seg_owner, changed, rep)
 
 
+#: rounded input: a short line (at most ``_TIP_SHORT`` quanta, over 1 to ``_TIP_STEPS`` input
+#: steps) between two corners that turn the same way, ``_TIP_TURN`` radians or more together,
+#: is a tip the thinning cut (its point within the bound of the chord of its neighbours)
+_TIP_SHORT = 2.0
+_TIP_STEPS = 3
+_TIP_TURN = math.radians(90.0)
+
+
+def _tips_joined(W, points, is_cubic, tail, step, gfirst, glast, seg_owner, quant, bound,
+                 changed, wstep=None):
+    """Rounded input: a short line the thinning left across an acute tip (``_TIP_SHORT``,
+    ``_TIP_STEPS``, ``_TIP_TURN``: the tip's own input point within the bound of the chord
+    between its neighbours, the corners kept one step before and after it) taken out where
+    the two segments beside it, their ends moved onto the crossing of their end tangents
+    (kept inside the rounding square of the line's input point nearest to it), both keep
+    within ``bound`` (per path) of their input points and polyline (:func:`_seg_fits_arrays`);
+    the joint's input point is that one. Returns the segments as :func:`_connectors_out`."""
+    ns = len(is_cubic)
+    unchanged = (is_cubic, points, tail, step, gfirst, glast, seg_owner, changed)
+    if ns < 3:
+        return unchanged
+    c = np.flatnonzero(~is_cubic)
+    c = c[(c > 0) & (c < ns - 1)]
+    c = c[(seg_owner[c - 1] == seg_owner[c]) & (seg_owner[c + 1] == seg_owner[c])]
+    q = quant[seg_owner[c]]
+    n_in = glast[c] - gfirst[c]
+    A = points[tail[c] - 1]
+    B = points[tail[c]]
+    c = c[(q > 0.0) & (n_in >= 1) & (n_in <= _TIP_STEPS)
+          & (np.hypot(*(B - A).T) <= _TIP_SHORT * q)]
+    if len(c) == 0:
+        return unchanged
+    A = points[tail[c] - 1]
+    B = points[tail[c]]
+    a, b = c - 1, c + 1
+    # the segment before: its end tangent; the one after: its start tangent
+    ea = points[tail[a] + step[a] - 1]
+    pa = np.where(is_cubic[a, None], points[tail[a] + 1], points[tail[a] - 1])
+    ta = ea - pa
+    tb = points[tail[b]] - B  # (a line's end, a cubic's first handle)
+    u = B - A
+
+    def cross(x, y):
+        return x[:, 0] * y[:, 1] - x[:, 1] * y[:, 0]
+
+    def angle(x, y):
+        return np.abs(np.arctan2(cross(x, y), (x * y).sum(axis=1)))
+
+    den = cross(ta, tb)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        sa = cross(B - A, tb) / den
+        sb = cross(B - A, ta) / den
+    ok = ((np.sign(cross(ta, u)) == np.sign(cross(u, tb))) & (cross(ta, u) != 0.0)
+          & (angle(ta, tb) >= _TIP_TURN) & np.isfinite(sa) & (sa >= 0.0) & (sb <= 0.0))
+    c, A, B, ta, sa = c[ok], A[ok], B[ok], ta[ok], sa[ok]
+    if len(c) == 0:
+        return unchanged
+    # (no two share a neighbour: every other one of a run of them)
+    one = np.r_[True, c[1:] > c[:-1] + 2]
+    c, A, B, ta, sa = c[one], A[one], B[one], ta[one], sa[one]
+    X = A + sa[:, None] * ta
+    # the joint's input point: the line's input point nearest to the crossing; the crossing
+    # kept inside its rounding square
+    own, off = _ragged(np.arange(len(c)), glast[c] - gfirst[c] + 1)
+    idx = gfirst[c][own] + off
+    d = np.hypot(*(W[idx] - X[own]).T)
+    st = np.cumsum(glast[c] - gfirst[c] + 1) - (glast[c] - gfirst[c] + 1)
+    dm = np.minimum.reduceat(d, st)
+    at = np.flatnonzero(d <= dm[own])
+    at = at[np.r_[True, own[at][1:] != own[at][:-1]]]
+    m = idx[at]
+    h2 = 0.5 * quant[seg_owner[c]][:, None]
+    X = np.clip(X, W[m] - h2, W[m] + h2)
+    a, b = c - 1, c + 1
+    C4 = np.zeros((2, len(c), 4, 2))
+    for k, sg in enumerate((a, b)):
+        r0 = tail[sg] - 1
+        cb = is_cubic[sg]
+        C4[k, :, :2] = points[r0[:, None] + np.arange(2)]
+        C4[k, cb, 2:] = points[r0[cb, None] + np.arange(2, 4)]
+    dva = X - A
+    C4[0, ~is_cubic[a], 1] += dva[~is_cubic[a]]
+    C4[0, is_cubic[a], 2] += dva[is_cubic[a]]
+    C4[0, is_cubic[a], 3] += dva[is_cubic[a]]
+    dvb = X - B
+    C4[1, :, 0] += dvb
+    C4[1, is_cubic[b], 1] += dvb[is_cubic[b]]
+    if wstep is None:
+        wstep = _step_lengths(W)
+    bj = np.asarray(bound, dtype=np.float64)[seg_owner[c]]
+    h = _CONNECTOR_STEP * quant[seg_owner[c]]
+    fa = _seg_fits_arrays(W, wstep, C4[0], is_cubic[a], gfirst[a], m, bj, h)
+    fb = np.zeros(len(c), dtype=bool)
+    if fa.any():
+        fb[fa] = _seg_fits_arrays(W, wstep, C4[1, fa], is_cubic[b][fa], m[fa], glast[b][fa],
+                                  bj[fa], h[fa])
+    both = fa & fb
+    if not both.any():
+        return unchanged
+    rep: dict[int, list] = {}
+    for t in np.flatnonzero(both).tolist():
+        ci = int(c[t])
+        rep[ci] = []
+        rep[ci - 1] = [(C4[0, t] if is_cubic[ci - 1] else C4[0, t, :2], int(gfirst[ci - 1]),
+                        int(m[t]))]
+        rep[ci + 1] = [(C4[1, t] if is_cubic[ci + 1] else C4[1, t, :2], int(m[t]),
+                        int(glast[ci + 1]))]
+    return _rebuilt(points, is_cubic, tail, step, gfirst, glast, seg_owner, changed, rep)
+
+
 def _rebuilt(points, is_cubic, tail, step, gfirst, glast, seg_owner, changed, rep):
     """The segments with ``rep`` (segment -> its new pieces (ctrl, first, last)) in place."""
     ns = len(is_cubic)
@@ -5795,6 +5907,9 @@ _SMOOTH_ALWAYS = True
 #: a smooth vertex beside a design line written as its two rounded ends (one input step of
 #: at least ``_JOINT_LINE`` quanta) moves only along that line
 _SMOOTH_ALONG = True
+#: a smooth vertex next to a corner moves only where its window holds at least this many
+#: input points on that side of it, or beside a design line (along it, above; 0: always)
+_SMOOTH_SIDES = 2
 
 
 def _on_the_design(W, K, Q, arc, t_in, t_out, smooth, quant, tlen, eps, found=None,
@@ -5857,6 +5972,15 @@ def _on_the_design(W, K, Q, arc, t_in, t_out, smooth, quant, tlen, eps, found=No
                 d = d / np.hypot(d[:, 0], d[:, 1])[:, None]
                 est[one] = wk[one] + ((est[one] - wk[one]) * d).sum(axis=1)[:, None] * d
             est[gi & go] = wk[gi & go]
+        if _SMOOTH_SIDES:
+            # (beside a design line the move along it above stays)
+            two = (((K[k] - np.minimum(lo, K[sm])[ok] >= _SMOOTH_SIDES) | smooth[k - 1]
+                    | (ln[k - 1] > short[ok]))
+                   & ((np.maximum(hi, K[sm])[ok] - K[k] >= _SMOOTH_SIDES) | smooth[k + 1]
+                      | (ln[k] > short[ok])))
+            if _SMOOTH_ALONG:
+                two |= gi | go
+            est = np.where(two[:, None], est, W[K[k]])
         Q[k] = np.clip(est, W[K[k]] - h, W[K[k]] + h)
         t_in[k] = tan[ok]
         t_out[k] = tan[ok]
