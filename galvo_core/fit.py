@@ -5907,6 +5907,12 @@ _SMOOTH_ALWAYS = True
 #: a smooth vertex beside a design line written as its two rounded ends (one input step of
 #: at least ``_JOINT_LINE`` quanta) moves only along that line
 _SMOOTH_ALONG = True
+#: rounded input: a corner's line side (its other end a corner too) whose first input step
+#: from the corner is a design line written as its two rounded ends (``_LONE_LENGTH`` quanta
+#: or more) and at least ``_FIRST_SHARE`` of the side's length, with more input points after
+#: it, takes its direction from that step (``_FIRST_STEP`` False: its least-squares line)
+_FIRST_STEP = True
+_FIRST_SHARE = 0.75
 #: a smooth vertex next to a corner moves only where its window holds at least this many
 #: input points on that side of it, or beside a design line (along it, above; 0: always)
 _SMOOTH_SIDES = 2
@@ -6474,6 +6480,26 @@ def _corners_on_the_design(W, K, Q, arc, smooth, rnd, first, last, quant, eps,
     if lin_out.any():
         p, t, ok = _local_lines(W, k[lin_out], K[vo + 1][lin_out], k[lin_out])
         p_out[lin_out], t_out[lin_out], ok_out[lin_out] = p, t, ok
+    # a line side whose first input step from the corner is a design line written as its
+    # two rounded ends, most of the side's length, with more points after it: that step's
+    # line (the points after it are another stretch of the design)
+    if _FIRST_STEP:
+        for side in (0, 1):
+            v = vi if side == 0 else vo
+            nb = K[v - 1] if side == 0 else K[v + 1]
+            lin = ~smooth[v - 1] if side == 0 else ~smooth[v + 1]
+            j = K[v] - 1 if side == 0 else K[v] + 1
+            st = np.hypot(*(W[j] - W[K[v]]).T)
+            seg_len = np.hypot(*(W[nb] - W[K[v]]).T)
+            sel = (lin & (np.abs(nb - K[v]) > 1) & (st >= _LONE_LENGTH * quant[v])
+                   & (st >= _FIRST_SHARE * seg_len))
+            if sel.any():
+                d = (W[K[v]] - W[j])[sel] if side == 0 else (W[j] - W[K[v]])[sel]
+                d = d / np.hypot(d[:, 0], d[:, 1])[:, None]
+                if side == 0:
+                    p_in[sel], t_in[sel], ok_in[sel] = W[K[v]][sel], d, True
+                else:
+                    p_out[sel], t_out[sel], ok_out[sel] = W[K[v]][sel], d, True
     # a side that is a line written as its two ends only (no least-squares line) beside a
     # curve side: the line through those two rounded ends, long enough to give a direction
     # (the curve side of such a corner is not checked as a line below: the fitter checks
