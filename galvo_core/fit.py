@@ -114,6 +114,7 @@ from galvo_core.parallel import run_chunks
 from galvo_core.precision import path_quanta
 from galvo_core.runs import segmented_cumsum, split_pieces_many
 from galvo_core.thin import check_positive, thin, thin_many
+from galvo_core.turns import turn_deg
 
 __all__ = [
     "DEFAULT_EPS_LINE",
@@ -5105,6 +5106,25 @@ _CONNECTOR_SHARES = (1.0, 0.75, 0.5, 0.25, 0.0)
 _CONNECTOR_STEP = 0.1
 
 
+def _ends_moved_many(points, is_cubic, tail, segs, at_start, dv):
+    """:func:`_end_moved` on arrays: the control points (n, 4, 2) of the segments ``segs``
+    (a line's in its first two rows, the others zeros), each with its start (``at_start``)
+    or its end moved by ``dv``, a cubic's inner control point there moved along."""
+    C4 = np.zeros((len(segs), 4, 2))
+    r0 = tail[segs] - 1
+    cb = is_cubic[segs]
+    C4[:, :2] = points[r0[:, None] + np.arange(2)]
+    C4[cb, 2:] = points[r0[cb, None] + np.arange(2, 4)]
+    C4[at_start, 0] += dv[at_start]
+    C4[at_start & cb, 1] += dv[at_start & cb]
+    e = ~at_start & ~cb
+    C4[e, 1] += dv[e]
+    e = ~at_start & cb
+    C4[e, 3] += dv[e]
+    C4[e, 2] += dv[e]
+    return C4
+
+
 def _connectors_out(W, points, is_cubic, tail, step, gfirst, glast, seg_owner, quant, bound,
                     changed, wstep=None):
     """Rounded input: the connectors :func:`_valid_lines` left (a line over no input step
@@ -5166,24 +5186,10 @@ def _connectors_out(W, points, is_cubic, tail, step, gfirst, glast, seg_owner, q
         C4 = np.zeros((2, len(rem), 4, 2))
         moved = np.empty((2, len(rem)), dtype=bool)
         for k in (0, 1):
-            sg = segs2[k, rem]
             dv = v - at2[k, rem]
             moved[k] = (dv != 0.0).any(axis=1)
-            cb = cub2[k, rem]
-            af = after2[k, rem]
-            r0 = tail[sg] - 1
-            cc = C4[k]
-            cc[:, :2] = points[r0[:, None] + np.arange(2)]
-            cc[cb, 2:] = points[r0[cb, None] + np.arange(2, 4)]
-            # the segment after the connector starts at the joint (a cubic's first handle
-            # along), the one before ends there (its last handle along)
-            cc[af, 0] += dv[af]
-            cc[af & cb, 1] += dv[af & cb]
-            e = ~af & ~cb
-            cc[e, 1] += dv[e]
-            e = ~af & cb
-            cc[e, 3] += dv[e]
-            cc[e, 2] += dv[e]
+            # the segment after the connector starts at the joint, the one before ends there
+            C4[k] = _ends_moved_many(points, is_cubic, tail, segs2[k, rem], after2[k, rem], dv)
         fits = np.ones((2, len(rem)), dtype=bool)
         fk = first_k[rem]
         todo = np.arange(len(rem))
@@ -5213,17 +5219,17 @@ def _connectors_out(W, points, is_cubic, tail, step, gfirst, glast, seg_owner, q
 
 
 #: rounded input: a short line (at most ``_TIP_SHORT`` quanta, over 1 to ``_TIP_STEPS`` input
-#: steps) between two corners that turn the same way, ``_TIP_TURN`` radians or more together,
+#: steps) between two corners that turn the same way, ``_TIP_TURN_DEG`` degrees or more together,
 #: is a tip the thinning cut (its point within the bound of the chord of its neighbours)
 _TIP_SHORT = 2.0
 _TIP_STEPS = 3
-_TIP_TURN = math.radians(90.0)
+_TIP_TURN_DEG = 90.0
 
 
 def _tips_joined(W, points, is_cubic, tail, step, gfirst, glast, seg_owner, quant, bound,
                  changed, wstep=None):
     """Rounded input: a short line the thinning left across an acute tip (``_TIP_SHORT``,
-    ``_TIP_STEPS``, ``_TIP_TURN``: the tip's own input point within the bound of the chord
+    ``_TIP_STEPS``, ``_TIP_TURN_DEG``: the tip's own input point within the bound of the chord
     between its neighbours, the corners kept one step before and after it) taken out where
     the two segments beside it, their ends moved onto the crossing of their end tangents
     (kept inside the rounding square of the line's input point nearest to it), both keep
@@ -5240,12 +5246,11 @@ def _tips_joined(W, points, is_cubic, tail, step, gfirst, glast, seg_owner, quan
     n_in = glast[c] - gfirst[c]
     A = points[tail[c] - 1]
     B = points[tail[c]]
-    c = c[(q > 0.0) & (n_in >= 1) & (n_in <= _TIP_STEPS)
-          & (np.hypot(*(B - A).T) <= _TIP_SHORT * q)]
+    short = (q > 0.0) & (n_in >= 1) & (n_in <= _TIP_STEPS) & (np.hypot(*(B - A).T)
+                                                                <= _TIP_SHORT * q)
+    c, A, B = c[short], A[short], B[short]
     if len(c) == 0:
         return unchanged
-    A = points[tail[c] - 1]
-    B = points[tail[c]]
     a, b = c - 1, c + 1
     # the segment before: its end tangent; the one after: its start tangent
     ea = points[tail[a] + step[a] - 1]
@@ -5257,15 +5262,12 @@ def _tips_joined(W, points, is_cubic, tail, step, gfirst, glast, seg_owner, quan
     def cross(x, y):
         return x[:, 0] * y[:, 1] - x[:, 1] * y[:, 0]
 
-    def angle(x, y):
-        return np.abs(np.arctan2(cross(x, y), (x * y).sum(axis=1)))
-
     den = cross(ta, tb)
     with np.errstate(invalid="ignore", divide="ignore"):
         sa = cross(B - A, tb) / den
         sb = cross(B - A, ta) / den
     ok = ((np.sign(cross(ta, u)) == np.sign(cross(u, tb))) & (cross(ta, u) != 0.0)
-          & (angle(ta, tb) >= _TIP_TURN) & np.isfinite(sa) & (sa >= 0.0) & (sb <= 0.0))
+          & (turn_deg(ta, tb) >= _TIP_TURN_DEG) & np.isfinite(sa) & (sa >= 0.0) & (sb <= 0.0))
     c, A, B, ta, sa = c[ok], A[ok], B[ok], ta[ok], sa[ok]
     if len(c) == 0:
         return unchanged
@@ -5286,19 +5288,9 @@ def _tips_joined(W, points, is_cubic, tail, step, gfirst, glast, seg_owner, quan
     h2 = 0.5 * quant[seg_owner[c]][:, None]
     X = np.clip(X, W[m] - h2, W[m] + h2)
     a, b = c - 1, c + 1
-    C4 = np.zeros((2, len(c), 4, 2))
-    for k, sg in enumerate((a, b)):
-        r0 = tail[sg] - 1
-        cb = is_cubic[sg]
-        C4[k, :, :2] = points[r0[:, None] + np.arange(2)]
-        C4[k, cb, 2:] = points[r0[cb, None] + np.arange(2, 4)]
-    dva = X - A
-    C4[0, ~is_cubic[a], 1] += dva[~is_cubic[a]]
-    C4[0, is_cubic[a], 2] += dva[is_cubic[a]]
-    C4[0, is_cubic[a], 3] += dva[is_cubic[a]]
-    dvb = X - B
-    C4[1, :, 0] += dvb
-    C4[1, is_cubic[b], 1] += dvb[is_cubic[b]]
+    start = np.ones(len(c), dtype=bool)
+    C4 = np.stack([_ends_moved_many(points, is_cubic, tail, a, ~start, X - A),
+                   _ends_moved_many(points, is_cubic, tail, b, start, X - B)])
     if wstep is None:
         wstep = _step_lengths(W)
     bj = np.asarray(bound, dtype=np.float64)[seg_owner[c]]
@@ -5440,18 +5432,32 @@ def _split_bulging_lines(W, arc, la, lpts, lfirst, llast, lerr, lkey, quant, eps
     v = np.clip(pos[hit], W[mc] - h, W[mc] + h)
     e = eps[la[c]] * (1.0 + 1e-9)
     for attempt in range(2):
-        a_pts = np.stack([lpts[c, 0], v], axis=1)
-        b_pts = np.stack([v, lpts[c, 1]], axis=1)
-        ea = _line_errors(W, a_pts, lfirst[c], mc)
-        eb = _line_errors(W, b_pts, mc, llast[c])
-        fine = (ea <= e) & (eb <= e)
+        halves = _split_halves(W, lpts, lfirst, llast, c, mc, v)
+        fine = (halves[2] <= e) & (halves[3] <= e)
         if attempt == 0:
             v = np.where(fine[:, None], v, W[mc])
-    keep = fine
-    c, a_pts, b_pts, ea, eb, mc = c[keep], a_pts[keep], b_pts[keep], ea[keep], eb[keep], mc[keep]
-    if len(c) == 0:
+    return _lines_split(la, lpts, lfirst, llast, lerr, lkey, c, mc, halves, fine)
+
+
+def _split_halves(W, lpts, lfirst, llast, c, mc, v):
+    """The lines ``c`` (points ``lpts``, input points ``lfirst``..``llast``) each split at
+    its input point ``mc`` into two lines meeting at ``v``: (first halves' points, second
+    halves' points, their errors, :func:`_line_errors`)."""
+    a_pts = np.stack([lpts[c, 0], v], axis=1)
+    b_pts = np.stack([v, lpts[c, 1]], axis=1)
+    return (a_pts, b_pts, _line_errors(W, a_pts, lfirst[c], mc),
+            _line_errors(W, b_pts, mc, llast[c]))
+
+
+def _lines_split(la, lpts, lfirst, llast, lerr, lkey, c, mc, halves, keep):
+    """The lines (start thinned index ``la``, points, first/last input points, errors, sort
+    keys) with each line ``c[keep]`` replaced by its two ``halves`` (:func:`_split_halves`,
+    meeting at input point ``mc``): the first half in the line's place, the second right
+    after it. Returns them and whether any line was split."""
+    if not keep.any():
         return la, lpts, lfirst, llast, lerr, lkey, False
-    # the split lines' first halves in their place, the second halves right after them
+    a_pts, b_pts, ea, eb = (x[keep] for x in halves)
+    c, mc = c[keep], mc[keep]
     n = len(la)
     rep = np.ones(n, dtype=np.intp)
     rep[c] = 2
@@ -5551,34 +5557,10 @@ def _split_gap_joints(W, la, lpts, lfirst, llast, lerr, lkey, quant, eps, coarse
     order = np.lexsort((-t, c))
     one = order[np.r_[True, c[order][1:] != c[order][:-1]]]
     c, mc = c[one], g[one]
-    v = W[mc].astype(np.float64)
     e = eps[la[c]] * (1.0 + 1e-9)
-    a_pts = np.stack([lpts[c, 0], v], axis=1)
-    b_pts = np.stack([v, lpts[c, 1]], axis=1)
-    ea = _line_errors(W, a_pts, lfirst[c], mc)
-    eb = _line_errors(W, b_pts, mc, llast[c])
-    fine = (ea <= e) & (eb <= e)
-    c, a_pts, b_pts, ea, eb, mc = c[fine], a_pts[fine], b_pts[fine], ea[fine], eb[fine], mc[fine]
-    if len(c) == 0:
-        return la, lpts, lfirst, llast, lerr, lkey, False
-    n = len(la)
-    rep = np.ones(n, dtype=np.intp)
-    rep[c] = 2
-    pos_new = np.cumsum(rep) - rep  # each old line's first row
-    la2 = np.repeat(la, rep)
-    key2 = np.repeat(lkey, rep)
-    pts2 = np.repeat(lpts, rep, axis=0)
-    f2 = np.repeat(lfirst, rep)
-    l2 = np.repeat(llast, rep)
-    e2 = np.repeat(lerr, rep)
-    r = pos_new[c]
-    pts2[r] = a_pts
-    pts2[r + 1] = b_pts
-    l2[r] = mc
-    f2[r + 1] = mc
-    e2[r] = ea
-    e2[r + 1] = eb
-    return la2, pts2, f2, l2, e2, key2, True
+    halves = _split_halves(W, lpts, lfirst, llast, c, mc, W[mc].astype(np.float64))
+    fine = (halves[2] <= e) & (halves[3] <= e)
+    return _lines_split(la, lpts, lfirst, llast, lerr, lkey, c, mc, halves, fine)
 
 
 def _valid_lines(W, K, Q, la, lb, lpts, lfirst, llast, lerr, eps):

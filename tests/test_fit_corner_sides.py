@@ -8,8 +8,7 @@ from __future__ import annotations
 import numpy as np
 
 from galvo_core import fit as fitmod
-from galvo_core.fit import check_fit, fit_paths
-from tests.test_fit_design_places import _local_distance, _rounded
+from tests.test_fit_design_places import _fit_rounded, _local_distance, _rounded
 
 #: Inconsolata at em 700 in the held-out text: contour 6, the "5"; at (1838.2, 91.8) a short
 #: S-shaped cubic ends at a 44-unit design line written as its two rounded ends
@@ -43,13 +42,6 @@ _FIVE = [
 _FIVE_CORNER = np.array([1838.1986, 91.823])
 
 
-def _fit(segs):
-    pts = _rounded(segs)
-    fp = fit_paths([pts], [True])[0]
-    assert not check_fit(pts, fp, 0.02, 0.02, report=True)["violation"]
-    return fp
-
-
 def _input_distance(segs, place) -> float:
     """The rounded input polyline's own both-ways distance to the design near ``place``."""
     pts = _rounded(segs)
@@ -66,11 +58,11 @@ def test_a_curve_side_that_misses_its_quadratic_gives_no_crossing_with_a_two_poi
         monkeypatch):
     # the curve side's quadratic spans the S-shaped cubic's inflection (a point 0.84 quanta
     # off it): its tangent slid the crossing along the line 0.67 from the design's corner
-    fp = _fit(_FIVE)
+    fp = _fit_rounded(_FIVE)[1]
     d = _local_distance(_FIVE, fp, _FIVE_CORNER, 2.0)
     assert d < 0.6 and d <= _input_distance(_FIVE, _FIVE_CORNER) + 0.02, d
     monkeypatch.setattr(fitmod, "_LONE_RES", np.inf)
-    fp0 = _fit(_FIVE)
+    fp0 = _fit_rounded(_FIVE)[1]
     assert _local_distance(_FIVE, fp0, _FIVE_CORNER, 2.0) > 0.6
 
 
@@ -100,10 +92,10 @@ def test_a_smooth_vertex_beside_a_design_line_moves_only_along_it(monkeypatch):
     # estimate, tilted the line 0.63 from the design (the rounded input: 0.44)
     segs = _dejavu("sans", 2)
     place = np.array([387.11, 32.42])
-    fp = _fit(segs)
+    fp = _fit_rounded(segs)[1]
     d = _local_distance(segs, fp, place, 2.0)
     assert d < 0.6 and d <= _input_distance(segs, place) + 0.02, d
     monkeypatch.setattr(fitmod, "_SMOOTH_ALONG", False)
-    fp0 = _fit(segs)
+    fp0 = _fit_rounded(segs)[1]
     assert _local_distance(segs, fp0, place, 2.0) > 0.6
     assert fp.n_segments <= fp0.n_segments

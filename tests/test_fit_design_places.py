@@ -37,6 +37,20 @@ def _rounded(segs) -> np.ndarray:
     return w[np.r_[True, (w[1:] != w[:-1]).any(axis=1)]]
 
 
+def _scaled(segs, k: float):
+    """The design ``segs`` (e.g. in font units) with every point times ``k``."""
+    return [(kind, *[(x * k, y * k) for x, y in p]) for kind, *p in segs]
+
+
+def _fit_rounded(segs):
+    """The design rounded (:func:`_rounded`) and fitted as one closed path at the defaults,
+    with zero violations of the stated bound asserted: (input points, fitted path)."""
+    w = _rounded(segs)
+    fp = fit_paths([w], [True])[0]
+    assert not check_fit(w, fp, 0.02, 0.02, report=True)["violation"]
+    return w, fp
+
+
 def _local_distance(segs, fp, place, r: float, truth=None) -> float:
     """Both-ways distance of the fit and the design within ``r`` of ``place`` (``truth``: the
     design's dense points, by default ``segs`` flattened here)."""

@@ -8,8 +8,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from galvo_core import fit as fitmod
-from tests.test_fit_design_places import _local_distance, _rounded
+from tests.test_fit_design_places import _fit_rounded, _local_distance, _scaled
 
 #: NimbusRoman-Italic (URW base35) "x" (its design in font units, laid out as in the benches'
 #: text), to be set at em 2048: at (26927, 176) the right stroke's curve meets a 124-unit
@@ -54,10 +53,8 @@ def test_a_corner_side_takes_its_direction_from_the_design_line_step() -> None:
     """Before: the tip's joint at (55145.88, 359.76), 0.92 from the design's tip (55146.5,
     360.45), where the rounded input point (55146, 360) is 0.67 from it. After: the joint
     stays within 0.75 of the tip (no farther than the rounding's own 0.71 and a little)."""
-    segs = [(k, *[(x * 2.048, y * 2.048) for x, y in p]) for k, *p in _NIMBUS_ITALIC_X]
-    w = _rounded(segs)
-    fp = fitmod.fit_paths([w], [True])[0]
-    assert not fitmod.check_fit(w, fp, 0.02, 0.02, report=True)["violation"]
+    segs = _scaled(_NIMBUS_ITALIC_X, 2.048)
+    _, fp = _fit_rounded(segs)
     tip = np.array([26927.0, 176.0]) * 2.048
     assert _local_distance(segs, fp, tip, 3.0) <= 0.75
     assert len(fp.segments) <= 1.2 * len(segs)

@@ -11,7 +11,7 @@ import pytest
 
 from galvo_core import fit as fitmod
 from galvo_core import hpgl
-from tests.test_fit_design_places import _local_distance, _rounded
+from tests.test_fit_design_places import _fit_rounded, _local_distance, _scaled
 
 CORPUS = Path(__file__).resolve().parents[2] / "shared" / "corpus" / "plt"
 TEK = CORPUS / "vk2bea__hpgl-plotter__tektronix.hpgl"
@@ -63,9 +63,7 @@ def test_a_gap_end_beside_a_curve_that_is_no_line_is_kept() -> None:
     makes it one, so the line's start was dropped and the fit passed 0.67 from the design's
     corner. Thinned on its own, the rest is a few lines, each within the bound: the line's
     start is kept and the fit passes within 0.6 of the design there."""
-    w = _rounded(_NIMBUS_ITALIC_L)
-    fp = fitmod.fit_paths([w], [True])[0]
-    assert not fitmod.check_fit(w, fp, 0.02, 0.02, report=True)["violation"]
+    _, fp = _fit_rounded(_NIMBUS_ITALIC_L)
     ends = np.array([s.points[-1] for s in fp.segments])
     assert np.hypot(*(ends - [128.0, 99.0]).T).min() <= 0.71  # (a joint at the line's start)
     assert _local_distance(_NIMBUS_ITALIC_L, fp, np.array([128.0, 99.0]), 2.0) <= 0.6
@@ -107,10 +105,8 @@ def test_the_ends_of_a_design_line_between_two_curves_are_kept() -> None:
     the design's line-curve joint bends 0.97 off it (the rounded input is 0.46 there). With
     the design line's two ends kept, the fit follows the design: within 0.6 of it there, at
     most 1.2 times the design's count (issue 16's bound)."""
-    segs = [(k, *[(x * 2.048, y * 2.048) for x, y in p]) for k, *p in _NIMBUS_ITALIC_U]
-    w = _rounded(segs)
-    fp = fitmod.fit_paths([w], [True])[0]
-    assert not fitmod.check_fit(w, fp, 0.02, 0.02, report=True)["violation"]
+    segs = _scaled(_NIMBUS_ITALIC_U, 2.048)
+    _, fp = _fit_rounded(segs)
     joint = np.array([13049.0, 255.0]) * 2.048  # (the design line's end, the cubic's start)
     ends = np.array([s.points[-1] for s in fp.segments])
     assert np.hypot(*(ends - joint).T).min() <= 0.71

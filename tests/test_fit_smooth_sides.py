@@ -8,8 +8,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from galvo_core import fit as fitmod
-from tests.test_fit_design_places import _local_distance, _rounded
+from tests.test_fit_design_places import _fit_rounded, _local_distance, _scaled
 
 #: NimbusRoman-Italic (URW base35) "i"'s stem (its design in font units, laid out as in the
 #: benches' text), to be set at em 2048: a 37-unit line, then a 2-unit and a 2-unit line (a
@@ -41,10 +40,8 @@ def test_a_vertex_with_one_input_point_beyond_it_is_not_pulled_off_the_notch() -
     smooth and moved half a unit across the stem onto a quadratic through the curve's points
     before it and the one point after it: 0.94 from the design there, where the rounded
     input is 0.47. Left on its input point, the fit is within 0.6 of the design there."""
-    segs = [(k, *[(x * 2.048, y * 2.048) for x, y in p]) for k, *p in _NIMBUS_ITALIC_I]
-    w = _rounded(segs)
-    fp = fitmod.fit_paths([w], [True])[0]
-    assert not fitmod.check_fit(w, fp, 0.02, 0.02, report=True)["violation"]
+    segs = _scaled(_NIMBUS_ITALIC_I, 2.048)
+    _, fp = _fit_rounded(segs)
     notch = np.array([20194.0, 115.0]) * 2.048
     assert _local_distance(segs, fp, notch, 4.0) <= 0.6
     assert len(fp.segments) <= 1.2 * len(segs)

@@ -8,8 +8,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from galvo_core import fit as fitmod
-from tests.test_fit_design_places import _local_distance, _rounded
+from tests.test_fit_design_places import _fit_rounded, _local_distance, _scaled
 
 #: NimbusRoman-Italic (URW base35) "%"'s upper ring (its design in font units, laid out as in
 #: the benches' text), to be set at em 2048: at (34315, 593) the ring's outer curve comes up
@@ -38,10 +37,8 @@ def test_a_tip_cut_by_a_short_line_is_joined_at_its_sides_crossing() -> None:
     """Before: corners at (70275, 1213) and (70276, 1214) and a 0.8-unit line between them,
     0.84 from the design's tip (70275.07, 1214.46), whose own rounded point (70275, 1214) the
     thinning dropped. After: one joint 0.1 from the tip, one segment fewer."""
-    segs = [(k, *[(x * 2.048, y * 2.048) for x, y in p]) for k, *p in _NIMBUS_ITALIC_PERCENT]
-    w = _rounded(segs)
-    fp = fitmod.fit_paths([w], [True])[0]
-    assert not fitmod.check_fit(w, fp, 0.02, 0.02, report=True)["violation"]
+    segs = _scaled(_NIMBUS_ITALIC_PERCENT, 2.048)
+    _, fp = _fit_rounded(segs)
     tip = np.array([34314.0, 593.0]) * 2.048
     ends = np.array([s.points[-1] for s in fp.segments])
     assert np.hypot(*(ends - tip).T).min() <= 0.3
