@@ -3,9 +3,10 @@ its file, or with them in another order gives the same segments, bit for bit
 (:func:`galvo_core.fit.fit_paths` promises "the same result as one call per path"). An
 operator who deletes one outline, or a cache that re-fits one layer, must not see another
 outline change. (The quantum is the drawing's: a path too short to tell its grid takes the
-file's, so the lone fits here are given the file's quantum, one unit.) Before this test the smooth-stretch repair shared one re-fit budget and one
-split budget among all paths: 4 of the 29 DejaVu Sans contours below (and 11 of 98 of
-DejaVu Sans ExtraLight at em 2048) fitted differently alone."""
+file's, so the lone fits here are given the file's quantum, one unit.) Before this test the
+smooth-stretch repair shared one re-fit budget and one split budget among all paths: 4 of
+the 29 DejaVu Sans contours below (and 11 of 98 of DejaVu Sans ExtraLight at em 2048)
+fitted differently alone."""
 
 from __future__ import annotations
 

@@ -10,6 +10,7 @@ from _util import waved_ellipse, whole_units
 from galvo_core import fit as fitmod
 from galvo_core.fit import check_fit, fit_paths
 from galvo_core.geometry import flatten_cubic, point_polyline_distance
+from tests.test_fit_design_places import _fit_rounded, _local_distance
 
 BOUND = 0.02 + np.sqrt(0.5)  # e_per beyond the rounding of whole units
 
@@ -246,3 +247,23 @@ def test_a_corner_beside_a_sparse_curve_keeps_to_its_rounding():
     far = max(point_polyline_distance(near_d, dense).max(),
               point_polyline_distance(near_f, design).max())
     assert far <= 0.4
+
+
+#: FreeSans "&"'s inner loop (font units, em 1000, laid out as in the benches' text): four
+#: cubics, written whole-unit at em 1000
+_FREESANS_AMP_LOOP = [
+    ("cubic", (38423, 431), (38362, 501), (38353, 518), (38353, 553)),
+    ("cubic", (38353, 553), (38353, 605), (38387, 639), (38439, 639)),
+    ("cubic", (38439, 639), (38489, 639), (38526, 603), (38526, 554)),
+    ("cubic", (38526, 554), (38526, 509), (38501, 480), (38423, 431)),
+]
+
+
+def test_a_small_path_may_split_a_segment_far_off_its_estimates():
+    """A path of a few segments has no split in its 2 % share, but a segment 0.55 q or more
+    off the design estimates is split anyway (``_STRETCH_SPLIT_FAR``): here a 45-degree line
+    across the loop's upper-left curve, 0.71 from the design where the rounded input is 0.03,
+    becomes two segments within 0.1 of it."""
+    w, fp = _fit_rounded(_FREESANS_AMP_LOOP)
+    assert _local_distance(_FREESANS_AMP_LOOP, fp, np.array([38376.5, 615.5]), 3.0) <= 0.1
+    assert fp.n_segments <= 7
