@@ -3318,8 +3318,8 @@ def _gap_ends_kept(W, K, tlen, quanta, eps, coarse):
         add = np.setdiff1d(add, np.concatenate([K2[miss], K2[miss + 1]]))
     if len(add) == 0:
         return K, tlen
+    # (K2: K with add, from the last round above)
     path = np.searchsorted(last, np.searchsorted(K, add) - 1)  # (the segment's start's path)
-    K2 = np.sort(np.concatenate([K, add]))
     return K2, tlen + np.bincount(path, minlength=len(tlen))
 
 
@@ -4914,16 +4914,21 @@ class _Stretch:
 _STRETCH_CORNER_DEG = 15.0
 
 
-def _no_estimates_at_corners(points, is_cubic, tail, step, gfirst, seg_owner, valid):
+def _joint_tangents(points, tail, step, a, b):
+    """The end tangent of each segment ``a`` and the start tangent of each segment ``b``
+    (unnormalised: a line's chord, a cubic's end handle), from the shared control points."""
+    e = tail[a] + step[a]
+    return points[e - 1] - points[e - 2], points[tail[b]] - points[tail[b] - 1]
+
+
+def _no_estimates_at_corners(points, tail, step, gfirst, seg_owner, valid):
     """``valid`` (per input point, in place) False at each joint of the segments
     (``points``, ``tail``, ``step``; ``gfirst`` their first input points, ``seg_owner`` their
     paths) where they turn ``_STRETCH_CORNER_DEG`` degrees or more."""
     jb = np.flatnonzero(seg_owner[1:] == seg_owner[:-1]) + 1
     if len(jb) == 0:
         return
-    e = tail[jb - 1] + step[jb - 1]
-    t_end = points[e - 1] - points[e - 2]
-    t_start = points[tail[jb]] - points[tail[jb] - 1]
+    t_end, t_start = _joint_tangents(points, tail, step, jb - 1, jb)
     with np.errstate(invalid="ignore", divide="ignore"):
         corner = turn_deg(t_end, t_start) >= _STRETCH_CORNER_DEG
     jb = jb[corner]
@@ -4965,7 +4970,7 @@ def _smooth_stretches(W, arc, points, is_cubic, tail, step, gfirst, glast, seg_o
     take[paths] = True
     rp = take[seg_owner]
     est, valid = _stretch_estimates(W, arc, ps[paths], pe[paths], quant[paths])
-    _no_estimates_at_corners(points, is_cubic, tail, step, gfirst, seg_owner, valid)
+    _no_estimates_at_corners(points, tail, step, gfirst, seg_owner, valid)
     # per segment: the largest distance of a smooth point's estimate (or of the middle
     # between two smooth neighbours' estimates) to it
     sr = np.flatnonzero(rp)
@@ -5367,16 +5372,12 @@ def _tips_joined(W, points, is_cubic, tail, step, gfirst, glast, seg_owner, quan
     short = (q > 0.0) & (n_in >= 1) & (n_in <= _TIP_STEPS) & (
         (ln <= _TIP_SHORT * q) | (many & (ln <= _TIP_SHORT_MANY * q)))
     c, A, B = c[short], A[short], B[short]
-    turn_min = np.where(many[short] & (ln[short] <= _TIP_SHORT_MANY * q[short]),
-                        _TIP_TURN_MANY, _TIP_TURN_DEG)
+    turn_min = np.where(many[short], _TIP_TURN_MANY, _TIP_TURN_DEG)
     if len(c) == 0:
         return unchanged
     a, b = c - 1, c + 1
     # the segment before: its end tangent; the one after: its start tangent
-    ea = points[tail[a] + step[a] - 1]
-    pa = np.where(is_cubic[a, None], points[tail[a] + 1], points[tail[a] - 1])
-    ta = ea - pa
-    tb = points[tail[b]] - B  # (a line's end, a cubic's first handle)
+    ta, tb = _joint_tangents(points, tail, step, a, b)
     u = B - A
 
     def cross(x, y):

@@ -68,13 +68,12 @@ def test_only_a_corner_joints_own_estimate_is_dropped() -> None:
     of the rounding leaves a twisted cubic that only they correct)."""
     points = np.array([[0, 0], [10, 0], [10, 10],  # path 0: lines (0,0)-(10,0)-(10,10)
                        [20, 0], [30, 0], [40, 0.875]], dtype=np.float64)
-    is_cubic = np.zeros(4, dtype=bool)
     tail = np.array([1, 2, 4, 5])
     step = np.ones(4, dtype=np.intp)
     gfirst = np.array([0, 10, 21, 31])
     seg_owner = np.array([0, 0, 1, 1])
     valid = np.ones(42, dtype=bool)
-    fitmod._no_estimates_at_corners(points, is_cubic, tail, step, gfirst, seg_owner, valid)
+    fitmod._no_estimates_at_corners(points, tail, step, gfirst, seg_owner, valid)
     assert np.flatnonzero(~valid).tolist() == [10]
 
 
