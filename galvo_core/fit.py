@@ -3891,14 +3891,49 @@ def _seg_fits(W, ctrl, first, last, bound, h) -> bool:
     points first..last and its samples (at most h apart; the check keeps h / 2 spare)
     within ``bound`` of their polyline."""
     loc = W[first:last + 1]
+    ctrl = np.ascontiguousarray(ctrl, dtype=np.float64)
     if len(ctrl) == 2:
         d = point_segment_distance(loc, ctrl[0], ctrl[1])
+        if d.max() > bound:
+            return False
     else:
-        _, d = nearest_on_cubic(ctrl, loc, seeds=64, iters=8)
-    if d.max() > bound:
-        return False
-    return bool(_samples_within(np.ascontiguousarray(ctrl, dtype=np.float64), h, W, first,
-                                last, bound - 0.5 * h))
+        near = _points_near_cubic(ctrl, h, W, first, last, bound)
+        if near < 0:
+            _, d = nearest_on_cubic(ctrl, loc, seeds=64, iters=8)
+            near = int(d.max() <= bound)
+        if not near:
+            return False
+    return bool(_samples_within(ctrl, h, W, first, last, bound - 0.5 * h))
+
+
+#: :func:`_points_near_cubic` samples the cubic this many times h apart (the sagitta of
+#: its chords stays a few thousandths of the bound)
+_NEAR_CUBIC_STEP = 4.0
+
+
+@njit(cache=True, nogil=True)
+def _points_near_cubic(ctrl, h, W, first, last, bound):  # pragma: no cover (compiled)
+    """Whether the input points first..last lie within ``bound`` of the cubic ``ctrl``:
+    1 where all lie within bound less the chords' sagitta of its samples' polyline
+    (:func:`_seg_samples` at ``_NEAR_CUBIC_STEP`` h; the sagitta at most |B''| du² / 8,
+    |B''| at most 6 x the largest second difference of the control points), 0 where one
+    lies farther than bound plus the sagitta from it, -1 where neither is shown
+    (measure)."""
+    samp = _seg_samples(ctrl, _NEAR_CUBIC_STEP * h)
+    dd = 0.0
+    for k in range(2):
+        dd = max(dd, math.hypot(ctrl[k + 2, 0] - 2.0 * ctrl[k + 1, 0] + ctrl[k, 0],
+                                ctrl[k + 2, 1] - 2.0 * ctrl[k + 1, 1] + ctrl[k, 1]))
+    du = 1.0 / (samp.shape[0] - 1)
+    sag = 0.75 * dd * du * du + 1e-9 * (1.0 + bound)
+    lim = bound - sag
+    if not lim > 0.0:
+        return -1
+    d, over = _max_over(W[first:last + 1], samp, lim, _NEAR_SEGMENTS, lim, bound + sag,
+                        _WITHIN_STRIDE)
+    if over:
+        return 0
+    return 1 if d <= lim else -1
 
 
 #: samples in order along a polyline are measured first against this many of its segments
@@ -4444,10 +4479,6 @@ def _stretch_targets(W, est, valid, f, e, q):
     return _targets_kernel(W, est, valid, f, e, _STRETCH_STEP * q, _STRETCH_TARGETS)
 
 
-#: no cubic yet (:func:`_ls_step`)
-_NO_CTRL = np.zeros((0, 2))
-
-
 @njit(cache=True, nogil=True)
 def _ls_step(ctrl, t, tg, s, b1, b2) -> None:  # pragma: no cover (compiled)
     """:func:`_ls_cubic`'s elementwise part (the former numpy arithmetic, the same
@@ -4496,43 +4527,73 @@ def _ls_step(ctrl, t, tg, s, b1, b2) -> None:  # pragma: no cover (compiled)
         b2[k] = 3.0 * sk * tk * tk
 
 
-@njit(cache=True, nogil=True)
-def _ls_rest(tg, s3, t3, p0, p3, r) -> None:  # pragma: no cover (compiled)
-    """:func:`_ls_cubic`'s residuals r = tg - s³ p0 - t³ p3 (the former numpy arithmetic;
-    s³, t³ numpy's powers)."""
-    for k in range(tg.shape[0]):
-        r[k, 0] = (tg[k, 0] - s3[k] * p0[0]) - t3[k] * p3[0]
-        r[k, 1] = (tg[k, 1] - s3[k] * p0[1]) - t3[k] * p3[1]
-
-
 def _ls_cubic(p0, p3, tg):
     """The cubic from p0 to p3 whose inner control points fit the targets ``tg`` best
     (least squares, parameters re-fitted by Newton steps towards the nearest points); None
-    when degenerate."""
-    c = np.hypot(*np.diff(tg, axis=0).T)
-    tot = c.sum()
-    if len(tg) < 4 or tot <= 0.0:
+    when degenerate (compiled: :func:`_ls_cubic_kernel`)."""
+    out = np.empty((4, 2))
+    if not _ls_cubic_kernel(np.asarray(p0, dtype=np.float64), np.asarray(p3, dtype=np.float64),
+                            np.ascontiguousarray(tg, dtype=np.float64), out):
         return None
-    t = np.r_[0.0, np.cumsum(c)] / tot
-    ctrl = None
-    s = np.empty(len(t))
-    b1 = np.empty(len(t))
-    b2 = np.empty(len(t))
-    r = np.empty((len(t), 2))
+    return out
+
+
+@njit(cache=True, nogil=True)
+def _ls_cubic_kernel(p0, p3, tg, out):  # pragma: no cover (compiled)
+    """:func:`_ls_cubic` compiled: the chord-length parameters, then ``_STRETCH_ITERS``
+    rounds of (a Newton step of each target's parameter towards its nearest point on the
+    cubic so far, :func:`_ls_step`; the 2x2 normal equations of the inner control points
+    with the ends fixed); out gets the cubic; False when there is none (fewer than 4
+    targets, no length, the first system singular). A singular later system keeps the
+    cubic before it."""
+    n = tg.shape[0]
+    if n < 4:
+        return False
+    t = np.empty(n)
+    t[0] = 0.0
+    for k in range(1, n):
+        t[k] = t[k - 1] + math.hypot(tg[k, 0] - tg[k - 1, 0], tg[k, 1] - tg[k - 1, 1])
+    tot = t[n - 1]
+    if not tot > 0.0:
+        return False
+    for k in range(n):
+        t[k] /= tot
+    s = np.empty(n)
+    b1 = np.empty(n)
+    b2 = np.empty(n)
+    ctrl = np.zeros((4, 2))
+    none = np.zeros((0, 2))
+    have = False
     for it in range(_STRETCH_ITERS + 1):
-        # (compiled: a Newton step of each target's parameter towards its nearest point
-        # where there is a cubic, then the weights; the products below stay numpy's, BLAS)
-        _ls_step(ctrl if ctrl is not None else _NO_CTRL, t, tg, s, b1, b2)
+        _ls_step(ctrl if have else none, t, tg, s, b1, b2)
         if it == _STRETCH_ITERS:
-            return ctrl
-        _ls_rest(tg, s ** 3, t ** 3, p0, p3, r)
-        a11, a12, a22 = b1 @ b1, b1 @ b2, b2 @ b2
+            break
+        a11 = a12 = a22 = 0.0
+        r1x = r1y = r2x = r2y = 0.0
+        for k in range(n):
+            s3 = s[k] * s[k] * s[k]
+            t3 = t[k] * t[k] * t[k]
+            rx = (tg[k, 0] - s3 * p0[0]) - t3 * p3[0]
+            ry = (tg[k, 1] - s3 * p0[1]) - t3 * p3[1]
+            a11 += b1[k] * b1[k]
+            a12 += b1[k] * b2[k]
+            a22 += b2[k] * b2[k]
+            r1x += b1[k] * rx
+            r1y += b1[k] * ry
+            r2x += b2[k] * rx
+            r2y += b2[k] * ry
         det = a11 * a22 - a12 * a12
         if not det > 1e-12 * max(a11 * a22, 1e-300):
-            return ctrl
-        r1, r2 = b1 @ r, b2 @ r
-        ctrl = np.stack([p0, (a22 * r1 - a12 * r2) / det, (a11 * r2 - a12 * r1) / det, p3])
-    return ctrl
+            break
+        ctrl[0, 0], ctrl[0, 1] = p0[0], p0[1]
+        ctrl[1, 0] = (a22 * r1x - a12 * r2x) / det
+        ctrl[1, 1] = (a22 * r1y - a12 * r2y) / det
+        ctrl[2, 0] = (a11 * r2x - a12 * r1x) / det
+        ctrl[2, 1] = (a11 * r2y - a12 * r1y) / det
+        ctrl[3, 0], ctrl[3, 1] = p3[0], p3[1]
+        have = True
+    out[:] = ctrl
+    return have
 
 
 def _design_off(W, est, valid, ctrl, f, e, h, limit=math.inf):
@@ -4550,6 +4611,24 @@ def _design_off(W, est, valid, ctrl, f, e, h, limit=math.inf):
 
 
 @njit(cache=True, nogil=True)
+def _seg_samples_count(ctrl, h):  # pragma: no cover (compiled)
+    """How many samples :func:`_seg_samples` takes."""
+    if ctrl.shape[0] == 4:
+        length = (math.hypot(ctrl[1, 0] - ctrl[0, 0], ctrl[1, 1] - ctrl[0, 1])
+                  + math.hypot(ctrl[2, 0] - ctrl[1, 0], ctrl[2, 1] - ctrl[1, 1])) \
+            + math.hypot(ctrl[3, 0] - ctrl[2, 0], ctrl[3, 1] - ctrl[2, 1])
+        return max(16, int(math.ceil(length / h)) + 1)
+    length = math.hypot(ctrl[1, 0] - ctrl[0, 0], ctrl[1, 1] - ctrl[0, 1])
+    return max(2, int(math.ceil(length / h)) + 1)
+
+
+#: :func:`_samples_within` measures every this many samples first (:func:`_max_over`)
+_WITHIN_STRIDE = 8
+#: ... :func:`_design_off`, every this many of its targets and samples
+_DESIGN_STRIDE = 4
+
+
+@njit(cache=True, nogil=True)
 def _seg_samples(ctrl, h):  # pragma: no cover (compiled)
     """The samples of the segment ``ctrl`` (2 or 4 points) at most h apart that
     :func:`_seg_fits` and :func:`_design_off` take: m = max(2 (16 for a cubic),
@@ -4557,14 +4636,7 @@ def _seg_samples(ctrl, h):  # pragma: no cover (compiled)
     order) at np.linspace(0, 1, m), cubic_eval's arithmetic or the line's ctrl[0] +
     t (ctrl[1] - ctrl[0]) (the same numbers)."""
     cub = ctrl.shape[0] == 4
-    if cub:
-        length = (math.hypot(ctrl[1, 0] - ctrl[0, 0], ctrl[1, 1] - ctrl[0, 1])
-                  + math.hypot(ctrl[2, 0] - ctrl[1, 0], ctrl[2, 1] - ctrl[1, 1])) \
-            + math.hypot(ctrl[3, 0] - ctrl[2, 0], ctrl[3, 1] - ctrl[2, 1])
-        m = max(16, int(math.ceil(length / h)) + 1)
-    else:
-        length = math.hypot(ctrl[1, 0] - ctrl[0, 0], ctrl[1, 1] - ctrl[0, 1])
-        m = max(2, int(math.ceil(length / h)) + 1)
+    m = _seg_samples_count(ctrl, h)
     samp = np.empty((m, 2))
     c3 = ctrl.reshape(1, ctrl.shape[0], 2)
     step = 1.0 / (m - 1)
@@ -4585,13 +4657,11 @@ def _samples_within(ctrl, h, W, first, last, lim):  # pragma: no cover (compiled
     """:func:`_seg_fits`' polyline side compiled: whether the samples
     (:func:`_seg_samples`) all lie within ``lim`` of the polyline W[first..last]
     (:func:`_polyline_distance_over`'s numbers; NaN fails)."""
-    samp = _seg_samples(ctrl, h)
-    # (up to the first sample over ``lim``: the answer is False then anyway)
-    d, cnt = _distance_over_upto(samp, W[first:last + 1], lim, _NEAR_SEGMENTS, lim)
-    for t in range(cnt):
-        if not d[t] <= lim:
-            return False
-    return True
+    # (the samples near a measured one that lie within lim by the distance between them
+    # are not measured: the same answer, :func:`_max_over`)
+    d, over = _max_over(_seg_samples(ctrl, h), W[first:last + 1], lim, _NEAR_SEGMENTS, lim, lim,
+                        _WITHIN_STRIDE)
+    return not over and d <= lim
 
 
 @njit(cache=True, nogil=True)
@@ -4618,16 +4688,13 @@ def _design_off_kernel(W, est, valid, ctrl, f, e, h, limit, out):  # pragma: no 
                 nt += 1
     d1 = 0.0
     if nt:
-        # (finite, moderate coordinates give no NaN distance: the first target over
-        # ``limit`` decides, the others need not be measured)
+        # (finite, moderate coordinates give no NaN distance: a target over ``limit``
+        # decides, the others need not be measured; only the targets that can be the
+        # largest are, :func:`_max_over`)
         stop = limit if _moderate(tp, nt) and _moderate(samp, m) else np.inf
-        d, cnt = _distance_over_upto(tp[:nt], samp, lim, 64, stop)
-        if cnt < nt:
+        d1, over = _max_over(tp[:nt], samp, lim, 64, -np.inf, stop, _DESIGN_STRIDE)
+        if over:
             return False
-        d1 = d[0]
-        for t in range(1, nt):  # (np.max: NaN wins)
-            if not d[t] <= d1 and d1 == d1:
-                d1 = d[t]
     out[0] = d1
     if d1 > limit:
         return False
@@ -4636,12 +4703,7 @@ def _design_off_kernel(W, est, valid, ctrl, f, e, h, limit, out):  # pragma: no 
         src = est if valid[g] else W
         poly[g - f, 0] = src[g, 0]
         poly[g - f, 1] = src[g, 1]
-    d = _distance_over(samp, poly, lim, _NEAR_SEGMENTS)
-    d2 = d[0]
-    for t in range(1, m):
-        if not d[t] <= d2 and d2 == d2:
-            d2 = d[t]
-    out[1] = d2
+    out[1] = _max_over(samp, poly, lim, _NEAR_SEGMENTS, -np.inf, np.inf, _DESIGN_STRIDE)[0]
     return True
 
 
@@ -4698,6 +4760,118 @@ def _distance_over_upto(samp, poly, lim, k, stop):  # pragma: no cover (compiled
     if ms:
         cnt = _over_kernel_upto(samp, sstep, poly, pstep, lim, k, d, stop)
     return d, cnt
+
+
+@njit(cache=True, nogil=True)
+def _max_over(samp, poly, lim, k, floor, stop, stride):  # pragma: no cover (compiled)
+    """The largest distance of the points ``samp`` (in order along ``poly``) to the
+    polyline ``poly`` as :func:`_distance_over_upto` measures each (the segments near its
+    share of the length, exactly where over ``lim``: an upper bound, exact when over
+    ``lim``), measured only where it can matter. First an upper bound of each point's
+    distance: its distance to the segment a walk along the polyline reaches from the
+    previous point's (a local nearest), or, where within ``floor`` (at most ``lim``) by
+    the path length from the last point so bounded (the distance to a fixed polyline
+    moves no more than the point does; every ``stride``-th point bounded anyway); then
+    the point of the largest bound measured, and every point whose bound is over the
+    largest so far and ``floor``. Returns (the largest, True) at the first distance over
+    ``stop`` (that distance), else (the largest, False); NaN or huge coordinates: every
+    point measured, in order (np.max's NaN)."""
+    n = poly.shape[0]
+    ms = samp.shape[0]
+    if ms == 0:
+        return -np.inf, False
+    if not (_moderate(samp, ms) and _moderate(poly, n)):
+        d, cnt = _distance_over_upto(samp, poly, lim, k, stop)
+        best = d[0]
+        for t in range(1, cnt):
+            if not d[t] <= best and best == best:
+                best = d[t]
+        return (d[cnt - 1], True) if cnt < ms else (best, False)
+    # (moderate coordinates: sqrt of the squares, not libm's slower hypot; the lengths
+    # place the windows and bound the moves, both with room for the rounding)
+    cs = np.empty(ms)
+    cs[0] = 0.0
+    for t in range(ms - 1):
+        dx = samp[t + 1, 0] - samp[t, 0]
+        dy = samp[t + 1, 1] - samp[t, 1]
+        cs[t + 1] = cs[t] + math.sqrt(dx * dx + dy * dy)
+    cum = np.empty(n)
+    cum[0] = 0.0
+    for t in range(n - 1):
+        dx = poly[t + 1, 0] - poly[t, 0]
+        dy = poly[t + 1, 1] - poly[t, 1]
+        cum[t + 1] = cum[t] + math.sqrt(dx * dx + dy * dy)
+    scale = cs[ms - 1] > 0.0
+    r = cum[n - 1] / cs[ms - 1] if scale else 1.0
+    tol = 1e-9 * (1.0 + cs[ms - 1] + cum[n - 1])
+    fl = min(floor, lim)
+    ub = np.empty(ms)
+    top = 0
+    j = 0
+    la = -1
+    for t in range(ms):
+        px = samp[t, 0]
+        py = samp[t, 1]
+        if la >= 0 and t - la < stride:
+            b = ub[la] + (cs[t] - cs[la]) + tol
+            if b <= fl:
+                ub[t] = b
+                continue
+        if n == 1:
+            ub[t] = math.hypot(px - poly[0, 0], py - poly[0, 1])
+        else:
+            dj = _seg_d2(px, py, poly, j, True)
+            while j + 2 < n:
+                dn = _seg_d2(px, py, poly, j + 1, True)
+                if dn > dj:
+                    break
+                j += 1
+                dj = dn
+            while j > 0:
+                dn = _seg_d2(px, py, poly, j - 1, True)
+                if dn >= dj:
+                    break
+                j -= 1
+                dj = dn
+            ub[t] = math.sqrt(dj) * (1.0 + 1e-12) + tol
+        la = t
+        if ub[t] > ub[top]:
+            top = t
+    best = -np.inf
+    for rnd in range(2):
+        for t in range(ms):
+            if rnd == 0 and t != top or rnd == 1 and (t == top or ub[t] <= max(best, fl)):
+                continue
+            d = _one_over(samp[t, 0], samp[t, 1], poly, n, cum, cs[t] * r if scale else cs[t],
+                          k, lim, min(max(best, fl), stop))
+            if d > stop:
+                return d, True
+            best = max(best, d)
+    return best, False
+
+
+@njit(cache=True, nogil=True)
+def _one_over(px, py, poly, n, cum, val, k, lim, need):  # pragma: no cover (compiled)
+    """One point's distance to the polyline as :func:`_over_kernel_upto` measures it
+    (``val`` its share of the polyline's length ``cum``), or where the window's distance
+    is ``need`` or less, that (an upper bound: the exact one changes nothing there)."""
+    if n == 1:
+        return math.hypot(px - poly[0, 0], py - poly[0, 1])
+    if n <= 2 * k + 2:
+        return _brute_d(px, py, poly, 0, n)
+    lo = 0
+    hi = n
+    while lo < hi:  # (np.searchsorted, side left)
+        mid = (lo + hi) >> 1
+        if cum[mid] < val:
+            lo = mid + 1
+        else:
+            hi = mid
+    at = lo - 1
+    d = _win_d(px, py, poly, 0, n - 1, at, k, cum, np.inf)
+    if d > lim and d > need:
+        d = _full_d(px, py, poly, 0, n, at, cum, d)
+    return d
 
 
 def _estimates_off(points, is_cubic, tail, gfirst, glast, sr, est, valid):
