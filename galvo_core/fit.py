@@ -3893,8 +3893,7 @@ def _seg_fits(W, ctrl, first, last, bound, h) -> bool:
     loc = W[first:last + 1]
     ctrl = np.ascontiguousarray(ctrl, dtype=np.float64)
     if len(ctrl) == 2:
-        d = point_segment_distance(loc, ctrl[0], ctrl[1])
-        if d.max() > bound:
+        if not _points_near_line(ctrl, W, first, last, bound):
             return False
     else:
         near = _points_near_cubic(ctrl, h, W, first, last, bound)
@@ -3904,6 +3903,25 @@ def _seg_fits(W, ctrl, first, last, bound, h) -> bool:
         if not near:
             return False
     return bool(_samples_within(ctrl, h, W, first, last, bound - 0.5 * h))
+
+
+@njit(cache=True, nogil=True)
+def _points_near_line(ctrl, W, first, last, bound):  # pragma: no cover (compiled)
+    """Whether the input points first..last all lie within ``bound`` of the line ``ctrl``
+    (:func:`point_segment_distance`'s arithmetic; NaN fails)."""
+    abx = ctrl[1, 0] - ctrl[0, 0]
+    aby = ctrl[1, 1] - ctrl[0, 1]
+    den = abx * abx + aby * aby
+    for g in range(first, last + 1):
+        apx = W[g, 0] - ctrl[0, 0]
+        apy = W[g, 1] - ctrl[0, 1]
+        u = (apx * abx + apy * aby) / den if den > 0.0 else 0.0
+        if u != u:
+            return False
+        u = min(max(u, 0.0), 1.0)
+        if not math.hypot(apx - u * abx, apy - u * aby) <= bound:
+            return False
+    return True
 
 
 #: :func:`_points_near_cubic` samples the cubic this many times h apart (the sagitta of
@@ -4773,9 +4791,9 @@ def _max_over(samp, poly, lim, k, floor, stop, stride):  # pragma: no cover (com
     the path length from the last point so bounded (the distance to a fixed polyline
     moves no more than the point does; every ``stride``-th point bounded anyway); then
     the point of the largest bound measured, and every point whose bound is over the
-    largest so far and ``floor``. Returns (the largest, True) at the first distance over
-    ``stop`` (that distance), else (the largest, False); NaN or huge coordinates: every
-    point measured, in order (np.max's NaN)."""
+    largest so far and ``floor`` (a point whose bound is over ``stop``: at once).
+    Returns (a distance over ``stop``, True) where there is one, else (the largest,
+    False); NaN or huge coordinates: every point measured, in order (np.max's NaN)."""
     n = poly.shape[0]
     ms = samp.shape[0]
     if ms == 0:
@@ -4835,6 +4853,12 @@ def _max_over(samp, poly, lim, k, floor, stop, stride):  # pragma: no cover (com
                 dj = dn
             ub[t] = math.sqrt(dj) * (1.0 + 1e-12) + tol
         la = t
+        if ub[t] > stop:  # (a point possibly over the stop: measured at once)
+            d = _one_over(px, py, poly, n, cum, cs[t] * r if scale else cs[t], k, lim,
+                          min(fl, stop))
+            if d > stop:
+                return d, True
+            ub[t] = d
         if ub[t] > ub[top]:
             top = t
     best = -np.inf
@@ -5172,6 +5196,17 @@ def _smooth_stretches(W, arc, points, is_cubic, tail, step, gfirst, glast, seg_o
                      ).astype(np.int64)
     rep: dict[int, list] = {}
     done = np.zeros(ns, dtype=bool)
+    oldoff: dict[int, tuple[float, float]] = {}
+
+    def before(x: int) -> tuple[float, float]:
+        """Segment x's distances to the estimates as fitted (:func:`_design_off`; once)."""
+        r = oldoff.get(x)
+        if r is None:
+            r = oldoff[x] = cast(tuple[float, float], _design_off(
+                W, est, valid, _seg_ctrl(points, is_cubic, tail, x), gfirst[x], glast[x],
+                _STRETCH_LOOK * float(quant[seg_owner[x]])))
+        return r
+
     offb = off[bad]
     for k in np.argsort(-offb, kind="stable").tolist():
         s = int(sr[bad][k])
@@ -5181,16 +5216,6 @@ def _smooth_stretches(W, arc, points, is_cubic, tail, step, gfirst, glast, seg_o
         # a split beyond the path's share where the segment lies far off the estimates
         may_split = splits[o] > 0 or offb[k] >= _STRETCH_SPLIT_FAR * quant[o]
         q = float(quant[o])
-        old = {}
-        oldoff = {}
-
-        def before(x, old=old, oldoff=oldoff, q=q):
-            if x not in old:
-                old[x] = _seg_ctrl(points, is_cubic, tail, x)
-                oldoff[x] = _design_off(W, est, valid, old[x], gfirst[x], glast[x],
-                                        _STRETCH_LOOK * q)
-            return oldoff[x]
-
         best = None  # (split used, (d1, d2), {segment: [(ctrl, first, last)]})
 
         def consider(new, used, q=q):
@@ -5267,8 +5292,7 @@ def _smooth_stretches(W, arc, points, is_cubic, tail, step, gfirst, glast, seg_o
         ca = _seg_ctrl(points, is_cubic, tail, a)
         cb = _seg_ctrl(points, is_cubic, tail, b)
         fa, ea, fb, eb = int(gfirst[a]), int(glast[a]), int(gfirst[b]), int(glast[b])
-        oa = _design_off(W, est, valid, ca, fa, ea, _STRETCH_LOOK * q)
-        ob = _design_off(W, est, valid, cb, fb, eb, _STRETCH_LOOK * q)
+        oa, ob = before(a), before(b)
         ra = st.shapes(ca[0], v, fa, ea, o, oa[0], not is_cubic[a], ca)
         if ra is None or ra[0][1] > max(oa[1], ra[0][0]):
             continue
@@ -5314,8 +5338,7 @@ def _smooth_stretches(W, arc, points, is_cubic, tail, step, gfirst, glast, seg_o
             ca = _seg_ctrl(points, is_cubic, tail, a)
             cb = _seg_ctrl(points, is_cubic, tail, b)
             fa, ea, fb, eb = int(gfirst[a]), int(glast[a]), int(gfirst[b]), int(glast[b])
-            oa = _design_off(W, est, valid, ca, fa, ea, _STRETCH_LOOK * q)
-            ob = _design_off(W, est, valid, cb, fb, eb, _STRETCH_LOOK * q)
+            oa, ob = before(a), before(b)
             ra = st.shapes(ca[0], v, fa, ea, o, oa[0], not is_cubic[a], ca)
             if ra is None:
                 continue
