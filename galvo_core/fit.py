@@ -4793,7 +4793,11 @@ def _max_over(samp, poly, lim, k, floor, stop, stride):  # pragma: no cover (com
     the point of the largest bound measured, and every point whose bound is over the
     largest so far and ``floor`` (a point whose bound is over ``stop``: at once).
     Returns (a distance over ``stop``, True) where there is one, else (the largest,
-    False); NaN or huge coordinates: every point measured, in order (np.max's NaN)."""
+    False); NaN or huge coordinates: every point measured, in order (np.max's NaN).
+    With ``floor`` at ``lim`` only the verdict "all within lim" is exact (points under the
+    floor are not measured: the largest may be missed below it); ``stop`` at least
+    ``floor``. Values at or under ``lim`` are upper bounds, and may differ from measuring
+    every point (its windows): a ``stop`` under ``lim`` compares such bounds."""
     n = poly.shape[0]
     ms = samp.shape[0]
     if ms == 0:

@@ -1,7 +1,8 @@
 """Issue 16 (s7, sparse whole-unit speed): the smooth-stretch pass's compiled steps
 (:func:`fit._design_off`, :func:`fit._seg_fits`) must give the numbers of the numpy code
-they replaced, so the fitted arrays stay the same bit for bit, also where (s14) they
-measure only the samples that can matter (:func:`fit._max_over`). Each test compares them
+they replaced, also where (s14) they measure only the samples that can matter
+(:func:`fit._max_over`: the same numbers over the exactness limit, upper bounds at or under
+it that may differ from the former windows' in rare cases). Each test compares them
 with that former code, copied here, on arcs rounded to whole units like the fitter's
 rounded input. :func:`fit._ls_cubic`, compiled whole in s14, sums its normal equations in
 order (numpy's dot products sum in blocks): the same cubic up to that rounding."""
