@@ -16,8 +16,10 @@ counts: equal hashes = the same fit bit for bit). ``--profile`` adds a cProfile 
 ``--sparse`` (issue 16, fifth round): the same on 1 M whole-unit points of font-like smooth
 closed outlines (516 ellipses with a k-lobed wobble, points 1-2 units apart, seeded).
 
+``--sparse --truth`` (s14): no timing; each sparse path's fit against its unrounded curve.
+
 Usage: python bench/bench_precision_speed.py [--reps 3] [--code DIR] [--only exact|whole]
-       [--nesting] [--plt FILE | --sparse [--profile]]
+       [--nesting] [--plt FILE | --sparse [--profile | --truth]]
 """
 
 from __future__ import annotations
@@ -45,6 +47,9 @@ def main() -> None:
                     help="fit_drawing on 1 M whole-unit points of font-like outlines only")
     ap.add_argument("--profile", action="store_true",
                     help="with --plt/--sparse: cProfile one run")
+    ap.add_argument("--truth", action="store_true",
+                    help="with --sparse: each path's fit against its unrounded curve (both "
+                         "ways), no timing")
     a = ap.parse_args()
     root = os.path.abspath(a.code) if a.code else os.path.join(HERE, "..")
     sys.path.insert(0, root)
@@ -65,7 +70,11 @@ def main() -> None:
         import galvo_core
         from galvo_core import hpgl
 
-        d = hpgl.read_file(a.plt) if a.plt else sparse_outlines(Drawing, Path)
+        truths: list = []
+        d = hpgl.read_file(a.plt) if a.plt else sparse_outlines(Drawing, Path, truths=truths)
+        if a.truth and a.sparse:
+            sparse_truth(d, truths, fit_drawing)
+            return
         try:
             from galvo_core.parallel import THREADS as threads
         except ImportError:  # (older code: one thread)
@@ -145,9 +154,11 @@ def main() -> None:
                   f"wall {wall:.2f} s  {segments(f)} segments", flush=True)
 
 
-def sparse_outlines(Drawing, Path, n_points: int = 1_000_000):  # noqa: N803 (the classes)
+def sparse_outlines(Drawing, Path, n_points: int = 1_000_000,  # noqa: N803 (the classes)
+                    truths: list | None = None):
     """Closed smooth outlines rounded to whole units, font-like spacing (1-2 units between
-    points): ellipses (axes 60-400) with a k-lobed radial wobble, seeded."""
+    points): ellipses (axes 60-400) with a k-lobed radial wobble, seeded. ``truths``: gets
+    each outline's unrounded curve (40,000 points, closed)."""
     rng = np.random.default_rng(5)
     paths = []
     n = 0
@@ -161,13 +172,47 @@ def sparse_outlines(Drawing, Path, n_points: int = 1_000_000):  # noqa: N803 (th
         r = 1.0 + amp * np.cos(k * t)
         x, y = ax * r * np.cos(t), ay * r * np.sin(t)
         c, s = np.cos(rot), np.sin(rot)
-        w = np.round(np.stack([cx + c * x - s * y, cy + s * x + c * y], axis=1))
+        tr = np.stack([cx + c * x - s * y, cy + s * x + c * y], axis=1)
+        if truths is not None:
+            truths.append(np.vstack([tr, tr[:1]]))
+        w = np.round(tr)
         w = w[np.r_[True, (w[1:] != w[:-1]).any(axis=1)]]
         if (w[-1] == w[0]).all():
             w = w[:-1]
         paths.append(w)
         n += len(w)
     return Drawing(tuple(Path(p, 1, True) for p in paths), name="sparse")
+
+
+def sparse_truth(d, truths, fit_drawing) -> None:
+    """Per path of the sparse outlines: the fit's both-ways distance to the unrounded
+    curve (the fit flattened at 0.01 units; :func:`fonts.curve_distance`); the largest,
+    the 99th percentile and mean of the per-path largest, the paths over 0.6, and the
+    worst paths with the place and the design's direction there (degrees from the
+    nearest axis: 0 axis-parallel, 45 diagonal)."""
+    from bench_precision import fitted_dense
+    from fonts import curve_distance
+
+    from galvo_core.geometry import point_polyline_distance
+
+    f = fit_drawing(d)
+    res = []
+    for fp, tr in zip(f, truths, strict=True):
+        res.append(curve_distance(fitted_dense(fp, 0.01), tr))
+    r = np.array(res)
+    print(f"sparse: {len(r)} paths, {sum(len(x.is_cubic) for x in f)} segments; distance to the "
+          f"design per path: max {r.max():.3f}, p99 {np.percentile(r, 99):.3f}, mean "
+          f"{r.mean():.3f}; paths over 0.6: {int((r > 0.6).sum())}")
+    for i in np.argsort(-r)[:8].tolist():
+        dd = fitted_dense(f[i], 0.01)
+        tr = truths[i]
+        a = point_polyline_distance(dd, tr)
+        p = dd[int(np.argmax(a))]
+        j = int(np.argmin(((tr - p) ** 2).sum(axis=1)))
+        v = tr[(j + 20) % len(tr)] - tr[j - 20]
+        ang = float(np.degrees(np.arctan2(v[1], v[0])) % 90)
+        print(f"  path {i}: {r[i]:.3f} (fit to design {a.max():.3f} at "
+              f"({p[0]:.1f}, {p[1]:.1f}), {min(ang, 90 - ang):.0f} deg from an axis)")
 
 
 if __name__ == "__main__":
