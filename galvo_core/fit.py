@@ -5039,6 +5039,11 @@ class _Stretch:
         self.budget = budget  # re-fits left, per path (each path's own: the same result
         # whatever other paths are fitted with it)
 
+    def spend(self, o) -> None:
+        """One re-fit of path o's budget used without making it (as :meth:`shapes`)."""
+        if self.budget[o] > 0:
+            self.budget[o] -= 1
+
     def shapes(self, p0, p1, f, e, o, limit, line_ok, old=None):
         """The best piece from p0 to p1 over the input points f..e: the line (when
         ``line_ok``), the least-squares cubic, the cubic ``old`` with its ends moved (its
@@ -5254,6 +5259,11 @@ def _smooth_stretches(W, arc, points, is_cubic, tail, step, gfirst, glast, seg_o
             fa, ea, fb, eb = int(gfirst[a]), int(glast[a]), int(gfirst[b]), int(glast[b])
             lim = max(before(a)[0], before(b)[0]) - _STRETCH_GAIN * q
             ra = st.shapes(ca[0], v, fa, ea, o, lim, not is_cubic[a], ca)
+            if ra is None and (best is not None and best[0] == 0 or not may_split):
+                # (rb could serve nothing: no pair without ra, no split here; its re-fit
+                # is counted all the same, so the budget and the result stay the same)
+                st.spend(o)
+                continue
             rb = st.shapes(v, cb[-1], fb, eb, o, lim, not is_cubic[b], cb)
             if ra is not None and rb is not None:
                 consider({a: (ra[0], [(ra[1], fa, ea)]), b: (rb[0], [(rb[1], fb, eb)])}, 0)
