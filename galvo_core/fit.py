@@ -3999,6 +3999,21 @@ def _over_kernel(samp, sstep, poly, pstep, lim, k, out):  # pragma: no cover (co
     _over_kernel_upto(samp, sstep, poly, pstep, lim, k, out, np.inf)
 
 
+@njit(cache=True, nogil=True, inline="always")
+def _share_at(cum, n, val):  # pragma: no cover (compiled)
+    """The segment of a polyline (``cum`` its n cumulated lengths) at its share ``val`` of
+    the length: the index before np.searchsorted(cum[:n], val) (side left)."""
+    lo = 0
+    hi = n
+    while lo < hi:
+        mid = (lo + hi) >> 1
+        if cum[mid] < val:
+            lo = mid + 1
+        else:
+            hi = mid
+    return lo - 1
+
+
 @njit(cache=True, nogil=True)
 def _over_kernel_upto(samp, sstep, poly, pstep, lim, k, out,
                       stop):  # pragma: no cover (compiled)
@@ -4017,16 +4032,7 @@ def _over_kernel_upto(samp, sstep, poly, pstep, lim, k, out,
     scale = cs[ms - 1] > 0.0
     r = cum[n - 1] / cs[ms - 1] if scale else 1.0
     for t in range(ms):
-        val = cs[t] * r if scale else cs[t]
-        lo = 0
-        hi = n
-        while lo < hi:  # (np.searchsorted, side left)
-            mid = (lo + hi) >> 1
-            if cum[mid] < val:
-                lo = mid + 1
-            else:
-                hi = mid
-        at = lo - 1
+        at = _share_at(cum, n, cs[t] * r if scale else cs[t])
         px = samp[t, 0]
         py = samp[t, 1]
         d = _win_d(px, py, poly, 0, n - 1, at, k, cum, np.inf)
@@ -4101,16 +4107,7 @@ def _polyline_checks(C4, cub, msz, W, wstep, first, last, lim, k,
             r = cum[n - 1] / cs[ms - 1] if scale else 1.0
             nseg = n - 1
             for t in range(ms):
-                val = cs[t] * r if scale else cs[t]
-                lo = 0
-                hi = n
-                while lo < hi:  # (np.searchsorted, side left)
-                    mid = (lo + hi) >> 1
-                    if cum[mid] < val:
-                        lo = mid + 1
-                    else:
-                        hi = mid
-                at = lo - 1
+                at = _share_at(cum, n, cs[t] * r if scale else cs[t])
                 px = sx[t]
                 py = sy[t]
                 d = _win_d(px, py, W, f, nseg, at, k, cum, np.inf)
@@ -4628,22 +4625,10 @@ def _design_off(W, est, valid, ctrl, f, e, h, limit=math.inf):
     return float(r[0]), float(r[1])
 
 
-@njit(cache=True, nogil=True)
-def _seg_samples_count(ctrl, h):  # pragma: no cover (compiled)
-    """How many samples :func:`_seg_samples` takes."""
-    if ctrl.shape[0] == 4:
-        length = (math.hypot(ctrl[1, 0] - ctrl[0, 0], ctrl[1, 1] - ctrl[0, 1])
-                  + math.hypot(ctrl[2, 0] - ctrl[1, 0], ctrl[2, 1] - ctrl[1, 1])) \
-            + math.hypot(ctrl[3, 0] - ctrl[2, 0], ctrl[3, 1] - ctrl[2, 1])
-        return max(16, int(math.ceil(length / h)) + 1)
-    length = math.hypot(ctrl[1, 0] - ctrl[0, 0], ctrl[1, 1] - ctrl[0, 1])
-    return max(2, int(math.ceil(length / h)) + 1)
-
-
-#: :func:`_samples_within` measures every this many samples first (:func:`_max_over`)
+#: :func:`_samples_within` and :func:`_points_near_cubic` bound at least every this many
+#: points by a walk (:func:`_max_over`; the points between by the path length where that
+#: keeps them within the floor)
 _WITHIN_STRIDE = 8
-#: ... :func:`_design_off`, every this many of its targets and samples
-_DESIGN_STRIDE = 4
 
 
 @njit(cache=True, nogil=True)
@@ -4654,7 +4639,14 @@ def _seg_samples(ctrl, h):  # pragma: no cover (compiled)
     order) at np.linspace(0, 1, m), cubic_eval's arithmetic or the line's ctrl[0] +
     t (ctrl[1] - ctrl[0]) (the same numbers)."""
     cub = ctrl.shape[0] == 4
-    m = _seg_samples_count(ctrl, h)
+    if cub:
+        length = (math.hypot(ctrl[1, 0] - ctrl[0, 0], ctrl[1, 1] - ctrl[0, 1])
+                  + math.hypot(ctrl[2, 0] - ctrl[1, 0], ctrl[2, 1] - ctrl[1, 1])) \
+            + math.hypot(ctrl[3, 0] - ctrl[2, 0], ctrl[3, 1] - ctrl[2, 1])
+        m = max(16, int(math.ceil(length / h)) + 1)
+    else:
+        length = math.hypot(ctrl[1, 0] - ctrl[0, 0], ctrl[1, 1] - ctrl[0, 1])
+        m = max(2, int(math.ceil(length / h)) + 1)
     samp = np.empty((m, 2))
     c3 = ctrl.reshape(1, ctrl.shape[0], 2)
     step = 1.0 / (m - 1)
@@ -4710,7 +4702,7 @@ def _design_off_kernel(W, est, valid, ctrl, f, e, h, limit, out):  # pragma: no 
         # decides, the others need not be measured; only the targets that can be the
         # largest are, :func:`_max_over`)
         stop = limit if _moderate(tp, nt) and _moderate(samp, m) else np.inf
-        d1, over = _max_over(tp[:nt], samp, lim, 64, -np.inf, stop, _DESIGN_STRIDE)
+        d1, over = _max_over(tp[:nt], samp, lim, 64, -np.inf, stop, 1)
         if over:
             return False
     out[0] = d1
@@ -4721,7 +4713,7 @@ def _design_off_kernel(W, est, valid, ctrl, f, e, h, limit, out):  # pragma: no 
         src = est if valid[g] else W
         poly[g - f, 0] = src[g, 0]
         poly[g - f, 1] = src[g, 1]
-    out[1] = _max_over(samp, poly, lim, _NEAR_SEGMENTS, -np.inf, np.inf, _DESIGN_STRIDE)[0]
+    out[1] = _max_over(samp, poly, lim, _NEAR_SEGMENTS, -np.inf, np.inf, 1)[0]
     return True
 
 
@@ -4887,15 +4879,7 @@ def _one_over(px, py, poly, n, cum, val, k, lim, need):  # pragma: no cover (com
         return math.hypot(px - poly[0, 0], py - poly[0, 1])
     if n <= 2 * k + 2:
         return _brute_d(px, py, poly, 0, n)
-    lo = 0
-    hi = n
-    while lo < hi:  # (np.searchsorted, side left)
-        mid = (lo + hi) >> 1
-        if cum[mid] < val:
-            lo = mid + 1
-        else:
-            hi = mid
-    at = lo - 1
+    at = _share_at(cum, n, val)
     d = _win_d(px, py, poly, 0, n - 1, at, k, cum, np.inf)
     if d > lim and d > need:
         d = _full_d(px, py, poly, 0, n, at, cum, d)
