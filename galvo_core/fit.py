@@ -5554,7 +5554,8 @@ def _straight_cubics(points, is_cubic, tail) -> np.ndarray:
 
 def _tips_joined(W, points, is_cubic, tail, step, gfirst, glast, seg_owner, quant, bound,
                  changed, wstep=None, arc=None):
-    """Rounded input: a short line the thinning left across an acute tip (``_TIP_SHORT``,
+    """Rounded input: a short line (or a cubic with both handles on its ends, the same line)
+    the thinning left across an acute tip (``_TIP_SHORT``,
     ``_TIP_STEPS``, ``_TIP_TURN_DEG``: the tip's own input point within the bound of the chord
     between its neighbours, the corners kept one step before and after it) taken out where
     the two segments beside it, their ends moved onto the crossing of their end tangents
@@ -6541,6 +6542,12 @@ def _window_hi(W, arc, k, hi, quant):
 #: its quadratic (the window spans another corner: sans-light "J" at em 400, a 16-unit side
 #: fitted across its far corner moved the corner 0.5 away from the design's, 0.90 from it)
 _CORNER_RES = 1.0
+#: ... and a curve side beside a side of two input points (:func:`_lone_sides`) gives no
+#: crossing where one of its input points lies this many quanta or more off its quadratic:
+#: the crossing slides along the line by the curve's error there (Inconsolata "5" at em 700,
+#: a quadratic over a short S-shaped cubic's inflection, 0.84 quanta off: the corner 0.67
+#: from the design where the rounded input is 0.49); the corner stays
+_LONE_RES = 0.75
 #: a curve side whose run has more input points than its window: a second quadratic over up
 #: to this many points (within ``_LONG_ARC`` quanta of arc), averaged with the first where
 #: its points too stay within ``_LONG_RES`` quanta of it: the rounding's error at a window's
@@ -6550,6 +6557,7 @@ _CORNER_RES = 1.0
 #: 0.46 -> 0.42, over 0.4 quanta 68 -> 53 and 80 -> 44 of 2456 and 3433; 30 or 40 points
 #: alone give a larger worst); 0: off
 _CORNER_LONG = 30
+#: ... (the arc length, in quanta, that second window may reach from the corner)
 _LONG_ARC = 90.0
 #: ... (rounding alone keeps the points within q/sqrt(2) of the design; with 1.0 instead the
 #: worst of those distances on the second set 0.69, with 0.75 0.58; C059 "X" at em 1000, a
@@ -6557,12 +6565,6 @@ _LONG_ARC = 90.0
 _LONG_RES = 0.75
 #: ... also at tips (turns over 120 degrees, ``_TIP_COS``) if True (for measurements)
 _LONG_AT_TIPS = False
-#: ... and a curve side beside a side of two input points (:func:`_lone_sides`) gives no
-#: crossing where one of its input points lies this many quanta or more off its quadratic:
-#: the crossing slides along the line by the curve's error there (Inconsolata "5" at em 700,
-#: a quadratic over a short S-shaped cubic's inflection, 0.84 quanta off: the corner 0.67
-#: from the design where the rounded input is 0.49); the corner stays
-_LONE_RES = 0.75
 
 
 #: a side written as its two rounded ends only gives the corner a direction where it is at
@@ -6858,6 +6860,15 @@ def _corners_beside_gaps(W, K, vo, smooth, quant, coarse, t_in, ok_in, t_out, ok
     return np.concatenate(out_v), np.concatenate(out_j), np.concatenate(out_m)
 
 
+def _side_directions(W, a, b, t, ok) -> np.ndarray:
+    """Unit directions of corner sides from input point b to a: ``t`` where ``ok``, else the
+    chord's (a side without a usable quadratic)."""
+    d = W[a] - W[b]
+    ln = np.hypot(d[:, 0], d[:, 1])
+    d = d / np.where(ln > 0.0, ln, 1.0)[:, None]
+    return np.where(ok[:, None], t, d)
+
+
 def _longer_sides(W, arc, k, end, bound, quant, p, t, ok, step) -> None:
     """:func:`_corners_on_the_design`'s curve sides at the input points ``k`` (window to
     ``end``, ``step`` -1: before k, +1: after it) with more input points up to ``bound`` (the
@@ -6880,7 +6891,7 @@ def _longer_sides(W, arc, k, end, bound, quant, p, t, ok, step) -> None:
     lo, hi = (far, k) if step < 0 else (k, far)
     res = np.empty(len(sel))
     p2, t2, ok2 = _local_fits(W, arc, lo, hi, k, res)
-    ok2 &= (res <= _LONG_RES * quant) & (np.abs(far - k) + 1 > _CORNER_POINTS)
+    ok2 &= (res <= _LONG_RES * quant) & (np.abs(far - k) + 1 > cnt[sel])
     g = sel[ok2]
     if len(g) == 0:
         return
@@ -6955,9 +6966,13 @@ def _corners_on_the_design(W, K, Q, arc, smooth, rnd, first, last, quant, eps,
     ok_in &= r_in <= _CORNER_RES * quant[vi]
     ok_out &= r_out <= _CORNER_RES * quant[vo]
     if _CORNER_LONG:
-        # (not at a tip: there the longer window's bias moves the crossing by over the sine
-        # of the small interior angle, sans "g" at em 400 0.62 -> 0.75 from the design)
-        long = ((t_in * t_out).sum(axis=1) >= _TIP_COS) | _LONG_AT_TIPS
+        # (not at a tip: there the longer window's bias moves the crossing by its error over
+        # the sine of the small interior angle, sans "g" at em 400 0.62 -> 0.75 from the
+        # design; a side without a quadratic, a line of 2 or 3 input points, turns by its
+        # thinned segment's direction)
+        long = _LONG_AT_TIPS | (
+            (_side_directions(W, K[vi], K[vi - 1], t_in, ok_in)
+             * _side_directions(W, K[vo + 1], K[vo], t_out, ok_out)).sum(axis=1) >= _TIP_COS)
         _longer_sides(W, arc, K[vi], lo_i, np.maximum(K[first[pid_i]], K[prev_c[vi - 1]]),
                       quant[vi], p_in, t_in, ok_in & long, -1)
         _longer_sides(W, arc, k, hi_o, np.minimum(K[last[pid_o]], K[next_c[vo + 1]]),
