@@ -1,0 +1,82 @@
+"""Rounded input, issue 16 (fifteenth session): a unit jog of the rounding after a diagonal
+straight run (a 45-degree staircase shifting its phase where the design's slope drifts) is a
+rounding wiggle, not two corners (``runs._JOG``, ``runs._JOG_DIAG``). The outlines are paths of
+the sparse bench (``bench_precision_speed.py --sparse``: waved ellipses rounded to whole units,
+their true curves known), generated here the same way."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from galvo_core import runs
+from galvo_core.fit import check_fit, fit_paths
+from galvo_core.geometry import point_polyline_distance
+from tests._util import flattened_cubic
+
+
+def _sparse_path(i: int) -> tuple[np.ndarray, np.ndarray]:
+    """Path i of the sparse bench's generator (seed 5): (rounded points, true curve)."""
+    rng = np.random.default_rng(5)
+    for _ in range(i + 1):
+        ax, ay = rng.uniform(60, 400, 2)
+        cx, cy = rng.uniform(0, 3000, 2)
+        rot = rng.uniform(0, np.pi)
+        k = rng.integers(2, 6)
+        amp = rng.uniform(0.0, 0.2)
+    t = np.linspace(0, 2 * np.pi, 40000, endpoint=False)
+    r = 1.0 + amp * np.cos(k * t)
+    x, y = ax * r * np.cos(t), ay * r * np.sin(t)
+    c, s = np.cos(rot), np.sin(rot)
+    tr = np.stack([cx + c * x - s * y, cy + s * x + c * y], axis=1)
+    w = np.round(tr)
+    w = w[np.r_[True, (w[1:] != w[:-1]).any(axis=1)]]
+    if (w[-1] == w[0]).all():
+        w = w[:-1]
+    return w, np.vstack([tr, tr[:1]])
+
+
+def _dense(fp) -> np.ndarray:
+    return np.vstack([flattened_cubic(*s.points, chord=0.002) if s.kind == "cubic"
+                      else np.asarray(s.points) for s in fp.segments])
+
+
+def _fit(w):
+    fp = fit_paths([w], [True])[0]
+    assert not check_fit(w, fp, 0.02, 0.02, report=True)["violation"]
+    return fp
+
+
+def _distance(fd, tr, place=None, r=3.0) -> float:
+    """Both-ways distance of the fit and the true curve (within r of ``place`` if given)."""
+    a, b = fd, tr
+    if place is not None:
+        a = fd[np.hypot(*(fd - place).T) < r]
+        b = tr[np.hypot(*(tr - place).T) < r]
+    return max(float(point_polyline_distance(a, tr).max()),
+               float(point_polyline_distance(b, fd).max()))
+
+
+def test_a_unit_jog_after_a_diagonal_run_is_no_corner(monkeypatch):
+    # path 21 near (1144, 953): 55 units of 45-degree staircase, then a one-unit horizontal
+    # jog where the design's slope turns to 41 degrees; as two corners the joint stayed on
+    # the rounded point, 0.67 from the design
+    w, tr = _sparse_path(21)
+    place = np.array([1144.0, 953.0])
+    fp = _fit(w)
+    d = _distance(_dense(fp), tr, place)
+    monkeypatch.setattr(runs, "_JOG", 0.0)
+    fp0 = _fit(w)
+    d0 = _distance(_dense(fp0), tr, place)
+    assert d < 0.3 and d0 > 0.6, (d, d0)
+    assert fp.n_segments < fp0.n_segments
+
+
+def test_a_jog_after_an_axis_parallel_run_stays_out_of_the_rule(monkeypatch):
+    # path 507: a 147-unit flat top (all points at y = 1763, the design 0.4 above them in
+    # places): taken into one curve run it became one cubic that sags 0.5 below the points,
+    # within the bound and 0.87 from the design
+    w, tr = _sparse_path(507)
+    d = _distance(_dense(_fit(w)), tr)
+    monkeypatch.setattr(runs, "_JOG_DIAG", 0.0)
+    d_all = _distance(_dense(_fit(w)), tr)
+    assert d < 0.65 and d_all > 0.8, (d, d_all)
