@@ -211,7 +211,8 @@ def _rounded_rules(smooth, sign, rounding, inner, dot, cr, la, lb, length_ratio,
     rule aside), so that the run ends at the corner; where the corner's other side is a
     curve too, the segment is rather a wiggle of the rounding inside one curve (the
     thinning cut a curve's stretch into long, short, long): both of its ends are smooth
-    where the two long segments around it meet as a smooth vertex may. Such vertices have
+    where the two long segments around it meet as a smooth vertex may, and so are the ends
+    of a unit jog (``_JOG``) after a diagonal line (``_JOG_DIAG``). Such vertices have
     no sign (their turn is the rounding's). Then the stretches of several short segments
     (:func:`_short_clusters`). ``cos_join``: the plain rule's threshold; ``seg``: the
     segment vectors of the points."""
@@ -264,8 +265,7 @@ def _wiggle_rules(smooth, sign, rounding, rnd, dot, cr, la, lb, length_ratio, co
     # (a unit jog, _JOG quanta or shorter, also after a line that runs diagonally, 15-75
     # degrees from the axes: a staircase shifting phase at a straight run's end)
     sa = seg[cand]
-    with np.errstate(invalid="ignore", divide="ignore"):
-        diag = 2.0 * np.abs(sa[:, 0] * sa[:, 1]) >= _JOG_DIAG * (sa * sa).sum(axis=1)
+    diag = 2.0 * np.abs(sa[:, 0] * sa[:, 1]) >= _JOG_DIAG * (sa * sa).sum(axis=1)
     jog = short_b[cand] & (cb <= _JOG * qq[cand]) & diag
     w = np.flatnonzero(short_b[cand] & ~next_s & (prev_s | jog) & next2 & (cb < ca))
     if _WIGGLE and len(w):
