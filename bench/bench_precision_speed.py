@@ -154,6 +154,38 @@ def main() -> None:
                   f"wall {wall:.2f} s  {segments(f)} segments", flush=True)
 
 
+def _sparse_params(rng):
+    """One outline's parameters, drawn from ``rng`` (in the generator's order)."""
+    ax, ay = rng.uniform(60, 400, 2)
+    cx, cy = rng.uniform(0, 3000, 2)
+    rot = rng.uniform(0, np.pi)
+    k = rng.integers(2, 6)
+    amp = rng.uniform(0.0, 0.2)
+    return ax, ay, cx, cy, rot, k, amp
+
+
+def _sparse_curve(ax, ay, cx, cy, rot, k, amp):
+    """(rounded points, unrounded curve closed) of one outline."""
+    t = np.linspace(0, 2 * np.pi, 40000, endpoint=False)
+    r = 1.0 + amp * np.cos(k * t)
+    x, y = ax * r * np.cos(t), ay * r * np.sin(t)
+    c, s = np.cos(rot), np.sin(rot)
+    tr = np.stack([cx + c * x - s * y, cy + s * x + c * y], axis=1)
+    w = np.round(tr)
+    w = w[np.r_[True, (w[1:] != w[:-1]).any(axis=1)]]
+    if (w[-1] == w[0]).all():
+        w = w[:-1]
+    return w, np.vstack([tr, tr[:1]])
+
+
+def sparse_outline(i: int):
+    """Outline i of :func:`sparse_outlines`: (rounded points, unrounded curve closed)."""
+    rng = np.random.default_rng(5)
+    for _ in range(i):
+        _sparse_params(rng)
+    return _sparse_curve(*_sparse_params(rng))
+
+
 def sparse_outlines(Drawing, Path, n_points: int = 1_000_000,  # noqa: N803 (the classes)
                     truths: list | None = None):
     """Closed smooth outlines rounded to whole units, font-like spacing (1-2 units between
@@ -163,22 +195,9 @@ def sparse_outlines(Drawing, Path, n_points: int = 1_000_000,  # noqa: N803 (the
     paths = []
     n = 0
     while n < n_points:
-        ax, ay = rng.uniform(60, 400, 2)
-        cx, cy = rng.uniform(0, 3000, 2)
-        rot = rng.uniform(0, np.pi)
-        k = rng.integers(2, 6)
-        amp = rng.uniform(0.0, 0.2)
-        t = np.linspace(0, 2 * np.pi, 40000, endpoint=False)
-        r = 1.0 + amp * np.cos(k * t)
-        x, y = ax * r * np.cos(t), ay * r * np.sin(t)
-        c, s = np.cos(rot), np.sin(rot)
-        tr = np.stack([cx + c * x - s * y, cy + s * x + c * y], axis=1)
+        w, tr = _sparse_curve(*_sparse_params(rng))
         if truths is not None:
-            truths.append(np.vstack([tr, tr[:1]]))
-        w = np.round(tr)
-        w = w[np.r_[True, (w[1:] != w[:-1]).any(axis=1)]]
-        if (w[-1] == w[0]).all():
-            w = w[:-1]
+            truths.append(tr)
         paths.append(w)
         n += len(w)
     return Drawing(tuple(Path(p, 1, True) for p in paths), name="sparse")

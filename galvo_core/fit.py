@@ -6973,10 +6973,11 @@ def _corners_on_the_design(W, K, Q, arc, smooth, rnd, first, last, quant, eps,
         long = _LONG_AT_TIPS | (
             (_side_directions(W, K[vi], K[vi - 1], t_in, ok_in)
              * _side_directions(W, K[vo + 1], K[vo], t_out, ok_out)).sum(axis=1) >= _TIP_COS)
-        _longer_sides(W, arc, K[vi], lo_i, np.maximum(K[first[pid_i]], K[prev_c[vi - 1]]),
-                      quant[vi], p_in, t_in, ok_in & long, -1)
-        _longer_sides(W, arc, k, hi_o, np.minimum(K[last[pid_o]], K[next_c[vo + 1]]),
-                      quant[vo], p_out, t_out, ok_out & long, 1)
+        # (prev_c / next_c stop at the path's first / last point too)
+        _longer_sides(W, arc, K[vi], lo_i, K[prev_c[vi - 1]], quant[vi], p_in, t_in,
+                      ok_in & long, -1)
+        _longer_sides(W, arc, k, hi_o, K[next_c[vo + 1]], quant[vo], p_out, t_out,
+                      ok_out & long, 1)
     # a side that is a line (its other end a corner too): its least-squares line
     lin_in = ~smooth[vi - 1]
     if lin_in.any():

@@ -15,24 +15,14 @@ from tests._util import flattened_cubic
 
 
 def _sparse_path(i: int) -> tuple[np.ndarray, np.ndarray]:
-    """Path i of the sparse bench's generator (seed 5): (rounded points, true curve)."""
-    rng = np.random.default_rng(5)
-    for _ in range(i + 1):
-        ax, ay = rng.uniform(60, 400, 2)
-        cx, cy = rng.uniform(0, 3000, 2)
-        rot = rng.uniform(0, np.pi)
-        k = rng.integers(2, 6)
-        amp = rng.uniform(0.0, 0.2)
-    t = np.linspace(0, 2 * np.pi, 40000, endpoint=False)
-    r = 1.0 + amp * np.cos(k * t)
-    x, y = ax * r * np.cos(t), ay * r * np.sin(t)
-    c, s = np.cos(rot), np.sin(rot)
-    tr = np.stack([cx + c * x - s * y, cy + s * x + c * y], axis=1)
-    w = np.round(tr)
-    w = w[np.r_[True, (w[1:] != w[:-1]).any(axis=1)]]
-    if (w[-1] == w[0]).all():
-        w = w[:-1]
-    return w, np.vstack([tr, tr[:1]])
+    """Path i of the sparse bench's generator: (rounded points, true curve)."""
+    import os
+    import sys
+
+    sys.path.insert(0, os.path.join(os.path.dirname(__file__), "..", "bench"))
+    from bench_precision_speed import sparse_outline
+
+    return sparse_outline(i)
 
 
 def _dense(fp) -> np.ndarray:
