@@ -66,7 +66,8 @@ def census(style: str, em: float, text: str, near: int, listing: bool):
         q = works[ci][kk]
         rnd = np.array([[eps + slack[ci], slack[ci] / fitmod._HALF_DIAGONAL]])
         a, b, curve, _, _, smooth = runsmod.split_pieces_many(
-            q, [len(q)], [True], rounding=rnd, return_smooth=True)
+            q, [len(q)], [True], rounding=rnd, return_smooth=True,
+            steps=np.diff(np.asarray(kk), append=0))
         lay = runsmod._Layout.of([len(q)])
         sm0, turn, sign = runsmod._vertex_rules(q, lay, 0.95, 3.0, want_turn=True)
         # design joints as input indices (first point of each design segment)

@@ -3027,7 +3027,7 @@ def _fit_concatenated(
     closed_t = np.asarray(closed)[todo]
     Q = W[K]
     pa, pb, curve, t_in, t_out, smooth = split_pieces_many(
-        Q, tlen, closed_t, rounding=rounding, return_smooth=True
+        Q, tlen, closed_t, rounding=rounding, return_smooth=True, steps=np.diff(K, append=0)
     )
     if move_q is not None and (move_q > 0.0).any():
         assert rounding is not None  # (move_q comes from it)
@@ -3402,7 +3402,7 @@ def _split_again(W, arc, K, tlen, K2, tlen2, touched, Q, pa, pb, t_in, t_out, sm
     ts = tlen2[P]
     Qs = W[Ks]
     sa, sb, _, si, so, ss = split_pieces_many(Qs, ts, closed[P], rounding=rounding[P],
-                                              return_smooth=True)
+                                              return_smooth=True, steps=np.diff(Ks, append=0))
     Qs = Qs.copy()
     _on_the_design(W, Ks, Qs, arc, si, so, ss, np.repeat(move_q[P], ts), ts,
                    np.repeat(rounding[P, 0], ts), None, coarse)
@@ -3439,6 +3439,11 @@ _LONE_SHARE = 0.5
 #: rounding's width on the other side of it), is re-fitted without that segment, which
 #: becomes a line (the cubic's tangent there the line's direction)
 _LONE_BULGE = 0.3
+#: ... or this many where that segment is the gap's one input step alone (the line then
+#: holds no other input points: P052 Bold Italic "r" at em 2048, a 149-unit design line,
+#: the cubic 0.298 off the chord and 0.77 off the design; with any segment, 0.15-0.2 broke
+#: NimbusRoman-Italic "w", a segment holding a curve's points beside the gap)
+_LONE_BULGE_GAP = 0.2
 #: ... the cubic sampled at this many parameters
 _LONE_SAMPLES = 65
 #: ... and replaced where the re-fit of the rest takes at most this many segments (serif-italic
@@ -3450,10 +3455,11 @@ _LONE_BASIS = seed_basis(_LONE_SAMPLES - 1)[1]
 def _lone_lines_out(W, K, Q, arc, t_in, t_out, e_per, eps_sum, quant, eps, ca, cb, ctrl,
                     bound, la, coarse=None, wstep=None):
     """Rounded input (``quant`` per thinned point, 0: not moved): the cubics that swallow a
-    design line at one of their ends (``_LONE_SHARE``, ``_LONE_BULGE``) are re-fitted over
-    their other segments, that end segment made a line. Returns (ca, cb, ctrl, bound, la)
-    with those cubics replaced; ``t_in``, ``t_out`` changed in place at the new joints.
-    ``coarse``: the fitter's chords of coarse curves (:func:`_coarse_chords`), for the re-fit."""
+    design line at one of their ends (``_LONE_SHARE``, ``_LONE_BULGE``, ``_LONE_BULGE_GAP``)
+    are re-fitted over their other segments, that end segment made a line. Returns (ca, cb,
+    ctrl, bound, la) with those cubics replaced; ``t_in``, ``t_out`` changed in place at the
+    new joints. ``coarse``: the fitter's chords of coarse curves (:func:`_coarse_chords`),
+    for the re-fit."""
     if len(ca) == 0:
         return ca, cb, ctrl, bound, la
     q = quant[ca]
@@ -3497,7 +3503,10 @@ def _lone_lines_out(W, K, Q, arc, t_in, t_out, e_per, eps_sum, quant, eps, ca, c
         perp /= np.sqrt(e2)[:, None]
         inside = (s > 0.05) & (s < 0.95)
         bul = np.where(inside, perp, 0.0).max(axis=1)
-        r = r[bul >= _LONE_BULGE * q[r]]
+        # (a smaller bulge where the segment is the gap alone: made a line, it holds no
+        # other points)
+        lim = np.where(kv[r] - ku[r] == 1, _LONE_BULGE_GAP, _LONE_BULGE)
+        r = r[bul >= lim * q[r]]
         # ... where the line between the segment's (moved) ends holds its input points
         err = _line_errors(W, np.stack([Q[u[r]], Q[v[r]]], axis=1), ku[r], kv[r])
         ok[r[err <= eps[u[r]]]] = True
@@ -6347,6 +6356,8 @@ _SMOOTH_ALONG = True
 #: it, takes its direction from that step (``_FIRST_STEP`` False: its least-squares line)
 _FIRST_STEP = True
 _FIRST_SHARE = 0.75
+#: ... and also where every input step of the side is that long (``_FIRST_STEP`` needed)
+_FIRST_CHAIN = True
 #: a smooth vertex next to a corner moves only where its window holds at least this many
 #: input points on that side of it, or beside a design line (along it, above; 0: always)
 _SMOOTH_SIDES = 2
@@ -6998,8 +7009,19 @@ def _corners_on_the_design(W, K, Q, arc, smooth, rnd, first, last, quant, eps,
             j = K[v] - 1 if side == 0 else K[v] + 1
             st = np.hypot(*(W[j] - W[K[v]]).T)
             seg_len = np.hypot(*(W[nb] - W[K[v]]).T)
-            sel = (lin & (np.abs(nb - K[v]) > 1) & (st >= _LONE_LENGTH * quant[v])
-                   & (st >= _FIRST_SHARE * seg_len))
+            base = lin & (np.abs(nb - K[v]) > 1) & (st >= _LONE_LENGTH * quant[v])
+            sel = base & (st >= _FIRST_SHARE * seg_len)
+            if _FIRST_CHAIN:
+                # ... or a side whose every input step is that long: a chain of design lines
+                # each written as its rounded ends (their least-squares line is none of them)
+                cand = np.flatnonzero(base & ~sel)
+                if len(cand):
+                    a, b = np.minimum(nb, K[v])[cand], np.maximum(nb, K[v])[cand]
+                    own, off = _ragged(np.arange(len(cand)), b - a)
+                    i = a[own] + off
+                    sl = np.hypot(*(W[i + 1] - W[i]).T)
+                    mn = np.minimum.reduceat(sl, np.cumsum(b - a) - (b - a))
+                    sel[cand] = mn >= _LONE_LENGTH * quant[v][cand]
             if sel.any():
                 d = (W[K[v]] - W[j])[sel] if side == 0 else (W[j] - W[K[v]])[sel]
                 d = d / np.hypot(d[:, 0], d[:, 1])[:, None]

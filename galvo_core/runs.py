@@ -137,11 +137,13 @@ def _vertex_rules(
     want_turn: bool = False,
     seg: tuple[np.ndarray, np.ndarray] | None = None,
     rounding: np.ndarray | None = None,
+    steps: np.ndarray | None = None,
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Per point of the concatenation: (smooth, turn angle or zeros, cross sign); only a
     path's interior points can be smooth or have a turn (the rules of the module doc).
     ``seg``: the segment vectors and lengths of ``q`` when already known. ``rounding``: per
-    point (eps, quantum) rows of its path, for rounded input (see :func:`_rounded_rules`).
+    point (eps, quantum) rows of its path, for rounded input (see :func:`_rounded_rules`);
+    ``steps``: per point the input steps of the segment starting there (None: unknown).
     """
     n = len(q)
     smooth = np.zeros(n, dtype=bool)
@@ -169,7 +171,7 @@ def _vertex_rules(
         sign[1:-1] = np.where(inner & (np.abs(cr) > 1e-12 * la * lb), np.sign(cr), 0.0)
         if rounding is not None:
             _rounded_rules(smooth, sign, rounding, inner, dot, cr, la, lb, length_ratio,
-                           cos_join, s)
+                           cos_join, s, steps)
     return smooth, turn, sign
 
 
@@ -196,7 +198,7 @@ _JOG_DIAG = 0.5
 
 
 def _rounded_rules(smooth, sign, rounding, inner, dot, cr, la, lb, length_ratio,
-                   cos_join, seg) -> None:
+                   cos_join, seg, steps=None) -> None:
     """The vertex rules on rounded input (quantum q > 0, thinned with tolerance eps), in
     place. Thinning a smooth curve of radius R with eps leaves chords of sagitta about eps,
     so each turns about l / R <= 8 eps / l: on a tight curve the chords turn more than
@@ -222,7 +224,7 @@ def _rounded_rules(smooth, sign, rounding, inner, dot, cr, la, lb, length_ratio,
     _wiggle_rules(smooth, sign, rounding, rnd, dot, cr, la, lb, length_ratio, cos_join, seg)
     if _CLUSTERS:
         _short_clusters(smooth, sign, rounding, rnd, dot, cr, la, lb, length_ratio, cos_join,
-                        seg)
+                        seg, steps)
 
 
 def _wiggle_rules(smooth, sign, rounding, rnd, dot, cr, la, lb, length_ratio, cos_join,
@@ -290,10 +292,22 @@ def _wiggle_rules(smooth, sign, rounding, rnd, dot, cr, la, lb, length_ratio, co
 #: rounded input: clusters of short thinned segments are looked at as a whole (see
 #: :func:`_short_clusters`)
 _CLUSTERS = True  # (False: off, for measurements)
+#: ... and a cluster between two parallel segments is a jog of the staircase: its ends
+#: smooth too (see :func:`_short_clusters`)
+_CLUSTER_JOG = True
+#: ... (|sin 2a| of one of the two segments' angle a at least this; 0: any direction) ...
+_CLUSTER_DIAG = 0.5
+#: ... where the cluster shifts the run across by at most this many quanta (a staircase
+#: changing its phase shifts it by up to sqrt 2; a step of the design shifts it more: a
+#: 2-unit step between two long diagonal lines taken for a jog came out 0.92 from the design)
+_CLUSTER_SHIFT = 1.5
+#: ... and not beside a design line written as its two rounded ends (one input step) where
+#: the input steps are known (False: also there, for measurements)
+_CLUSTER_STEPS = True
 
 
 def _short_clusters(smooth, sign, rounding, rnd, dot, cr, la, lb, length_ratio, cos_join,
-                    seg) -> None:
+                    seg, steps=None) -> None:
     """Rounded input: a cluster of consecutive short thinned segments (each up to
     ``_SHORT_END`` quanta, all its vertices inside a rounded path) between two longer
     ones is what the thinning leaves of a stretch where the rounding zigzags (the design
@@ -305,7 +319,15 @@ def _short_clusters(smooth, sign, rounding, rnd, dot, cr, la, lb, length_ratio, 
     add up to is within what the rounding of the short segments on that side can make
     (q sqrt2 over their length) or a smooth vertex may turn. A cluster's end vertex is
     made smooth only where the vertex beyond it is smooth already (a long line running
-    into the cluster stays a line). The vertices of a zigzag, and those made smooth beside
+    into the cluster stays a line). A cluster is a jog of the rounding where its two longer
+    segments are parallel up to the rounding (q sqrt2 over each length), whatever their
+    lengths, it shifts the run across by at most ``_CLUSTER_SHIFT`` quanta, and neither
+    longer segment is one input step (``steps``): then its vertices are smooth and so is
+    each end whose longer segment runs diagonally (``_CLUSTER_DIAG``; a staircase changing
+    its phase, P052 Bold Italic "Q" at em 2048: kept as two corners, the cubic before them
+    bent into the jog, 0.83 from the design; axis-parallel, URW C059 "M" at em 2048: the
+    stems' flat runs taken into cubics sagged). The vertices of a zigzag, and those made
+    smooth beside
     a corner, have no sign (their turns are the rounding's; a vertex beside a corner that
     was smooth already keeps its sign). In place; the arrays as in
     :func:`_rounded_rules`."""
@@ -344,6 +366,24 @@ def _short_clusters(smooth, sign, rounding, rnd, dot, cr, la, lb, length_ratio, 
                          / (lmax * lmax), _ROUNDED_TURN_CAP)
         wig = ((dot2 > cos_join * wa * wc) | (np.abs(net) <= lim))
         wig &= (wc <= length_ratio * wa) & (wa <= length_ratio * wc)
+        # a jog of the rounding: the two longer segments parallel up to the rounding (one of
+        # them diagonal where _CLUSTER_DIAG asks it), whatever their lengths (_CLUSTER_JOG)
+        da = 2.0 * np.abs(a_[:, 0] * a_[:, 1]) >= _CLUSTER_DIAG * (a_ * a_).sum(axis=1)
+        dc = 2.0 * np.abs(c_[:, 0] * c_[:, 1]) >= _CLUSTER_DIAG * (c_ * c_).sum(axis=1)
+        # ... and the cluster shifts the run across by at most _CLUSTER_SHIFT quanta (a
+        # staircase's phase, not a step of the design)
+        # (point i to point j + 1: the cluster's own segments summed, each path alone)
+        inner_v = v[v <= np.repeat(j, cnt)]
+        across = np.add.reduceat(seg[inner_v], np.cumsum(cnt - 1) - (cnt - 1), axis=0)
+        shift = np.abs(a_[:, 0] * across[:, 1] - a_[:, 1] * across[:, 0]) / wa
+        jog = (np.abs(net) <= _SQRT2 * qp[i] * (1.0 / wa + 1.0 / wc)) & (da | dc) & (
+            shift <= _CLUSTER_SHIFT * qp[i]) if _CLUSTER_JOG else np.zeros(len(i), dtype=bool)
+        if steps is not None and _CLUSTER_STEPS:
+            # ... not beside a design line written as its two rounded ends (one input step):
+            # the cluster after it is a curve's start (serif-bolditalic "Q" at em 400: a
+            # 30-unit line taken into the cubic after it, 0.68 from the design)
+            jog &= (steps[i - 1] > 1) & (steps[j + 1] > 1)
+        wig |= jog
     make = np.zeros(n, dtype=bool)
     make[v[wig[own]]] = True
     # a zigzag's vertices have no sign where they turn as the rounding can make them
@@ -386,6 +426,10 @@ def _short_clusters(smooth, sign, rounding, rnd, dot, cr, la, lb, length_ratio, 
     end_j[j + 1] = True
     beyond_prev = np.r_[False, smooth[:-1]]
     beyond_next = np.r_[smooth[1:], False]
+    # ... or where the cluster is a jog (and the segment beyond that end diagonal where
+    # _CLUSTER_DIAG asks it)
+    beyond_prev[i[jog & da]] = True
+    beyond_next[j[jog & dc] + 1] = True
     make &= (~end_i | beyond_prev) & (~end_j | beyond_next)
     unsigned = make & (zig | ~smooth)
     smooth |= make
@@ -594,17 +638,20 @@ def split_pieces_many(
     length_ratio: float = 3.0,
     rounding: object = None,
     return_smooth: bool = False,
+    steps: object = None,
 ) -> tuple[np.ndarray, ...]:
     """:func:`split_pieces` of many thinned paths at once.
 
     ``q`` (N, 2) is the concatenation of the paths, ``lens`` their point counts (sum N),
-    With ``return_smooth`` the per-point smooth flags come sixth.
-    ``rounding``: optional (eps, quantum) per path, the thinning tolerance and the grid of
-    rounded input (:func:`_rounded_rules`; rows with quantum 0 follow the plain rules).
-    ``closed`` one flag per path. Returns ``(a, b, curve, t_in, t_out)``: the pieces of
-    every path in path order, as inclusive ranges ``a[i]..b[i]`` of indices into ``q``
-    (never crossing a path), ``curve[i]`` True for a "curve" piece, False for a line, and
-    the (N, 2) tangents. Exactly (bit for bit) the pieces and tangents of
+    ``closed`` one flag per path. With ``return_smooth`` the per-point smooth flags come
+    sixth. ``rounding``: optional (eps, quantum) per path, the thinning tolerance and the
+    grid of rounded input (:func:`_rounded_rules`; rows with quantum 0 follow the plain
+    rules). ``steps``: optional, per point of ``q`` the input steps of the thinned segment
+    starting there (the rounded rules leave a segment of one step, a design line written as
+    its two rounded ends, out of the jogs). Returns ``(a, b, curve, t_in, t_out)``: the
+    pieces of every path in path order, as inclusive ranges ``a[i]..b[i]`` of indices into
+    ``q`` (never crossing a path), ``curve[i]`` True for a "curve" piece, False for a line,
+    and the (N, 2) tangents. Exactly (bit for bit) the pieces and tangents of
     :func:`split_pieces` on each path, offset by the path's first index.
     """
     qq = np.asarray(q, dtype=np.float64).reshape(-1, 2)
@@ -622,7 +669,11 @@ def split_pieces_many(
             raise ValueError("split_pieces_many: one (eps, quantum) row per path")
         if (rr[:, 1] > 0.0).any():
             rnd = np.repeat(rr, lay.lens, axis=0)
-    smooth, _, sign = _vertex_rules(qq, lay, cos_join, length_ratio, seg=seg, rounding=rnd)
+    st = None if steps is None or rnd is None else np.asarray(steps).reshape(-1)
+    if st is not None and len(st) != len(qq):
+        raise ValueError("split_pieces_many: steps must have one entry per point")
+    smooth, _, sign = _vertex_rules(qq, lay, cos_join, length_ratio, seg=seg, rounding=rnd,
+                                    steps=st)
     t_in, t_out = _tangents(qq, lay, smooth, cl, cos_join, length_ratio, seg=seg)
     ra, rb = _runs(smooth, sign, lay)
     ca, cb = _split_runs(ra, rb, t_in, t_out, math.radians(max_turn_deg))

@@ -11,7 +11,7 @@ import numpy as np
 from galvo_core import runs
 from galvo_core.fit import check_fit, fit_paths
 from galvo_core.geometry import point_polyline_distance
-from tests._util import flattened_cubic
+from tests._util import flattened_cubic, resampled
 
 
 def _sparse_path(i: int) -> tuple[np.ndarray, np.ndarray]:
@@ -70,3 +70,22 @@ def test_a_jog_after_an_axis_parallel_run_stays_out_of_the_rule(monkeypatch):
     monkeypatch.setattr(runs, "_JOG_DIAG", 0.0)
     d_all = _distance(_dense(_fit(w)), tr)
     assert d < 0.65 and d_all > 0.8, (d, d_all)
+
+
+def test_a_step_of_the_design_between_parallel_runs_stays_sharp(monkeypatch):
+    # a designed step 2 units across (more than _CLUSTER_SHIFT quanta) between two long
+    # diagonal lines written as 1-unit steps is no jog of the rounding: its corners stay
+    d = np.array([np.cos(0.8), np.sin(0.8)])
+    n = np.array([-d[1], d[0]])
+    p1 = 300.0 * d
+    p3 = p1 + 2.0 * n + 300.0 * d
+    design = np.array([(0.0, 0.0), p1, p1 + 2.0 * n, p3, p3 + 200.0 * n, 200.0 * n,
+                       (0.0, 0.0)]) + [0.3, 0.2]
+    w = np.round(resampled(design, 1.0))
+    w = w[np.r_[True, (np.diff(w, axis=0) != 0).any(axis=1)]]
+    fine = resampled(design, 0.05)
+    dist = _distance(_dense(_fit(w)), fine)
+    # (taken for a jog, the step's corners are rounded off: 0.92 from the design)
+    monkeypatch.setattr(runs, "_CLUSTER_SHIFT", 100.0)
+    d_any = _distance(_dense(_fit(w)), fine)
+    assert dist < 0.6 and d_any > 0.75, (dist, d_any)
