@@ -6366,6 +6366,28 @@ _FIRST_CHAIN = True
 _SMOOTH_SIDES = 2
 
 
+def _range_steps(W, a, b):
+    """The input steps of the ranges a[r]..b[r] (a < b): per step its range and its first
+    point, their lengths (libm's hypot), and each range's first position among them."""
+    own, off = _ragged(np.arange(len(a)), b - a)
+    st = a[own] + off
+    return own, st, np.hypot(*(W[st + 1] - W[st]).T), np.cumsum(b - a) - (b - a)
+
+
+def _line_steps(W, a, b, quant):
+    """Per thinned segment a[r]..b[r] (input indices, a < b): is it a design line written as
+    its two rounded ends (:func:`_on_the_design`'s ``_SMOOTH_ALONG``): its longest input step
+    at least ``_JOINT_LINE`` quanta, the whole segment or (``_SMOOTH_ALONG_SHARE``) that share
+    of its chord or more; and that step's vector (its first occurrence)."""
+    own, st, sl, first = _range_steps(W, a, b)
+    top = np.maximum.reduceat(sl, first)
+    at = np.flatnonzero(sl == top[own])
+    j0 = st[at[np.unique(own[at], return_index=True)[1]]]
+    chord = np.hypot(*(W[b] - W[a]).T)
+    share = (b - a == 1) | ((_SMOOTH_ALONG_SHARE > 0.0) & (top >= _SMOOTH_ALONG_SHARE * chord))
+    return (top >= _JOINT_LINE * quant) & share, W[j0 + 1] - W[j0]
+
+
 def _on_the_design(W, K, Q, arc, t_in, t_out, smooth, quant, tlen, eps, found=None,
                    coarse=None) -> None:
     """Rounded input (per thinned point its path's quantum ``quant``): the smooth thinned
@@ -6416,47 +6438,19 @@ def _on_the_design(W, K, Q, arc, t_in, t_out, smooth, quant, tlen, eps, found=No
             # were rounded from: sans "B" at em 400, a 63-unit line into a tangent curve,
             # 0.63 from the design where the rounded input is 0.44)
             wk = W[K[k]]
-            gi = (K[k] - K[k - 1] == 1) & (np.hypot(*(wk - W[K[k - 1]]).T)
-                                           >= _JOINT_LINE * quant[k])
-            go = (K[k + 1] - K[k] == 1) & (np.hypot(*(W[K[k + 1]] - wk).T)
-                                           >= _JOINT_LINE * quant[k])
             # (also where that line is most of a thinned segment of more steps, the rest a
-            # few short steps of the curve's start at the vertex: URW Bookman Light Italic
-            # "m" at em 2048, a 78-unit line meeting a curve at 13 degrees, the line tilted
-            # 0.4 off its row, 0.69 from the design where the rounded input is 0.33)
-            di = np.zeros((len(k), 2))
-            do = np.zeros((len(k), 2))
-            if _SMOOTH_ALONG_SHARE:
-                for side in (0, 1):
-                    a, b = (K[k - 1], K[k]) if side == 0 else (K[k], K[k + 1])
-                    c = np.flatnonzero((b - a > 1) & ~(gi if side == 0 else go))
-                    if len(c) == 0:
-                        continue
-                    own, off = _ragged(np.arange(len(c)), b[c] - a[c])
-                    st_i = a[c][own] + off
-                    sl = np.hypot(*(W[st_i + 1] - W[st_i]).T)
-                    top = np.maximum.reduceat(sl, np.cumsum(b[c] - a[c]) - (b[c] - a[c]))
-                    chord = np.hypot(*(W[b[c]] - W[a[c]]).T)
-                    g = ((top >= _JOINT_LINE * quant[k][c])
-                         & (top >= _SMOOTH_ALONG_SHARE * chord))
-                    if not g.any():
-                        continue
-                    # (the long step's direction: its first occurrence in the segment)
-                    at = np.flatnonzero(sl == top[own])
-                    fi = np.unique(own[at], return_index=True)[1]
-                    j0 = st_i[at[fi]]
-                    dd = W[j0 + 1] - W[j0]
-                    if side == 0:
-                        gi[c[g]] = True
-                        di[c[g]] = dd[g]
-                    else:
-                        go[c[g]] = True
-                        do[c[g]] = dd[g]
+            # few short steps of the curve's start at the vertex, _SMOOTH_ALONG_SHARE: URW
+            # Bookman Light Italic "m" at em 2048, a 78-unit line meeting a curve at 13
+            # degrees, the line tilted 0.4 off its row, 0.69 from the design where the
+            # rounded input is 0.33); each thinned segment beside the vertices once
+            sg = np.unique(np.concatenate([k - 1, k]))
+            along, dirs = _line_steps(W, K[sg], K[sg + 1], quant[sg])
+            gi = along[np.searchsorted(sg, k - 1)]
+            go = along[np.searchsorted(sg, k)]
             one = gi ^ go
             if one.any():
-                di = np.where((K[k] - K[k - 1] == 1)[:, None], wk - W[K[k - 1]], di)
-                do = np.where((K[k + 1] - K[k] == 1)[:, None], W[K[k + 1]] - wk, do)
-                d = np.where(gi[:, None], di, do)[one]
+                d = np.where(gi[:, None], dirs[np.searchsorted(sg, k - 1)],
+                             dirs[np.searchsorted(sg, k)])[one]
                 d = d / np.hypot(d[:, 0], d[:, 1])[:, None]
                 est[one] = wk[one] + ((est[one] - wk[one]) * d).sum(axis=1)[:, None] * d
             est[gi & go] = wk[gi & go]
@@ -7053,12 +7047,9 @@ def _corners_on_the_design(W, K, Q, arc, smooth, rnd, first, last, quant, eps,
                 # each written as its rounded ends (their least-squares line is none of them)
                 cand = np.flatnonzero(base & ~sel)
                 if len(cand):
-                    a, b = np.minimum(nb, K[v])[cand], np.maximum(nb, K[v])[cand]
-                    own, off = _ragged(np.arange(len(cand)), b - a)
-                    i = a[own] + off
-                    sl = np.hypot(*(W[i + 1] - W[i]).T)
-                    mn = np.minimum.reduceat(sl, np.cumsum(b - a) - (b - a))
-                    sel[cand] = mn >= _LONE_LENGTH * quant[v][cand]
+                    _, _, sl, at = _range_steps(W, np.minimum(nb, K[v])[cand],
+                                                np.maximum(nb, K[v])[cand])
+                    sel[cand] = np.minimum.reduceat(sl, at) >= _LONE_LENGTH * quant[v][cand]
             if sel.any():
                 d = (W[K[v]] - W[j])[sel] if side == 0 else (W[j] - W[K[v]])[sel]
                 d = d / np.hypot(d[:, 0], d[:, 1])[:, None]

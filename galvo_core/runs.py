@@ -197,6 +197,12 @@ _JOG = 1.5
 _JOG_DIAG = 0.5
 
 
+def _diagonal(v: np.ndarray, least: float) -> np.ndarray:
+    """Per vector: |sin 2a| of its angle a at least ``least`` (0.5: 15-75 degrees from the
+    axes; 0: every vector)."""
+    return 2.0 * np.abs(v[:, 0] * v[:, 1]) >= least * (v * v).sum(axis=1)
+
+
 def _rounded_rules(smooth, sign, rounding, inner, dot, cr, la, lb, length_ratio,
                    cos_join, seg, steps=None) -> None:
     """The vertex rules on rounded input (quantum q > 0, thinned with tolerance eps), in
@@ -266,9 +272,7 @@ def _wiggle_rules(smooth, sign, rounding, rnd, dot, cr, la, lb, length_ratio, co
     # both of its ends smooth (see above)
     # (a unit jog, _JOG quanta or shorter, also after a line that runs diagonally, 15-75
     # degrees from the axes: a staircase shifting phase at a straight run's end)
-    sa = seg[cand]
-    diag = 2.0 * np.abs(sa[:, 0] * sa[:, 1]) >= _JOG_DIAG * (sa * sa).sum(axis=1)
-    jog = short_b[cand] & (cb <= _JOG * qq[cand]) & diag
+    jog = short_b[cand] & (cb <= _JOG * qq[cand]) & _diagonal(seg[cand], _JOG_DIAG)
     w = np.flatnonzero(short_b[cand] & ~next_s & (prev_s | jog) & next2 & (cb < ca))
     if _WIGGLE and len(w):
         k = cand[w]  # vertex index - 1; next2 true: segment k + 2 exists
@@ -327,9 +331,8 @@ def _short_clusters(smooth, sign, rounding, rnd, dot, cr, la, lb, length_ratio, 
     its phase, P052 Bold Italic "Q" at em 2048: kept as two corners, the cubic before them
     bent into the jog, 0.83 from the design; axis-parallel, URW C059 "M" at em 2048: the
     stems' flat runs taken into cubics sagged). The vertices of a zigzag, and those made
-    smooth beside
-    a corner, have no sign (their turns are the rounding's; a vertex beside a corner that
-    was smooth already keeps its sign). In place; the arrays as in
+    smooth beside a corner, have no sign (their turns are the rounding's; a vertex beside a
+    corner that was smooth already keeps its sign). In place; the arrays as in
     :func:`_rounded_rules`."""
     n = len(smooth)
     ln = np.hypot(seg[:, 0], seg[:, 1])  # segment s: point s -> s + 1
@@ -368,8 +371,8 @@ def _short_clusters(smooth, sign, rounding, rnd, dot, cr, la, lb, length_ratio, 
         wig &= (wc <= length_ratio * wa) & (wa <= length_ratio * wc)
         # a jog of the rounding: the two longer segments parallel up to the rounding (one of
         # them diagonal where _CLUSTER_DIAG asks it), whatever their lengths (_CLUSTER_JOG)
-        da = 2.0 * np.abs(a_[:, 0] * a_[:, 1]) >= _CLUSTER_DIAG * (a_ * a_).sum(axis=1)
-        dc = 2.0 * np.abs(c_[:, 0] * c_[:, 1]) >= _CLUSTER_DIAG * (c_ * c_).sum(axis=1)
+        da = _diagonal(a_, _CLUSTER_DIAG)
+        dc = _diagonal(c_, _CLUSTER_DIAG)
         # ... and the cluster shifts the run across by at most _CLUSTER_SHIFT quanta (a
         # staircase's phase, not a step of the design)
         # (point i to point j + 1: the cluster's own segments summed, each path alone)
@@ -651,8 +654,10 @@ def split_pieces_many(
     its two rounded ends, out of the jogs). Returns ``(a, b, curve, t_in, t_out)``: the
     pieces of every path in path order, as inclusive ranges ``a[i]..b[i]`` of indices into
     ``q`` (never crossing a path), ``curve[i]`` True for a "curve" piece, False for a line,
-    and the (N, 2) tangents. Exactly (bit for bit) the pieces and tangents of
-    :func:`split_pieces` on each path, offset by the path's first index.
+    and the (N, 2) tangents. Exactly (bit for bit) what each path gives alone, offset by
+    its first index: without ``rounding`` the pieces and tangents of :func:`split_pieces`;
+    with it, this function's on that path with its row of ``rounding`` and its slice of
+    ``steps`` (a path's last entry of ``steps`` is never read).
     """
     qq = np.asarray(q, dtype=np.float64).reshape(-1, 2)
     lay = _Layout.of(lens)
