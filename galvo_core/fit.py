@@ -5210,75 +5210,88 @@ def _smooth_stretches(W, arc, points, is_cubic, tail, step, gfirst, glast, seg_o
         return r
 
     offb = off[bad]
-    for k in np.argsort(-offb, kind="stable").tolist():
-        s = int(sr[bad][k])
-        o = int(seg_owner[s])
-        if done[s] or st.budget[o] <= 0:
-            continue
-        # a split beyond the path's share where the segment lies far off the estimates
-        may_split = splits[o] > 0 or offb[k] >= _STRETCH_SPLIT_FAR * quant[o]
-        q = float(quant[o])
-        best = None  # (split used, (d1, d2), {segment: [(ctrl, first, last)]})
+    bs = sr[bad]
+    # worst first, each path's own list: a repair touches only its own path's segments,
+    # budget and splits, so the lists of chunks of paths run at once on the kernel threads
+    # (the compiled checks release the GIL; the same result whatever the chunks)
+    order = np.argsort(-offb, kind="stable")
+    owner = seg_owner[bs[order]]
+    by_path = np.argsort(owner, kind="stable")
+    order = order[by_path]
+    pcut = np.searchsorted(owner[by_path], np.arange(len(quant) + 1))
 
-        def consider(new, used, q=q):
-            nonlocal best
-            segs = list(new)
-            o1 = max(before(x)[0] for x in segs)
-            o2 = max(before(x)[1] for x in segs)
-            n1 = max(r[0] for r, _ in new.values())
-            n2 = max(r[1] for r, _ in new.values())
-            if n1 > o1 - _STRETCH_GAIN * q or n2 > max(o2, n1):
-                return
-            if best is None or (used, max(n1, n2)) < (best[0], max(best[1])):
-                best = (used, (n1, n2), {x: p for x, (_, p) in new.items()})
+    def repairs(lo: int, hi: int) -> None:  # (the paths lo..hi - 1)
+        for k in order[pcut[lo]:pcut[hi]].tolist():
+            s = int(bs[k])
+            o = int(seg_owner[s])
+            if done[s] or st.budget[o] <= 0:
+                continue
+            # a split beyond the path's share where the segment lies far off the estimates
+            may_split = splits[o] > 0 or offb[k] >= _STRETCH_SPLIT_FAR * quant[o]
+            q = float(quant[o])
+            best = None  # (split used, (d1, d2), {segment: [(ctrl, first, last)]})
 
-        c0 = _seg_ctrl(points, is_cubic, tail, s)
-        f, e = int(gfirst[s]), int(glast[s])
-        lim = before(s)[0] - _STRETCH_GAIN * q
-        r = st.shapes(c0[0], c0[-1], f, e, o, lim, False, None)
-        if r is not None:
-            consider({s: (r[0], [(r[1], f, e)])}, 0)
-        joints = []
-        for a, b in ((s - 1, s), (s, s + 1)):
-            if a < 0 or b >= ns or seg_owner[a] != o or seg_owner[b] != o or done[a] \
-                    or done[b] or glast[a] <= gfirst[a] or glast[b] <= gfirst[b]:
-                continue
-            j = int(gfirst[b])
-            if valid[j]:
-                joints.append((a, b, np.clip(est[j], W[j] - 0.5 * q, W[j] + 0.5 * q)))
-        for a, b, v in joints:
-            ca = _seg_ctrl(points, is_cubic, tail, a)
-            cb = _seg_ctrl(points, is_cubic, tail, b)
-            fa, ea, fb, eb = int(gfirst[a]), int(glast[a]), int(gfirst[b]), int(glast[b])
-            lim = max(before(a)[0], before(b)[0]) - _STRETCH_GAIN * q
-            ra = st.shapes(ca[0], v, fa, ea, o, lim, not is_cubic[a], ca)
-            if ra is None and (best is not None and best[0] == 0 or not may_split):
-                # (rb could serve nothing: no pair without ra, no split here; its re-fit
-                # is counted all the same, so the budget and the result stay the same)
-                st.spend(o)
-                continue
-            rb = st.shapes(v, cb[-1], fb, eb, o, lim, not is_cubic[b], cb)
-            if ra is not None and rb is not None:
-                consider({a: (ra[0], [(ra[1], fa, ea)]), b: (rb[0], [(rb[1], fb, eb)])}, 0)
-            if best is not None and best[0] == 0 or not may_split:
-                continue
-            if rb is not None:
-                sa = st.split(ca[0], v, fa, ea, o, lim)
-                if sa is not None:
-                    consider({a: (sa[0], sa[1]), b: (rb[0], [(rb[1], fb, eb)])}, 1)
-            if ra is not None:
-                sb = st.split(v, cb[-1], fb, eb, o, lim)
-                if sb is not None:
-                    consider({a: (ra[0], [(ra[1], fa, ea)]), b: (sb[0], sb[1])}, 1)
-        if (best is None or best[0] == 1) and may_split:
-            r = st.split(c0[0], c0[-1], f, e, o, before(s)[0] - _STRETCH_GAIN * q)
+            def consider(new, used, q=q):
+                nonlocal best
+                segs = list(new)
+                o1 = max(before(x)[0] for x in segs)
+                o2 = max(before(x)[1] for x in segs)
+                n1 = max(r[0] for r, _ in new.values())
+                n2 = max(r[1] for r, _ in new.values())
+                if n1 > o1 - _STRETCH_GAIN * q or n2 > max(o2, n1):
+                    return
+                if best is None or (used, max(n1, n2)) < (best[0], max(best[1])):
+                    best = (used, (n1, n2), {x: p for x, (_, p) in new.items()})
+
+            c0 = _seg_ctrl(points, is_cubic, tail, s)
+            f, e = int(gfirst[s]), int(glast[s])
+            lim = before(s)[0] - _STRETCH_GAIN * q
+            r = st.shapes(c0[0], c0[-1], f, e, o, lim, False, None)
             if r is not None:
-                consider({s: (r[0], r[1])}, 1)
-        if best is not None:
-            splits[o] -= best[0]
-            for x, p in best[2].items():
-                rep[x] = p
-                done[x] = True
+                consider({s: (r[0], [(r[1], f, e)])}, 0)
+            joints = []
+            for a, b in ((s - 1, s), (s, s + 1)):
+                if a < 0 or b >= ns or seg_owner[a] != o or seg_owner[b] != o or done[a] \
+                        or done[b] or glast[a] <= gfirst[a] or glast[b] <= gfirst[b]:
+                    continue
+                j = int(gfirst[b])
+                if valid[j]:
+                    joints.append((a, b, np.clip(est[j], W[j] - 0.5 * q, W[j] + 0.5 * q)))
+            for a, b, v in joints:
+                ca = _seg_ctrl(points, is_cubic, tail, a)
+                cb = _seg_ctrl(points, is_cubic, tail, b)
+                fa, ea, fb, eb = int(gfirst[a]), int(glast[a]), int(gfirst[b]), int(glast[b])
+                lim = max(before(a)[0], before(b)[0]) - _STRETCH_GAIN * q
+                ra = st.shapes(ca[0], v, fa, ea, o, lim, not is_cubic[a], ca)
+                if ra is None and (best is not None and best[0] == 0 or not may_split):
+                    # (rb could serve nothing: no pair without ra, no split here; its re-fit
+                    # is counted all the same, so the budget and the result stay the same)
+                    st.spend(o)
+                    continue
+                rb = st.shapes(v, cb[-1], fb, eb, o, lim, not is_cubic[b], cb)
+                if ra is not None and rb is not None:
+                    consider({a: (ra[0], [(ra[1], fa, ea)]), b: (rb[0], [(rb[1], fb, eb)])}, 0)
+                if best is not None and best[0] == 0 or not may_split:
+                    continue
+                if rb is not None:
+                    sa = st.split(ca[0], v, fa, ea, o, lim)
+                    if sa is not None:
+                        consider({a: (sa[0], sa[1]), b: (rb[0], [(rb[1], fb, eb)])}, 1)
+                if ra is not None:
+                    sb = st.split(v, cb[-1], fb, eb, o, lim)
+                    if sb is not None:
+                        consider({a: (ra[0], [(ra[1], fa, ea)]), b: (sb[0], sb[1])}, 1)
+            if (best is None or best[0] == 1) and may_split:
+                r = st.split(c0[0], c0[-1], f, e, o, before(s)[0] - _STRETCH_GAIN * q)
+                if r is not None:
+                    consider({s: (r[0], r[1])}, 1)
+            if best is not None:
+                splits[o] -= best[0]
+                for x, p in best[2].items():
+                    rep[x] = p
+                    done[x] = True
+
+    run_chunks(repairs, np.bincount(seg_owner[bs], (glast - gfirst + 1)[bs], len(quant)))
     # the joints still on their input point, ``_STRETCH_JOINT`` quanta or more from their
     # estimate: moved onto it with both segments re-fitted, where neither of them gets
     # farther from the estimates
@@ -5295,7 +5308,6 @@ def _smooth_stretches(W, arc, points, is_cubic, tail, step, gfirst, glast, seg_o
         o = int(seg_owner[b])
         if done[a] or done[b] or st.budget[o] <= 0:
             continue
-        q = float(quant[o])
         ca = _seg_ctrl(points, is_cubic, tail, a)
         cb = _seg_ctrl(points, is_cubic, tail, b)
         fa, ea, fb, eb = int(gfirst[a]), int(glast[a]), int(gfirst[b]), int(glast[b])
@@ -5341,7 +5353,6 @@ def _smooth_stretches(W, arc, points, is_cubic, tail, step, gfirst, glast, seg_o
             o = int(seg_owner[b])
             if done[a] or done[b] or st.budget[o] <= 0:
                 continue
-            q = float(quant[o])
             ca = _seg_ctrl(points, is_cubic, tail, a)
             cb = _seg_ctrl(points, is_cubic, tail, b)
             fa, ea, fb, eb = int(gfirst[a]), int(glast[a]), int(gfirst[b]), int(glast[b])

@@ -100,7 +100,9 @@ def run_chunks(fn: Callable[[int, int], object], weights: np.ndarray, *,
     futs: list[Future[object]] = [pool.submit(_run_marked, fn, lo, hi)
                                   for lo, hi in bounds[1:]]
     try:
-        first = fn(*bounds[0])
+        # (marked as the pool's chunks are: a call to run_chunks inside ``fn`` runs inline,
+        # not waiting for a pool thread busy with another chunk)
+        first = _run_marked(fn, *bounds[0])
     finally:
         rest = []
         err: BaseException | None = None
