@@ -2157,11 +2157,11 @@ class _BatchFitter:
             g, v = g[hope], v[hope]
             if len(g) == 0:
                 continue
-            ok1, c1, e1 = self._try(a0[g], v)
+            ok1, c1, e1 = self._try(a0[g], v, screened=True)
             h = np.flatnonzero(ok1)
             if len(h) == 0:
                 continue
-            ok2, c2, e2 = self._try(v[h], d0[g[h]])
+            ok2, c2, e2 = self._try(v[h], d0[g[h]], screened=True)
             h = h[ok2]
             gh = g[h]
             found[gh] = True
@@ -2290,13 +2290,15 @@ class _BatchFitter:
         self._store(A[keep], B[keep], C[keep], E[keep], isl[keep], fixed[keep])
         return True
 
-    def _try(self, A: np.ndarray, B: np.ndarray):
+    def _try(self, A: np.ndarray, B: np.ndarray, screened: bool = False):
         """One cubic per piece A..B (no split): (passed, ctrl, bound) (:meth:`_try_full`).
         In the refined rounds (:meth:`_refined_rounds`) the ranges tried before are not
         fitted again: one that passed has its cubic back, one that failed is tried only by
-        the refinement of its cached start (:meth:`_refine_cached`); a new range fails."""
+        the refinement of its cached start (:meth:`_refine_cached`); a new range fails.
+        ``screened``: every piece passed :meth:`_screen` (its coarse screening is not
+        repeated)."""
         if self._starts is None:
-            out = self._try_full(A, B)
+            out = self._try_full(A, B, screened)
             if _REFINED_ROUNDS and self.quant is not None and out[0].any():
                 p = out[0]
                 self._pass_keys.append(self._range_keys(A[p], B[p]))
@@ -2323,9 +2325,9 @@ class _BatchFitter:
         key = self._range_keys(A, B)
         return np.zeros(m, dtype=bool), np.zeros((m, 4, 2)), np.zeros(m), key
 
-    def _try_full(self, A: np.ndarray, B: np.ndarray):
+    def _try_full(self, A: np.ndarray, B: np.ndarray, screened: bool = False):
         """One cubic per piece A..B (no split): (passed, ctrl, bound) for the pieces whose
-        end tangents meet (the others fail)."""
+        end tangents meet (the others fail). ``screened``: as :meth:`_try`."""
         passed, ctrl_all, em_all, key = self._try_arrays(A, B)
         # a range that failed before fails again (same ends, tangents and points): skipped
         fresh = ~self._failed_before(key)
@@ -2339,10 +2341,13 @@ class _BatchFitter:
         a, b = A[w], B[w]
         i0, i1 = self.kept[a], self.kept[b]
         # a coarse cubic (few points, few steps) screens out the hopeless pieces (a loose
-        # test: over twice the bound on a small sample) before the real one
-        cc = self._dichotomy(p0[w], qq[w], p3[w], sig[w], i0, i1, _SCREEN_SAMPLE,
-                             _SCREEN_STEPS, 10.0 * self.eps_sum)
-        hope = self._sample_ok(cc, i0, i1, _SCREEN_SLACK * self.e_per[a], _SCREEN_SAMPLE)
+        # test: over twice the bound on a small sample) before the real one (:meth:`_screen`
+        # did, where ``screened``: each piece's own numbers, the same verdicts)
+        hope = np.ones(len(w), dtype=bool)
+        if not screened:
+            cc = self._dichotomy(p0[w], qq[w], p3[w], sig[w], i0, i1, _SCREEN_SAMPLE,
+                                 _SCREEN_STEPS, 10.0 * self.eps_sum)
+            hope = self._sample_ok(cc, i0, i1, _SCREEN_SLACK * self.e_per[a], _SCREEN_SAMPLE)
         if not hope.all():
             w, a, b, i0, i1 = w[hope], a[hope], b[hope], i0[hope], i1[hope]
             if len(w) == 0:
@@ -2638,14 +2643,14 @@ class _BatchFitter:
         def chunk(lo: int, hi: int) -> None:
             # (every piece's rounds on its own: a chunk of pieces runs all of them)
             c = ctrl[lo:hi]
-            for it in range(rounds):
-                N = np.empty((hi - lo, 4, 4))
-                g = np.empty((hi - lo, 4, 1))
-                _gn_free_sums(i0[lo:hi], i1[lo:hi], self.work, self.arc, _BISECT_SAMPLE,
-                              ps[lo:hi + 1], pts, u, c, it == 0, N, g)
-                with np.errstate(divide="ignore", invalid="ignore"):
+            N = np.empty((hi - lo, 4, 4))
+            g = np.empty((hi - lo, 4, 1))
+            with np.errstate(divide="ignore", invalid="ignore"):
+                for it in range(rounds):
+                    _gn_free_sums(i0[lo:hi], i1[lo:hi], self.work, self.arc, _BISECT_SAMPLE,
+                                  ps[lo:hi + 1], pts, u, c, it == 0, N, g)
                     d = np.linalg.solve(N, g)
-                _gn_free_step(c, d, chord[lo:hi])
+                    _gn_free_step(c, d, chord[lo:hi])
 
         run_chunks(chunk, cnt * rounds)
         h0 = ctrl[:, 1] - ctrl[:, 0]
@@ -5023,6 +5028,55 @@ def _screen_segments(points, tail, is_cubic, gfirst, glast, sr, est, valid, lim,
         out[i] = math.sqrt(worst)
 
 
+@njit(cache=True, nogil=True)
+def _split_candidates(W, est, valid, f, e, p0, p1, gap, lo, hi,
+                      out):  # pragma: no cover (compiled)
+    """:meth:`_Stretch.split`'s split points (compiled), ascending, those in lo..hi into
+    ``out``; returns their number: both ends of every step of W[f..e] longer than ``gap``,
+    the first and the last smooth point (``valid``), the smooth point whose estimate lies
+    farthest from the chord p0-p1 (:func:`point_segment_distance`'s arithmetic; the first
+    of equals, a NaN first, as np.argmax), the middle (f + e) // 2."""
+    n = e - f + 1
+    take = np.zeros(n, dtype=np.bool_)
+    for i in range(n - 1):
+        if math.hypot(W[f + i + 1, 0] - W[f + i, 0], W[f + i + 1, 1] - W[f + i, 1]) > gap:
+            take[i] = True
+            take[i + 1] = True
+    abx = p1[0] - p0[0]
+    aby = p1[1] - p0[1]
+    den = abx * abx + aby * aby
+    first = -1
+    last = -1
+    far = -1
+    dmax = 0.0
+    for i in range(n):
+        if not valid[f + i]:
+            continue
+        if first < 0:
+            first = i
+        last = i
+        apx = est[f + i, 0] - p0[0]
+        apy = est[f + i, 1] - p0[1]
+        t = (apx * abx + apy * aby) / den if den > 0.0 else 0.0
+        if t == t:  # (np.clip: NaN kept)
+            t = min(max(t, 0.0), 1.0)
+        d = math.hypot(apx - t * abx, apy - t * aby)
+        if far < 0 or (d > dmax and dmax == dmax) or (d != d and dmax == dmax):
+            far = i
+            dmax = d
+    if first >= 0:
+        take[first] = True
+        take[last] = True
+        take[far] = True
+    take[(f + e) // 2 - f] = True
+    nc = 0
+    for i in range(max(lo - f, 0), min(hi - f, n - 1) + 1):
+        if take[i]:
+            out[nc] = f + i
+            nc += 1
+    return nc
+
+
 class _Stretch:
     """The state of :func:`_smooth_stretches` on one call: the input, the estimates, the
     bound and step per path."""
@@ -5048,7 +5102,7 @@ class _Stretch:
         q = float(self.quant[o])
         alts = []
         if line_ok:
-            alts.append(np.stack([p0, p1]))
+            alts.append(np.array([p0, p1], dtype=np.float64))
         if e - f + 1 >= _STRETCH_CUBIC:
             c = _ls_cubic(p0, p1, _stretch_targets(self.W, self.est, self.valid, f, e, q))
             if c is not None:
@@ -5077,18 +5131,12 @@ class _Stretch:
         if hi < lo:
             return None
         q = float(self.quant[o])
-        cand = set()
-        gap = np.hypot(*np.diff(W[f:e + 1], axis=0).T) > _STRETCH_GAP * q
-        for i in np.flatnonzero(gap).tolist():
-            cand.update((f + i, f + i + 1))
-        v = np.flatnonzero(valid[f:e + 1])
-        if len(v):
-            cand.update((f + int(v[0]), f + int(v[-1])))
-            dv = point_segment_distance(est[f + v], p0, p1)
-            cand.add(f + int(v[np.argmax(dv)]))
-        cand.add((f + e) // 2)
+        cand = np.empty(e - f + 1, dtype=np.int64)
+        nc = _split_candidates(W, est, valid, f, e, np.asarray(p0, dtype=np.float64),
+                               np.asarray(p1, dtype=np.float64), _STRETCH_GAP * q, lo, hi,
+                               cand)
         best = None
-        for m in sorted(c for c in cand if lo <= c <= hi):
+        for m in cand[:nc].tolist():
             pm = (np.clip(est[m], W[m] - 0.5 * q, W[m] + 0.5 * q) if valid[m]
                   else W[m].astype(np.float64))
             a = self.shapes(p0, pm, f, m, o, limit, True)
