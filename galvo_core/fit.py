@@ -6434,17 +6434,28 @@ def _range_steps(W, a, b):
 
 
 def _line_steps(W, a, b, quant):
-    """Per thinned segment a[r]..b[r] (input indices, a < b): is it a design line written as
-    its two rounded ends (:func:`_on_the_design`'s ``_SMOOTH_ALONG``): its longest input step
-    at least ``_JOINT_LINE`` quanta, the whole segment or (``_SMOOTH_ALONG_SHARE``) that share
-    of its chord or more; and that step's vector (its first occurrence)."""
-    own, st, sl, first = _range_steps(W, a, b)
-    top = np.maximum.reduceat(sl, first)
-    at = np.flatnonzero(sl == top[own])
-    j0 = st[at[np.unique(own[at], return_index=True)[1]]]
+    """Per thinned segment a[r]..b[r] (input indices, a < b, increasing): is it a design line
+    written as its two rounded ends (:func:`_on_the_design`'s ``_SMOOTH_ALONG``): its longest
+    input step at least ``_JOINT_LINE`` quanta, the whole segment or
+    (``_SMOOTH_ALONG_SHARE``) that share of its chord or more; and, where it is, that step's
+    vector (its first occurrence; zeros elsewhere)."""
+    if len(a) == 0:
+        return np.zeros(0, dtype=bool), np.zeros((0, 2))
+    lo = int(a[0])
+    # (the steps of the whole span once, each range's longest by a reduction over its slice)
+    sl = np.hypot(*np.diff(W[lo:int(b.max()) + 1], axis=0).T)
+    top = np.maximum.reduceat(np.append(sl, 0.0), np.column_stack([a - lo, b - lo]).ravel())[::2]
     chord = np.hypot(*(W[b] - W[a]).T)
     share = (b - a == 1) | ((_SMOOTH_ALONG_SHARE > 0.0) & (top >= _SMOOTH_ALONG_SHARE * chord))
-    return (top >= _JOINT_LINE * quant) & share, W[j0 + 1] - W[j0]
+    along = (top >= _JOINT_LINE * quant) & share
+    dirs = np.zeros((len(a), 2))
+    al = np.flatnonzero(along)
+    if len(al):
+        own, st, sla, _ = _range_steps(W, a[al], b[al])
+        at = np.flatnonzero(sla == top[al][own])
+        j0 = st[at[np.unique(own[at], return_index=True)[1]]]
+        dirs[al] = W[j0 + 1] - W[j0]
+    return along, dirs
 
 
 def _on_the_design(W, K, Q, arc, t_in, t_out, smooth, quant, tlen, eps, found=None,

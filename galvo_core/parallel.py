@@ -68,8 +68,9 @@ def chunk_bounds(weights: np.ndarray, parts: int) -> list[tuple[int, int]]:
         return [(0, m)] if m else []
     cum = np.cumsum(np.maximum(np.asarray(weights, dtype=np.float64), 0.0) + 1.0)
     cuts = np.searchsorted(cum, cum[-1] * np.arange(1, parts) / parts, side="right")
-    edges = np.unique(np.r_[0, np.clip(cuts, 1, m - 1), m])
-    return [(int(a), int(b)) for a, b in zip(edges[:-1], edges[1:], strict=True)]
+    # (in Python: a few numbers, called once per kernel call, where numpy's calls cost more)
+    edges = sorted({0, m, *(min(max(c, 1), m - 1) for c in cuts.tolist())})
+    return list(zip(edges[:-1], edges[1:], strict=True))
 
 
 def _run_marked(fn: Callable[[int, int], object], lo: int, hi: int) -> object:

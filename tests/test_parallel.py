@@ -84,6 +84,28 @@ def test_a_threaded_fit_is_the_one_thread_fit(monkeypatch: pytest.MonkeyPatch) -
             assert np.array_equal(x, y)
 
 
+def test_threaded_repairs_are_the_one_thread_repairs(monkeypatch: pytest.MonkeyPatch) -> None:
+    # the smooth-stretch repairs (fit._smooth_stretches) run per path in chunks of paths:
+    # each path's repairs in the same order, its budget its own, so the same segments
+    paths = _outlines()
+    monkeypatch.setattr(parallel, "THREADS", 1)
+    one = _fit_arrays(paths)
+    _threads(monkeypatch, 3)
+    names: list[str] = []
+    real = parallel._run_marked
+
+    def run_marked(fn, lo, hi):  # type: ignore[no-untyped-def]
+        names.append(fn.__name__)
+        return real(fn, lo, hi)
+
+    monkeypatch.setattr(parallel, "_run_marked", run_marked)
+    three = _fit_arrays(paths)
+    assert names.count("repairs") >= 2  # the repairs were split over chunks of paths
+    for a, b in zip(one, three, strict=True):
+        for x, y in zip(a, b, strict=True):
+            assert np.array_equal(x, y)
+
+
 def test_threaded_thinning_is_the_one_thread_thinning(monkeypatch: pytest.MonkeyPatch) -> None:
     paths = _outlines() + [np.zeros((0, 2)), np.array([[1.0, 2.0]])]
     monkeypatch.setattr(parallel, "THREADS", 1)
