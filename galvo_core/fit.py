@@ -6434,14 +6434,14 @@ def _range_steps(W, a, b):
 
 
 def _line_steps(W, a, b, quant):
-    """Per thinned segment a[r]..b[r] (input indices, a < b, increasing): is it a design line
+    """Per thinned segment a[r]..b[r] (input indices, a < b): is it a design line
     written as its two rounded ends (:func:`_on_the_design`'s ``_SMOOTH_ALONG``): its longest
     input step at least ``_JOINT_LINE`` quanta, the whole segment or
     (``_SMOOTH_ALONG_SHARE``) that share of its chord or more; and, where it is, that step's
     vector (its first occurrence; zeros elsewhere)."""
     if len(a) == 0:
         return np.zeros(0, dtype=bool), np.zeros((0, 2))
-    lo = int(a[0])
+    lo = int(a.min())
     # (the steps of the whole span once, each range's longest by a reduction over its slice)
     sl = np.hypot(*np.diff(W[lo:int(b.max()) + 1], axis=0).T)
     top = np.maximum.reduceat(np.append(sl, 0.0), np.column_stack([a - lo, b - lo]).ravel())[::2]
