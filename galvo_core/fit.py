@@ -3170,6 +3170,16 @@ _GAP_RATIO = 3.0
 #: polyline's few short strokes beside a long one are lines of the design, and one thinned
 #: line within the bound serves them; vk2bea tektronix.hpgl: 761 -> 957 segments without)
 _GAP_REST = 5
+#: ... or at least this many (as long as that many quanta or line bounds), each at most
+#: ``_GAP_SHORT_STEP`` quanta long, where an input point of the rest lies ``_GAP_SHORT_OFF``
+#: quanta or more off the gap's line (the curve after a design line bends away at once: URW
+#: Z003 "3" at em 2048, a 59-unit line meeting a curve at 15 degrees, two of the curve's
+#: steps taken into the line, 0.80 from the design where the rounded input is 0.23; not a
+#: polyline's strokes, nor a scaled file's jitter at a corner: lectra_astm_test.hpgl,
+#: tektronix.hpgl the same)
+_GAP_SHORT_REST = 2
+_GAP_SHORT_OFF = 0.6
+_GAP_SHORT_STEP = 3.0
 #: ... and where that rest is no line within the bound, it is split at its farthest input
 #: point up to this many times (each piece a line within the bound) or the gap's end is not kept
 _GAP_SPLITS = 2
@@ -3180,8 +3190,9 @@ def _gap_ends_kept(W, K, tlen, quanta, eps, coarse):
     indices, each path's in order; ``tlen`` per path) with the ends of each long gap
     (``_LONE_LENGTH``; not a chord of a coarse curve, ``coarse``) added where the thinning
     left one of them inside a thinned segment (the gap at its other end) that also holds
-    points off the gap's line (``_GAP_OFF``), the gap at least ``_GAP_RATIO`` times the input
-    step beside it inside the segment, and the rest of the segment within ``eps`` (per path,
+    points off the gap's line (``_GAP_OFF``; or a few dense steps of which one lies
+    ``_GAP_SHORT_OFF`` off, ``_GAP_SHORT_REST``), the gap at least ``_GAP_RATIO`` times the
+    input step beside it inside the segment, and the rest of the segment within ``eps`` (per path,
     the line bound) of its chord, or of the chords of its pieces where it is split at its
     farthest input points (``_GAP_SPLITS``; those points are kept too): the thinning keeps a
     curve's end and the design line after it in one segment where they are nearly collinear,
@@ -3236,7 +3247,22 @@ def _gap_ends_kept(W, K, tlen, quanta, eps, coarse):
     e = e / np.hypot(e[:, 0], e[:, 1])[:, None]
     r = W[a[own] + off] - W[g][own]
     across = np.abs(r[:, 0] * e[own, 1] - r[:, 1] * e[own, 0])
-    far = np.maximum.reduceat(across, np.cumsum(b - a + 1) - (b - a + 1)) >= _GAP_OFF * q
+    top = np.maximum.reduceat(across, np.cumsum(b - a + 1) - (b - a + 1))
+    rest = np.where(after, b - g - 1, g - a)  # the input steps of the rest
+    far = (top >= _GAP_OFF * q) & (rest >= _GAP_REST)
+    # ... or a short rest (_GAP_SHORT_REST) of a dense curve's steps bending away from the
+    # line by more than the rounding's noise (_GAP_SHORT_OFF)
+    short = (rest >= _GAP_SHORT_REST) & (top >= _GAP_SHORT_OFF * q) & ~far
+    if short.any():
+        # ... its input steps all dense (_GAP_SHORT_STEP quanta at most: a finely flattened
+        # curve's, not a polyline's strokes)
+        sh = np.flatnonzero(short)
+        _, _, sl, at = _range_steps(W, np.where(after, g + 1, a)[sh], np.where(after, b, g)[sh])
+        # (and as long as that many quanta or line bounds, the larger: repeated points are no
+        # steps, and a scaled file's jitter at a polyline's corner is far shorter than its
+        # bound: vk2bea tektronix.hpgl, q 0.0056, the bound 0.024)
+        far[sh] = (np.maximum.reduceat(sl, at) <= _GAP_SHORT_STEP * q[sh]) & (
+            np.add.reduceat(sl, at) >= _GAP_SHORT_REST * np.maximum(q, eps_k[seg])[sh])
     if not far.any():
         return K, tlen
     # the point kept: the gap's end inside the segment; the rest of the segment, a line from
@@ -3246,10 +3272,6 @@ def _gap_ends_kept(W, K, tlen, quanta, eps, coarse):
     v = np.where(after, g + 1, g)
     r0 = np.where(after, v, a)
     r1 = np.where(after, b, v)
-    keep = r1 - r0 >= _GAP_REST
-    v, r0, r1, seg = v[keep], r0[keep], r1[keep], seg[keep]
-    if len(v) == 0:
-        return K, tlen
     err = _line_errors(W, np.stack([W[r0], W[r1]], axis=1), r0, r1)
     held = err <= eps_k[seg]
     # ... or, where it does not (the curve's end bends away from the chord), the rest split

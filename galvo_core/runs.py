@@ -308,6 +308,9 @@ _CLUSTER_SHIFT = 1.5
 #: ... and not beside a design line written as its two rounded ends (one input step) where
 #: the input steps are known (False: also there, for measurements)
 _CLUSTER_STEPS = True
+#: ... and no vertex of it turning more than a smooth curve's thinning and the rounding can
+#: make it (False: any turn, for measurements)
+_CLUSTER_TURNS = True
 
 
 def _short_clusters(smooth, sign, rounding, rnd, dot, cr, la, lb, length_ratio, cos_join,
@@ -318,7 +321,9 @@ def _short_clusters(smooth, sign, rounding, rnd, dot, cr, la, lb, length_ratio, 
     passing a grid line, a tangent point on a half unit) or of a curve's end at a corner.
     Where the two longer segments meet as a smooth vertex would (the turn over the
     cluster's length of a thinned circle, :func:`_rounded_rules`; their lengths within
-    ``length_ratio``), every vertex of the cluster is smooth; else the vertex that turns
+    ``length_ratio``) and no vertex of the cluster turns more than a thinned smooth curve and
+    the rounding of its own two segments can make it (``_CLUSTER_TURNS``: a corner whose turn
+    the others undo), every vertex of the cluster is smooth; else the vertex that turns
     most is a corner and the vertices on either side of it are smooth where the turn they
     add up to is within what the rounding of the short segments on that side can make
     (q sqrt2 over their length) or a smooth vertex may turn. A cluster's end vertex is
@@ -387,6 +392,19 @@ def _short_clusters(smooth, sign, rounding, rnd, dot, cr, la, lb, length_ratio, 
             # 30-unit line taken into the cubic after it, 0.68 from the design)
             jog &= (steps[i - 1] > 1) & (steps[j + 1] > 1)
         wig |= jog
+        if _CLUSTER_TURNS:
+            # ... but not where one of its vertices turns more than a thinned smooth curve
+            # and the rounding of its two segments together can make it turn: a corner
+            # whose turn the cluster's other vertices undo (FreeMono Bold "c" at em 1000: a
+            # 95-degree cusp between segments of 12 and 26 units after four turning 12-19
+            # degrees the other way, made smooth, 0.68 from the design on its input point)
+            la_v, lb_v = ln[v - 1], ln[v]
+            lm = np.maximum(la_v, lb_v)
+            allow = np.minimum(_ROUNDED_TURN_MARGIN * (la_v + lb_v) * 4.0 * ep[v] / (lm * lm),
+                               _ROUNDED_TURN_CAP) + _SQRT2 * qp[v] * (1.0 / la_v + 1.0 / lb_v)
+            sharp = np.zeros(len(i), dtype=bool)
+            sharp[own[np.abs(turn[v]) > allow]] = True
+            wig &= ~sharp
     make = np.zeros(n, dtype=bool)
     make[v[wig[own]]] = True
     # a zigzag's vertices have no sign where they turn as the rounding can make them

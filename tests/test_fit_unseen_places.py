@@ -10,7 +10,11 @@ inline contours as bench/fonts.py reads them, coordinates to 0.01) where the fit
 - a cubic that swallowed a design line written as its two rounded ends, the line being its
   end segment alone (``fit._LONE_BULGE_GAP``: a line there at a smaller bulge);
 - a smooth vertex beside a thinned segment that is mostly one long input step (a design line
-  written as its two rounded ends) moving across that line (``fit._SMOOTH_ALONG_SHARE``)."""
+  written as its two rounded ends) moving across that line (``fit._SMOOTH_ALONG_SHARE``);
+- (seventeenth session) a curve's first few dense steps taken into the design line before it
+  (``fit._GAP_SHORT_REST``: the line's end input point kept);
+- (seventeenth session, FreeMono Bold at em 1000) a cluster of short thinned segments made
+  smooth on its net turn although one of its vertices is a corner (``runs._CLUSTER_TURNS``)."""
 
 from __future__ import annotations
 
@@ -157,6 +161,82 @@ _BM = [
 ]
 
 
+#: Z003 Medium Italic "3" at em 2048, contour 75: a 59-unit design line (written as its two
+#: rounded ends) meets a cubic at 15 degrees at (57139.20, 847.87); the thinning took the
+#: curve's first two steps into the line, which then ended 3.6 units into the curve
+_THREE = [
+    ('cubic', (56352.77, 53.25), (56438.78, 6.14), (56504.32, -12.29), (56594.43, -12.29)),
+    ('cubic', (56594.43, -12.29), (56885.25, -12.29), (57188.35, 266.24), (57188.35, 532.48)),
+    ('cubic', (57188.35, 532.48), (57188.35, 595.97), (57159.68, 653.31), (57112.58, 686.08)),
+    ('cubic', (57112.58, 686.08), (57079.81, 708.61), (57051.14, 718.85), (56979.46, 729.09)),
+    ('cubic', (56979.46, 729.09), (56997.89, 741.38), (57012.22, 751.62), (57028.61, 765.95)),
+    ('line', (57028.61, 765.95), (57092.10, 813.06)),
+    ('line', (57092.10, 813.06), (57139.20, 847.87)),
+    ('cubic', (57139.20, 847.87), (57192.45, 915.46), (57214.98, 966.66), (57214.98, 1030.14)),
+    ('cubic', (57214.98, 1030.14), (57214.98, 1118.21), (57145.34, 1177.60), (57042.94, 1177.60)),
+    ('cubic', (57042.94, 1177.60), (57014.27, 1177.60), (56989.70, 1173.50), (56938.50, 1159.17)),
+    ('cubic', (56938.50, 1159.17), (56911.87, 1144.83), (56889.34, 1132.54), (56881.15, 1126.40)),
+    ('cubic', (56881.15, 1126.40), (56868.86, 1120.26), (56840.19, 1097.73), (56795.14, 1067.01)),
+    ('cubic', (56795.14, 1067.01), (56786.94, 1060.86), (56766.46, 1046.53), (56735.74, 1026.05)),
+    ('line', (56735.74, 1026.05), (56733.70, 974.85)),
+    ('cubic', (56733.70, 974.85), (56817.66, 1028.10), (56895.49, 1060.86), (56942.59, 1060.86)),
+    ('cubic', (56942.59, 1060.86), (57010.18, 1060.86), (57057.28, 1009.66), (57057.28, 940.03)),
+    ('cubic', (57057.28, 940.03), (57057.28, 815.10), (56936.45, 716.80), (56653.82, 608.26)),
+    ('line', (56653.82, 608.26), (56647.68, 555.01)),
+    ('cubic', (56647.68, 555.01), (56815.62, 618.50), (56815.62, 618.50), (56858.62, 618.50)),
+    ('cubic', (56858.62, 618.50), (56958.98, 618.50), (57030.66, 538.62), (57030.66, 421.89)),
+    ('cubic', (57030.66, 421.89), (57030.66, 337.92), (56995.84, 247.81), (56938.50, 180.22)),
+    ('cubic', (56938.50, 180.22), (56881.15, 112.64), (56803.33, 77.82), (56713.22, 77.82)),
+    ('cubic', (56713.22, 77.82), (56635.39, 77.82), (56598.53, 88.06), (56446.98, 157.70)),
+    ('line', (56446.98, 157.70), (56352.77, 53.25)),
+]
+
+#: FreeMono Bold "c" at em 1000 (the font's own units: its corners are on input points),
+#: contour 38: a 95-degree cusp at (17254, 420) between a 26-unit thinned segment and four
+#: of 9-12 units turning 12-19 degrees the other way; the cluster rule saw only their net turn
+_C = [
+    ('line', (17340.00, 307.00), (17340.00, 384.00)),
+    ('cubic', (17340.00, 384.00), (17340.00, 430.00), (17325.00, 450.00), (17292.00, 450.00)),
+    ('cubic', (17292.00, 450.00), (17271.00, 450.00), (17260.00, 441.00), (17254.00, 420.00)),
+    ('cubic', (17254.00, 420.00), (17215.00, 440.00), (17167.00, 450.00), (17110.00, 450.00)),
+    ('cubic', (17110.00, 450.00), (16959.00, 450.00), (16854.00, 350.00), (16854.00, 207.00)),
+    ('cubic', (16854.00, 207.00), (16854.00, 110.00), (16908.00, -16.00), (17123.00, -16.00)),
+    ('cubic', (17123.00, -16.00), (17273.00, -16.00), (17365.00, 34.00), (17365.00, 89.00)),
+    ('cubic', (17365.00, 89.00), (17365.00, 117.00), (17342.00, 140.00), (17315.00, 140.00)),
+    ('cubic', (17315.00, 140.00), (17274.00, 140.00), (17284.00, 84.00), (17130.00, 84.00)),
+    ('cubic', (17130.00, 84.00), (17013.00, 84.00), (16954.00, 125.00), (16954.00, 207.00)),
+    ('cubic', (16954.00, 207.00), (16954.00, 292.00), (17015.00, 350.00), (17110.00, 350.00)),
+    ('cubic', (17110.00, 350.00), (17154.00, 350.00), (17190.00, 341.00), (17216.00, 325.00)),
+    ('cubic', (17216.00, 325.00), (17252.00, 299.00), (17228.00, 241.00), (17290.00, 241.00)),
+    ('cubic', (17290.00, 241.00), (17332.00, 241.00), (17340.00, 272.00), (17340.00, 307.00)),
+]
+
+#: FreeMono Bold "@" at em 1000, contour 86: a curve, a 3-unit design line down and a line
+#: on, two corners of 90-98 degrees whose net turn is nothing
+_AT = [
+    ('cubic', (37502.00, -152.00), (37597.00, -152.00), (37679.00, -113.00), (37679.00, -66.00)),
+    ('cubic', (37679.00, -66.00), (37679.00, -43.00), (37661.00, -25.00), (37639.00, -25.00)),
+    ('cubic', (37639.00, -25.00), (37608.00, -25.00), (37606.00, -74.00), (37505.00, -74.00)),
+    ('cubic', (37505.00, -74.00), (37385.00, -74.00), (37355.00, 70.00), (37355.00, 161.00)),
+    ('line', (37355.00, 161.00), (37355.00, 317.00)),
+    ('cubic', (37355.00, 317.00), (37355.00, 445.00), (37418.00, 541.00), (37502.00, 541.00)),
+    ('cubic', (37502.00, 541.00), (37564.00, 541.00), (37607.00, 495.00), (37607.00, 429.00)),
+    ('line', (37607.00, 429.00), (37607.00, 397.00)),
+    ('cubic', (37607.00, 397.00), (37495.00, 389.00), (37418.00, 319.00), (37418.00, 226.00)),
+    ('cubic', (37418.00, 226.00), (37418.00, 143.00), (37489.00, 72.00), (37574.00, 72.00)),
+    ('cubic', (37574.00, 72.00), (37583.00, 72.00), (37592.00, 73.00), (37607.00, 75.00)),
+    ('line', (37607.00, 75.00), (37607.00, 72.00)),
+    ('line', (37607.00, 72.00), (37654.00, 72.00)),
+    ('cubic', (37654.00, 72.00), (37691.00, 72.00), (37709.00, 85.00), (37709.00, 113.00)),
+    ('cubic', (37709.00, 113.00), (37709.00, 130.00), (37702.00, 141.00), (37686.00, 148.00)),
+    ('line', (37686.00, 148.00), (37686.00, 429.00)),
+    ('cubic', (37686.00, 429.00), (37686.00, 540.00), (37609.00, 620.00), (37501.00, 620.00)),
+    ('cubic', (37501.00, 620.00), (37371.00, 620.00), (37276.00, 495.00), (37276.00, 323.00)),
+    ('line', (37276.00, 323.00), (37276.00, 154.00)),
+    ('cubic', (37276.00, 154.00), (37276.00, 39.00), (37321.00, -152.00), (37502.00, -152.00)),
+]
+
+
 @pytest.mark.parametrize(("segs", "place", "mod", "knob", "off", "now", "before"), [
     (_FOUR, (57321.47, 317.44), fitmod, "_FIRST_CHAIN", False, 0.6, 0.9),
     (_Q, (23187.4, -98.1), runs, "_CLUSTER_JOG", False, 0.3, 0.75),
@@ -164,8 +244,15 @@ _BM = [
     # (the vertex moved onto the curve's estimate tilted the line off its row: 0.69 from
     # the design corner where the rounded input is 0.33)
     (_BM, (49055.7, 995.3), fitmod, "_SMOOTH_ALONG_SHARE", 0.0, 0.45, 0.6),
+    # (the line's end 0.80 from the design corner where the rounded input is 0.23)
+    (_THREE, (57139.2, 847.9), fitmod, "_GAP_SHORT_REST", 10**9, 0.45, 0.7),
+    # (each corner moved off its input point, the design's, to a corner of its rounding
+    # square: 0.68 and 0.71 from the design where the rounded input is 0.28 and 0.26)
+    (_C, (17254.0, 420.0), runs, "_CLUSTER_TURNS", False, 0.3, 0.6),
+    (_AT, (37607.0, 75.0), runs, "_CLUSTER_TURNS", False, 0.35, 0.6),
 ], ids=["line-chain-corner", "diagonal-jog-cluster", "swallowed-gap-line",
-        "smooth-vertex-along-a-long-step"])
+        "smooth-vertex-along-a-long-step", "curve-steps-after-a-gap-line",
+        "cusp-in-a-cluster", "step-in-a-cluster"])
 def test_the_fit_lies_near_the_design_there(segs, place, mod, knob, off, now, before,
                                             monkeypatch):
     p = np.array(place)

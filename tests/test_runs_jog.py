@@ -85,7 +85,10 @@ def test_a_step_of_the_design_between_parallel_runs_stays_sharp(monkeypatch):
     w = w[np.r_[True, (np.diff(w, axis=0) != 0).any(axis=1)]]
     fine = resampled(design, 0.05)
     dist = _distance(_dense(_fit(w)), fine)
-    # (taken for a jog, the step's corners are rounded off: 0.92 from the design)
+    # (the shift's guard alone: taken for a jog, the step's corners are rounded off, 0.92
+    # from the design; the turn guard, runs._CLUSTER_TURNS, holds them too)
     monkeypatch.setattr(runs, "_CLUSTER_SHIFT", 100.0)
+    d_turns = _distance(_dense(_fit(w)), fine)
+    monkeypatch.setattr(runs, "_CLUSTER_TURNS", False)
     d_any = _distance(_dense(_fit(w)), fine)
-    assert dist < 0.6 and d_any > 0.75, (dist, d_any)
+    assert dist < 0.6 and d_turns < 0.6 and d_any > 0.75, (dist, d_turns, d_any)
