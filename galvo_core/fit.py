@@ -3019,10 +3019,10 @@ def _fit_concatenated(
     K = K[np.repeat(in_todo, klen)]
     tlen = klen[todo]
     coarse = None
+    wstep = _step_lengths(W)  # (once: the passes below all read it)
     if rounding is not None and (rounding[:, 1] > 0.0).any():
         coarse = _coarse_chords(W, woff[todo], wlen[todo], rounding[:, 1])
-        K, tlen = _gap_ends_kept(W, K, tlen, rounding[:, 1], rounding[:, 0], coarse)
-    wstep = _step_lengths(W)  # (once: the passes below all read it)
+        K, tlen = _gap_ends_kept(W, K, tlen, rounding[:, 1], rounding[:, 0], coarse, wstep)
     arc = _arc_per_path(W, wlen, wstep)
     move_q = None
     if rounding is not None:
@@ -3039,7 +3039,7 @@ def _fit_concatenated(
         Q = Q.copy()
         found: list[tuple[np.ndarray, np.ndarray, np.ndarray]] = []
         _on_the_design(W, K, Q, arc, t_in, t_out, smooth, np.repeat(move_q, tlen), tlen,
-                       np.repeat(rounding[:, 0], tlen), found, coarse)
+                       np.repeat(rounding[:, 0], tlen), found, coarse, wstep)
         if found and len(found[0][0]):
             # corners the thinning kept beside the design's: their input points kept instead
             # (or too), and those paths' pieces split again
@@ -3048,7 +3048,7 @@ def _fit_concatenated(
             if touched.any():
                 K, tlen, Q, pa, pb, curve, t_in, t_out, smooth = _split_again(
                     W, arc, K, tlen, K2, tlen2, touched, Q, pa, pb, t_in, t_out, smooth,
-                    closed_t, rounding, move_q, coarse)
+                    closed_t, rounding, move_q, coarse, wstep)
     kend = np.cumsum(tlen) - 1  # each path's last thinned point
     is_kend = np.zeros(len(Q), dtype=bool)
     is_kend[kend] = True
@@ -3185,7 +3185,7 @@ _GAP_SHORT_STEP = 3.0
 _GAP_SPLITS = 2
 
 
-def _gap_ends_kept(W, K, tlen, quanta, eps, coarse):
+def _gap_ends_kept(W, K, tlen, quanta, eps, coarse, wstep=None):
     """Rounded input (``quanta`` per path, 0: exact): ``K`` (the thinned points, global
     indices, each path's in order; ``tlen`` per path) with the ends of each long gap
     (``_LONE_LENGTH``; not a chord of a coarse curve, ``coarse``) added where the thinning
@@ -3198,7 +3198,8 @@ def _gap_ends_kept(W, K, tlen, quanta, eps, coarse):
     curve's end and the design line after it in one segment where they are nearly collinear,
     and the curve piece then swallows the line (a cubic through its two rounded ends may bulge
     over it by the rounding; Cantarell "a" at em 1500: 0.75 from the design where the rounded
-    input is 0.5). Returns (K, tlen)."""
+    input is 0.5). ``wstep``: the step lengths of W (:func:`_step_lengths`) where known.
+    Returns (K, tlen)."""
     q_k = np.repeat(quanta, tlen)
     eps_k = np.repeat(eps, tlen)
     if len(K) < 2 or not (q_k > 0.0).any():
@@ -3257,7 +3258,8 @@ def _gap_ends_kept(W, K, tlen, quanta, eps, coarse):
         # ... its input steps all dense (_GAP_SHORT_STEP quanta at most: a finely flattened
         # curve's, not a polyline's strokes)
         sh = np.flatnonzero(short)
-        _, _, sl, at = _range_steps(W, np.where(after, g + 1, a)[sh], np.where(after, b, g)[sh])
+        _, _, sl, at = _range_steps(_step_lengths(W) if wstep is None else wstep,
+                                    np.where(after, g + 1, a)[sh], np.where(after, b, g)[sh])
         # (and as long as that many quanta or line bounds, the larger: repeated points are no
         # steps, and a scaled file's jitter at a polyline's corner is far shorter than its
         # bound: vk2bea tektronix.hpgl, q 0.0056, the bound 0.024)
@@ -3417,7 +3419,7 @@ def _corners_kept_right(W, K, tlen, v, j, both, eps):
 
 
 def _split_again(W, arc, K, tlen, K2, tlen2, touched, Q, pa, pb, t_in, t_out, smooth,
-                 closed, rounding, move_q, coarse):
+                 closed, rounding, move_q, coarse, wstep=None):
     """The pieces, tangents, smooth flags and moved vertices (:func:`_on_the_design`) of the
     thinned points ``K2`` (``tlen2`` per path), where only the paths ``touched`` differ from
     ``K`` (``tlen``), whose results ``Q``, ``pa``, ``pb``, ``t_in``, ``t_out``, ``smooth`` are
@@ -3432,7 +3434,7 @@ def _split_again(W, arc, K, tlen, K2, tlen2, touched, Q, pa, pb, t_in, t_out, sm
                                               return_smooth=True, steps=np.diff(Ks, append=0))
     Qs = Qs.copy()
     _on_the_design(W, Ks, Qs, arc, si, so, ss, np.repeat(move_q[P], ts), ts,
-                   np.repeat(rounding[P, 0], ts), None, coarse)
+                   np.repeat(rounding[P, 0], ts), None, coarse, wstep)
     # per thinned point: the old rows of the other paths, the new rows of the touched ones
     src = np.empty(len(K2), dtype=np.intp)
     src[~sel] = np.flatnonzero(~np.repeat(touched, tlen))
@@ -6447,33 +6449,34 @@ _FIRST_CHAIN = True
 _SMOOTH_SIDES = 2
 
 
-def _range_steps(W, a, b):
+def _range_steps(wstep, a, b):
     """The input steps of the ranges a[r]..b[r] (a < b): per step its range and its first
-    point, their lengths (libm's hypot), and each range's first position among them."""
+    point, their lengths (from ``wstep``, :func:`_step_lengths`), and each range's first
+    position among them."""
     own, off = _ragged(np.arange(len(a)), b - a)
     st = a[own] + off
-    return own, st, np.hypot(*(W[st + 1] - W[st]).T), np.cumsum(b - a) - (b - a)
+    return own, st, wstep[st], np.cumsum(b - a) - (b - a)
 
 
-def _line_steps(W, a, b, quant):
+def _line_steps(W, wstep, a, b, quant):
     """Per thinned segment a[r]..b[r] (input indices, a < b): is it a design line
     written as its two rounded ends (:func:`_on_the_design`'s ``_SMOOTH_ALONG``): its longest
     input step at least ``_JOINT_LINE`` quanta, the whole segment or
     (``_SMOOTH_ALONG_SHARE``) that share of its chord or more; and, where it is, that step's
-    vector (its first occurrence; zeros elsewhere)."""
+    vector (its first occurrence; zeros elsewhere). ``wstep``: the step lengths of W."""
     if len(a) == 0:
         return np.zeros(0, dtype=bool), np.zeros((0, 2))
     lo = int(a.min())
-    # (the steps of the whole span once, each range's longest by a reduction over its slice)
-    sl = np.hypot(*np.diff(W[lo:int(b.max()) + 1], axis=0).T)
-    top = np.maximum.reduceat(np.append(sl, 0.0), np.column_stack([a - lo, b - lo]).ravel())[::2]
+    # (each range's longest step by a reduction over its slice of the span's steps)
+    sl = np.append(wstep[lo:int(b.max())], 0.0)
+    top = np.maximum.reduceat(sl, np.column_stack([a - lo, b - lo]).ravel())[::2]
     chord = np.hypot(*(W[b] - W[a]).T)
     share = (b - a == 1) | ((_SMOOTH_ALONG_SHARE > 0.0) & (top >= _SMOOTH_ALONG_SHARE * chord))
     along = (top >= _JOINT_LINE * quant) & share
     dirs = np.zeros((len(a), 2))
     al = np.flatnonzero(along)
     if len(al):
-        own, st, sla, _ = _range_steps(W, a[al], b[al])
+        own, st, sla, _ = _range_steps(wstep, a[al], b[al])
         at = np.flatnonzero(sla == top[al][own])
         j0 = st[at[np.unique(own[at], return_index=True)[1]]]
         dirs[al] = W[j0 + 1] - W[j0]
@@ -6481,7 +6484,7 @@ def _line_steps(W, a, b, quant):
 
 
 def _on_the_design(W, K, Q, arc, t_in, t_out, smooth, quant, tlen, eps, found=None,
-                   coarse=None) -> None:
+                   coarse=None, wstep=None) -> None:
     """Rounded input (per thinned point its path's quantum ``quant``): the smooth thinned
     vertices (inside curve runs) moved onto a least-squares estimate of the design curve
     (a quadratic in arc length through the input points between the middles of the two
@@ -6489,7 +6492,8 @@ def _on_the_design(W, K, Q, arc, t_in, t_out, smooth, quant, tlen, eps, found=No
     segment or where that half has fewer than ``_SMOOTH_FEW``), kept inside the point's
     rounding square, with the fit's
     tangent as both of its tangents; the ends of curve runs keep their place and get
-    one-sided fitted tangents. In place on ``Q``, ``t_in``, ``t_out``."""
+    one-sided fitted tangents. In place on ``Q``, ``t_in``, ``t_out``. ``wstep``: the step
+    lengths of W (:func:`_step_lengths`) where known."""
     n = len(Q)
     last = np.cumsum(tlen) - 1
     first = last - tlen + 1
@@ -6536,7 +6540,9 @@ def _on_the_design(W, K, Q, arc, t_in, t_out, smooth, quant, tlen, eps, found=No
             # degrees, the line tilted 0.4 off its row, 0.69 from the design where the
             # rounded input is 0.33); each thinned segment beside the vertices once
             sg = np.unique(np.concatenate([k - 1, k]))
-            along, dirs = _line_steps(W, K[sg], K[sg + 1], quant[sg])
+            if wstep is None:
+                wstep = _step_lengths(W)
+            along, dirs = _line_steps(W, wstep, K[sg], K[sg + 1], quant[sg])
             gi = along[np.searchsorted(sg, k - 1)]
             go = along[np.searchsorted(sg, k)]
             one = gi ^ go
@@ -6575,7 +6581,8 @@ def _on_the_design(W, K, Q, arc, t_in, t_out, smooth, quant, tlen, eps, found=No
             K[ci] - _SIDE_POINTS + 1, k_first[ci]), quant[ci]))
         _, tan, ok = _local_fits(W, arc, lo, K[ci], K[ci])
         t_in[ci[ok]] = tan[ok]
-    _corners_on_the_design(W, K, Q, arc, smooth, rnd, first, last, quant, eps, found, coarse)
+    _corners_on_the_design(W, K, Q, arc, smooth, rnd, first, last, quant, eps, found, coarse,
+                           wstep)
 
 
 #: one-sided tangents of rounded input are fitted over at least this many input points
@@ -7036,7 +7043,7 @@ def _longer_sides(W, arc, k, end, bound, quant, p, t, ok, step) -> None:
 
 
 def _corners_on_the_design(W, K, Q, arc, smooth, rnd, first, last, quant, eps,
-                           found=None, coarse=None) -> None:
+                           found=None, coarse=None, wstep=None) -> None:
     """Rounded input: the corners (thinned vertices that are not smooth; a closed path's seam too)
     move inside their rounding squares onto an estimate of the design's corner. Per side, the
     input points of the thinned segment on that side give a position and a tangent at the
@@ -7058,7 +7065,7 @@ def _corners_on_the_design(W, K, Q, arc, smooth, rnd, first, last, quant, eps,
     more than ``eps`` (per thinned point), so the lines keep their bound (the
     curve side of a corner with a two-point side is not held to that: the fitter tests its
     cubics against the bound, and a line there is made valid by :func:`_valid_lines`). In place
-    on ``Q``."""
+    on ``Q``; ``wstep`` as in :func:`_on_the_design`."""
     n = len(Q)
     is_first = np.zeros(n, dtype=bool)
     is_first[first] = True
@@ -7139,7 +7146,9 @@ def _corners_on_the_design(W, K, Q, arc, smooth, rnd, first, last, quant, eps,
                 # each written as its rounded ends (their least-squares line is none of them)
                 cand = np.flatnonzero(base & ~sel)
                 if len(cand):
-                    _, _, sl, at = _range_steps(W, np.minimum(nb, K[v])[cand],
+                    if wstep is None:
+                        wstep = _step_lengths(W)
+                    _, _, sl, at = _range_steps(wstep, np.minimum(nb, K[v])[cand],
                                                 np.maximum(nb, K[v])[cand])
                     sel[cand] = np.minimum.reduceat(sl, at) >= _LONE_LENGTH * quant[v][cand]
             if sel.any():
