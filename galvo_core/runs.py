@@ -197,6 +197,14 @@ _JOG = 1.5
 _JOG_DIAG = 0.5
 
 
+def _smooth_turn(total: np.ndarray, longest: np.ndarray, eps: np.ndarray) -> np.ndarray:
+    """The turn (radians) a thinned smooth curve may make over segments of summed length
+    ``total``, the longest ``longest``, thinned with ``eps``: ``_ROUNDED_TURN_MARGIN`` times
+    total 4 eps / longest^2, at most ``_ROUNDED_TURN_CAP`` (:func:`_rounded_rules`)."""
+    return np.minimum(_ROUNDED_TURN_MARGIN * total * 4.0 * eps / (longest * longest),
+                      _ROUNDED_TURN_CAP)
+
+
 def _diagonal(v: np.ndarray, least: float) -> np.ndarray:
     """Per vector: |sin 2a| of its angle a at least ``least`` (0.5: 15-75 degrees from the
     axes; 0: every vector)."""
@@ -242,8 +250,7 @@ def _wiggle_rules(smooth, sign, rounding, rnd, dot, cr, la, lb, length_ratio, co
     ang = np.abs(np.arctan2(cr, dot))
     lmax = np.maximum(la, lb)
     with np.errstate(invalid="ignore", divide="ignore"):
-        lim = np.minimum(_ROUNDED_TURN_MARGIN * (la + lb) * 4.0 * eps / (lmax * lmax),
-                         _ROUNDED_TURN_CAP)
+        lim = _smooth_turn(la + lb, lmax, eps)
         ratio_ok = (lb <= length_ratio * la) & (la <= length_ratio * lb)
         add = rnd & ratio_ok & (ang <= lim)
         flat = rnd & (ang < qq / lmax)
@@ -281,9 +288,7 @@ def _wiggle_rules(smooth, sign, rounding, rnd, dot, cr, la, lb, length_ratio, co
         with np.errstate(invalid="ignore", divide="ignore"):
             dot2 = (a_ * c_).sum(axis=1)
             cr2 = a_[:, 0] * c_[:, 1] - a_[:, 1] * c_[:, 0]
-            lmax2 = np.maximum(wa, wc)
-            lim2 = np.minimum(_ROUNDED_TURN_MARGIN * (wa + wc) * 4.0 * eps[k] / (lmax2 * lmax2),
-                              _ROUNDED_TURN_CAP)
+            lim2 = _smooth_turn(wa + wc, np.maximum(wa, wc), eps[k])
             ok2 = (dot2 > cos_join * wa * wc) | (np.abs(np.arctan2(cr2, dot2)) <= lim2)
             ok2 &= ((wc <= length_ratio * wa) & (wa <= length_ratio * wc)
                     | jog[w]) & (lb[k] < wc)
@@ -369,9 +374,7 @@ def _short_clusters(smooth, sign, rounding, rnd, dot, cr, la, lb, length_ratio, 
     dot2 = (a_ * c_).sum(axis=1)
     net = np.arctan2(a_[:, 0] * c_[:, 1] - a_[:, 1] * c_[:, 0], dot2)
     with np.errstate(invalid="ignore", divide="ignore"):
-        lmax = np.maximum(wa, wc)
-        lim = np.minimum(_ROUNDED_TURN_MARGIN * (wa + wc + 2.0 * gap) * 4.0 * ep[i]
-                         / (lmax * lmax), _ROUNDED_TURN_CAP)
+        lim = _smooth_turn(wa + wc + 2.0 * gap, np.maximum(wa, wc), ep[i])
         wig = ((dot2 > cos_join * wa * wc) | (np.abs(net) <= lim))
         wig &= (wc <= length_ratio * wa) & (wa <= length_ratio * wc)
         # a jog of the rounding: the two longer segments parallel up to the rounding (one of
@@ -399,9 +402,8 @@ def _short_clusters(smooth, sign, rounding, rnd, dot, cr, la, lb, length_ratio, 
             # 95-degree cusp between segments of 12 and 26 units after four turning 12-19
             # degrees the other way, made smooth, 0.68 from the design on its input point)
             la_v, lb_v = ln[v - 1], ln[v]
-            lm = np.maximum(la_v, lb_v)
-            allow = np.minimum(_ROUNDED_TURN_MARGIN * (la_v + lb_v) * 4.0 * ep[v] / (lm * lm),
-                               _ROUNDED_TURN_CAP) + _SQRT2 * qp[v] * (1.0 / la_v + 1.0 / lb_v)
+            allow = (_smooth_turn(la_v + lb_v, np.maximum(la_v, lb_v), ep[v])
+                     + _SQRT2 * qp[v] * (1.0 / la_v + 1.0 / lb_v))
             sharp = np.zeros(len(i), dtype=bool)
             sharp[own[np.abs(turn[v]) > allow]] = True
             wig &= ~sharp
