@@ -30,9 +30,9 @@ def test_chunks_cover_every_item_once_in_order(parts: int) -> None:
     assert len(b) == 2
 
 
-def _threads(monkeypatch: pytest.MonkeyPatch, n: int) -> list[str]:
+def _threads(monkeypatch: pytest.MonkeyPatch, n: int, fns: list[str] | None = None) -> list[str]:
     """Run every kernel in up to n chunks whatever its size; the names of the threads that
-    ran chunks are collected."""
+    ran chunks are collected (and into ``fns`` the names of the chunk functions)."""
     monkeypatch.setattr(parallel, "THREADS", n)
     monkeypatch.setattr(parallel, "MIN_WORK", 0)
     seen: list[str] = []
@@ -40,6 +40,8 @@ def _threads(monkeypatch: pytest.MonkeyPatch, n: int) -> list[str]:
 
     def run_marked(fn, lo, hi):  # type: ignore[no-untyped-def]
         seen.append(threading.current_thread().name)
+        if fns is not None:
+            fns.append(fn.__name__)
         return real(fn, lo, hi)
 
     monkeypatch.setattr(parallel, "_run_marked", run_marked)
@@ -90,15 +92,8 @@ def test_threaded_repairs_are_the_one_thread_repairs(monkeypatch: pytest.MonkeyP
     paths = _outlines()
     monkeypatch.setattr(parallel, "THREADS", 1)
     one = _fit_arrays(paths)
-    _threads(monkeypatch, 3)
     names: list[str] = []
-    real = parallel._run_marked
-
-    def run_marked(fn, lo, hi):  # type: ignore[no-untyped-def]
-        names.append(fn.__name__)
-        return real(fn, lo, hi)
-
-    monkeypatch.setattr(parallel, "_run_marked", run_marked)
+    _threads(monkeypatch, 3, names)
     three = _fit_arrays(paths)
     assert names.count("repairs") >= 2  # the repairs were split over chunks of paths
     for a, b in zip(one, three, strict=True):
