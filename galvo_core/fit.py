@@ -3065,7 +3065,7 @@ def _fit_concatenated(
         ca, cb, ctrl, bound, fla = _lone_lines_out(
             W, K, Q, arc, t_in, t_out, np.repeat(e_per, tlen), eps_sum,
             np.repeat(move_q, tlen), np.repeat(rounding[:, 0], tlen), ca, cb, ctrl, bound, fla,
-            coarse=fitter.coarse, wstep=wstep)
+            coarse=fitter.coarse, wstep=wstep, line_pieces=pa[~curve])
     la = fla
     lb = la + 1
     owner = np.repeat(np.arange(len(todo)), tlen)  # thinned index -> position in todo
@@ -3479,16 +3479,22 @@ _LONE_SAMPLES = 65
 #: "R" at em 400: the rest of a cubic over a 44-unit design line needed a cubic and a line)
 _LONE_REFIT = 2
 _LONE_BASIS = seed_basis(_LONE_SAMPLES - 1)[1]
+#: ... and a line piece of the curve-run rules between two of a cubic's segments (the fitter's
+#: merge rounds took it in) holding a long gap, the cubic straying ``_LONE_BULGE`` quanta from
+#: its chord, is made a line too, the cubic's two rests re-fitted apart
+_LONE_MIDDLE = True
 
 
 def _lone_lines_out(W, K, Q, arc, t_in, t_out, e_per, eps_sum, quant, eps, ca, cb, ctrl,
-                    bound, la, coarse=None, wstep=None):
+                    bound, la, coarse=None, wstep=None, line_pieces=None):
     """Rounded input (``quant`` per thinned point, 0: not moved): the cubics that swallow a
     design line at one of their ends (``_LONE_SHARE``, ``_LONE_BULGE``, ``_LONE_BULGE_GAP``)
-    are re-fitted over their other segments, that end segment made a line. Returns (ca, cb,
-    ctrl, bound, la) with those cubics replaced; ``t_in``, ``t_out`` changed in place at the
-    new joints. ``coarse``: the fitter's chords of coarse curves (:func:`_coarse_chords`),
-    for the re-fit."""
+    or between two of their segments (``_LONE_MIDDLE``) are re-fitted over their other
+    segments, that segment made a line (there, only a line piece of the curve-run rules,
+    ``line_pieces``: their first thinned indices, that the fitter's merge rounds took into a
+    cubic). Returns (ca, cb, ctrl, bound, la) with those cubics replaced; ``t_in``, ``t_out``
+    changed in place at the new joints. ``coarse``: the fitter's chords of coarse curves
+    (:func:`_coarse_chords`), for the re-fit."""
     if len(ca) == 0:
         return ca, cb, ctrl, bound, la
     q = quant[ca]
@@ -3505,25 +3511,35 @@ def _lone_lines_out(W, K, Q, arc, t_in, t_out, e_per, eps_sum, quant, eps, ca, c
     if len(big) == 0:
         return ca, cb, ctrl, bound, la
 
-    def swallowed(u, v):
-        # per cubic: its segment u..v (thinned) holds a long gap that the cubic bulges over
+    def longest(lo, hi):
+        # the longest gap in each range big[lo:hi] (the first of equal ones)
+        return np.array([big[a + int(np.argmax(step[big[a:b]]))] for a, b in
+                         zip(lo.tolist(), hi.tolist(), strict=True)], dtype=np.intp)
+
+    def swallowed(u, r):
+        # per cubic r: its segment u..u+1 (thinned) holds a long gap that the cubic bulges
+        # over
         ok = np.zeros(len(ca), dtype=bool)
-        ku, kv = K[u], K[v]
+        ku, kv = K[u[r]], K[u[r] + 1]
         lo = np.searchsorted(big, ku)
         hi = np.searchsorted(big, kv)
-        r = np.flatnonzero(cand & (hi > lo))
+        has = hi > lo
+        r, ku, kv, lo, hi = r[has], ku[has], kv[has], lo[has], hi[has]
         if len(r) == 0:
             return ok
-        # the longest gap in each (the first of equal ones)
-        g = np.array([big[a + int(np.argmax(step[big[a:b]]))] for a, b in
-                      zip(lo[r].tolist(), hi[r].tolist(), strict=True)], dtype=np.intp)
-        d = W[kv[r]] - W[ku[r]]
+        g = longest(lo, hi)
+        d = W[kv] - W[ku]
         ln = np.hypot(d[:, 0], d[:, 1])
-        keep = (step[g] >= _LONE_LENGTH * q[r]) & (step[g] >= _LONE_SHARE * ln)
-        r, g = r[keep], g[keep]
+        inner = (u[r] > ca[r]) & (u[r] + 1 < cb[r])
+        # (a segment between two of the cubic's, a line piece: the curve-run rules found it
+        # a line whatever the share of its long gap)
+        keep = (step[g] >= _LONE_LENGTH * q[r]) & (inner | (step[g] >= _LONE_SHARE * ln))
+        r, g, inner, ku, kv = r[keep], g[keep], inner[keep], ku[keep], kv[keep]
         if len(r) == 0:
             return ok
-        a0, a1 = W[g], W[g + 1]
+        # the chord: the gap's, or the segment's where it lies between two of the cubic's
+        a0 = np.where(inner[:, None], Q[u[r]], W[g])
+        a1 = np.where(inner[:, None], Q[u[r] + 1], W[g + 1])
         e = a1 - a0
         e2 = (e * e).sum(axis=1)
         rel = np.einsum("tj,cjd->ctd", _LONE_BASIS, ctrl[r]) - a0[:, None, :]
@@ -3534,29 +3550,57 @@ def _lone_lines_out(W, K, Q, arc, t_in, t_out, e_per, eps_sum, quant, eps, ca, c
         bul = np.where(inside, perp, 0.0).max(axis=1)
         # (a smaller bulge where the segment is the gap alone: made a line, it holds no
         # other points)
-        lim = np.where(kv[r] - ku[r] == 1, _LONE_BULGE_GAP, _LONE_BULGE)
+        lim = np.where(kv - ku == 1, _LONE_BULGE_GAP, _LONE_BULGE)
         r = r[bul >= lim * q[r]]
         # ... where the line between the segment's (moved) ends holds its input points
-        err = _line_errors(W, np.stack([Q[u[r]], Q[v[r]]], axis=1), ku[r], kv[r])
-        ok[r[err <= eps[u[r]]]] = True
+        ur = u[r]
+        err = _line_errors(W, np.stack([Q[ur], Q[ur + 1]], axis=1), K[ur], K[ur + 1])
+        ok[r[err <= eps[ur]]] = True
         return ok
 
-    ce = swallowed(cb - 1, cb)
-    cs = swallowed(ca, ca + 1) & ((cb - ca - ce) >= 2)
-    fix = ce | cs
+    rc = np.flatnonzero(cand)
+    ce = swallowed(cb - 1, rc)
+    cs = swallowed(ca, rc) & ((cb - ca - ce) >= 2)
+    # ... or a design line between two of the cubic's segments (Z003 Medium Italic "l" at em
+    # 2048: a 37-unit line written as three rounded points between two dense curves, one
+    # cubic over all three 0.76 from the design where the rounded input is 0.42)
+    mid = np.full(len(ca), -1, dtype=np.intp)
+    cm = np.zeros(len(ca), dtype=bool)
+    if _LONE_MIDDLE and line_pieces is not None and len(line_pieces):
+        rm = np.flatnonzero(cand & ~ce & ~cs & (cb - ca >= 3))
+        lo = np.searchsorted(big, K[ca[rm]])
+        hi = np.searchsorted(big, K[cb[rm]])
+        rm, lo, hi = rm[hi > lo], lo[hi > lo], hi[hi > lo]
+        if len(rm):
+            mid[rm] = np.searchsorted(K, longest(lo, hi), side="right") - 1
+            rm = rm[(mid[rm] > ca[rm]) & (mid[rm] + 1 < cb[rm])]
+            # (a line piece between two curve pieces: a curve run's own segment, the cubic
+            # over its smooth joints, may place a design line better than its rounded ends)
+            rm = rm[np.isin(mid[rm], line_pieces)]
+            cm = swallowed(mid, rm)
+    fix = ce | cs | cm
     if not fix.any():
         return ca, cb, ctrl, bound, la
-    # the rest of each such cubic re-fitted (a copy of the tangents: a re-fit that does not
-    # hold leaves the cubic and its tangents as they were)
     fi = np.flatnonzero(fix)
-    fi = fi[np.argsort(ca[fi], kind="stable")]  # in path order
-    na, nb = (ca + cs)[fi], (cb - ce)[fi]
+    # each fixed cubic's rests (one, or two either side of a middle line), in path order;
+    # ``ro`` the cubic each rest belongs to
+    na = np.concatenate([(ca + cs)[fi], (mid + 1)[fi[cm[fi]]]])
+    nb = np.concatenate([np.where(cm, mid, cb - ce)[fi], cb[fi[cm[fi]]]])
+    ro = np.concatenate([fi, fi[cm[fi]]])
+    o = np.argsort(na, kind="stable")
+    na, nb, ro = na[o], nb[o], ro[o]
+    # the re-fit with the tangents at the new joints made the lines' directions (on a copy:
+    # a re-fit that does not hold leaves the cubic and its tangents as they were)
+    lines = np.concatenate([(cb - 1)[ce], ca[cs], mid[cm]])
+    joints = np.concatenate([(cb - 1)[ce], (ca + 1)[cs], mid[cm], (mid + 1)[cm]])
+    jl = np.concatenate([(cb - 1)[ce], ca[cs], mid[cm], mid[cm]])  # each joint's line
+    jo = np.concatenate([np.flatnonzero(ce), np.flatnonzero(cs), np.flatnonzero(cm),
+                         np.flatnonzero(cm)])  # ... and its cubic
     ti2, to2 = t_in.copy(), t_out.copy()
-    for u, v, at in (((cb - 1)[ce], cb[ce], (cb - 1)[ce]), (ca[cs], (ca + 1)[cs], (ca + 1)[cs])):
-        d = Q[v] - Q[u]
-        t = d / np.hypot(d[:, 0], d[:, 1])[:, None]
-        ti2[at] = t
-        to2[at] = t
+    d = Q[jl + 1] - Q[jl]
+    t = d / np.hypot(d[:, 0], d[:, 1])[:, None]
+    ti2[joints] = t
+    to2[joints] = t
     one = nb - na == 1
     f2 = _BatchFitter(W, K, ti2, to2, e_per, eps_sum, arc, q=Q)
     f2.quant = quant
@@ -3565,10 +3609,10 @@ def _lone_lines_out(W, K, Q, arc, t_in, t_out, e_per, eps_sum, quant, eps, ca, c
     with np.errstate(invalid="ignore", divide="ignore"):
         f2.fit(np.stack([na[~one], nb[~one]], axis=1), None)
     a3, b3, c3, bd3, l3 = f2.results()
-    # per fixed cubic: the re-fit holds where its segments (at most _LONE_REFIT of them,
-    # cubics and lines) cover exactly its rest (or the one segment left a line). (The
-    # re-fit's own merge rounds may join the rests of two neighbouring cubics: such a cubic
-    # lies in neither, and both stay as they were.)
+    # per rest: the re-fit holds where its segments (at most _LONE_REFIT of them, cubics and
+    # lines) cover exactly that rest (or the one segment left a line); per cubic, where all
+    # of its rests hold. (The re-fit's own merge rounds may join two neighbouring rests: such
+    # a cubic lies in neither, and both cubics stay as they were.)
     pos = np.flatnonzero(~one)
     sa = np.concatenate([a3, l3]).astype(np.intp)
     sb = np.concatenate([b3, l3 + 1]).astype(np.intp)
@@ -3579,20 +3623,20 @@ def _lone_lines_out(W, K, Q, arc, t_in, t_out, e_per, eps_sum, quant, eps, ca, c
     count = np.bincount(pc, minlength=len(pos) + 1)[:len(pos)]
     good = one.copy()
     good[pos] = (cover == (nb - na)[pos]) & (count <= _LONE_REFIT)
-    if not good.any():
+    bad = np.zeros(len(ca), dtype=bool)
+    bad[ro[~good]] = True
+    fix &= ~bad
+    if not fix.any():
         return ca, cb, ctrl, bound, la
-    fix[fi[~good]] = False
-    ce &= fix
-    cs &= fix
-    for at in ((cb - 1)[ce], (ca + 1)[cs]):
-        t_in[at] = ti2[at]
-        t_out[at] = to2[at]
+    took_j = fix[jo]
+    t_in[joints[took_j]] = ti2[joints[took_j]]
+    t_out[joints[took_j]] = to2[joints[took_j]]
     took = np.zeros(len(pos) + 1, dtype=bool)
-    took[:len(pos)] = good[pos]
+    took[:len(pos)] = fix[ro[pos]]
     held = took[pc[:len(a3)]]
     held_l = took[pc[len(a3):]]
-    new_lines = [(cb - 1)[ce], ca[cs], na[one & good], l3[held_l]]
-    extra = np.concatenate([la] + new_lines)
+    lo_ = np.concatenate([np.flatnonzero(ce), np.flatnonzero(cs), np.flatnonzero(cm)])
+    extra = np.concatenate([la, lines[fix[lo_]], na[one & fix[ro]], l3[held_l]])
     keep = ~fix
     ca2 = np.concatenate([ca[keep], a3[held]])
     cb2 = np.concatenate([cb[keep], b3[held]])

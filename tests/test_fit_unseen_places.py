@@ -14,7 +14,9 @@ inline contours as bench/fonts.py reads them, coordinates to 0.01) where the fit
 - (seventeenth session) a curve's first few dense steps taken into the design line before it
   (``fit._GAP_SHORT_REST``: the line's end input point kept);
 - (seventeenth session, FreeMono Bold at em 1000) a cluster of short thinned segments made
-  smooth on its net turn although one of its vertices is a corner (``runs._CLUSTER_TURNS``)."""
+  smooth on its net turn although one of its vertices is a corner (``runs._CLUSTER_TURNS``);
+- (eighteenth session) a line piece of the curve-run rules that the fitter's merge rounds took
+  into a cubic between two curves (``fit._LONE_MIDDLE``: a line again)."""
 
 from __future__ import annotations
 
@@ -237,6 +239,33 @@ _AT = [
 ]
 
 
+#: Z003 Medium Italic "l" at em 2048, contour 53: a 37-unit vertical design line written as three
+#: rounded points between two dense curves; the curve-run rules kept it a line piece, and the
+#: fitter's merge rounds took it and both curves into one cubic bowing 0.33 off the points'
+#: column, away from the design (0.76 from it where the rounded input is 0.42)
+_L = [
+    ('cubic', (41220.10, 264.19), (41177.09, 239.62), (41177.09, 239.62), (41089.02, 184.32)),
+    ('cubic', (41089.02, 184.32), (41029.63, 147.46), (40994.82, 131.07), (40972.29, 131.07)),
+    ('cubic', (40972.29, 131.07), (40951.81, 131.07), (40935.42, 155.65), (40935.42, 184.32)),
+    ('line', (40935.42, 184.32), (40935.42, 202.75)),
+    ('line', (40935.42, 202.75), (40935.42, 221.18)),
+    ('cubic', (40935.42, 221.18), (40935.42, 258.05), (41027.58, 655.36), (41103.36, 944.13)),
+    ('cubic', (41103.36, 944.13), (41183.23, 1247.23), (41201.66, 1282.05), (41291.78, 1282.05)),
+    ('cubic', (41291.78, 1282.05), (41322.50, 1282.05), (41342.98, 1280.00), (41392.13, 1267.71)),
+    ('line', (41392.13, 1267.71), (41480.19, 1376.26)),
+    ('cubic', (41480.19, 1376.26), (41437.18, 1386.50), (41416.70, 1388.54), (41388.03, 1388.54)),
+    ('cubic', (41388.03, 1388.54), (41306.11, 1388.54), (41242.62, 1357.82), (41142.27, 1267.71)),
+    ('cubic', (41142.27, 1267.71), (41052.16, 1187.84), (41029.63, 1155.07), (41003.01, 1081.34)),
+    ('cubic', (41003.01, 1081.34), (40986.62, 1032.19), (40941.57, 866.30), (40921.09, 776.19)),
+    ('line', (40921.09, 776.19), (40773.63, 135.17)),
+    ('cubic', (40773.63, 135.17), (40771.58, 122.88), (40769.54, 110.59), (40769.54, 98.30)),
+    ('cubic', (40769.54, 98.30), (40769.54, 34.82), (40804.35, -26.62), (40837.12, -26.62)),
+    ('line', (40837.12, -26.62), (40849.41, -26.62)),
+    ('line', (40849.41, -26.62), (40855.55, -26.62)),
+    ('cubic', (40855.55, -26.62), (40867.84, -32.77), (40933.38, 12.29), (41220.10, 219.14)),
+    ('line', (41220.10, 219.14), (41220.10, 264.19)),
+]
+
 @pytest.mark.parametrize(("segs", "place", "mod", "knob", "off", "now", "before"), [
     (_FOUR, (57321.47, 317.44), fitmod, "_FIRST_CHAIN", False, 0.6, 0.9),
     (_Q, (23187.4, -98.1), runs, "_CLUSTER_JOG", False, 0.3, 0.75),
@@ -250,9 +279,13 @@ _AT = [
     # square: 0.68 and 0.71 from the design where the rounded input is 0.28 and 0.26)
     (_C, (17254.0, 420.0), runs, "_CLUSTER_TURNS", False, 0.3, 0.6),
     (_AT, (37607.0, 75.0), runs, "_CLUSTER_TURNS", False, 0.35, 0.6),
+    # (eighteenth session: the line made a line again, both curves re-fitted apart)
+    (_L, (40934.7, 200.4), fitmod, "_LONE_MIDDLE", False, 0.5, 0.7),
+    (_L, (40850.7, -27.4), fitmod, "_LONE_MIDDLE", False, 0.5, 0.7),
 ], ids=["line-chain-corner", "diagonal-jog-cluster", "swallowed-gap-line",
         "smooth-vertex-along-a-long-step", "curve-steps-after-a-gap-line",
-        "cusp-in-a-cluster", "step-in-a-cluster"])
+        "cusp-in-a-cluster", "step-in-a-cluster", "line-piece-inside-a-cubic",
+        "line-piece-inside-a-cubic-row"])
 def test_the_fit_lies_near_the_design_there(segs, place, mod, knob, off, now, before,
                                             monkeypatch):
     p = np.array(place)
