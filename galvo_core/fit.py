@@ -3591,11 +3591,12 @@ def _lone_lines_out(W, K, Q, arc, t_in, t_out, e_per, eps_sum, quant, eps, ca, c
     na, nb, ro = na[o], nb[o], ro[o]
     # the re-fit with the tangents at the new joints made the lines' directions (on a copy:
     # a re-fit that does not hold leaves the cubic and its tangents as they were)
-    lines = np.concatenate([(cb - 1)[ce], ca[cs], mid[cm]])
+    lines = np.concatenate([(cb - 1)[ce], ca[cs], mid[cm]])  # the segments made lines
+    lc = np.concatenate([np.flatnonzero(ce), np.flatnonzero(cs), np.flatnonzero(cm)])  # cubics
+    # the new joints (a middle line has two), each with its line and cubic
     joints = np.concatenate([(cb - 1)[ce], (ca + 1)[cs], mid[cm], (mid + 1)[cm]])
-    jl = np.concatenate([(cb - 1)[ce], ca[cs], mid[cm], mid[cm]])  # each joint's line
-    jo = np.concatenate([np.flatnonzero(ce), np.flatnonzero(cs), np.flatnonzero(cm),
-                         np.flatnonzero(cm)])  # ... and its cubic
+    jl = np.concatenate([lines, mid[cm]])
+    jo = np.concatenate([lc, np.flatnonzero(cm)])
     ti2, to2 = t_in.copy(), t_out.copy()
     d = Q[jl + 1] - Q[jl]
     t = d / np.hypot(d[:, 0], d[:, 1])[:, None]
@@ -3635,8 +3636,7 @@ def _lone_lines_out(W, K, Q, arc, t_in, t_out, e_per, eps_sum, quant, eps, ca, c
     took[:len(pos)] = fix[ro[pos]]
     held = took[pc[:len(a3)]]
     held_l = took[pc[len(a3):]]
-    lo_ = np.concatenate([np.flatnonzero(ce), np.flatnonzero(cs), np.flatnonzero(cm)])
-    extra = np.concatenate([la, lines[fix[lo_]], na[one & fix[ro]], l3[held_l]])
+    extra = np.concatenate([la, lines[fix[lc]], na[one & fix[ro]], l3[held_l]])
     keep = ~fix
     ca2 = np.concatenate([ca[keep], a3[held]])
     cb2 = np.concatenate([cb[keep], b3[held]])
