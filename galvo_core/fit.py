@@ -3483,13 +3483,23 @@ _LONE_BASIS = seed_basis(_LONE_SAMPLES - 1)[1]
 #: merge rounds took it in) holding a long gap, the cubic straying ``_LONE_BULGE`` quanta from
 #: its chord, is made a line too, the cubic's two rests re-fitted apart
 _LONE_MIDDLE = True
+#: ... and so is a cubic's end segment that is a line piece of the curve-run rules at least
+#: this many quanta long, its three or more input points collinear (``_collinear``) with a
+#: step between them of ``_LONE_ROW_STEP`` quanta or more (a design line written as a row of
+#: rounded points with no gap of ``_LONE_LENGTH``: Z003 Medium Italic "l" at em 1000, a
+#: 16-unit row of ten points with a 6-unit step, one cubic over it and the curve after it
+#: 0.70 from the design where the rounded input is on it; a curve's flat stretch, densely
+#: flattened, is a row of unit steps and stays)
+_LONE_ROW = 8.0
+_LONE_ROW_STEP = 3.0
 
 
 def _lone_lines_out(W, K, Q, arc, t_in, t_out, e_per, eps_sum, quant, eps, ca, cb, ctrl,
                     bound, la, coarse=None, wstep=None, line_pieces=None):
     """Rounded input (``quant`` per thinned point, 0: not moved): the cubics that swallow a
-    design line at one of their ends (``_LONE_SHARE``, ``_LONE_BULGE``, ``_LONE_BULGE_GAP``)
-    or between two of their segments (``_LONE_MIDDLE``) are re-fitted over their other
+    design line at one of their ends (``_LONE_SHARE``, ``_LONE_BULGE``, ``_LONE_BULGE_GAP``;
+    a long gap, or a row of collinear points, ``_LONE_ROW``) or between two of their segments
+    (``_LONE_MIDDLE``) are re-fitted over their other
     segments, that segment made a line (there, only a line piece of the curve-run rules,
     ``line_pieces``: their first thinned indices, that the fitter's merge rounds took into a
     cubic). Returns (ca, cb, ctrl, bound, la) with those cubics replaced; ``t_in``, ``t_out``
@@ -3508,7 +3518,26 @@ def _lone_lines_out(W, K, Q, arc, t_in, t_out, e_per, eps_sum, quant, eps, ca, c
     if coarse is not None:
         long_ &= ~coarse
     big = np.flatnonzero(long_)
-    if len(big) == 0:
+    # the line pieces inside candidate cubics that are rows of collinear input points
+    row = np.zeros(len(K), dtype=bool)
+    if _LONE_ROW and line_pieces is not None and len(line_pieces):
+        inc = np.zeros(len(K) + 1, dtype=np.intp)
+        np.add.at(inc, ca[cand], 1)
+        np.add.at(inc, cb[cand], -1)
+        j = np.asarray(line_pieces, dtype=np.intp)
+        j = j[(np.cumsum(inc)[j] > 0) & (j + 1 < len(K))]
+        j = j[(K[j + 1] - K[j] >= 2) & (quant[j] > 0.0)]
+        d = W[K[j + 1]] - W[K[j]]
+        ln = np.hypot(d[:, 0], d[:, 1])
+        long_row = ln >= _LONE_ROW * quant[j]
+        j, d, ln = j[long_row], d[long_row], ln[long_row]
+        if len(j):
+            col = _collinear(W, K[j], K[j + 1], W[K[j]], d / ln[:, None], quant[j])
+            n = K[j + 1] - K[j]
+            own, off = _ragged(np.arange(len(j)), n)
+            mx = np.maximum.reduceat(step[K[j][own] + off], np.cumsum(n) - n)
+            row[j[col & (mx >= _LONE_ROW_STEP * quant[j])]] = True
+    if len(big) == 0 and not row.any():
         return ca, cb, ctrl, bound, la
 
     def longest(lo, hi):
@@ -3523,23 +3552,28 @@ def _lone_lines_out(W, K, Q, arc, t_in, t_out, e_per, eps_sum, quant, eps, ca, c
         ku, kv = K[u[r]], K[u[r] + 1]
         lo = np.searchsorted(big, ku)
         hi = np.searchsorted(big, kv)
-        has = hi > lo
+        has = (hi > lo) | row[u[r]]
         r, ku, kv, lo, hi = r[has], ku[has], kv[has], lo[has], hi[has]
         if len(r) == 0:
             return ok
-        g = longest(lo, hi)
+        g = np.zeros(len(r), dtype=np.intp)
+        hg = hi > lo
+        g[hg] = longest(lo[hg], hi[hg])
         d = W[kv] - W[ku]
         ln = np.hypot(d[:, 0], d[:, 1])
         inner = (u[r] > ca[r]) & (u[r] + 1 < cb[r])
         # (a segment between two of the cubic's, a line piece: the curve-run rules found it
         # a line whatever the share of its long gap)
-        keep = (step[g] >= _LONE_LENGTH * q[r]) & (inner | (step[g] >= _LONE_SHARE * ln))
-        r, g, inner, ku, kv = r[keep], g[keep], inner[keep], ku[keep], kv[keep]
+        gap = hg & (step[g] >= _LONE_LENGTH * q[r]) & (inner | (step[g] >= _LONE_SHARE * ln))
+        seg = inner | ~gap
+        keep = gap | row[u[r]]
+        r, g, seg, ku, kv, gap = r[keep], g[keep], seg[keep], ku[keep], kv[keep], gap[keep]
         if len(r) == 0:
             return ok
         # the chord: the gap's, or the segment's where it lies between two of the cubic's
-        a0 = np.where(inner[:, None], Q[u[r]], W[g])
-        a1 = np.where(inner[:, None], Q[u[r] + 1], W[g + 1])
+        # or is a row
+        a0 = np.where(seg[:, None], Q[u[r]], W[g])
+        a1 = np.where(seg[:, None], Q[u[r] + 1], W[g + 1])
         e = a1 - a0
         e2 = (e * e).sum(axis=1)
         rel = np.einsum("tj,cjd->ctd", _LONE_BASIS, ctrl[r]) - a0[:, None, :]
@@ -3550,7 +3584,7 @@ def _lone_lines_out(W, K, Q, arc, t_in, t_out, e_per, eps_sum, quant, eps, ca, c
         bul = np.where(inside, perp, 0.0).max(axis=1)
         # (a smaller bulge where the segment is the gap alone: made a line, it holds no
         # other points)
-        lim = np.where(kv - ku == 1, _LONE_BULGE_GAP, _LONE_BULGE)
+        lim = np.where(gap & (kv - ku == 1), _LONE_BULGE_GAP, _LONE_BULGE)
         r = r[bul >= lim * q[r]]
         # ... where the line between the segment's (moved) ends holds its input points
         ur = u[r]

@@ -16,7 +16,11 @@ inline contours as bench/fonts.py reads them, coordinates to 0.01) where the fit
 - (seventeenth session, FreeMono Bold at em 1000) a cluster of short thinned segments made
   smooth on its net turn although one of its vertices is a corner (``runs._CLUSTER_TURNS``);
 - (eighteenth session) a line piece of the curve-run rules that the fitter's merge rounds took
-  into a cubic between two curves (``fit._LONE_MIDDLE``: a line again)."""
+  into a cubic between two curves (``fit._LONE_MIDDLE``: a line again);
+- (nineteenth session) a row of collinear input points with no long gap, a cubic's end
+  segment (``fit._LONE_ROW``: a line again);
+- (nineteenth session) a unit jog of the rounding between a long design line and the first
+  chord of the curve it flows into (``runs._CLUSTER_UNIT``: smooth, not two corners)."""
 
 from __future__ import annotations
 
@@ -27,7 +31,7 @@ from galvo_core import fit as fitmod
 from galvo_core import runs
 from galvo_core.geometry import point_polyline_distance
 from tests._util import flattened_cubic, resampled
-from tests.test_fit_design_places import _dense, _fit_rounded
+from tests.test_fit_design_places import _dense, _fit_rounded, _scaled
 
 
 def _near(segs, fp, place, r: float = 2.0) -> float:
@@ -266,6 +270,74 @@ _L = [
     ('line', (41220.10, 219.14), (41220.10, 264.19)),
 ]
 
+#: Z003 Medium Italic "l" at em 1000, contour 53 (the foot of the same glyph as ``_L``): a
+#: 9-unit design line (two) after a curve's tangent end, written with the curve's last dense
+#: points as a 16-unit row of ten collinear points (steps up to 6 units, no long gap), then a
+#: 27-degree corner; one cubic over the row and the curve after it bowed 0.70 below the row,
+#: where the rounded input is on the design
+_L1000 = [
+    ('cubic', (20127.00, 129.00), (20106.00, 117.00), (20106.00, 117.00), (20063.00, 90.00)),
+    ('cubic', (20063.00, 90.00), (20034.00, 72.00), (20017.00, 64.00), (20006.00, 64.00)),
+    ('cubic', (20006.00, 64.00), (19996.00, 64.00), (19988.00, 76.00), (19988.00, 90.00)),
+    ('line', (19988.00, 90.00), (19988.00, 99.00)),
+    ('line', (19988.00, 99.00), (19988.00, 108.00)),
+    ('cubic', (19988.00, 108.00), (19988.00, 126.00), (20033.00, 320.00), (20070.00, 461.00)),
+    ('cubic', (20070.00, 461.00), (20109.00, 609.00), (20118.00, 626.00), (20162.00, 626.00)),
+    ('cubic', (20162.00, 626.00), (20177.00, 626.00), (20187.00, 625.00), (20211.00, 619.00)),
+    ('line', (20211.00, 619.00), (20254.00, 672.00)),
+    ('cubic', (20254.00, 672.00), (20233.00, 677.00), (20223.00, 678.00), (20209.00, 678.00)),
+    ('cubic', (20209.00, 678.00), (20169.00, 678.00), (20138.00, 663.00), (20089.00, 619.00)),
+    ('cubic', (20089.00, 619.00), (20045.00, 580.00), (20034.00, 564.00), (20021.00, 528.00)),
+    ('cubic', (20021.00, 528.00), (20013.00, 504.00), (19991.00, 423.00), (19981.00, 379.00)),
+    ('line', (19981.00, 379.00), (19909.00, 66.00)),
+    ('cubic', (19909.00, 66.00), (19908.00, 60.00), (19907.00, 54.00), (19907.00, 48.00)),
+    ('cubic', (19907.00, 48.00), (19907.00, 17.00), (19924.00, -13.00), (19940.00, -13.00)),
+    ('line', (19940.00, -13.00), (19946.00, -13.00)),
+    ('line', (19946.00, -13.00), (19949.00, -13.00)),
+    ('cubic', (19949.00, -13.00), (19955.00, -16.00), (19987.00, 6.00), (20127.00, 107.00)),
+    ('line', (20127.00, 107.00), (20127.00, 129.00)),
+]
+
+#: Z003 Medium Italic "f" at em 2048 (here in font units, times 2.048), contour 43, its
+#: crossbar: a 100-unit design line sloping 2 degrees flows into a flat curve; where the line's
+#: rounded row steps up one unit (a unit jog), the jog between the long line and the curve's
+#: first 24-unit chord was kept as two corners (the two longer segments' lengths not within
+#: the curve-run ratio), each moved 0.4 off its input point: 0.90 from the design where the
+#: rounded input is 0.50
+_F = _scaled([
+    ('cubic', (17686, -208), (17678, -219), (17669, -230), (17661, -242)),
+    ('cubic', (17661, -242), (17683, -245), (17692, -246), (17710, -246)),
+    ('cubic', (17710, -246), (17743, -246), (17769, -241), (17785, -232)),
+    ('cubic', (17785, -232), (17814, -216), (17865, -167), (17892, -132)),
+    ('cubic', (17892, -132), (17923, -90), (17959, -5), (17982, 87)),
+    ('cubic', (17982, 87), (18020, 230), (18039, 304), (18041, 311)),
+    ('cubic', (18041, 311), (18050, 310), (18054, 310), (18058, 310)),
+    ('line', (18058, 310), (18110, 312)),
+    ('cubic', (18110, 312), (18113, 312), (18119, 312), (18129, 311)),
+    ('line', (18129, 311), (18171, 343)),
+    ('cubic', (18171, 343), (18142, 344), (18131, 344), (18107, 344)),
+    ('cubic', (18107, 344), (18085, 344), (18076, 344), (18049, 343)),
+    ('cubic', (18049, 343), (18114, 598), (18128, 628), (18188, 628)),
+    ('cubic', (18188, 628), (18206, 628), (18220, 626), (18255, 620)),
+    ('line', (18255, 620), (18301, 674)),
+    ('cubic', (18301, 674), (18281, 679), (18273, 680), (18253, 680)),
+    ('cubic', (18253, 680), (18192, 680), (18152, 659), (18084, 593)),
+    ('cubic', (18084, 593), (18028, 538), (18015, 510), (17976, 343)),
+    ('cubic', (17976, 343), (17966, 344), (17961, 344), (17956, 344)),
+    ('line', (17956, 344), (17907, 342)),
+    ('cubic', (17907, 342), (17905, 342), (17900, 342), (17892, 343)),
+    ('cubic', (17892, 343), (17886, 339), (17880, 335), (17878, 334)),
+    ('cubic', (17878, 334), (17867, 328), (17865, 326), (17856, 322)),
+    ('cubic', (17856, 322), (17853, 320), (17845, 316), (17836, 311)),
+    ('line', (17836, 311), (17861, 311)),
+    ('line', (17861, 311), (17931, 310)),
+    ('cubic', (17931, 310), (17937, 310), (17948, 310), (17968, 311)),
+    ('cubic', (17968, 311), (17952, 250), (17946, 224), (17927, 136)),
+    ('cubic', (17927, 136), (17867, -140), (17844, -184), (17759, -184)),
+    ('cubic', (17759, -184), (17744, -184), (17732, -183), (17706, -179)),
+    ('line', (17706, -179), (17686, -208)),
+], 2.048)
+
 @pytest.mark.parametrize(("segs", "place", "mod", "knob", "off", "now", "before"), [
     (_FOUR, (57321.47, 317.44), fitmod, "_FIRST_CHAIN", False, 0.6, 0.9),
     (_Q, (23187.4, -98.1), runs, "_CLUSTER_JOG", False, 0.3, 0.75),
@@ -282,10 +354,15 @@ _L = [
     # (eighteenth session: the line made a line again, both curves re-fitted apart)
     (_L, (40934.7, 200.4), fitmod, "_LONE_MIDDLE", False, 0.5, 0.7),
     (_L, (40850.7, -27.4), fitmod, "_LONE_MIDDLE", False, 0.5, 0.7),
+    # (nineteenth session: the row made a line, the curve after it re-fitted alone)
+    (_L1000, (19946.4, -13.7), fitmod, "_LONE_ROW", False, 0.4, 0.65),
+    # (nineteenth session: the jog's vertices smooth, the line and the curve one run)
+    (_F, (36667.5, 699.6), runs, "_CLUSTER_UNIT", 0.0, 0.55, 0.8),
 ], ids=["line-chain-corner", "diagonal-jog-cluster", "swallowed-gap-line",
         "smooth-vertex-along-a-long-step", "curve-steps-after-a-gap-line",
         "cusp-in-a-cluster", "step-in-a-cluster", "line-piece-inside-a-cubic",
-        "line-piece-inside-a-cubic-row"])
+        "line-piece-inside-a-cubic-row", "collinear-row-at-a-cubic-end",
+        "unit-jog-after-a-long-line"])
 def test_the_fit_lies_near_the_design_there(segs, place, mod, knob, off, now, before,
                                             monkeypatch):
     p = np.array(place)
