@@ -20,7 +20,9 @@ inline contours as bench/fonts.py reads them, coordinates to 0.01) where the fit
 - (nineteenth session) a row of collinear input points with no long gap, a cubic's end
   segment (``fit._LONE_ROW``: a line again);
 - (nineteenth session) a unit jog of the rounding between a long design line and the first
-  chord of the curve it flows into (``runs._CLUSTER_UNIT``: smooth, not two corners)."""
+  chord of the curve it flows into (``runs._CLUSTER_UNIT``: smooth, not two corners);
+- (nineteenth session) a corner kept three input points past the design's, where its own
+  estimate lies in the design corner's rounding square (``fit._MISPLACED_EST``)."""
 
 from __future__ import annotations
 
@@ -319,6 +321,29 @@ _F = _scaled([
     ('line', (17706, -179), (17686, -208)),
 ], 2.048)
 
+#: Z003 Medium Italic "b" at em 2048 (here in font units, times 2.048), contour 34: a
+#: 19-degree corner between two curves that the thinning kept three input points late; the
+#: sides fitted again without the points beside it cross past the kept point, while the
+#: corner's own estimate lies by the design's: 0.78 from the design where the rounded input is
+#: 0.54
+_B = _scaled([
+    ('cubic', (16292, 131), (16219, 81), (16202, 71), (16192, 71)),
+    ('cubic', (16192, 71), (16185, 71), (16180, 79), (16180, 91)),
+    ('cubic', (16180, 91), (16180, 118), (16203, 223), (16240, 360)),
+    ('cubic', (16240, 360), (16251, 376), (16253, 378), (16269, 396)),
+    ('cubic', (16269, 396), (16221, 407), (16187, 411), (16143, 411)),
+    ('cubic', (16143, 411), (16102, 411), (16082, 407), (16057, 391)),
+    ('cubic', (16057, 391), (16021, 370), (15979, 339), (15966, 325)),
+    ('cubic', (15966, 325), (15928, 283), (15887, 148), (15887, 67)),
+    ('cubic', (15887, 67), (15887, 19), (15903, -13), (15928, -13)),
+    ('cubic', (15928, -13), (15950, -13), (15983, 7), (16108, 97)),
+    ('cubic', (16108, 97), (16097, 46), (16093, 21), (16093, 8)),
+    ('cubic', (16093, 8), (16093, -6), (16099, -13), (16109, -13)),
+    ('cubic', (16109, -13), (16122, -13), (16130, -9), (16201, 38)),
+    ('cubic', (16201, 38), (16235, 61), (16254, 74), (16291, 101)),
+    ('line', (16291, 101), (16292, 131)),
+], 2.048)
+
 @pytest.mark.parametrize(("segs", "place", "mod", "knob", "off", "now", "before"), [
     (_FOUR, (57321.47, 317.44), fitmod, "_FIRST_CHAIN", False, 0.6, 0.9),
     (_Q, (23187.4, -98.1), runs, "_CLUSTER_JOG", False, 0.3, 0.75),
@@ -339,11 +364,13 @@ _F = _scaled([
     (_L1000, (19946.4, -13.7), fitmod, "_LONE_ROW", False, 0.4, 0.65),
     # (nineteenth session: the jog's vertices smooth, the line and the curve one run)
     (_F, (36667.5, 699.6), runs, "_CLUSTER_UNIT", 0.0, 0.55, 0.8),
+    # (nineteenth session: the corner kept on the input point by its estimate)
+    (_B, (33259.5, 737.3), fitmod, "_MISPLACED_EST", False, 0.45, 0.7),
 ], ids=["line-chain-corner", "diagonal-jog-cluster", "swallowed-gap-line",
         "smooth-vertex-along-a-long-step", "curve-steps-after-a-gap-line",
         "cusp-in-a-cluster", "step-in-a-cluster", "line-piece-inside-a-cubic",
         "line-piece-inside-a-cubic-row", "collinear-row-at-a-cubic-end",
-        "unit-jog-after-a-long-line"])
+        "unit-jog-after-a-long-line", "corner-kept-late-by-its-estimate"])
 def test_the_fit_lies_near_the_design_there(segs, place, mod, knob, off, now, before,
                                             monkeypatch):
     p = np.array(place)
