@@ -6993,26 +6993,26 @@ def _misplaced_corners(W, K, arc, vi, vo, lo_i, hi_o, line_in, line_out, est, ca
     cands = k[:, None] + np.arange(-S, S + 1)[None, :]
     inside = (cands > K[v - 1][:, None]) & (cands < K[v + 1][:, None])
     cands = np.clip(cands, 0, len(W) - 1)
-    dist = np.abs(W[cands] - x[:, None, :]).max(axis=2) - 0.5 * q[:, None]
-    dist = np.where(inside, dist, np.inf)
-    best = np.argmin(dist, axis=1)
-    db = dist[np.arange(len(v)), best]
-    d0 = dist[:, S]
-    good &= (best != S) & (db <= _MISPLACED_NEAR * q) & (d0 - db >= _MISPLACED_GAIN * q)
-    good &= d0 >= _MISPLACED_FAR * q
+
+    def nearest(p):
+        # per corner: the candidate whose rounding square lies nearest p, and whether that
+        # point is the corner (near p, nearer than the kept one's, which lies far from p)
+        dist = np.abs(W[cands] - p[:, None, :]).max(axis=2) - 0.5 * q[:, None]
+        dist = np.where(inside, dist, np.inf)
+        best = np.argmin(dist, axis=1)
+        db = dist[np.arange(len(v)), best]
+        d0 = dist[:, S]
+        return best, ((best != S) & (db <= _MISPLACED_NEAR * q)
+                      & (d0 - db >= _MISPLACED_GAIN * q) & (d0 >= _MISPLACED_FAR * q))
+
+    best, hit = nearest(x)
+    good &= hit
     if _MISPLACED_EST:
         # ... or the estimate itself (the crossing of the full windows) in such a square
-        ci = np.flatnonzero(sel)[ok]
-        e0 = est[ci]
-        dist2 = np.abs(W[cands] - e0[:, None, :]).max(axis=2) - 0.5 * q[:, None]
-        dist2 = np.where(inside, dist2, np.inf)
-        best2 = np.argmin(dist2, axis=1)
-        db2 = dist2[np.arange(len(v)), best2]
-        d02 = dist2[:, S]
-        g2_ = ~good & (best2 != S) & (db2 <= _MISPLACED_NEAR * q) & (
-            d02 - db2 >= _MISPLACED_GAIN * q) & (d02 >= _MISPLACED_FAR * q)
-        best = np.where(g2_, best2, best)
-        good |= g2_
+        best2, hit2 = nearest(est[np.flatnonzero(sel)[ok]])
+        use = ~good & hit2
+        best = np.where(use, best2, best)
+        good |= use
     return v[good], cands[np.flatnonzero(good), best[good]]
 
 
