@@ -3533,10 +3533,8 @@ def _lone_lines_out(W, K, Q, arc, t_in, t_out, e_per, eps_sum, quant, eps, ca, c
         j, d, ln = j[long_row], d[long_row], ln[long_row]
         if len(j):
             col = _collinear(W, K[j], K[j + 1], W[K[j]], d / ln[:, None], quant[j])
-            n = K[j + 1] - K[j]
-            own, off = _ragged(np.arange(len(j)), n)
-            mx = np.maximum.reduceat(step[K[j][own] + off], np.cumsum(n) - n)
-            row[j[col & (mx >= _LONE_ROW_STEP * quant[j])]] = True
+            _, _, sl, at = _range_steps(step, K[j], K[j + 1])
+            row[j[col & (np.maximum.reduceat(sl, at) >= _LONE_ROW_STEP * quant[j])]] = True
     if len(big) == 0 and not row.any():
         return ca, cb, ctrl, bound, la
 
