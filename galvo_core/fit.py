@@ -5996,6 +5996,11 @@ _GAP_JOINT_OFF = 0.25
 #: the thinned lines at their merged vertices: +6,420 segments over the PLT corpus)
 _GAP_JOINT_RUN = 6
 _GAP_JOINTS = True
+#: ... and at an input point between one long step and a row of this many short input steps
+#: on one line of the grid (a design line after a curve's straight end: P052 Bold Italic "$"
+#: at em 2048, a 123-unit line after a 10-unit row, the line over both 0.89 from their
+#: joint where the rounded input is 0.43); 0: off
+_GAP_ROW = 4
 
 
 def _dense_run_beyond(W, start, step, lo, hi, qg):
@@ -6015,12 +6020,33 @@ def _dense_run_beyond(W, start, step, lo, hi, qg):
     return ok
 
 
+def _collinear_row(W, g, step, bound, qg):
+    """Per point ``g``: do the ``_GAP_ROW`` input steps from it in the direction ``step``
+    (+1 / -1), all within ``bound`` (the last / first index allowed), each shorter than
+    ``_LONE_LENGTH`` quanta ``qg`` and not zero, lie on one line (exactly, up to the
+    arithmetic's error: a row of the rounding grid)?"""
+    end = g + step * _GAP_ROW
+    ok = (end - bound) * step <= 0
+    e = np.where(ok, end, g)
+    d = W[e] - W[g]
+    ln = np.hypot(d[:, 0], d[:, 1])
+    ok &= ln > 0.0
+    for k in range(1, _GAP_ROW + 1):
+        i = np.where(ok, g + step * k, g)
+        s = np.hypot(*(W[i] - W[i - step]).T)
+        ok &= (s > 0.0) & (s < _LONE_LENGTH * qg)
+        r = W[i] - W[g]
+        ok &= np.abs(r[:, 0] * d[:, 1] - r[:, 1] * d[:, 0]) <= 1e-9 * qg * np.maximum(ln, 1.0)
+    return ok
+
+
 def _split_gap_joints(W, la, lpts, lfirst, llast, lerr, lkey, quant, eps, coarse, woff, wlen):
     """Rounded input (``quant`` per thinned point, 0: exact): each line (start thinned index
     ``la``, points ``lpts``, input points ``lfirst``..``llast``) split at its input point
     farthest from it among those between two long input steps (``_LONE_LENGTH`` quanta each,
     not ``coarse`` chords, one of them followed on its far side by ``_GAP_JOINT_RUN`` short
-    steps of a curve on the same path: W[``woff[i]``:``woff[i] + wlen[i]``] is path i) that
+    steps of a curve on the same path: W[``woff[i]``:``woff[i] + wlen[i]``] is path i; or
+    between one such step and a row of the grid, :func:`_collinear_row`) that
     lie ``_GAP_JOINT_OFF`` quanta or more from it, into two lines meeting at that input
     point, where both keep within ``eps`` (the line's bound) of their input points. The
     thinning keeps two nearly collinear design lines in one segment, which then misses their
@@ -6040,13 +6066,24 @@ def _split_gap_joints(W, la, lpts, lfirst, llast, lerr, lkey, quant, eps, coarse
     s0 = np.hypot(*(W[g] - W[g - 1]).T)
     s1 = np.hypot(*(W[g + 1] - W[g]).T)
     sel = (s0 >= _LONE_LENGTH * qg) & (s1 >= _LONE_LENGTH * qg) & ~coarse[g - 1] & ~coarse[g]
+    row = np.zeros(len(g), dtype=bool)
+    if _GAP_ROW:
+        # ... or between one long step and a row of collinear short steps inside the line
+        # (the row: a curve's straight end, or a design line of its own)
+        row = ((s1 >= _LONE_LENGTH * qg) & ~coarse[g]
+               & _collinear_row(W, g, -1, lfirst[cand][own], qg))
+        row |= ((s0 >= _LONE_LENGTH * qg) & ~coarse[g - 1]
+                & _collinear_row(W, g, 1, llast[cand][own], qg))
+        row &= ~sel
+        sel |= row
     if not sel.any():
         return la, lpts, lfirst, llast, lerr, lkey, False
-    own, g, qg = own[sel], g[sel], qg[sel]
-    # (the far side of one of the two long steps: a curve's dense points, on the same path)
+    own, g, qg, row = own[sel], g[sel], qg[sel], row[sel]
+    # (the far side of one of the two long steps: a curve's dense points, on the same path;
+    # a row is such points itself)
     p = np.searchsorted(woff, g, side="right") - 1
     lo, hi = woff[p], woff[p] + wlen[p] - 1
-    sel = (_dense_run_beyond(W, g + 1, 1, lo, hi, qg)
+    sel = (row | _dense_run_beyond(W, g + 1, 1, lo, hi, qg)
            | _dense_run_beyond(W, g - 1, -1, lo, hi, qg))
     if not sel.any():
         return la, lpts, lfirst, llast, lerr, lkey, False
@@ -6796,6 +6833,22 @@ _LONE_MIN_MOVE = 0.2
 #: a corner whose move makes a line beside it miss its input points goes back half its move
 #: at a time, this many times, before it goes back to its input point
 _CORNER_HALVINGS = 2
+#: ... a line beside it: a thinned segment whose other end is a corner too. A segment of
+#: short input steps to a smooth vertex is not held to that: it lies in a curve run, fitted
+#: by cubics that the fitter holds to the bound (and where it stays a line,
+#: :func:`_valid_lines` makes it valid). URW Z003 Medium Italic "z" at em 2048: a 77-degree
+#: corner kept one point late whose curve side misses its points by 0.82 as a line wherever
+#: the corner is went back to its input point, 0.92 from the design where the rounded input
+#: is 0.48. Still held: a segment with an input step of ``_LONE_LENGTH`` quanta or more (a
+#: design line that :func:`_lone_lines_out` may give back as a line: P052 Bold Italic "$" at
+#: em 2048, a 123-unit line after a curve's straight end, 0.89 from their joint) and a row of
+#: the grid, its input points on their chord (a design line), and those beside a closed
+#: path's seam (serif "g" at em 400, a seam 6 degrees from smooth moved 0.15 off a design
+#: line by its sides' mean position, the cubic to it 0.70 from the design where the rounded
+#: input is 0.45) or beside two corners a short segment apart (P052 Bold Italic "$" at em
+#: 2048: both moved, the cubics failed, three lines 0.82 from the design where the rounded
+#: input is 0.39). False: every segment beside a corner, for measurements
+_CORNER_LINES_ONLY = True
 #: a corner turning by more than 120 degrees (the cosine of its turn below this) is a tip: an
 #: error d in either side's estimated offset moves the tangents' crossing by d / sin(interior
 #: angle) along the tip's axis, more than the rounding ...
@@ -6803,8 +6856,11 @@ _TIP_COS = -0.5
 #: ... so a crossing that cuts the tip (moves the corner inward along its axis) by more than
 #: this many quanta moves across the axis only (serif "g" at em 400: the crossing cut the
 #: tip by 0.55 quanta, the fit 1.055 from the design; a tip's rounded point is within
-#: q/sqrt(2) of the design's outline, and smaller cuts and moves outward hold)
-_TIP_CUT = 0.45
+#: q/sqrt(2) of the design's outline, and smaller cuts and moves outward hold; C059 "2" at
+#: em 2048, a 134-degree tip on a design line written as a row of the grid, whose offset is
+#: the rounding's: a cut of 0.36 quanta put the fit 0.78 from the design where the rounded
+#: input is 0.53; P052 Bold Italic "n", a 166-degree tip, 0.40 quanta, 0.75 against 0.52)
+_TIP_CUT = 0.3
 #: ... and one that stretches the tip (moves the corner outward along its axis) by more than
 #: this many quanta too (sans-light "g" at em 400, a 160-degree tip: the crossing 1.0 beyond
 #: the input point, the fit 0.73 from the design where the rounded input is 0.36)
@@ -6847,11 +6903,16 @@ def _collinear(W, a, b, p, t, quant) -> np.ndarray:
     too)."""
     if len(a) == 0:
         return np.zeros(0, dtype=bool)
+    return _line_residuals(W, a, b, p, t) <= _STRAIGHT_SLACK * quant
+
+
+def _line_residuals(W, a, b, p, t) -> np.ndarray:
+    """Per line through ``p`` along the unit ``t``: the largest distance of the input points
+    a..b (global indices, ends included, at least one) to it."""
     own, off = _ragged(np.arange(len(a)), b - a + 1)
     d = W[a[own] + off] - p[own]
     across = np.abs(d[:, 0] * t[own, 1] - d[:, 1] * t[own, 0])
-    err = np.maximum.reduceat(across, np.cumsum(b - a + 1) - (b - a + 1))
-    return err <= _STRAIGHT_SLACK * quant
+    return np.maximum.reduceat(across, np.cumsum(b - a + 1) - (b - a + 1))
 
 
 #: rounded input: two corners with a thinned segment of at most this many input steps ...
@@ -7012,6 +7073,88 @@ def _misplaced_corners(W, K, arc, vi, vo, lo_i, hi_o, line_in, line_out, est, ca
         best = np.where(use, best2, best)
         good |= use
     return v[good], cands[np.flatnonzero(good), best[good]]
+
+
+#: rounded input: a sharp corner kept up to this many input points beside the design's
+#: (:func:`_corners_shifted`) ...
+_SHIFT_STEPS = 2
+#: ... where the sides fitted with the corner at another input point c (their windows ending
+#: and starting there) fit their points better, their largest residuals summed lower by this
+#: many quanta, and cross inside c's rounding square, while those of the kept point cross
+#: outside its own (C059 "5" at em 2048, a 28-degree corner kept one point late, 0.73 from
+#: the design where the rounded input is 0.50)
+_SHIFT_GAIN = 0.1
+#: ... (inside: up to this many quanta outside it, the crossing's own error; the kept point's
+#: crossing lies farther out than that)
+_SHIFT_NEAR = 0.1
+#: (False: off, for measurements)
+_SHIFT = True
+
+
+def _beside_short(W, K, smooth, vi, vo, quant, length=np.inf):
+    """Per corner (``vi`` as the end of the segment before it, ``vo`` as the start of the
+    next): is it one of two corners at most ``_SPLIT_STEPS`` input steps and ``length``
+    quanta apart (one design corner the thinning split, :func:`_split_corners`)?"""
+    out = np.zeros(len(vo), dtype=bool)
+    for a, b, other in ((vo, vo + 1, vo + 1), (vi - 1, vi, vi - 1)):
+        out |= (~smooth[other] & (K[b] - K[a] <= _SPLIT_STEPS)
+                & (np.hypot(*(W[K[b]] - W[K[a]]).T) <= length * quant[vo]))
+    return out
+
+
+def _corners_shifted(W, K, arc, vo, lo_i, hi_o, line_in, line_out, cand, quant):
+    """:func:`_corners_on_the_design`'s sharp corners ``vo`` (where ``cand``; their windows
+    ``lo_i``, ``hi_o``; ``line_in``/``line_out``: that side is a line, fitted over its thinned
+    segment) kept on an input point beside the design's corner, found by the sides' fit: with
+    the corner at each input point c up to ``_SHIFT_STEPS`` steps away inside its two thinned
+    segments, the sides are fitted again up to c (each side's largest residual; the crossing
+    of their tangent lines); c is the corner where that crossing lies in c's rounding square
+    (within ``_SHIFT_NEAR`` quanta) while the kept point's crossing lies outside its own, and
+    c's residuals sum lower by ``_SHIFT_GAIN`` quanta (the least sum of those).
+    Returns (thinned index of the corner, global index of the input point)."""
+    sel = np.flatnonzero(cand)
+    v = vo[sel]
+    k = K[v]
+    q = quant[v]
+    li, lo_ = line_in[sel], line_out[sel]
+    a_in = np.where(li, K[v - 1], lo_i[sel])
+    b_out = np.where(lo_, K[v + 1], hi_o[sel])
+
+    def sides(c):
+        # per corner: (valid, crossing off c's square in quanta, residuals summed)
+        ok = (c > K[v - 1]) & (c < K[v + 1])
+        ok &= c - a_in + 1 >= np.where(li, 3, 4)
+        ok &= b_out - c + 1 >= np.where(lo_, 3, 4)
+        c = np.where(ok, c, k)
+        r1 = np.empty(len(v))
+        r2 = np.empty(len(v))
+        p1, t1, g1 = _local_fits(W, arc, a_in, c, c, r1)
+        p2, t2, g2 = _local_fits(W, arc, c, b_out, c, r2)
+        for m, lo, hi, p, t, g, r in ((li, a_in, c, p1, t1, g1, r1),
+                                      (lo_, c, b_out, p2, t2, g2, r2)):
+            if m.any():
+                p[m], t[m], g[m] = _local_lines(W, lo[m], hi[m], c[m])
+                r[m] = _line_residuals(W, lo[m], hi[m], p[m], t[m])
+        cr = t1[:, 0] * t2[:, 1] - t1[:, 1] * t2[:, 0]
+        ok &= g1 & g2 & (np.abs(cr) >= _CORNER_SINE)
+        d = p2 - p1
+        s = (d[:, 0] * t2[:, 1] - d[:, 1] * t2[:, 0]) / np.where(ok, cr, 1.0)
+        x = p1 + s[:, None] * t1
+        off = (np.abs(x - W[c]).max(axis=1) - 0.5 * q) / q
+        return ok, off, (r1 + r2) / q
+
+    ok0, off0, sum0 = sides(k)
+    best = k.copy()
+    best_sum = np.where(ok0 & (off0 > _SHIFT_NEAR), sum0 - _SHIFT_GAIN, -np.inf)
+    for s in range(-_SHIFT_STEPS, _SHIFT_STEPS + 1):
+        if s == 0:
+            continue
+        ok, off, sm = sides(k + s)
+        take = ok & (off <= _SHIFT_NEAR) & (sm <= best_sum)
+        best = np.where(take, k + s, best)
+        best_sum = np.where(take, sm, best_sum)
+    moved = best != k
+    return v[moved], best[moved]
 
 
 #: ... (:func:`_corners_beside_gaps`) where the input steps between the thinned corner and the
@@ -7329,8 +7472,18 @@ def _corners_on_the_design(W, K, Q, arc, smooth, rnd, first, last, quant, eps,
         mv, mj = _misplaced_corners(W, K, arc, vi, vo, lo_i, hi_o, ~smooth[vi - 1],
                                     ~smooth[vo + 1], est, sharp & ~lone, quant)
         keep = ~np.isin(mv, gv)
-        found.append((np.concatenate([gv, mv[keep]]), np.concatenate([gj, mj[keep]]),
-                      np.concatenate([gm, np.ones(int(keep.sum()), dtype=bool)])))
+        gv, gj = np.concatenate([gv, mv[keep]]), np.concatenate([gj, mj[keep]])
+        gm = np.concatenate([gm, np.ones(int(keep.sum()), dtype=bool)])
+        if _SHIFT:
+            # (not a tip, nor one of two corners a short segment apart: _split_corners)
+            sv, sj = _corners_shifted(W, K, arc, vo, lo_i, hi_o, ~smooth[vi - 1],
+                                      ~smooth[vo + 1], sharp & ~lone & ~tip & (vi == vo)
+                                      & ~_beside_short(W, K, smooth, vi, vo, quant,
+                                                       _SPLIT_LENGTH), quant)
+            keep = ~np.isin(sv, gv)
+            gv, gj = np.concatenate([gv, sv[keep]]), np.concatenate([gj, sj[keep]])
+            gm = np.concatenate([gm, np.ones(int(keep.sum()), dtype=bool)])
+        found.append((gv, gj, gm))
     vi, vo, est = vi[both], vo[both], est[both]
     lone_in, lone_out = lone_in[both], lone_out[both]
     wk = W[K[vo]]
@@ -7355,10 +7508,29 @@ def _corners_on_the_design(W, K, Q, arc, smooth, rnd, first, last, quant, eps,
     # each segment's error as last measured (``known``: its ends have not moved since)
     errs = np.empty(n)
     known = np.zeros(n, dtype=bool)
+    # the thinned segments beside the corners not held to that (_CORNER_LINES_ONLY)
+    free = np.zeros(n, dtype=bool)
+    # (not a closed path's seam, nor one of two corners a short segment apart: the thinning
+    # split one corner there, _split_corners)
+    one = (vi == vo) & ~_beside_short(W, K, smooth, vi, vo, quant)
+    sg = np.unique(np.concatenate([vi[one] - 1, vo[one]]))
+    sg = sg[smooth[sg] | smooth[sg + 1]]
+    if _CORNER_LINES_ONLY and len(sg):
+        if wstep is None:
+            wstep = _step_lengths(W)
+        _, _, sl, at = _range_steps(wstep, K[sg], K[sg + 1])
+        free[sg] = np.maximum.reduceat(sl, at) < _LONE_LENGTH * quant[sg]
+        # (not a row of the grid: its input points on their chord)
+        a, b = K[sg], K[sg + 1]
+        d = W[b] - W[a]
+        t = d / np.maximum(np.hypot(d[:, 0], d[:, 1]), 1e-300)[:, None]
+        free[sg] &= _line_residuals(W, a, b, W[a].astype(np.float64), t) > (
+            _STRAIGHT_SLACK * quant[sg])
     while True:
         # the thinned segments next to a moved corner, as lines: within eps of their points?
         seg = np.unique(np.concatenate([vi[~lone_out] - 1, vo[~lone_in]]))
         seg = seg[moved[seg] | moved[seg + 1]]
+        seg = seg[~free[seg]]
         if len(seg) == 0:
             break
         new_s = seg[~known[seg]]

@@ -41,7 +41,9 @@ def _quad_chain(scale: float, *, whole: bool, seed: int) -> tuple[np.ndarray, in
 @pytest.mark.parametrize("whole", [False, True])
 def test_greedy_round_takes_fewer_segments_within_the_bound(monkeypatch, whole):
     fewer = 0
-    for seed in range(3):
+    # (whole units: five outlines; since the twentieth session's corner rules the fit without
+    # the round already matches it on the first three)
+    for seed in range(5 if whole else 3):
         pts, own = _quad_chain(1000.0, whole=whole, seed=seed)
         with_greedy = fitmod.fit_paths([pts], [True])[0]
         with monkeypatch.context() as mp:

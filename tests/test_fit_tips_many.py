@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from galvo_core import fit as fitmod
 from tests.test_fit_design_places import _fit_rounded, _local_distance, _scaled
 
 #: P052 Bold Italic (URW base35) "7" (font units, laid out as in the benches' text), to be set
@@ -38,7 +39,7 @@ def _joints(fp) -> np.ndarray:
     return np.array([s.points[0] for s in fp.segments], dtype=np.float64)
 
 
-def test_a_corner_cut_in_two_by_the_thinning_is_one_corner_again() -> None:
+def test_a_corner_cut_in_two_by_the_thinning_is_one_corner_again(monkeypatch) -> None:
     """Before: corners at (71695, -6) and (71698, -3) with a 3.6-unit line between them over
     two input steps, 0.81 from the design's corner (71696.38, -6.14) where the rounded input
     (its point (71696, -6)) is 0.40. After: one joint within 0.3 of the corner, no line there,
@@ -49,4 +50,7 @@ def test_a_corner_cut_in_two_by_the_thinning_is_one_corner_again() -> None:
     near = np.hypot(*(_joints(fp) - corner).T)
     assert (near <= 0.3).sum() == 1 and (near <= 5.0).sum() == 1
     assert _local_distance(segs, fp, corner, 2.0) <= 0.3
-    assert fp.n_segments <= 19
+    # (one segment fewer than without the rule: 19 against 20 until the twentieth session,
+    # whose corner rules give the diagonal stroke two more, 21 against 22)
+    monkeypatch.setattr(fitmod, "_TIP_SHORT_MANY", 0.0)
+    assert fp.n_segments < _fit_rounded(segs)[1].n_segments
