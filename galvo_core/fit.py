@@ -7091,6 +7091,15 @@ _SHIFT_NEAR = 0.1
 _SHIFT = True
 
 
+def _found_added(gv, gj, gm, v, j):
+    """The corners found so far (thinned index ``gv``, input point ``gj``, whether both may
+    be kept ``gm``) with the corners ``v`` (their input points ``j``, both allowed) that are
+    not among them yet."""
+    keep = ~np.isin(v, gv)
+    return (np.concatenate([gv, v[keep]]), np.concatenate([gj, j[keep]]),
+            np.concatenate([gm, np.ones(int(keep.sum()), dtype=bool)]))
+
+
 def _beside_short(W, K, smooth, vi, vo, quant, length=np.inf):
     """Per corner (``vi`` as the end of the segment before it, ``vo`` as the start of the
     next): is it one of two corners at most ``_SPLIT_STEPS`` input steps and ``length``
@@ -7471,18 +7480,14 @@ def _corners_on_the_design(W, K, Q, arc, smooth, rnd, first, last, quant, eps,
                                       ok_out[one] & ~lone_out[one])
         mv, mj = _misplaced_corners(W, K, arc, vi, vo, lo_i, hi_o, ~smooth[vi - 1],
                                     ~smooth[vo + 1], est, sharp & ~lone, quant)
-        keep = ~np.isin(mv, gv)
-        gv, gj = np.concatenate([gv, mv[keep]]), np.concatenate([gj, mj[keep]])
-        gm = np.concatenate([gm, np.ones(int(keep.sum()), dtype=bool)])
+        gv, gj, gm = _found_added(gv, gj, gm, mv, mj)
         if _SHIFT:
             # (not a tip, nor one of two corners a short segment apart: _split_corners)
             sv, sj = _corners_shifted(W, K, arc, vo, lo_i, hi_o, ~smooth[vi - 1],
                                       ~smooth[vo + 1], sharp & ~lone & ~tip & (vi == vo)
                                       & ~_beside_short(W, K, smooth, vi, vo, quant,
                                                        _SPLIT_LENGTH), quant)
-            keep = ~np.isin(sv, gv)
-            gv, gj = np.concatenate([gv, sv[keep]]), np.concatenate([gj, sj[keep]])
-            gm = np.concatenate([gm, np.ones(int(keep.sum()), dtype=bool)])
+            gv, gj, gm = _found_added(gv, gj, gm, sv, sj)
         found.append((gv, gj, gm))
     vi, vo, est = vi[both], vo[both], est[both]
     lone_in, lone_out = lone_in[both], lone_out[both]
@@ -7524,7 +7529,7 @@ def _corners_on_the_design(W, K, Q, arc, smooth, rnd, first, last, quant, eps,
         a, b = K[sg], K[sg + 1]
         d = W[b] - W[a]
         t = d / np.maximum(np.hypot(d[:, 0], d[:, 1]), 1e-300)[:, None]
-        free[sg] &= _line_residuals(W, a, b, W[a].astype(np.float64), t) > (
+        free[sg] &= _line_residuals(W, a, b, W[a], t) > (
             _STRAIGHT_SLACK * quant[sg])
     while True:
         # the thinned segments next to a moved corner, as lines: within eps of their points?
