@@ -6003,14 +6003,16 @@ _GAP_JOINTS = True
 _GAP_ROW = 4
 
 
-def _dense_run_beyond(W, start, step, lo, hi, qg):
-    """Per point ``start``: True where the ``_GAP_JOINT_RUN`` input steps from it in the
-    direction ``step`` (+1: W[i] -> W[i + 1] for i from ``start`` on; -1: W[i] -> W[i - 1]
-    for i from ``start`` down) all lie within ``lo``..``hi`` (the path's first and last
-    point indices) and are each shorter than ``_LONE_LENGTH`` quanta ``qg`` and not zero."""
-    end = start + step * _GAP_JOINT_RUN
+def _dense_run_beyond(W, start, step, lo, hi, qg, n=None):
+    """Per point ``start``: True where the ``n`` (default ``_GAP_JOINT_RUN``) input steps
+    from it in the direction ``step`` (+1: W[i] -> W[i + 1] for i from ``start`` on; -1:
+    W[i] -> W[i - 1] for i from ``start`` down) all lie within ``lo``..``hi`` (the path's
+    first and last point indices) and are each shorter than ``_LONE_LENGTH`` quanta ``qg``
+    and not zero."""
+    n = _GAP_JOINT_RUN if n is None else n
+    end = start + step * n
     ok = (end >= lo) & (end <= hi)
-    for k in range(_GAP_JOINT_RUN):
+    for k in range(n):
         if not ok.any():
             break
         i = np.where(ok, start + step * k, start)
@@ -6020,22 +6022,16 @@ def _dense_run_beyond(W, start, step, lo, hi, qg):
     return ok
 
 
-def _collinear_row(W, g, step, bound, qg):
-    """Per point ``g``: do the ``_GAP_ROW`` input steps from it in the direction ``step``
-    (+1 / -1), all within ``bound`` (the last / first index allowed), each shorter than
-    ``_LONE_LENGTH`` quanta ``qg`` and not zero, lie on one line (exactly, up to the
-    arithmetic's error: a row of the rounding grid)?"""
-    end = g + step * _GAP_ROW
-    ok = (end - bound) * step <= 0
-    e = np.where(ok, end, g)
-    d = W[e] - W[g]
+def _collinear_row(W, g, step, lo, hi, qg):
+    """Per point ``g``: are the ``_GAP_ROW`` input steps from it in the direction ``step``
+    (+1 / -1) a dense run within ``lo``..``hi`` (:func:`_dense_run_beyond`) whose points lie
+    on one line (exactly, up to the arithmetic's error: a row of the rounding grid)?"""
+    ok = _dense_run_beyond(W, g, step, lo, hi, qg, _GAP_ROW)
+    d = W[np.where(ok, g + step * _GAP_ROW, g)] - W[g]
     ln = np.hypot(d[:, 0], d[:, 1])
     ok &= ln > 0.0
-    for k in range(1, _GAP_ROW + 1):
-        i = np.where(ok, g + step * k, g)
-        s = np.hypot(*(W[i] - W[i - step]).T)
-        ok &= (s > 0.0) & (s < _LONE_LENGTH * qg)
-        r = W[i] - W[g]
+    for k in range(1, _GAP_ROW):
+        r = W[np.where(ok, g + step * k, g)] - W[g]
         ok &= np.abs(r[:, 0] * d[:, 1] - r[:, 1] * d[:, 0]) <= 1e-9 * qg * np.maximum(ln, 1.0)
     return ok
 
@@ -6070,10 +6066,9 @@ def _split_gap_joints(W, la, lpts, lfirst, llast, lerr, lkey, quant, eps, coarse
     if _GAP_ROW:
         # ... or between one long step and a row of collinear short steps inside the line
         # (the row: a curve's straight end, or a design line of its own)
-        row = ((s1 >= _LONE_LENGTH * qg) & ~coarse[g]
-               & _collinear_row(W, g, -1, lfirst[cand][own], qg))
-        row |= ((s0 >= _LONE_LENGTH * qg) & ~coarse[g - 1]
-                & _collinear_row(W, g, 1, llast[cand][own], qg))
+        lo, hi = lfirst[cand][own], llast[cand][own]
+        row = (s1 >= _LONE_LENGTH * qg) & ~coarse[g] & _collinear_row(W, g, -1, lo, hi, qg)
+        row |= (s0 >= _LONE_LENGTH * qg) & ~coarse[g - 1] & _collinear_row(W, g, 1, lo, hi, qg)
         row &= ~sel
         sel |= row
     if not sel.any():
@@ -7037,17 +7032,7 @@ def _misplaced_corners(W, K, arc, vi, vo, lo_i, hi_o, line_in, line_out, est, ca
     if not ok.any():
         return none
     v, k, q, lo, hi, lo2, hi2, li, lo_ = (x[ok] for x in (v, k, q, lo, hi, lo2, hi2, li, lo_))
-    p1, t1, g1 = _local_fits(W, arc, lo, hi, k)
-    p2, t2, g2 = _local_fits(W, arc, lo2, hi2, k)
-    if li.any():
-        p1[li], t1[li], g1[li] = _local_lines(W, lo[li], hi[li], k[li])
-    if lo_.any():
-        p2[lo_], t2[lo_], g2[lo_] = _local_lines(W, lo2[lo_], hi2[lo_], k[lo_])
-    cr = t1[:, 0] * t2[:, 1] - t1[:, 1] * t2[:, 0]
-    good = g1 & g2 & (np.abs(cr) >= _CORNER_SINE)
-    d = p2 - p1
-    s = (d[:, 0] * t2[:, 1] - d[:, 1] * t2[:, 0]) / np.where(good, cr, 1.0)
-    x = p1 + s[:, None] * t1
+    x, good = _sides_crossing(W, arc, lo, hi, lo2, hi2, k, li, lo_)
     # the candidates: the input points k - S .. k + S strictly inside the two segments
     cands = k[:, None] + np.arange(-S, S + 1)[None, :]
     inside = (cands > K[v - 1][:, None]) & (cands < K[v + 1][:, None])
@@ -7089,6 +7074,28 @@ _SHIFT_GAIN = 0.1
 _SHIFT_NEAR = 0.1
 #: (False: off, for measurements)
 _SHIFT = True
+
+
+def _sides_crossing(W, arc, lo1, hi1, lo2, hi2, at, line1, line2, res=None):
+    """A corner's two sides at the input points ``at``: least-squares quadratics over the
+    input points lo1..hi1 and lo2..hi2 (:func:`_local_fits`; a least-squares line where
+    ``line1`` / ``line2``, :func:`_local_lines`) and the crossing of their tangent lines:
+    (crossing (V, 2), ok: both sides fitted, meeting at ``_CORNER_SINE`` or more). ``res``:
+    two arrays (V,) filled with each side's largest residual."""
+    r1, r2 = res if res is not None else (None, None)
+    p1, t1, g1 = _local_fits(W, arc, lo1, hi1, at, r1)
+    p2, t2, g2 = _local_fits(W, arc, lo2, hi2, at, r2)
+    for m, lo, hi, p, t, g, r in ((line1, lo1, hi1, p1, t1, g1, r1),
+                                  (line2, lo2, hi2, p2, t2, g2, r2)):
+        if m.any():
+            p[m], t[m], g[m] = _local_lines(W, lo[m], hi[m], at[m])
+            if r is not None:
+                r[m] = _line_residuals(W, lo[m], hi[m], p[m], t[m])
+    cr = t1[:, 0] * t2[:, 1] - t1[:, 1] * t2[:, 0]
+    good = g1 & g2 & (np.abs(cr) >= _CORNER_SINE)
+    d = p2 - p1
+    s = (d[:, 0] * t2[:, 1] - d[:, 1] * t2[:, 0]) / np.where(good, cr, 1.0)
+    return p1 + s[:, None] * t1, good
 
 
 def _found_added(gv, gj, gm, v, j):
@@ -7137,18 +7144,8 @@ def _corners_shifted(W, K, arc, vo, lo_i, hi_o, line_in, line_out, cand, quant):
         c = np.where(ok, c, k)
         r1 = np.empty(len(v))
         r2 = np.empty(len(v))
-        p1, t1, g1 = _local_fits(W, arc, a_in, c, c, r1)
-        p2, t2, g2 = _local_fits(W, arc, c, b_out, c, r2)
-        for m, lo, hi, p, t, g, r in ((li, a_in, c, p1, t1, g1, r1),
-                                      (lo_, c, b_out, p2, t2, g2, r2)):
-            if m.any():
-                p[m], t[m], g[m] = _local_lines(W, lo[m], hi[m], c[m])
-                r[m] = _line_residuals(W, lo[m], hi[m], p[m], t[m])
-        cr = t1[:, 0] * t2[:, 1] - t1[:, 1] * t2[:, 0]
-        ok &= g1 & g2 & (np.abs(cr) >= _CORNER_SINE)
-        d = p2 - p1
-        s = (d[:, 0] * t2[:, 1] - d[:, 1] * t2[:, 0]) / np.where(ok, cr, 1.0)
-        x = p1 + s[:, None] * t1
+        x, good = _sides_crossing(W, arc, a_in, c, c, b_out, c, li, lo_, (r1, r2))
+        ok &= good
         off = (np.abs(x - W[c]).max(axis=1) - 0.5 * q) / q
         return ok, off, (r1 + r2) / q
 
@@ -7519,8 +7516,8 @@ def _corners_on_the_design(W, K, Q, arc, smooth, rnd, first, last, quant, eps,
     # split one corner there, _split_corners)
     one = (vi == vo) & ~_beside_short(W, K, smooth, vi, vo, quant)
     sg = np.unique(np.concatenate([vi[one] - 1, vo[one]]))
-    sg = sg[smooth[sg] | smooth[sg + 1]]
-    if _CORNER_LINES_ONLY and len(sg):
+    sg = sg[smooth[sg] | smooth[sg + 1]] if _CORNER_LINES_ONLY else sg[:0]
+    if len(sg):
         if wstep is None:
             wstep = _step_lengths(W)
         _, _, sl, at = _range_steps(wstep, K[sg], K[sg + 1])
@@ -7529,8 +7526,7 @@ def _corners_on_the_design(W, K, Q, arc, smooth, rnd, first, last, quant, eps,
         a, b = K[sg], K[sg + 1]
         d = W[b] - W[a]
         t = d / np.maximum(np.hypot(d[:, 0], d[:, 1]), 1e-300)[:, None]
-        free[sg] &= _line_residuals(W, a, b, W[a], t) > (
-            _STRAIGHT_SLACK * quant[sg])
+        free[sg] &= ~_collinear(W, a, b, W[a], t, quant[sg])
     while True:
         # the thinned segments next to a moved corner, as lines: within eps of their points?
         seg = np.unique(np.concatenate([vi[~lone_out] - 1, vo[~lone_in]]))
